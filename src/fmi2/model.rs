@@ -1,0 +1,163 @@
+//! The contract between the generic FMI 2.0 Co-Simulation layer and a model.
+//!
+//! The layer knows nothing about pneumatics: it owns the state machine, the C ABI,
+//! logging, FMU-state handling and argument checking against the variable table.
+//! A model only provides its variable table, values and a `do_step`.
+
+/// FMI 2.0 causality of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    Input,
+    Output,
+    Local,
+}
+
+/// FMI 2.0 variability of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variability {
+    Fixed,
+    Tunable,
+    Discrete,
+    Continuous,
+}
+
+/// FMI 2.0 base type of a variable. Boolean and Integer values travel as `f64` in
+/// `start` (0/1 for Boolean).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VarType {
+    Real,
+    Integer,
+    Boolean,
+}
+
+/// One row of the variable table: the single source of the model description and of
+/// the getters and setters.
+#[derive(Clone, Copy, Debug)]
+pub struct Variable {
+    pub name: &'static str,
+    pub value_reference: u32,
+    pub var_type: VarType,
+    pub causality: Causality,
+    pub variability: Variability,
+    /// Unit name; must appear in [`ModelInfo::units`].
+    pub unit: Option<&'static str>,
+    /// Start value (for parameters and inputs: the default; for outputs: ignored,
+    /// outputs are `initial="calculated"`).
+    pub start: f64,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub description: &'static str,
+}
+
+/// A unit with its SI base-unit exponents, for `<UnitDefinitions>`.
+#[derive(Clone, Copy, Debug)]
+pub struct UnitDefinition {
+    pub name: &'static str,
+    pub kg: i32,
+    pub m: i32,
+    pub s: i32,
+    pub a: i32,
+    pub k: i32,
+}
+
+/// Static description of a model: everything the model description needs.
+#[derive(Debug)]
+pub struct ModelInfo {
+    pub model_name: &'static str,
+    pub model_identifier: &'static str,
+    pub guid: &'static str,
+    pub description: &'static str,
+    pub author: &'static str,
+    pub version: &'static str,
+    pub generation_tool: &'static str,
+    pub default_start_time: f64,
+    pub default_stop_time: f64,
+    pub default_tolerance: f64,
+    pub default_step_size: f64,
+    pub log_categories: &'static [(&'static str, &'static str)],
+    pub units: &'static [UnitDefinition],
+    pub variables: &'static [Variable],
+    /// `canInterpolateInputs`: the model accepts first-order input derivatives.
+    pub can_interpolate_inputs: bool,
+}
+
+/// Why a step did not complete.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepError {
+    /// The step could not be completed but the state up to `last_successful_time`
+    /// is valid (`fmi2Discard`).
+    Discard { message: String, last_successful_time: f64 },
+    /// Invalid request; nothing was changed (`fmi2Error`).
+    Error(String),
+}
+
+/// What the generic layer needs from a model. All methods are plain Rust: no FFI types.
+///
+/// Values arrive already checked by the layer for value reference, type, causality and
+/// the legality of the call in the current state; the model checks physical validity
+/// (finite, in range) and returns a message that names the variable and the value.
+pub trait CoSimModel: Send + Sized + 'static {
+    /// The static description (identifier, GUID, variable table).
+    fn info() -> &'static ModelInfo;
+
+    /// A fresh instance with every variable at its start value.
+    fn instantiate() -> Self;
+
+    /// Back to the state right after `instantiate` (all start values).
+    fn reset(&mut self) {
+        *self = Self::instantiate();
+    }
+
+    fn get_real(&self, vr: u32) -> Result<f64, String>;
+    fn set_real(&mut self, vr: u32, value: f64) -> Result<(), String>;
+    fn get_integer(&self, vr: u32) -> Result<i32, String> {
+        Err(format!("no Integer variable with value reference {vr}"))
+    }
+    fn set_integer(&mut self, vr: u32, _value: i32) -> Result<(), String> {
+        Err(format!("no Integer variable with value reference {vr}"))
+    }
+    fn get_boolean(&self, vr: u32) -> Result<bool, String> {
+        Err(format!("no Boolean variable with value reference {vr}"))
+    }
+    fn set_boolean(&mut self, vr: u32, _value: bool) -> Result<(), String> {
+        Err(format!("no Boolean variable with value reference {vr}"))
+    }
+
+    /// `fmi2SetupExperiment`. `tolerance` is `None` when `toleranceDefined` is false.
+    fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        stop_time: Option<f64>,
+    ) -> Result<(), String>;
+
+    /// `fmi2EnterInitializationMode`.
+    fn enter_initialization(&mut self) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: compute the initial state (e.g. an equilibrium).
+    fn exit_initialization(&mut self) -> Result<(), String>;
+
+    /// `fmi2SetRealInputDerivatives` for one variable; `order` is at least 1.
+    fn set_real_input_derivative(&mut self, vr: u32, order: i32, value: f64) -> Result<(), String> {
+        let _ = value;
+        Err(format!(
+            "input derivatives of order {order} for value reference {vr} are not supported"
+        ))
+    }
+
+    /// Advance from `current_time` by `step_size` (> 0, already checked).
+    fn do_step(&mut self, current_time: f64, step_size: f64) -> Result<(), StepError>;
+
+    /// The model's current time (`fmi2LastSuccessfulTime`).
+    fn time(&self) -> f64;
+
+    /// A self-contained, versioned byte image of the whole model state (no pointers).
+    fn serialize(&self) -> Vec<u8>;
+
+    /// Restore from `serialize`'s output; reject foreign or corrupted bytes with a
+    /// message and leave `self` unchanged.
+    fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String>;
+}
