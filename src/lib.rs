@@ -1,4 +1,13 @@
 //! Jet-pipe electropneumatic actuator of the Utah/MIT Dextrous Hand (P.D. Henri, 1994).
+//!
+//! * [`physics`]: the thesis model, one module per physical part, equations cited by number;
+//! * [`integrator`]: the error-controlled stiff integrator, independent of the physics;
+//! * [`simulation`]: stepping between communication points (FMU, CLI and tests share it);
+//! * [`fmi2`]: the generic FMI 2.0 Co-Simulation layer, which knows nothing of pneumatics;
+//! * [`variables`]: the table of FMU variables from which the model description comes.
 
 pub mod fmi2;
+pub mod integrator;
+pub mod physics;
+pub mod simulation;
 pub mod variables;

@@ -47,22 +47,119 @@ pub mod vr {
 }
 
 pub const UNITS: &[UnitDefinition] = &[
-    UnitDefinition { name: "V", kg: 1, m: 2, s: -3, a: -1, k: 0 },
-    UnitDefinition { name: "m", kg: 0, m: 1, s: 0, a: 0, k: 0 },
-    UnitDefinition { name: "N", kg: 1, m: 1, s: -2, a: 0, k: 0 },
-    UnitDefinition { name: "Pa", kg: 1, m: -1, s: -2, a: 0, k: 0 },
-    UnitDefinition { name: "A", kg: 0, m: 0, s: 0, a: 1, k: 0 },
-    UnitDefinition { name: "K", kg: 0, m: 0, s: 0, a: 0, k: 1 },
-    UnitDefinition { name: "J/(kg.K)", kg: 0, m: 2, s: -2, a: 0, k: -1 },
-    UnitDefinition { name: "A/V", kg: -1, m: -2, s: 3, a: 2, k: 0 },
-    UnitDefinition { name: "rad/s", kg: 0, m: 0, s: -1, a: 0, k: 0 },
-    UnitDefinition { name: "N/A", kg: 1, m: 1, s: -2, a: -1, k: 0 },
-    UnitDefinition { name: "m2", kg: 0, m: 2, s: 0, a: 0, k: 0 },
-    UnitDefinition { name: "N/m", kg: 1, m: 0, s: -2, a: 0, k: 0 },
-    UnitDefinition { name: "1", kg: 0, m: 0, s: 0, a: 0, k: 0 },
+    UnitDefinition {
+        name: "V",
+        kg: 1,
+        m: 2,
+        s: -3,
+        a: -1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m",
+        kg: 0,
+        m: 1,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N",
+        kg: 1,
+        m: 1,
+        s: -2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Pa",
+        kg: 1,
+        m: -1,
+        s: -2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "A",
+        kg: 0,
+        m: 0,
+        s: 0,
+        a: 1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "K",
+        kg: 0,
+        m: 0,
+        s: 0,
+        a: 0,
+        k: 1,
+    },
+    UnitDefinition {
+        name: "J/(kg.K)",
+        kg: 0,
+        m: 2,
+        s: -2,
+        a: 0,
+        k: -1,
+    },
+    UnitDefinition {
+        name: "A/V",
+        kg: -1,
+        m: -2,
+        s: 3,
+        a: 2,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "rad/s",
+        kg: 0,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N/A",
+        kg: 1,
+        m: 1,
+        s: -2,
+        a: -1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m2",
+        kg: 0,
+        m: 2,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N/m",
+        kg: 1,
+        m: 0,
+        s: -2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "1",
+        kg: 0,
+        m: 0,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
 ];
 
-const fn input(name: &'static str, vr: u32, unit: &'static str, start: f64, description: &'static str) -> Variable {
+const fn input(
+    name: &'static str,
+    vr: u32,
+    unit: &'static str,
+    start: f64,
+    description: &'static str,
+) -> Variable {
     Variable {
         name,
         value_reference: vr,
@@ -77,7 +174,12 @@ const fn input(name: &'static str, vr: u32, unit: &'static str, start: f64, desc
     }
 }
 
-const fn output(name: &'static str, vr: u32, unit: &'static str, description: &'static str) -> Variable {
+const fn output(
+    name: &'static str,
+    vr: u32,
+    unit: &'static str,
+    description: &'static str,
+) -> Variable {
     Variable {
         name,
         value_reference: vr,
@@ -92,7 +194,13 @@ const fn output(name: &'static str, vr: u32, unit: &'static str, description: &'
     }
 }
 
-const fn parameter(name: &'static str, vr: u32, unit: &'static str, start: f64, description: &'static str) -> Variable {
+const fn parameter(
+    name: &'static str,
+    vr: u32,
+    unit: &'static str,
+    start: f64,
+    description: &'static str,
+) -> Variable {
     Variable {
         name,
         value_reference: vr,

@@ -1,0 +1,263 @@
+//! The assembled six-state model, (4.1): x = [i, x_jp, ẋ_jp, ẍ_jp, P1, P2].
+//!
+//! The current driver and jet pipe are linear apart from the static curve f3 and do not
+//! feel the air; the chambers are driven by the jet pipe through the orifice areas.
+
+use nalgebra::{SMatrix, SVector};
+
+use super::chambers::{pressure_rate, CylinderGeometry};
+use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
+use super::orifice_geometry::{orifice_areas, OrificeAreas};
+use super::parameters::Parameters;
+use super::{current_driver, jet_pipe, piston};
+
+pub const N_STATES: usize = 6;
+pub type State = SVector<f64, N_STATES>;
+pub type Jacobian = SMatrix<f64, N_STATES, N_STATES>;
+
+/// Positions in the state vector.
+pub mod index {
+    pub const CURRENT: usize = 0;
+    pub const JET_POSITION: usize = 1;
+    pub const JET_VELOCITY: usize = 2;
+    pub const JET_ACCELERATION: usize = 3;
+    pub const P1: usize = 4;
+    pub const P2: usize = 5;
+}
+
+/// Inputs at one instant: command, stopper position and stopper velocity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inputs {
+    pub v_da: f64,
+    pub x_s: f64,
+    pub x_s_rate: f64,
+}
+
+/// The mass flows of (2.24)–(2.25), kg/s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MassFlows {
+    pub supply_1: f64,
+    pub return_1: f64,
+    pub supply_2: f64,
+    pub return_2: f64,
+    /// From chamber 1 to chamber 2.
+    pub leakage: f64,
+}
+
+impl MassFlows {
+    /// Net inflow of chamber 1, (2.24).
+    pub fn net_1(&self) -> f64 {
+        self.supply_1 - self.return_1 - self.leakage
+    }
+    /// Net inflow of chamber 2, (2.25).
+    pub fn net_2(&self) -> f64 {
+        self.supply_2 - self.return_2 + self.leakage
+    }
+}
+
+/// The model's outputs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outputs {
+    pub f_act: f64,
+    pub p1: f64,
+    pub p2: f64,
+    pub current: f64,
+    pub x_jp: f64,
+}
+
+/// The thesis model with fixed parameters; derived constants computed once.
+#[derive(Clone, Debug)]
+pub struct Actuator {
+    pub params: Parameters,
+    pub flow: FlowConstants,
+    pub cylinder: CylinderGeometry,
+    pub piston_area: f64,
+}
+
+impl Actuator {
+    pub fn new(params: Parameters) -> Result<Self, String> {
+        params.validate()?;
+        let flow = params.flow_constants();
+        let cylinder = params.cylinder();
+        let piston_area = cylinder.piston_area();
+        Ok(Self {
+            params,
+            flow,
+            cylinder,
+            piston_area,
+        })
+    }
+
+    pub fn areas(&self, x_jp: f64) -> OrificeAreas {
+        orifice_areas(
+            self.params.d_jp,
+            jet_pipe::absolute_position(x_jp, self.params.x_jp_offset),
+        )
+    }
+
+    /// Mass flows for a jet pipe position and chamber pressures, (2.18)–(2.23).
+    pub fn mass_flows(&self, x_jp: f64, p1: f64, p2: f64) -> MassFlows {
+        let p = &self.params;
+        let a = self.areas(x_jp);
+        let k = &self.flow;
+        MassFlows {
+            supply_1: mass_flow(k, p.c_d * a.supply_1, p.p_s, p1),
+            return_1: mass_flow(k, p.c_d * a.return_1, p1, p.p_r),
+            supply_2: mass_flow(k, p.c_d * a.supply_2, p.p_s, p2),
+            return_2: mass_flow(k, p.c_d * a.return_2, p2, p.p_r),
+            leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+        }
+    }
+
+    /// dP1/dt and dP2/dt, (2.29).
+    pub fn pressure_rates(
+        &self,
+        x_jp: f64,
+        p1: f64,
+        p2: f64,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> (f64, f64) {
+        let p = &self.params;
+        let flows = self.mass_flows(x_jp, p1, p2);
+        let (v1, v2) = self.cylinder.volumes(x_s);
+        let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
+        (
+            pressure_rate(p.gamma, p.r_gas, p.temperature, v1, dv1, flows.net_1(), p1),
+            pressure_rate(p.gamma, p.r_gas, p.temperature, v2, dv2, flows.net_2(), p2),
+        )
+    }
+
+    /// Static jet pipe position x̄ for a current, (2.4)–(2.5).
+    pub fn static_jet_position(&self, current: f64) -> f64 {
+        let p = &self.params;
+        jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current))
+    }
+
+    /// The state equations (4.1).
+    pub fn derivatives(&self, y: &State, u: &Inputs) -> State {
+        use index::*;
+        let p = &self.params;
+        let static_current = current_driver::static_current(p.k_cd, p.i_offset, u.v_da);
+        let x_bar = self.static_jet_position(y[CURRENT]);
+        let (dp1, dp2) = self.pressure_rates(y[JET_POSITION], y[P1], y[P2], u.x_s, u.x_s_rate);
+        State::from([
+            current_driver::current_rate(p.omega_cd, static_current, y[CURRENT]),
+            y[JET_VELOCITY],
+            y[JET_ACCELERATION],
+            jet_pipe::third_derivative(
+                p.omega_1,
+                p.omega_2,
+                p.zeta_2,
+                x_bar,
+                y[JET_POSITION],
+                y[JET_VELOCITY],
+                y[JET_ACCELERATION],
+            ),
+            dp1,
+            dp2,
+        ])
+    }
+
+    /// ∂f/∂y: exact for the current driver and jet pipe, forward differences for the
+    /// two pressure rows (which depend on x_jp, P1 and P2 only).
+    pub fn jacobian(&self, y: &State, u: &Inputs, f_y: &State) -> Jacobian {
+        use index::*;
+        let p = &self.params;
+        let mut jac = Jacobian::zeros();
+        jac[(CURRENT, CURRENT)] = -p.omega_cd;
+        jac[(JET_POSITION, JET_VELOCITY)] = 1.0;
+        jac[(JET_VELOCITY, JET_ACCELERATION)] = 1.0;
+        let c2 = 2.0 * p.zeta_2 * p.omega_2 + p.omega_1;
+        let c3 = p.omega_2 * p.omega_2 + 2.0 * p.zeta_2 * p.omega_1 * p.omega_2;
+        let c4 = p.omega_1 * p.omega_2 * p.omega_2;
+        let slope = jet_pipe::static_position_slope(
+            p.x_jp_sat,
+            p.f_jp_sat,
+            jet_pipe::tip_force(p.k_m, y[CURRENT]),
+        );
+        jac[(JET_ACCELERATION, CURRENT)] = c4 * slope * p.k_m;
+        jac[(JET_ACCELERATION, JET_POSITION)] = -c4;
+        jac[(JET_ACCELERATION, JET_VELOCITY)] = -c3;
+        jac[(JET_ACCELERATION, JET_ACCELERATION)] = -c2;
+        for (column, scale) in [(JET_POSITION, 1e-7), (P1, 1e3), (P2, 1e3)] {
+            let h = 1e-7 * y[column].abs().max(scale);
+            let mut x = [y[JET_POSITION], y[P1], y[P2]];
+            let slot = match column {
+                JET_POSITION => 0,
+                P1 => 1,
+                _ => 2,
+            };
+            x[slot] += h;
+            let (dp1, dp2) = self.pressure_rates(x[0], x[1], x[2], u.x_s, u.x_s_rate);
+            jac[(P1, column)] = (dp1 - f_y[P1]) / h;
+            jac[(P2, column)] = (dp2 - f_y[P2]) / h;
+        }
+        jac
+    }
+
+    pub fn spring_force(&self, x_s: f64) -> f64 {
+        let p = &self.params;
+        piston::spring_force(p.k_spring, p.l_spring0, p.l_s, p.l_p, x_s)
+    }
+
+    pub fn outputs(&self, y: &State, x_s: f64) -> Outputs {
+        use index::*;
+        let pressure_force = piston::pressure_force(self.piston_area, y[P1], y[P2]);
+        Outputs {
+            f_act: piston::actuator_force(pressure_force, self.spring_force(x_s)),
+            p1: y[P1],
+            p2: y[P2],
+            current: y[CURRENT],
+            x_jp: y[JET_POSITION],
+        }
+    }
+
+    /// Per-state scales used for absolute tolerances: a current of 0.1 A, a tip
+    /// displacement of 0.1 mm with its natural-frequency derivatives, and 1 bar.
+    pub fn state_scales(&self) -> State {
+        let w = self.params.omega_2;
+        let x = 1e-4;
+        State::from([0.1, x, x * w, x * w * w, 1e5, 1e5])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jacobian_matches_finite_differences_of_the_whole_model() {
+        let model = Actuator::new(Parameters::default()).unwrap();
+        let u = Inputs {
+            v_da: 2.5,
+            x_s: 0.054,
+            x_s_rate: 0.01,
+        };
+        let y = State::from([0.09, 2.1e-4, 0.03, -20.0, 4.0e5, 1.7e5]);
+        let f = model.derivatives(&y, &u);
+        let analytic = model.jacobian(&y, &u, &f);
+        let numeric =
+            crate::integrator::finite_difference_jacobian(|yy| model.derivatives(yy, &u), &y, &f);
+        for r in 0..N_STATES {
+            for c in 0..N_STATES {
+                let (a, n) = (analytic[(r, c)], numeric[(r, c)]);
+                assert!(
+                    (a - n).abs() <= 1e-4 * n.abs().max(1e-6 * analytic.row(r).amax()),
+                    "J[{r},{c}] {a} vs {n}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn mass_flows_balance_when_the_chambers_are_sealed() {
+        let mut p = Parameters::default();
+        p.c_d = 0.0;
+        p.c_db_a_lpp = 0.0;
+        p.c_dm_a_lpp = 0.0;
+        let model = Actuator::new(p).unwrap();
+        let f = model.mass_flows(3e-4, 4e5, 2e5);
+        assert_eq!((f.net_1(), f.net_2()), (0.0, 0.0));
+    }
+}

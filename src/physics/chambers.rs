@@ -1,0 +1,118 @@
+//! The two chambers: volumes from the stopper position (2.30)–(2.32), net mass flows
+//! (2.24)–(2.25) and the pressure rate (2.26)–(2.29) with the constant temperature of §2.6.
+
+use std::f64::consts::PI;
+
+/// Cylinder geometry needed for the chamber volumes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CylinderGeometry {
+    pub l_cyl: f64,
+    pub l_p: f64,
+    pub l_s: f64,
+    pub l_sup: f64,
+    pub d_cyl: f64,
+}
+
+impl CylinderGeometry {
+    /// Piston area A_p = π D_cyl² / 4.
+    pub fn piston_area(&self) -> f64 {
+        PI * self.d_cyl * self.d_cyl / 4.0
+    }
+
+    /// Piston position from the stopper position, (2.32): x_p = x_s − (L_p + L_s + L_sup).
+    pub fn piston_position(&self, x_s: f64) -> f64 {
+        x_s - (self.l_p + self.l_s + self.l_sup)
+    }
+
+    /// Chamber volumes (V1, V2), (2.30)–(2.31): V1 = A_p x_p, V2 = A_p (L_cyl − x_p − L_p).
+    pub fn volumes(&self, x_s: f64) -> (f64, f64) {
+        let a_p = self.piston_area();
+        let x_p = self.piston_position(x_s);
+        (a_p * x_p, a_p * (self.l_cyl - x_p - self.l_p))
+    }
+
+    /// Rates of change of the volumes for a stopper velocity: (A_p ẋ_s, −A_p ẋ_s).
+    pub fn volume_rates(&self, x_s_dot: f64) -> (f64, f64) {
+        let a_p = self.piston_area();
+        (a_p * x_s_dot, -a_p * x_s_dot)
+    }
+
+    /// Open interval of stopper positions for which both volumes are positive.
+    pub fn stopper_range(&self) -> (f64, f64) {
+        let lower = self.l_p + self.l_s + self.l_sup;
+        (lower, lower + self.l_cyl - self.l_p)
+    }
+}
+
+/// Rate of change of a chamber pressure, (2.26)–(2.29) with ρ = P/(R T):
+/// dP/dt = (γ / V) (R T ṁ − P dV/dt).
+pub fn pressure_rate(
+    gamma: f64,
+    r_gas: f64,
+    temperature: f64,
+    volume: f64,
+    volume_rate: f64,
+    net_mass_flow: f64,
+    pressure: f64,
+) -> f64 {
+    gamma / volume * (r_gas * temperature * net_mass_flow - pressure * volume_rate)
+}
+
+/// Pressure after an instantaneous volume change with no flow: the exact limit of
+/// (2.29) over a vanishing time, P V^γ = const. The air in the chamber is conserved.
+pub fn pressure_after_volume_jump(
+    gamma: f64,
+    pressure: f64,
+    volume_before: f64,
+    volume_after: f64,
+) -> f64 {
+    pressure * (volume_before / volume_after).powf(gamma)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn thesis_cylinder() -> CylinderGeometry {
+        CylinderGeometry {
+            l_cyl: 78e-3,
+            l_p: 8e-3,
+            l_s: 7e-3,
+            l_sup: 11e-3,
+            d_cyl: 15.875e-3,
+        }
+    }
+
+    #[test]
+    fn volumes_and_valid_range() {
+        let c = thesis_cylinder();
+        let (lo, hi) = c.stopper_range();
+        assert!((lo - 0.026).abs() < 1e-15 && (hi - 0.096).abs() < 1e-15);
+        let (v1, v2) = c.volumes(0.054);
+        let a_p = c.piston_area();
+        assert!((v1 - a_p * 0.028).abs() < 1e-18 && (v2 - a_p * 0.042).abs() < 1e-18);
+        let (v1_lo, _) = c.volumes(lo);
+        let (_, v2_hi) = c.volumes(hi);
+        assert!(v1_lo.abs() < 1e-20 && v2_hi.abs() < 1e-20);
+    }
+
+    #[test]
+    fn closed_chamber_compression_follows_the_adiabat_and_conserves_air() {
+        // Integrate (2.29) with no flow while the volume shrinks linearly; compare with
+        // P V^γ = const, the jump formula.
+        let (gamma, p0, v0, v1) = (1.4, 2e5, 5e-6, 3e-6);
+        let n = 200_000;
+        let dt = 1.0 / n as f64;
+        let dv = v1 - v0;
+        let mut p = p0;
+        for k in 0..n {
+            // midpoint rule
+            let v = v0 + dv * (k as f64 + 0.5) * dt;
+            let half =
+                p + 0.5 * dt * pressure_rate(gamma, 287.0, 293.15, v - 0.5 * dv * dt, dv, 0.0, p);
+            p += dt * pressure_rate(gamma, 287.0, 293.15, v, dv, 0.0, half);
+        }
+        let jump = pressure_after_volume_jump(gamma, p0, v0, v1);
+        assert!((p - jump).abs() < 1e-6 * jump, "{p} vs {jump}");
+    }
+}

@@ -1,0 +1,22 @@
+//! The actuator's physics, one module per physical part, in plain Rust (no FFI types).
+//! Equation numbers are those of P.D. Henri's 1994 thesis; `MODEL.md` corrects its slips.
+//!
+//! | part | module | equations |
+//! |---|---|---|
+//! | parameters and their defaults | [`parameters`] | Table 3.1, MODEL.md |
+//! | current driver | [`current_driver`] | (2.1)–(2.3) |
+//! | jet pipe | [`jet_pipe`] | (2.4)–(2.7) |
+//! | orifice areas (supply/return area of each port) | [`orifice_geometry`] | (2.8)–(2.17) |
+//! | orifice and leakage flow | [`orifice_flow`] | (2.18)–(2.23) |
+//! | chambers | [`chambers`] | (2.24)–(2.32) |
+//! | piston force and spring | [`piston`] | (2.36)–(2.38) |
+//! | the assembled six-state model | [`actuator`] | (4.1) |
+
+pub mod actuator;
+pub mod chambers;
+pub mod current_driver;
+pub mod jet_pipe;
+pub mod orifice_flow;
+pub mod orifice_geometry;
+pub mod parameters;
+pub mod piston;

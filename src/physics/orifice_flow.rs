@@ -1,0 +1,174 @@
+//! Compressible orifice flow, (2.18)–(2.22), and the leakage past the piston, (2.23).
+
+/// Width of the band of pressure ratios next to 1 in which the √(1 − r) law of (2.22) is
+/// replaced by a C¹ cubic through zero. The exact law has an infinite slope at equal
+/// pressures, which no implicit integrator can use; inside the band the pressure
+/// difference is below 1e-5 of the upstream pressure (≈ 1 Pa at atmospheric pressure,
+/// ≈ 2e-4 N of piston force), and outside it the flow is the thesis's to the last bit.
+pub const REGULARISATION_RATIO_BAND: f64 = 1e-5;
+
+/// Constants of (2.19)–(2.21) for one gas, precomputed once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlowConstants {
+    pub gamma: f64,
+    /// Critical pressure ratio r_c, (2.19).
+    pub critical_ratio: f64,
+    /// C1 of (2.20) (choked flow).
+    pub c1: f64,
+    /// C2 of (2.21) (unchoked flow).
+    pub c2: f64,
+    /// 1/√T of the upstream gas (constant temperature, §2.6).
+    pub inv_sqrt_temperature: f64,
+    band_edge_f2: f64,
+}
+
+impl FlowConstants {
+    pub fn new(gamma: f64, r_gas: f64, temperature: f64) -> Self {
+        let critical_ratio = (2.0 / (gamma + 1.0)).powf(gamma / (gamma - 1.0));
+        let c1 = (gamma / r_gas * (2.0 / (gamma + 1.0)).powf((gamma + 1.0) / (gamma - 1.0))).sqrt();
+        let c2 = (gamma / r_gas * (2.0 / (gamma - 1.0))).sqrt();
+        let band_edge_f2 = f2_exact(gamma, 1.0 - REGULARISATION_RATIO_BAND);
+        Self {
+            gamma,
+            critical_ratio,
+            c1,
+            c2,
+            inv_sqrt_temperature: 1.0 / temperature.sqrt(),
+            band_edge_f2,
+        }
+    }
+
+    /// f2 of (2.22), regularised in the band next to r = 1.
+    pub fn f2(&self, ratio: f64) -> f64 {
+        let s = (1.0 - ratio) / REGULARISATION_RATIO_BAND;
+        if s >= 1.0 {
+            f2_exact(self.gamma, ratio)
+        } else {
+            // g(s) = (5s − s³)/4: g(0) = 0, g(1) = 1, g'(1) = 1/2 = d√s/ds at s = 1.
+            let s = s.max(0.0);
+            self.band_edge_f2 * (1.25 * s - 0.25 * s * s * s)
+        }
+    }
+}
+
+/// f2 of (2.22): √(r^{2/γ} − r^{(γ+1)/γ}).
+pub fn f2_exact(gamma: f64, ratio: f64) -> f64 {
+    (ratio.powf(2.0 / gamma) - ratio.powf((gamma + 1.0) / gamma))
+        .max(0.0)
+        .sqrt()
+}
+
+/// Mass flow (kg/s) through an orifice of effective area `cd_area` (C_d·A, m²) between
+/// pressures `p_from` and `p_to`, (2.18): positive from `p_from` to `p_to`, negative when
+/// the pressure difference is reversed; choked below the critical ratio.
+pub fn mass_flow(k: &FlowConstants, cd_area: f64, p_from: f64, p_to: f64) -> f64 {
+    let (p_up, p_down, sign) = if p_from >= p_to {
+        (p_from, p_to, 1.0)
+    } else {
+        (p_to, p_from, -1.0)
+    };
+    if p_up <= 0.0 || cd_area == 0.0 {
+        return 0.0;
+    }
+    let ratio = p_down / p_up;
+    let scale = cd_area * p_up * k.inv_sqrt_temperature;
+    let flow = if ratio <= k.critical_ratio {
+        scale * k.c1
+    } else {
+        scale * k.c2 * k.f2(ratio)
+    };
+    sign * flow
+}
+
+/// Effective area C_d,lpp·A_lpp of the leakage past the piston, (2.23): the discharge
+/// coefficient depends on the pressure ratio across the long, narrow ring.
+pub fn leakage_cd_area(c_dm_a_lpp: f64, c_db_a_lpp: f64, p1: f64, p2: f64) -> f64 {
+    let (p_up, p_down) = if p1 >= p2 { (p1, p2) } else { (p2, p1) };
+    if p_up <= 0.0 {
+        return 0.0;
+    }
+    (c_dm_a_lpp * (p_down / p_up) + c_db_a_lpp).max(0.0)
+}
+
+/// Leakage mass flow from chamber 1 to chamber 2 (negative when P2 > P1).
+pub fn leakage_flow(k: &FlowConstants, c_dm_a_lpp: f64, c_db_a_lpp: f64, p1: f64, p2: f64) -> f64 {
+    mass_flow(k, leakage_cd_area(c_dm_a_lpp, c_db_a_lpp, p1, p2), p1, p2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn air() -> FlowConstants {
+        FlowConstants::new(1.4, 287.0, 293.15)
+    }
+
+    #[test]
+    fn constants_of_2_19_to_2_21() {
+        let k = air();
+        assert!(
+            (k.critical_ratio - 0.5283).abs() < 1e-4,
+            "r_c = {}",
+            k.critical_ratio
+        );
+        assert!((k.c1 - 0.040418).abs() < 1e-5, "C1 = {}", k.c1);
+        assert!((k.c2 - 0.156174).abs() < 1e-5, "C2 = {}", k.c2);
+    }
+
+    #[test]
+    fn flow_is_continuous_and_smooth_at_the_choke_point() {
+        // At r = r_c the unchoked law must equal the choked one: C2 f2(r_c) = C1.
+        let k = air();
+        let (cda, pu) = (0.5e-6, 6e5);
+        let at = |r: f64| mass_flow(&k, cda, pu, r * pu);
+        let below = at(k.critical_ratio * (1.0 - 1e-12));
+        let above = at(k.critical_ratio * (1.0 + 1e-12));
+        assert!((below - above).abs() < 1e-9 * below, "{below} vs {above}");
+        // The slope is continuous too: the unchoked flow has its maximum at r_c, so just
+        // above r_c it is flat compared with its slope at r = 0.8.
+        let slope = |r: f64, h: f64| (at(r + h) - at(r)) / h;
+        let near = slope(k.critical_ratio + 1e-7, 1e-8).abs();
+        let far = slope(0.8, 1e-6).abs();
+        assert!(near < 1e-3 * far, "slope near r_c {near}, at 0.8 {far}");
+    }
+
+    #[test]
+    fn flow_reverses_with_the_pressure_difference_and_vanishes_at_equal_pressures() {
+        let k = air();
+        let forward = mass_flow(&k, 0.5e-6, 3e5, 2e5);
+        let backward = mass_flow(&k, 0.5e-6, 2e5, 3e5);
+        assert!(forward > 0.0);
+        // Reversed flow has the upstream pressure 3e5 too: equal magnitude.
+        assert!((forward + backward).abs() < 1e-18);
+        assert_eq!(mass_flow(&k, 0.5e-6, 2e5, 2e5), 0.0);
+    }
+
+    #[test]
+    fn regularisation_is_continuous_at_the_band_edge_and_monotone_inside() {
+        let k = air();
+        let edge = 1.0 - REGULARISATION_RATIO_BAND;
+        let exact = f2_exact(1.4, edge);
+        assert!((k.f2(edge) - exact).abs() < 1e-9 * exact);
+        assert!((k.f2(edge + 1e-13) - exact).abs() < 1e-7 * exact);
+        let mut last = 0.0;
+        for j in 0..=100 {
+            let r = 1.0 - REGULARISATION_RATIO_BAND * j as f64 / 100.0;
+            let v = k.f2(r);
+            assert!(v >= last);
+            last = v;
+        }
+        // Outside the band the law is untouched.
+        assert_eq!(k.f2(0.9), f2_exact(1.4, 0.9));
+    }
+
+    #[test]
+    fn leakage_coefficient_follows_2_23() {
+        // C_d,lpp A_lpp = −0.0475 (P_d/P_u) + 0.0971 mm², Table 3.1.
+        let a = leakage_cd_area(-0.0475e-6, 0.0971e-6, 5e5, 2.5e5);
+        assert!((a - (0.0971e-6 - 0.0475e-6 * 0.5)).abs() < 1e-20);
+        assert_eq!(a, leakage_cd_area(-0.0475e-6, 0.0971e-6, 2.5e5, 5e5));
+        let k = air();
+        assert!(leakage_flow(&k, -0.0475e-6, 0.0971e-6, 5e5, 2.5e5) > 0.0);
+        assert!(leakage_flow(&k, -0.0475e-6, 0.0971e-6, 2.5e5, 5e5) < 0.0);
+    }
+}

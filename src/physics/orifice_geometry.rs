@@ -1,0 +1,185 @@
+//! Orifice areas from the receiver-plate geometry, (2.8)–(2.17), §2.5.
+//!
+//! Geometry (MODEL.md): the two control ports are circles of radius R = D_jp/2 centred at
+//! +D_jp (port 1, charging side) and −D_jp (port 2, venting side); the jet exit is a circle
+//! of radius R centred at the absolute tip position x; the tip flange is a disc of radius
+//! 3R centred at x.
+//!
+//! * supply area of port i: A_si = area(port i ∩ jet exit), (2.8) and (2.10);
+//! * return area of port i: A_ri = area(port i) − area(port i ∩ flange), (2.9) and (2.11).
+//!
+//! The thesis writes these piecewise with the helper functions f_a, f_b, f_r1, f_r2
+//! (2.12)–(2.17), whose OCR has sign slips; all of them are the area of a lens between two
+//! circles, which [`circle_intersection_area`] computes in closed form. The unit tests check
+//! every area against a numerical integration of the geometry and against (2.8)/(2.12).
+
+use std::f64::consts::PI;
+
+/// Area of the intersection of two discs of radii `r1`, `r2` whose centres are `d` apart.
+pub fn circle_intersection_area(r1: f64, r2: f64, d: f64) -> f64 {
+    let d = d.abs();
+    if d >= r1 + r2 {
+        return 0.0;
+    }
+    let r_small = r1.min(r2);
+    if d <= (r1 - r2).abs() {
+        return PI * r_small * r_small;
+    }
+    // Half chord c and the signed distances a1, a2 of the chord from each centre; atan2
+    // keeps the segment angles accurate near tangency, where acos would lose half the digits.
+    let kite = (-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2);
+    let half_chord = 0.5 * kite.max(0.0).sqrt() / d;
+    let a1 = (d * d + r1 * r1 - r2 * r2) / (2.0 * d);
+    let a2 = d - a1;
+    let segment = |r: f64, a: f64| r * r * half_chord.atan2(a) - a * half_chord;
+    segment(r1, a1) + segment(r2, a2)
+}
+
+/// Area of the jet exit and of each port, A_jp = π R².
+pub fn port_area(d_jp: f64) -> f64 {
+    let r = 0.5 * d_jp;
+    PI * r * r
+}
+
+/// Supply area of port 1, (2.8): overlap of the jet exit at `x_abs` with port 1 at +D.
+pub fn supply_area_port1(d_jp: f64, x_abs: f64) -> f64 {
+    let r = 0.5 * d_jp;
+    circle_intersection_area(r, r, x_abs - d_jp)
+}
+
+/// Supply area of port 2, (2.10): A_s2(x) = A_s1(−x), port 2 at −D.
+pub fn supply_area_port2(d_jp: f64, x_abs: f64) -> f64 {
+    supply_area_port1(d_jp, -x_abs)
+}
+
+/// Return area of port 1, (2.9): the part of port 1 not covered by the flange (radius 3R).
+pub fn return_area_port1(d_jp: f64, x_abs: f64) -> f64 {
+    let r = 0.5 * d_jp;
+    (port_area(d_jp) - circle_intersection_area(r, 3.0 * r, x_abs - d_jp)).max(0.0)
+}
+
+/// Return area of port 2, (2.11): A_r2(x) = A_r1(−x), the part of port 2 (at −D) not
+/// covered by the flange.
+pub fn return_area_port2(d_jp: f64, x_abs: f64) -> f64 {
+    return_area_port1(d_jp, -x_abs)
+}
+
+/// The four orifice areas at one tip position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrificeAreas {
+    pub supply_1: f64,
+    pub return_1: f64,
+    pub supply_2: f64,
+    pub return_2: f64,
+}
+
+/// All four areas for the absolute tip position `x_abs` (2.7).
+pub fn orifice_areas(d_jp: f64, x_abs: f64) -> OrificeAreas {
+    OrificeAreas {
+        supply_1: supply_area_port1(d_jp, x_abs),
+        return_1: return_area_port1(d_jp, x_abs),
+        supply_2: supply_area_port2(d_jp, x_abs),
+        return_2: return_area_port2(d_jp, x_abs),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const D: f64 = 0.9652e-3;
+
+    /// Area of (disc a ∩ disc b) minus nothing, or of (disc a \ disc b), by integrating the
+    /// chord overlap over y with the substitution y = r_a sin θ (smooth at the poles).
+    fn numerical_area(ca: f64, ra: f64, cb: f64, rb: f64, subtract: bool) -> f64 {
+        let n = 200_000;
+        let mut sum = 0.0;
+        for k in 0..n {
+            let theta = -PI / 2.0 + PI * (k as f64 + 0.5) / n as f64;
+            let y = ra * theta.sin();
+            let dy = ra * theta.cos() * PI / n as f64;
+            let ha = (ra * ra - y * y).max(0.0).sqrt();
+            let (a0, a1) = (ca - ha, ca + ha);
+            let overlap = if y.abs() < rb {
+                let hb = (rb * rb - y * y).sqrt();
+                (a1.min(cb + hb) - a0.max(cb - hb)).max(0.0)
+            } else {
+                0.0
+            };
+            sum += if subtract {
+                (a1 - a0) - overlap
+            } else {
+                overlap
+            } * dy;
+        }
+        sum
+    }
+
+    #[test]
+    fn areas_match_numerical_integration_of_the_geometry() {
+        let r = D / 2.0;
+        let a_jp = port_area(D);
+        for k in 0..=80 {
+            let x = -4.0 * D + 8.0 * D * k as f64 / 80.0;
+            let s1 = numerical_area(D, r, x, r, false);
+            let r1 = numerical_area(D, r, x, 3.0 * r, true);
+            let s2 = numerical_area(-D, r, x, r, false);
+            let r2 = numerical_area(-D, r, x, 3.0 * r, true);
+            let a = orifice_areas(D, x);
+            for (name, closed, numeric) in [
+                ("A_s1", a.supply_1, s1),
+                ("A_r1", a.return_1, r1),
+                ("A_s2", a.supply_2, s2),
+                ("A_r2", a.return_2, r2),
+            ] {
+                assert!(
+                    (closed - numeric).abs() < 2e-6 * a_jp,
+                    "{name} at x = {x:e}: closed form {closed:e}, integral {numeric:e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn supply_area_agrees_with_the_thesis_form_2_8() {
+        // (2.8): A_s1 = 2 f_a(|D − x|/2, R) for 0 ≤ x ≤ 2D, f_a(a, r) = r² acos(a/r) − a√(r² − a²).
+        let r = D / 2.0;
+        let f_a = |a: f64, r: f64| r * r * (a / r).acos() - a * (r * r - a * a).sqrt();
+        for k in 0..=50 {
+            let x = 2.0 * D * k as f64 / 50.0;
+            let thesis = 2.0 * f_a(((D - x) / 2.0).abs(), r);
+            assert!((supply_area_port1(D, x) - thesis).abs() < 1e-15, "x = {x}");
+        }
+    }
+
+    #[test]
+    fn centred_tip_covers_both_return_ports_and_feeds_neither() {
+        let a = orifice_areas(D, 0.0);
+        assert_eq!(a.supply_1, 0.0);
+        assert_eq!(a.supply_2, 0.0);
+        assert!(a.return_1.abs() < 1e-20 && a.return_2.abs() < 1e-20);
+        // Fully deflected onto port 1: port 1 fully fed, port 2 fully open to return.
+        let a = orifice_areas(D, D);
+        assert!((a.supply_1 - port_area(D)).abs() < 1e-18);
+        assert!((a.return_2 - port_area(D)).abs() < 1e-18);
+        assert_eq!(a.return_1, 0.0);
+        // Symmetry A_s2(x) = A_s1(−x), A_r2(x) = A_r1(−x) (MODEL.md's correction of (2.10)–(2.11)).
+        for x in [-1.7 * D, -0.3 * D, 0.2 * D, 1.1 * D, 2.5 * D] {
+            assert_eq!(supply_area_port2(D, x), supply_area_port1(D, -x));
+            assert_eq!(return_area_port2(D, x), return_area_port1(D, -x));
+        }
+    }
+
+    #[test]
+    fn piecewise_breakpoints_of_2_9_and_2_11() {
+        let a_jp = port_area(D);
+        // A_r1 = A_jp for x ≤ −D and x ≥ 3D, 0 on [0, 2D].
+        assert!((return_area_port1(D, -D) - a_jp).abs() < 1e-12 * a_jp);
+        assert!((return_area_port1(D, 3.0 * D) - a_jp).abs() < 1e-12 * a_jp);
+        assert!(return_area_port1(D, 0.5 * D) < 1e-20);
+        assert!(return_area_port1(D, 2.0 * D) < 1e-20);
+        // A_r2 = A_jp for x ≥ D, 0 on [−2D, 0].
+        assert!((return_area_port2(D, D) - a_jp).abs() < 1e-12 * a_jp);
+        assert!(return_area_port2(D, -D) < 1e-20);
+    }
+}

@@ -1,0 +1,274 @@
+//! The model's parameters, with the defaults of Table 3.1 and MODEL.md (taken from the
+//! FMU's variable table, so the two cannot disagree).
+
+use super::chambers::CylinderGeometry;
+use super::orifice_flow::FlowConstants;
+use crate::variables::{vr, VARIABLES};
+
+/// Every constant of the thesis model, in SI units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameters {
+    pub p_s: f64,
+    pub p_r: f64,
+    pub temperature: f64,
+    pub gamma: f64,
+    pub r_gas: f64,
+    pub k_cd: f64,
+    pub i_offset: f64,
+    pub omega_cd: f64,
+    pub k_m: f64,
+    pub omega_1: f64,
+    pub omega_2: f64,
+    pub zeta_2: f64,
+    pub x_jp_sat: f64,
+    pub f_jp_sat: f64,
+    pub x_jp_offset: f64,
+    pub d_jp: f64,
+    pub c_d: f64,
+    pub c_dm_a_lpp: f64,
+    pub c_db_a_lpp: f64,
+    pub l_cyl: f64,
+    pub l_p: f64,
+    pub l_s: f64,
+    pub l_sup: f64,
+    pub l_spring0: f64,
+    pub d_cyl: f64,
+    pub k_spring: f64,
+}
+
+/// Start value of a variable of the table (panics only on a programming error: a value
+/// reference that the table does not have).
+pub fn table_start(value_reference: u32) -> f64 {
+    VARIABLES
+        .iter()
+        .find(|v| v.value_reference == value_reference)
+        .map(|v| v.start)
+        .unwrap_or_else(|| panic!("value reference {value_reference} is not in the variable table"))
+}
+
+impl Default for Parameters {
+    fn default() -> Self {
+        let mut p = Parameters {
+            p_s: 0.0,
+            p_r: 0.0,
+            temperature: 0.0,
+            gamma: 0.0,
+            r_gas: 0.0,
+            k_cd: 0.0,
+            i_offset: 0.0,
+            omega_cd: 0.0,
+            k_m: 0.0,
+            omega_1: 0.0,
+            omega_2: 0.0,
+            zeta_2: 0.0,
+            x_jp_sat: 0.0,
+            f_jp_sat: 0.0,
+            x_jp_offset: 0.0,
+            d_jp: 0.0,
+            c_d: 0.0,
+            c_dm_a_lpp: 0.0,
+            c_db_a_lpp: 0.0,
+            l_cyl: 0.0,
+            l_p: 0.0,
+            l_s: 0.0,
+            l_sup: 0.0,
+            l_spring0: 0.0,
+            d_cyl: 0.0,
+            k_spring: 0.0,
+        };
+        for &vr in Parameters::VALUE_REFERENCES {
+            *p.field_mut(vr)
+                .expect("every parameter value reference has a field") = table_start(vr);
+        }
+        p
+    }
+}
+
+/// How a parameter value must be bounded.
+#[derive(Clone, Copy)]
+enum Bound {
+    Positive,
+    NonNegative,
+    Finite,
+    GreaterThanOne,
+}
+
+impl Parameters {
+    /// Value references of the fields, in the table's order.
+    pub const VALUE_REFERENCES: &'static [u32] = &[
+        vr::P_S,
+        vr::P_R,
+        vr::T_GAS,
+        vr::GAMMA,
+        vr::R_GAS,
+        vr::K_CD,
+        vr::I_OFFSET,
+        vr::OMEGA_CD,
+        vr::K_M,
+        vr::OMEGA_1,
+        vr::OMEGA_2,
+        vr::ZETA_2,
+        vr::X_JP_SAT,
+        vr::F_JP_SAT,
+        vr::X_JP_OFFSET,
+        vr::D_JP,
+        vr::C_D,
+        vr::C_DM_A_LPP,
+        vr::C_DB_A_LPP,
+        vr::L_CYL,
+        vr::L_P,
+        vr::L_S,
+        vr::L_SUP,
+        vr::L_SPRING0,
+        vr::D_CYL,
+        vr::K_SPRING,
+    ];
+
+    fn field_and_bound(&mut self, value_reference: u32) -> Option<(&mut f64, Bound)> {
+        use Bound::*;
+        Some(match value_reference {
+            vr::P_S => (&mut self.p_s, Positive),
+            vr::P_R => (&mut self.p_r, Positive),
+            vr::T_GAS => (&mut self.temperature, Positive),
+            vr::GAMMA => (&mut self.gamma, GreaterThanOne),
+            vr::R_GAS => (&mut self.r_gas, Positive),
+            vr::K_CD => (&mut self.k_cd, Finite),
+            vr::I_OFFSET => (&mut self.i_offset, Finite),
+            vr::OMEGA_CD => (&mut self.omega_cd, Positive),
+            vr::K_M => (&mut self.k_m, Finite),
+            vr::OMEGA_1 => (&mut self.omega_1, Positive),
+            vr::OMEGA_2 => (&mut self.omega_2, Positive),
+            vr::ZETA_2 => (&mut self.zeta_2, NonNegative),
+            vr::X_JP_SAT => (&mut self.x_jp_sat, Positive),
+            vr::F_JP_SAT => (&mut self.f_jp_sat, Positive),
+            vr::X_JP_OFFSET => (&mut self.x_jp_offset, Finite),
+            vr::D_JP => (&mut self.d_jp, Positive),
+            vr::C_D => (&mut self.c_d, NonNegative),
+            vr::C_DM_A_LPP => (&mut self.c_dm_a_lpp, Finite),
+            vr::C_DB_A_LPP => (&mut self.c_db_a_lpp, NonNegative),
+            vr::L_CYL => (&mut self.l_cyl, Positive),
+            vr::L_P => (&mut self.l_p, Positive),
+            vr::L_S => (&mut self.l_s, NonNegative),
+            vr::L_SUP => (&mut self.l_sup, NonNegative),
+            vr::L_SPRING0 => (&mut self.l_spring0, NonNegative),
+            vr::D_CYL => (&mut self.d_cyl, Positive),
+            vr::K_SPRING => (&mut self.k_spring, NonNegative),
+            _ => return None,
+        })
+    }
+
+    fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
+        self.field_and_bound(value_reference).map(|(f, _)| f)
+    }
+
+    /// Value of the parameter with this value reference, if it is one.
+    pub fn get(&self, value_reference: u32) -> Option<f64> {
+        let mut copy = self.clone();
+        copy.field_mut(value_reference).map(|f| *f)
+    }
+
+    /// Set one parameter, checking its own bound. The message names the variable and value.
+    pub fn set(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
+        let name = variable_name(value_reference);
+        let (field, bound) = self.field_and_bound(value_reference).ok_or_else(|| {
+            format!("value reference {value_reference} is not a parameter of the model")
+        })?;
+        let problem = if !value.is_finite() {
+            Some("must be finite")
+        } else {
+            match bound {
+                Bound::Positive if value <= 0.0 => Some("must be > 0"),
+                Bound::NonNegative if value < 0.0 => Some("must be >= 0"),
+                Bound::GreaterThanOne if value <= 1.0 => Some("must be > 1"),
+                _ => None,
+            }
+        };
+        if let Some(why) = problem {
+            return Err(format!("{name} = {value} is invalid: {why}"));
+        }
+        *field = value;
+        Ok(())
+    }
+
+    /// Checks that involve several parameters (run before initialisation).
+    pub fn validate(&self) -> Result<(), String> {
+        if self.c_db_a_lpp + self.c_dm_a_lpp < 0.0 {
+            return Err(format!(
+                "C_db_A_lpp + C_dm_A_lpp = {} m2 is invalid: the leakage area (2.23) must stay >= 0 for every pressure ratio",
+                self.c_db_a_lpp + self.c_dm_a_lpp
+            ));
+        }
+        if self.l_cyl <= self.l_p {
+            return Err(format!(
+                "L_cyl = {} m is invalid: must exceed L_p = {} m",
+                self.l_cyl, self.l_p
+            ));
+        }
+        Ok(())
+    }
+
+    pub fn cylinder(&self) -> CylinderGeometry {
+        CylinderGeometry {
+            l_cyl: self.l_cyl,
+            l_p: self.l_p,
+            l_s: self.l_s,
+            l_sup: self.l_sup,
+            d_cyl: self.d_cyl,
+        }
+    }
+
+    pub fn flow_constants(&self) -> FlowConstants {
+        FlowConstants::new(self.gamma, self.r_gas, self.temperature)
+    }
+
+    /// Check a stopper position against the cylinder (both volumes positive).
+    pub fn check_stopper(&self, x_s: f64) -> Result<(), String> {
+        let (lo, hi) = self.cylinder().stopper_range();
+        if !x_s.is_finite() || x_s <= lo || x_s >= hi {
+            return Err(format!(
+                "x_s = {x_s} m is outside the cylinder: both chamber volumes must be positive, {lo} < x_s < {hi} m"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Name of a variable of the table, for messages.
+pub fn variable_name(value_reference: u32) -> &'static str {
+    VARIABLES
+        .iter()
+        .find(|v| v.value_reference == value_reference)
+        .map(|v| v.name)
+        .unwrap_or("<unknown>")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_table_3_1() {
+        let p = Parameters::default();
+        assert_eq!(p.k_m, 1.946);
+        assert_eq!(p.omega_cd, 7050.0);
+        assert_eq!(p.c_dm_a_lpp, -0.0475e-6);
+        assert_eq!(p.p_s, 652_925.0);
+        assert!(p.validate().is_ok());
+    }
+
+    #[test]
+    fn bad_values_are_rejected_with_name_and_value() {
+        let mut p = Parameters::default();
+        let e = p.set(vr::P_S, -5.0).unwrap_err();
+        assert!(e.contains("P_s") && e.contains("-5"), "{e}");
+        let e = p.set(vr::C_D, f64::NAN).unwrap_err();
+        assert!(e.contains("C_d") && e.contains("NaN"), "{e}");
+        assert!(p.set(vr::D_CYL, 0.0).is_err());
+        assert_eq!(
+            p.p_s, 652_925.0,
+            "a rejected value leaves the parameter unchanged"
+        );
+        let e = p.check_stopper(0.02).unwrap_err();
+        assert!(e.contains("x_s") && e.contains("0.02"), "{e}");
+    }
+}

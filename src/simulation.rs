@@ -1,0 +1,468 @@
+//! Stepping the actuator between communication points: the one driver used by the FMU,
+//! the command-line tool and the tests.
+//!
+//! Inputs are held over a step, or move linearly when a first-order derivative is given
+//! for the step. A stopper position set without a derivative is a jump at the
+//! communication point: the air in each chamber is conserved and the pressures follow
+//! the exact no-flow limit of (2.29), P V^γ = const, so no spike comes from differencing.
+
+use nalgebra::SVector;
+
+use crate::integrator::{OdeSystem, Sdirk4, Statistics, Tolerances};
+use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, Outputs, State, N_STATES};
+use crate::physics::chambers::pressure_after_volume_jump;
+use crate::physics::current_driver;
+
+/// The default relative tolerance (also the model description's default experiment).
+pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-6;
+
+/// The actuator model over one step, with inputs linear in time from `t0`.
+struct StepSystem<'a> {
+    model: &'a Actuator,
+    t0: f64,
+    v_da: f64,
+    v_da_rate: f64,
+    x_s: f64,
+    x_s_rate: f64,
+}
+
+impl StepSystem<'_> {
+    fn inputs(&self, t: f64) -> Inputs {
+        let dt = t - self.t0;
+        Inputs {
+            v_da: self.v_da + self.v_da_rate * dt,
+            x_s: self.x_s + self.x_s_rate * dt,
+            x_s_rate: self.x_s_rate,
+        }
+    }
+}
+
+impl OdeSystem<N_STATES> for StepSystem<'_> {
+    fn rhs(&self, t: f64, y: &State) -> State {
+        self.model.derivatives(y, &self.inputs(t))
+    }
+    fn jacobian(&self, t: f64, y: &State, f_y: &State) -> Jacobian {
+        self.model.jacobian(y, &self.inputs(t), f_y)
+    }
+}
+
+/// Why a step failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepFailure {
+    /// The request is invalid; nothing changed.
+    InvalidRequest(String),
+    /// The integrator gave up; the simulation holds the last accepted state at `time`.
+    Integration { message: String, time: f64 },
+}
+
+/// A running simulation of one actuator.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    pub model: Actuator,
+    pub time: f64,
+    pub state: State,
+    pub v_da: f64,
+    pub x_s: f64,
+    /// First-order input derivatives for the next step only (cleared after it).
+    pub v_da_rate: f64,
+    pub x_s_rate: f64,
+    pub relative_tolerance: f64,
+    pub integrator: Sdirk4,
+    pub statistics: Statistics,
+}
+
+impl Simulation {
+    /// A simulation at rest at the equilibrium of the given inputs.
+    pub fn at_equilibrium(
+        model: Actuator,
+        v_da: f64,
+        x_s: f64,
+        time: f64,
+        relative_tolerance: f64,
+    ) -> Result<Self, String> {
+        check_finite("v_DA", v_da, "V")?;
+        model.params.check_stopper(x_s)?;
+        let state = equilibrium(&model, v_da, x_s)?;
+        Ok(Self::from_state(
+            model,
+            state,
+            v_da,
+            x_s,
+            time,
+            relative_tolerance,
+        ))
+    }
+
+    /// A simulation from a given state.
+    pub fn from_state(
+        model: Actuator,
+        state: State,
+        v_da: f64,
+        x_s: f64,
+        time: f64,
+        relative_tolerance: f64,
+    ) -> Self {
+        Self {
+            model,
+            time,
+            state,
+            v_da,
+            x_s,
+            v_da_rate: 0.0,
+            x_s_rate: 0.0,
+            relative_tolerance,
+            integrator: Sdirk4::default(),
+            statistics: Statistics::default(),
+        }
+    }
+
+    pub fn outputs(&self) -> Outputs {
+        self.model.outputs(&self.state, self.x_s)
+    }
+
+    pub fn set_command(&mut self, v_da: f64) -> Result<(), String> {
+        check_finite("v_DA", v_da, "V")?;
+        self.v_da = v_da;
+        Ok(())
+    }
+
+    /// Move the stopper instantly, conserving the air in each chamber.
+    pub fn set_stopper(&mut self, x_s: f64) -> Result<(), String> {
+        self.model.params.check_stopper(x_s)?;
+        if x_s != self.x_s {
+            let gamma = self.model.params.gamma;
+            let (v1_before, v2_before) = self.model.cylinder.volumes(self.x_s);
+            let (v1_after, v2_after) = self.model.cylinder.volumes(x_s);
+            self.state[index::P1] =
+                pressure_after_volume_jump(gamma, self.state[index::P1], v1_before, v1_after);
+            self.state[index::P2] =
+                pressure_after_volume_jump(gamma, self.state[index::P2], v2_before, v2_after);
+            self.x_s = x_s;
+        }
+        Ok(())
+    }
+
+    pub fn set_command_rate(&mut self, rate: f64) -> Result<(), String> {
+        check_finite("der(v_DA)", rate, "V/s")?;
+        self.v_da_rate = rate;
+        Ok(())
+    }
+
+    pub fn set_stopper_rate(&mut self, rate: f64) -> Result<(), String> {
+        check_finite("der(x_s)", rate, "m/s")?;
+        self.x_s_rate = rate;
+        Ok(())
+    }
+
+    pub fn tolerances(&self) -> Tolerances<N_STATES> {
+        Tolerances {
+            relative: self.relative_tolerance,
+            absolute: self.model.state_scales() * self.relative_tolerance,
+        }
+    }
+
+    /// Advance by `step` seconds.
+    pub fn step(&mut self, step: f64) -> Result<(), StepFailure> {
+        if !(step.is_finite() && step > 0.0) {
+            return Err(StepFailure::InvalidRequest(format!(
+                "communicationStepSize = {step} s is invalid: must be finite and > 0"
+            )));
+        }
+        let x_s_end = self.x_s + self.x_s_rate * step;
+        if self.x_s_rate != 0.0 {
+            self.model.params.check_stopper(x_s_end).map_err(|e| {
+                StepFailure::InvalidRequest(format!(
+                    "with der(x_s) = {} m/s the stopper would leave the cylinder during the step: {e}",
+                    self.x_s_rate
+                ))
+            })?;
+        }
+        let system = StepSystem {
+            model: &self.model,
+            t0: self.time,
+            v_da: self.v_da,
+            v_da_rate: self.v_da_rate,
+            x_s: self.x_s,
+            x_s_rate: self.x_s_rate,
+        };
+        let tolerances = self.tolerances();
+        let t_end = self.time + step;
+        match self.integrator.integrate(
+            &system,
+            self.time,
+            self.state,
+            t_end,
+            &tolerances,
+            &mut self.statistics,
+        ) {
+            Ok(y) => {
+                self.state = y;
+                self.time = t_end;
+                self.v_da += self.v_da_rate * step;
+                self.x_s = x_s_end;
+                self.v_da_rate = 0.0;
+                self.x_s_rate = 0.0;
+                Ok(())
+            }
+            Err(failure) => {
+                let elapsed = failure.time - self.time;
+                self.state = failure.state;
+                self.v_da += self.v_da_rate * elapsed;
+                self.x_s += self.x_s_rate * elapsed;
+                self.time = failure.time;
+                Err(StepFailure::Integration {
+                    message: failure.message,
+                    time: failure.time,
+                })
+            }
+        }
+    }
+}
+
+fn check_finite(name: &str, value: f64, unit: &str) -> Result<(), String> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{name} = {value} {unit} is invalid: must be finite"
+        ))
+    }
+}
+
+/// The equilibrium state for constant inputs: the current at its static value, the jet
+/// pipe at rest at f3 of it, and chamber pressures at which both net mass flows vanish.
+///
+/// The pressures come from a pseudo-transient run of the chamber equations (robust from
+/// any start) polished by Newton's method on the two net flows.
+pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, String> {
+    let p = &model.params;
+    let current = current_driver::static_current(p.k_cd, p.i_offset, v_da);
+    let x_jp = model.static_jet_position(current);
+    let mut y = State::from([
+        current,
+        x_jp,
+        0.0,
+        0.0,
+        0.5 * (p.p_s + p.p_r),
+        0.5 * (p.p_s + p.p_r),
+    ]);
+    let rates = |p1: f64, p2: f64| {
+        let (a, b) = model.pressure_rates(x_jp, p1, p2, x_s, 0.0);
+        SVector::<f64, 2>::new(a, b)
+    };
+    let system = StepSystem {
+        model,
+        t0: 0.0,
+        v_da,
+        v_da_rate: 0.0,
+        x_s,
+        x_s_rate: 0.0,
+    };
+    let tolerances = Tolerances {
+        relative: 1e-8,
+        absolute: model.state_scales() * 1e-8,
+    };
+    let mut integrator = Sdirk4::default();
+    let mut statistics = Statistics::default();
+    let pressure_scale = p.p_s.max(p.p_r);
+    let mut t = 0.0;
+    for _ in 0..400 {
+        y = integrator
+            .integrate(&system, t, y, t + 0.5, &tolerances, &mut statistics)
+            .map_err(|f| {
+                format!(
+                    "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m: {}",
+                    f.message
+                )
+            })?;
+        t += 0.5;
+        let r = rates(y[index::P1], y[index::P2]);
+        // Settled to where Newton converges quadratically: < 1 Pa of drift per 10 ms.
+        if r.amax() < 1e-4 * pressure_scale {
+            break;
+        }
+    }
+    let mut pressures = SVector::<f64, 2>::new(y[index::P1], y[index::P2]);
+    for _ in 0..50 {
+        let r = rates(pressures[0], pressures[1]);
+        if r.amax() == 0.0 {
+            break;
+        }
+        let jac =
+            crate::integrator::finite_difference_jacobian(|q| rates(q[0], q[1]), &pressures, &r);
+        let Some(delta) = jac.lu().solve(&(-r)) else {
+            break;
+        };
+        // Never jump further than a tenth of the supply pressure in one iteration.
+        let limit = 0.1 * pressure_scale;
+        let delta = if delta.amax() > limit {
+            delta * (limit / delta.amax())
+        } else {
+            delta
+        };
+        let trial = pressures + delta;
+        if rates(trial[0], trial[1]).amax() >= r.amax() && delta.amax() < 1e-9 * pressure_scale {
+            break;
+        }
+        pressures = trial;
+        if delta.amax() < 1e-12 * pressure_scale {
+            break;
+        }
+    }
+    y[index::P1] = pressures[0];
+    y[index::P2] = pressures[1];
+    let residual = rates(pressures[0], pressures[1]).amax();
+    if !residual.is_finite() || residual > 1e-3 * pressure_scale {
+        return Err(format!(
+            "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m: pressures still change by {residual} Pa/s"
+        ));
+    }
+    Ok(y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::parameters::Parameters;
+
+    fn thesis_model() -> Actuator {
+        Actuator::new(Parameters::default()).unwrap()
+    }
+
+    #[test]
+    fn equilibrium_has_zero_net_flow_and_stays_put() {
+        let model = thesis_model();
+        for v in [-4.0, 0.0, 1.0, 2.5, 10.0] {
+            let mut sim = Simulation::at_equilibrium(model.clone(), v, 0.054, 0.0, 1e-8).unwrap();
+            let flows = model.mass_flows(
+                sim.state[index::JET_POSITION],
+                sim.state[index::P1],
+                sim.state[index::P2],
+            );
+            assert!(
+                flows.net_1().abs() < 1e-12 && flows.net_2().abs() < 1e-12,
+                "v = {v}: {flows:?}"
+            );
+            let before = sim.outputs();
+            sim.step(1.0).unwrap();
+            let after = sim.outputs();
+            assert!(
+                (after.f_act - before.f_act).abs() < 1e-6 * before.f_act.abs().max(1.0),
+                "v = {v}: {before:?} -> {after:?}"
+            );
+            let p = &model.params;
+            assert!(after.p1 >= p.p_r - 1.0 && after.p1 <= p.p_s + 1.0);
+            assert!(after.p2 >= p.p_r - 1.0 && after.p2 <= p.p_s + 1.0);
+        }
+    }
+
+    #[test]
+    fn static_force_is_independent_of_stopper_position() {
+        // §3.3.1: at equilibrium both net flows vanish, which fixes P1 and P2 independently
+        // of the volumes.
+        let model = thesis_model();
+        for v in [0.5, 2.5, 6.0] {
+            let f: Vec<f64> = [0.040, 0.054, 0.070]
+                .iter()
+                .map(|&x| {
+                    Simulation::at_equilibrium(model.clone(), v, x, 0.0, 1e-8)
+                        .unwrap()
+                        .outputs()
+                        .f_act
+                })
+                .collect();
+            assert!(
+                (f[0] - f[1]).abs() < 1e-6 && (f[2] - f[1]).abs() < 1e-6,
+                "v = {v}: {f:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn sealed_chambers_conserve_air_when_the_stopper_moves() {
+        let mut p = Parameters::default();
+        p.c_d = 0.0;
+        p.c_db_a_lpp = 0.0;
+        p.c_dm_a_lpp = 0.0;
+        let model = Actuator::new(p).unwrap();
+        let mut state = equilibrium(&thesis_model(), 2.5, 0.054).unwrap();
+        state[index::P1] = 4e5;
+        state[index::P2] = 2e5;
+        let mut sim = Simulation::from_state(model.clone(), state, 2.5, 0.054, 0.0, 1e-8);
+        let invariant = |s: &Simulation| {
+            let (v1, v2) = s.model.cylinder.volumes(s.x_s);
+            (
+                s.state[index::P1] * v1.powf(1.4),
+                s.state[index::P2] * v2.powf(1.4),
+            )
+        };
+        let start = invariant(&sim);
+        // Linear motion over a step (input derivative), then a jump, then back.
+        sim.set_stopper_rate(0.2).unwrap();
+        sim.step(0.05).unwrap();
+        assert!((sim.x_s - 0.064).abs() < 1e-15);
+        let moved = invariant(&sim);
+        sim.set_stopper(0.040).unwrap();
+        let jumped = invariant(&sim);
+        for (a, b) in [(start, moved), (start, jumped)] {
+            assert!(
+                (a.0 - b.0).abs() < 1e-7 * a.0 && (a.1 - b.1).abs() < 1e-7 * a.1,
+                "{a:?} vs {b:?}"
+            );
+        }
+        sim.set_stopper(0.054).unwrap();
+        assert!(
+            (sim.state[index::P1] - 4e5).abs() < 1e-7 * 4e5
+                && (sim.state[index::P2] - 2e5).abs() < 1e-7 * 2e5
+        );
+    }
+
+    #[test]
+    fn results_do_not_depend_on_the_communication_step() {
+        let model = thesis_model();
+        let command = |t: f64| 2.5 + 3.0 * (2.0 * std::f64::consts::PI * 0.3 * t).sin();
+        let run = |substeps: usize| {
+            let mut sim = Simulation::at_equilibrium(
+                model.clone(),
+                command(0.0),
+                0.054,
+                0.0,
+                DEFAULT_RELATIVE_TOLERANCE,
+            )
+            .unwrap();
+            let mut forces = vec![];
+            for k in 0..100 {
+                sim.set_command(command(0.01 * k as f64)).unwrap();
+                for _ in 0..substeps {
+                    sim.step(0.01 / substeps as f64).unwrap();
+                }
+                forces.push(sim.outputs().f_act);
+            }
+            forces
+        };
+        let coarse = run(1);
+        let fine = run(100);
+        let worst = coarse
+            .iter()
+            .zip(&fine)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-4, "max |ΔF| = {worst} N");
+    }
+
+    #[test]
+    fn bad_requests_name_the_variable_and_value() {
+        let mut sim = Simulation::at_equilibrium(thesis_model(), 2.5, 0.054, 0.0, 1e-6).unwrap();
+        let e = sim.set_command(f64::NAN).unwrap_err();
+        assert!(e.contains("v_DA") && e.contains("NaN"), "{e}");
+        let e = sim.set_stopper(0.1).unwrap_err();
+        assert!(e.contains("x_s") && e.contains("0.1"), "{e}");
+        match sim.step(-1e-3) {
+            Err(StepFailure::InvalidRequest(e)) => assert!(e.contains("-0.001"), "{e}"),
+            other => panic!("{other:?}"),
+        }
+        sim.set_stopper_rate(1.0).unwrap();
+        assert!(matches!(sim.step(0.1), Err(StepFailure::InvalidRequest(_))));
+        assert_eq!(sim.time, 0.0);
+    }
+}
