@@ -7,7 +7,10 @@
 //! * [`variables`]: the table of FMU variables from which the model description comes.
 
 pub mod fmi2;
+pub mod fmu;
 pub mod integrator;
+pub mod packaging;
 pub mod physics;
+pub mod scenario;
 pub mod simulation;
 pub mod variables;

@@ -229,6 +229,16 @@ fn check_finite(name: &str, value: f64, unit: &str) -> Result<(), String> {
     }
 }
 
+/// The current at its static value and the jet pipe at rest at f3 of it; the pressures
+/// are set half-way between return and supply.
+pub fn equilibrium_of_electromechanics(model: &Actuator, v_da: f64) -> State {
+    let p = &model.params;
+    let current = current_driver::static_current(p.k_cd, p.i_offset, v_da);
+    let x_jp = model.static_jet_position(current);
+    let mid = 0.5 * (p.p_s + p.p_r);
+    State::from([current, x_jp, 0.0, 0.0, mid, mid])
+}
+
 /// The equilibrium state for constant inputs: the current at its static value, the jet
 /// pipe at rest at f3 of it, and chamber pressures at which both net mass flows vanish.
 ///
@@ -236,16 +246,8 @@ fn check_finite(name: &str, value: f64, unit: &str) -> Result<(), String> {
 /// any start) polished by Newton's method on the two net flows.
 pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, String> {
     let p = &model.params;
-    let current = current_driver::static_current(p.k_cd, p.i_offset, v_da);
-    let x_jp = model.static_jet_position(current);
-    let mut y = State::from([
-        current,
-        x_jp,
-        0.0,
-        0.0,
-        0.5 * (p.p_s + p.p_r),
-        0.5 * (p.p_s + p.p_r),
-    ]);
+    let mut y = equilibrium_of_electromechanics(model, v_da);
+    let x_jp = y[index::JET_POSITION];
     let rates = |p1: f64, p2: f64| {
         let (a, b) = model.pressure_rates(x_jp, p1, p2, x_s, 0.0);
         SVector::<f64, 2>::new(a, b)

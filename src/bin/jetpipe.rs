@@ -1,1 +1,123 @@
-fn main() {}
+//! `jetpipe`: package the FMU, print its model description, run the standard scenario.
+//! It drives the same library as the FMU; there is no second copy of the model.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::{Parser, Subcommand};
+use jetpipe::physics::actuator::Actuator;
+use jetpipe::physics::parameters::Parameters;
+use jetpipe::scenario;
+use jetpipe::simulation::{Simulation, DEFAULT_RELATIVE_TOLERANCE};
+
+#[derive(Parser)]
+#[command(name = "jetpipe", version, about = "Jet-pipe electropneumatic actuator (Henri 1994) as an FMI 2.0 FMU")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Write dist/JetPipeActuator.fmu (model description, linux64 binary, documentation).
+    Package {
+        #[arg(long, default_value = "dist/JetPipeActuator.fmu")]
+        out: PathBuf,
+        /// The compiled shared library; by default libjetpipe.so next to this executable.
+        #[arg(long)]
+        library: Option<PathBuf>,
+    },
+    /// Print the model description generated from the variable table.
+    ModelDescription,
+    /// Run the standard scenario in-process and print a summary.
+    Simulate {
+        /// Communication step in seconds.
+        #[arg(long, default_value_t = 0.01)]
+        step: f64,
+        /// Relative tolerance of the integrator.
+        #[arg(long, default_value_t = DEFAULT_RELATIVE_TOLERANCE)]
+        tolerance: f64,
+        /// Write time and outputs every 10 ms to this CSV file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("jetpipe: error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<(), String> {
+    match cli.command {
+        Command::Package { out, library } => {
+            let library = match library {
+                Some(path) => path,
+                None => std::env::current_exe()
+                    .map_err(|e| format!("cannot locate this executable: {e}"))?
+                    .with_file_name("libjetpipe.so"),
+            };
+            jetpipe::packaging::write_fmu(&out, &library)?;
+            println!("wrote {}", out.display());
+            Ok(())
+        }
+        Command::ModelDescription => {
+            print!("{}", jetpipe::packaging::actuator_model_description());
+            Ok(())
+        }
+        Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
+    }
+}
+
+fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), String> {
+    if !(step.is_finite() && step > 0.0 && step <= scenario::SAMPLE_PERIOD) {
+        return Err(format!("--step {step} is invalid: must be in (0, {}] s", scenario::SAMPLE_PERIOD));
+    }
+    let substeps = (scenario::SAMPLE_PERIOD / step).round().max(1.0) as usize;
+    let model = Actuator::new(Parameters::default())?;
+    let (v0, x0) = scenario::standard_inputs(0);
+    let started = Instant::now();
+    let mut sim = Simulation::at_equilibrium(model, v0, x0, 0.0, tolerance)?;
+    let mut rows = vec![(0.0, sim.outputs())];
+    for k in 0..scenario::standard_samples() {
+        let (v, x) = scenario::standard_inputs(k);
+        sim.set_command(v)?;
+        sim.set_stopper(x)?;
+        for _ in 0..substeps {
+            sim.step(scenario::SAMPLE_PERIOD / substeps as f64).map_err(|e| format!("{e:?}"))?;
+        }
+        rows.push((sim.time, sim.outputs()));
+    }
+    let elapsed = started.elapsed().as_secs_f64();
+    let force = rows.iter().map(|r| r.1.f_act);
+    let (f_min, f_max) = force.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f), b.max(f)));
+    let last = rows.last().expect("at least the initial row").1;
+    let st = sim.statistics;
+    println!("standard scenario: {} s, communication step {step} s, relative tolerance {tolerance:e}", scenario::DURATION);
+    println!("  F_act  min {f_min:.4} N  max {f_max:.4} N  final {:.6} N", last.f_act);
+    println!("  P1 final {:.1} Pa   P2 final {:.1} Pa", last.p1, last.p2);
+    println!(
+        "  work: {} steps ({} rejected), {} right-hand sides, {} Jacobians; {:.1} ms CPU ({:.0}x real time)",
+        st.steps,
+        st.rejected,
+        st.rhs_evaluations,
+        st.jacobians,
+        elapsed * 1e3,
+        scenario::DURATION / elapsed
+    );
+    if let Some(path) = csv {
+        let mut text = String::from("time_s,F_act_N,P1_Pa,P2_Pa,i_A,x_jp_m\n");
+        for (t, y) in &rows {
+            text.push_str(&format!("{t},{},{},{},{},{}\n", y.f_act, y.p1, y.p2, y.current, y.x_jp));
+        }
+        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        println!("  wrote {}", path.display());
+    }
+    Ok(())
+}

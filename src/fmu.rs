@@ -1,0 +1,451 @@
+//! The actuator behind the generic FMI layer: maps the variable table onto the physics
+//! and the simulation driver. No FFI types here.
+
+use crate::fmi2::model::{CoSimModel, ModelInfo, StepError};
+use crate::physics::actuator::{index, Actuator, State, N_STATES};
+use crate::physics::parameters::{variable_name, Parameters};
+use crate::simulation::{Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+use crate::variables::{vr, UNITS, VARIABLES};
+
+/// Changes whenever the interface (variable table) changes.
+pub const GUID: &str = "{5b0c7f0e-3d2a-4c1e-9a57-jetpipe-0001}";
+
+pub const LOG_CATEGORIES: &[(&str, &str)] = &[
+    ("logEvents", "initialisation, resets and state restores"),
+    ("logStatusWarning", "messages with status fmi2Warning"),
+    ("logStatusDiscard", "messages with status fmi2Discard"),
+    ("logStatusError", "messages with status fmi2Error"),
+    ("logStatusFatal", "messages with status fmi2Fatal"),
+    ("logAll", "every message"),
+];
+
+pub static MODEL_INFO: ModelInfo = ModelInfo {
+    model_name: "JetPipeActuator",
+    model_identifier: "JetPipeActuator",
+    guid: GUID,
+    description: "Jet-pipe electropneumatic actuator of the Utah/MIT Dextrous Hand (P.D. Henri, 1994): current driver, third-order jet pipe, orifice flows, leaky piston, two chambers with a moving stopper",
+    author: "jetpipe project",
+    version: env!("CARGO_PKG_VERSION"),
+    generation_tool: concat!("jetpipe ", env!("CARGO_PKG_VERSION")),
+    default_start_time: 0.0,
+    default_stop_time: 10.0,
+    default_tolerance: DEFAULT_RELATIVE_TOLERANCE,
+    default_step_size: 1e-3,
+    log_categories: LOG_CATEGORIES,
+    units: UNITS,
+    variables: VARIABLES,
+    can_interpolate_inputs: true,
+};
+
+/// One FMU instance: parameters and inputs until initialisation, then a simulation.
+#[derive(Clone, Debug)]
+pub struct ActuatorFmu {
+    params: Parameters,
+    v_da: f64,
+    x_s: f64,
+    v_da_rate: f64,
+    x_s_rate: f64,
+    start_at_equilibrium: bool,
+    p1_start: f64,
+    p2_start: f64,
+    tolerance: f64,
+    start_time: f64,
+    simulation: Option<Simulation>,
+}
+
+fn start(value_reference: u32) -> f64 {
+    crate::physics::parameters::table_start(value_reference)
+}
+
+impl ActuatorFmu {
+    /// The state the simulation would start from with the current settings.
+    fn initial_simulation(&self) -> Result<Simulation, String> {
+        let model = Actuator::new(self.params.clone())?;
+        model.params.check_stopper(self.x_s)?;
+        let mut simulation = if self.start_at_equilibrium {
+            Simulation::at_equilibrium(model, self.v_da, self.x_s, self.start_time, self.tolerance)?
+        } else {
+            let mut state = crate::simulation::equilibrium_of_electromechanics(&model, self.v_da);
+            state[index::P1] = self.p1_start;
+            state[index::P2] = self.p2_start;
+            Simulation::from_state(model, state, self.v_da, self.x_s, self.start_time, self.tolerance)
+        };
+        simulation.set_command_rate(self.v_da_rate)?;
+        simulation.set_stopper_rate(self.x_s_rate)?;
+        Ok(simulation)
+    }
+
+    pub fn simulation(&self) -> Option<&Simulation> {
+        self.simulation.as_ref()
+    }
+}
+
+impl CoSimModel for ActuatorFmu {
+    fn info() -> &'static ModelInfo {
+        &MODEL_INFO
+    }
+
+    fn instantiate() -> Self {
+        Self {
+            params: Parameters::default(),
+            v_da: start(vr::V_DA),
+            x_s: start(vr::X_S),
+            v_da_rate: 0.0,
+            x_s_rate: 0.0,
+            start_at_equilibrium: start(vr::START_AT_EQUILIBRIUM) != 0.0,
+            p1_start: start(vr::P1_START),
+            p2_start: start(vr::P2_START),
+            tolerance: DEFAULT_RELATIVE_TOLERANCE,
+            start_time: 0.0,
+            simulation: None,
+        }
+    }
+
+    fn get_real(&self, value_reference: u32) -> Result<f64, String> {
+        match value_reference {
+            vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, |s| s.v_da)),
+            vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, |s| s.x_s)),
+            vr::F_ACT | vr::P1 | vr::P2 | vr::I | vr::X_JP => {
+                let computed;
+                let simulation = match &self.simulation {
+                    Some(s) => s,
+                    None => {
+                        computed = self.initial_simulation()?;
+                        &computed
+                    }
+                };
+                let y = simulation.outputs();
+                Ok(match value_reference {
+                    vr::F_ACT => y.f_act,
+                    vr::P1 => y.p1,
+                    vr::P2 => y.p2,
+                    vr::I => y.current,
+                    _ => y.x_jp,
+                })
+            }
+            vr::P1_START => Ok(self.p1_start),
+            vr::P2_START => Ok(self.p2_start),
+            _ => self
+                .params
+                .get(value_reference)
+                .ok_or_else(|| format!("no Real variable with value reference {value_reference}")),
+        }
+    }
+
+    fn set_real(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
+        match value_reference {
+            vr::V_DA => match &mut self.simulation {
+                Some(s) => s.set_command(value),
+                None if value.is_finite() => {
+                    self.v_da = value;
+                    Ok(())
+                }
+                None => Err(format!("v_DA = {value} V is invalid: must be finite")),
+            },
+            vr::X_S => match &mut self.simulation {
+                Some(s) => s.set_stopper(value),
+                None => {
+                    self.params.check_stopper(value)?;
+                    self.x_s = value;
+                    Ok(())
+                }
+            },
+            vr::P1_START | vr::P2_START => {
+                if !(value.is_finite() && value > 0.0) {
+                    return Err(format!("{} = {value} Pa is invalid: must be finite and > 0", variable_name(value_reference)));
+                }
+                if value_reference == vr::P1_START {
+                    self.p1_start = value;
+                } else {
+                    self.p2_start = value;
+                }
+                Ok(())
+            }
+            _ => self.params.set(value_reference, value),
+        }
+    }
+
+    fn get_boolean(&self, value_reference: u32) -> Result<bool, String> {
+        match value_reference {
+            vr::START_AT_EQUILIBRIUM => Ok(self.start_at_equilibrium),
+            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
+        }
+    }
+
+    fn set_boolean(&mut self, value_reference: u32, value: bool) -> Result<(), String> {
+        match value_reference {
+            vr::START_AT_EQUILIBRIUM => {
+                self.start_at_equilibrium = value;
+                Ok(())
+            }
+            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
+        }
+    }
+
+    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64, _stop_time: Option<f64>) -> Result<(), String> {
+        if let Some(t) = tolerance {
+            if !(t.is_finite() && t > 0.0 && t < 1.0) {
+                return Err(format!("tolerance = {t} is invalid: must be in (0, 1)"));
+            }
+            // Below 1e-12 the error estimate is rounding noise.
+            self.tolerance = t.max(1e-12);
+        }
+        if !start_time.is_finite() {
+            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
+        }
+        self.start_time = start_time;
+        Ok(())
+    }
+
+    fn exit_initialization(&mut self) -> Result<(), String> {
+        self.simulation = Some(self.initial_simulation()?);
+        Ok(())
+    }
+
+    fn set_real_input_derivative(&mut self, value_reference: u32, order: i32, value: f64) -> Result<(), String> {
+        if order != 1 {
+            return Err(format!(
+                "input derivative of order {order} for {} is not supported: only order 1",
+                variable_name(value_reference)
+            ));
+        }
+        match (value_reference, &mut self.simulation) {
+            (vr::V_DA, Some(s)) => s.set_command_rate(value),
+            (vr::X_S, Some(s)) => s.set_stopper_rate(value),
+            (vr::V_DA | vr::X_S, None) if !value.is_finite() => Err(format!(
+                "der({}) = {value} is invalid: must be finite",
+                variable_name(value_reference)
+            )),
+            (vr::V_DA, None) => {
+                self.v_da_rate = value;
+                Ok(())
+            }
+            (vr::X_S, None) => {
+                self.x_s_rate = value;
+                Ok(())
+            }
+            _ => Err(format!("value reference {value_reference} is not an input")),
+        }
+    }
+
+    fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
+        let simulation = self
+            .simulation
+            .as_mut()
+            .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
+        simulation.step(step_size).map_err(|failure| match failure {
+            StepFailure::InvalidRequest(message) => StepError::Error(message),
+            StepFailure::Integration { message, time } => StepError::Discard { message, last_successful_time: time },
+        })
+    }
+
+    fn time(&self) -> f64 {
+        self.simulation.as_ref().map_or(self.start_time, |s| s.time)
+    }
+
+    fn serialize(&self) -> Vec<u8> {
+        let mut w = ByteWriter::default();
+        w.bytes(STATE_MAGIC);
+        w.u32(STATE_FORMAT_VERSION);
+        w.string(env!("CARGO_PKG_VERSION"));
+        for &value_reference in Parameters::VALUE_REFERENCES {
+            w.f64(self.params.get(value_reference).unwrap_or(f64::NAN));
+        }
+        for v in [self.v_da, self.x_s, self.v_da_rate, self.x_s_rate, self.p1_start, self.p2_start, self.tolerance, self.start_time] {
+            w.f64(v);
+        }
+        w.u32(self.start_at_equilibrium as u32);
+        match &self.simulation {
+            None => w.u32(0),
+            Some(s) => {
+                w.u32(1);
+                for v in [s.time, s.v_da, s.x_s, s.v_da_rate, s.x_s_rate, s.relative_tolerance, s.integrator.next_step, s.integrator.max_step] {
+                    w.f64(v);
+                }
+                for k in 0..N_STATES {
+                    w.f64(s.state[k]);
+                }
+                let st = &s.statistics;
+                for v in [st.steps, st.rejected, st.rhs_evaluations, st.jacobians, st.newton_failures] {
+                    w.u64(v);
+                }
+            }
+        }
+        w.0
+    }
+
+    fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let mut r = ByteReader { bytes, at: 0 };
+        if r.take(STATE_MAGIC.len())? != STATE_MAGIC {
+            return Err("the state was not written by the JetPipeActuator model".to_string());
+        }
+        let format = r.u32()?;
+        if format != STATE_FORMAT_VERSION {
+            return Err(format!("state format version {format} is not supported (this model reads version {STATE_FORMAT_VERSION})"));
+        }
+        let version = r.string()?;
+        if version != env!("CARGO_PKG_VERSION") {
+            return Err(format!(
+                "the state was written by model version {version}; this is version {}",
+                env!("CARGO_PKG_VERSION")
+            ));
+        }
+        let mut restored = Self::instantiate();
+        for &value_reference in Parameters::VALUE_REFERENCES {
+            restored.params.set(value_reference, r.f64()?)?;
+        }
+        restored.v_da = r.f64()?;
+        restored.x_s = r.f64()?;
+        restored.v_da_rate = r.f64()?;
+        restored.x_s_rate = r.f64()?;
+        restored.p1_start = r.f64()?;
+        restored.p2_start = r.f64()?;
+        restored.tolerance = r.f64()?;
+        restored.start_time = r.f64()?;
+        restored.start_at_equilibrium = r.u32()? != 0;
+        if r.u32()? == 1 {
+            let model = Actuator::new(restored.params.clone())?;
+            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step] = [(); 8].map(|_| r.f64()).map(|v| v.unwrap_or(f64::NAN));
+            let mut state = State::zeros();
+            for k in 0..N_STATES {
+                state[k] = r.f64()?;
+            }
+            let mut simulation = Simulation::from_state(model, state, v_da, x_s, time, rtol);
+            simulation.v_da_rate = v_da_rate;
+            simulation.x_s_rate = x_s_rate;
+            simulation.integrator.next_step = next_step;
+            simulation.integrator.max_step = max_step;
+            let st = &mut simulation.statistics;
+            st.steps = r.u64()?;
+            st.rejected = r.u64()?;
+            st.rhs_evaluations = r.u64()?;
+            st.jacobians = r.u64()?;
+            st.newton_failures = r.u64()?;
+            let finite = [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step].iter().all(|v| v.is_finite())
+                && state.iter().all(|v| v.is_finite());
+            if !finite {
+                return Err("the state holds non-finite values".to_string());
+            }
+            simulation.model.params.check_stopper(x_s)?;
+            restored.simulation = Some(simulation);
+        }
+        if r.at != bytes.len() {
+            return Err(format!("{} unexpected bytes after the state", bytes.len() - r.at));
+        }
+        *self = restored;
+        Ok(())
+    }
+}
+
+const STATE_MAGIC: &[u8] = b"JetPipeActuatorState";
+const STATE_FORMAT_VERSION: u32 = 1;
+
+#[derive(Default)]
+struct ByteWriter(Vec<u8>);
+
+impl ByteWriter {
+    fn bytes(&mut self, b: &[u8]) {
+        self.0.extend_from_slice(b);
+    }
+    fn u32(&mut self, v: u32) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn u64(&mut self, v: u64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn string(&mut self, s: &str) {
+        self.u32(s.len() as u32);
+        self.bytes(s.as_bytes());
+    }
+}
+
+struct ByteReader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> ByteReader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len()).ok_or_else(|| {
+            format!("the state is truncated: {} bytes, needed more than {}", self.bytes.len(), self.at)
+        })?;
+        let slice = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(slice)
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+    }
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+    }
+    fn string(&mut self) -> Result<String, String> {
+        let n = self.u32()? as usize;
+        if n > 64 {
+            return Err("the state's version string is implausibly long".to_string());
+        }
+        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| "the state's version string is not UTF-8".to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn initialised() -> ActuatorFmu {
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.setup_experiment(Some(1e-6), 0.0, None).unwrap();
+        fmu.set_real(vr::V_DA, 2.5).unwrap();
+        fmu.exit_initialization().unwrap();
+        fmu
+    }
+
+    #[test]
+    fn serialized_state_continues_bit_identically() {
+        let mut a = initialised();
+        a.do_step(0.0, 0.05).unwrap();
+        let bytes = a.serialize();
+        let mut b = ActuatorFmu::instantiate();
+        b.deserialize(&bytes).unwrap();
+        for fmu in [&mut a, &mut b] {
+            fmu.set_real(vr::V_DA, 6.0).unwrap();
+            fmu.do_step(0.05, 0.05).unwrap();
+        }
+        for value_reference in [vr::F_ACT, vr::P1, vr::P2, vr::I, vr::X_JP] {
+            assert_eq!(a.get_real(value_reference).unwrap().to_bits(), b.get_real(value_reference).unwrap().to_bits());
+        }
+    }
+
+    #[test]
+    fn corrupted_or_foreign_states_are_rejected_and_leave_the_instance_unchanged() {
+        let mut fmu = initialised();
+        let bytes = fmu.serialize();
+        let before = fmu.get_real(vr::F_ACT).unwrap();
+        let mut truncated = bytes.clone();
+        truncated.truncate(bytes.len() - 3);
+        assert!(fmu.deserialize(&truncated).unwrap_err().contains("truncated"));
+        let mut foreign = bytes.clone();
+        foreign[0] ^= 0xff;
+        assert!(fmu.deserialize(&foreign).is_err());
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(fmu.deserialize(&longer).is_err());
+        assert_eq!(fmu.get_real(vr::F_ACT).unwrap(), before);
+    }
+
+    #[test]
+    fn outputs_before_initialisation_are_the_equilibrium() {
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.set_real(vr::V_DA, 2.5).unwrap();
+        let early = fmu.get_real(vr::F_ACT).unwrap();
+        fmu.exit_initialization().unwrap();
+        assert_eq!(early, fmu.get_real(vr::F_ACT).unwrap());
+        assert!(early > 10.0 && early < 112.0, "{early}");
+    }
+}
