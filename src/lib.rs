@@ -4,13 +4,18 @@
 //! * [`integrator`]: the error-controlled stiff integrator, independent of the physics;
 //! * [`simulation`]: stepping between communication points (FMU, CLI and tests share it);
 //! * [`fmi2`]: the generic FMI 2.0 Co-Simulation layer, which knows nothing of pneumatics;
+//! * [`fmu`]: the actuator behind that layer; [`fmu_exports`]: the exported `fmi2*` symbols;
 //! * [`variables`]: the table of FMU variables from which the model description comes.
 
 pub mod fmi2;
 pub mod fmu;
+pub mod fmu_exports;
 pub mod integrator;
 pub mod packaging;
 pub mod physics;
 pub mod scenario;
 pub mod simulation;
 pub mod variables;
+
+/// The model behind the exported FMI symbols in [`fmu_exports`].
+pub type ExportedModel = fmu::ActuatorFmu;

@@ -1,0 +1,171 @@
+//! One FMU instance: the model plus everything the layer keeps about it, and logging.
+
+use std::ffi::{CStr, CString};
+
+use super::model::CoSimModel;
+use super::state::State;
+use super::types::*;
+
+/// Marks a live [`Instance`]; cleared by `fmi2FreeInstance`.
+pub const INSTANCE_MAGIC: u64 = 0x4649_4D32_494E_5354; // "FIM2INST"
+
+/// Log categories the layer itself uses.
+pub const CAT_ERROR: &str = "logStatusError";
+pub const CAT_FATAL: &str = "logStatusFatal";
+pub const CAT_DISCARD: &str = "logStatusDiscard";
+pub const CAT_WARNING: &str = "logStatusWarning";
+pub const CAT_CALLS: &str = "logCalls";
+
+/// An FMU instance. `fmi2Component` points to one of these (boxed).
+///
+/// `#[repr(C)]` with `magic` first, so the magic number sits at offset 0 whatever `M`
+/// is, and can be checked through a pointer before the instance is otherwise used.
+#[repr(C)]
+pub struct Instance<M: CoSimModel> {
+    magic: u64,
+    pub model: M,
+    pub instance_name: String,
+    instance_name_c: CString,
+    pub logger: fmi2CallbackLogger,
+    pub component_environment: fmi2ComponentEnvironment,
+    /// The last `loggingOn` given to `fmi2Instantiate` or `fmi2SetDebugLogging`.
+    pub logging_on: bool,
+    /// One flag per entry of `M::info().log_categories`.
+    pub categories_enabled: Vec<bool>,
+    pub state: State,
+    /// Status and time of the last `fmi2DoStep` that did not complete (fmi2Discard).
+    pub last_successful_time: Option<f64>,
+    /// The text of the last message logged with fmi2Error or fmi2Fatal.
+    pub last_error: Option<String>,
+    /// Every message that passed the filter (status, category, text); only in tests.
+    #[cfg(test)]
+    pub captured: Vec<(fmi2Status, String, String)>,
+}
+
+impl<M: CoSimModel> Instance<M> {
+    pub fn new(
+        model: M,
+        instance_name: &str,
+        callbacks: Option<&fmi2CallbackFunctions>,
+        logging_on: bool,
+    ) -> Self {
+        let n = M::info().log_categories.len();
+        Instance {
+            magic: INSTANCE_MAGIC,
+            model,
+            instance_name: instance_name.to_owned(),
+            instance_name_c: to_cstring(instance_name),
+            logger: callbacks.and_then(|c| c.logger),
+            component_environment: callbacks
+                .map_or(std::ptr::null_mut(), |c| c.componentEnvironment),
+            logging_on,
+            categories_enabled: vec![logging_on; n],
+            state: State::Instantiated,
+            last_successful_time: None,
+            last_error: None,
+            #[cfg(test)]
+            captured: Vec::new(),
+        }
+    }
+
+    /// Whether `c` points to a live instance (magic number intact).
+    ///
+    /// # Safety
+    /// `c` must be null or point to at least 8 readable bytes. A pointer to an instance
+    /// that was already freed is undefined behaviour to read; in practice the allocator
+    /// has reused or overwritten the first word, so the check catches a double
+    /// `fmi2FreeInstance` or a use after free in the common case, not always.
+    pub unsafe fn is_live(c: fmi2Component) -> bool {
+        !c.is_null() && std::ptr::read_volatile(c as *const u64) == INSTANCE_MAGIC
+    }
+
+    /// Clear the magic number (just before the instance is dropped).
+    pub fn kill(&mut self) {
+        // volatile so the store is not optimised away before the deallocation
+        unsafe { std::ptr::write_volatile(&mut self.magic, 0) };
+    }
+
+    /// Whether a message with this status and category passes the filter: fmi2Discard,
+    /// fmi2Error and fmi2Fatal always pass; others need logging on for their category
+    /// (a category the model does not declare follows the global `logging_on`).
+    pub fn should_log(&self, status: fmi2Status, category: &str) -> bool {
+        if status >= fmi2Discard {
+            return true;
+        }
+        match M::info()
+            .log_categories
+            .iter()
+            .position(|(name, _)| *name == category)
+        {
+            Some(i) => self.categories_enabled[i],
+            None => self.logging_on,
+        }
+    }
+
+    /// Log through the importer's logger (if any) after filtering; errors are remembered
+    /// in `last_error`.
+    pub fn log(&mut self, status: fmi2Status, category: &str, message: &str) {
+        if status >= fmi2Error {
+            self.last_error = Some(message.to_owned());
+        }
+        if !self.should_log(status, category) {
+            return;
+        }
+        #[cfg(test)]
+        self.captured
+            .push((status, category.to_owned(), message.to_owned()));
+        // SAFETY: the logger and environment come from the importer's callbacks.
+        unsafe {
+            call_logger(
+                self.logger,
+                self.component_environment,
+                &self.instance_name_c,
+                status,
+                category,
+                message,
+            )
+        };
+    }
+
+    pub fn log_error(&mut self, message: &str) {
+        self.log(fmi2Error, CAT_ERROR, message);
+    }
+
+    /// Log an error and return fmi2Error.
+    pub fn error(&mut self, message: impl AsRef<str>) -> fmi2Status {
+        self.log_error(message.as_ref());
+        fmi2Error
+    }
+}
+
+/// A `CString` from arbitrary text (interior NULs become U+FFFD).
+pub fn to_cstring(s: &str) -> CString {
+    CString::new(s.replace('\0', "\u{FFFD}")).expect("no interior NUL left")
+}
+
+/// Call an importer's variadic logger as `logger(env, name, status, category, "%s", message)`.
+/// The message is always passed as the argument of a `"%s"` format, never as the format.
+///
+/// # Safety
+/// `logger` and `env` must be what the importer passed in `fmi2CallbackFunctions`.
+pub unsafe fn call_logger(
+    logger: fmi2CallbackLogger,
+    env: fmi2ComponentEnvironment,
+    instance_name: &CStr,
+    status: fmi2Status,
+    category: &str,
+    message: &str,
+) {
+    if let Some(logger) = logger {
+        let category = to_cstring(category);
+        let message = to_cstring(message);
+        logger(
+            env,
+            instance_name.as_ptr(),
+            status,
+            category.as_ptr(),
+            c"%s".as_ptr(),
+            message.as_ptr(),
+        );
+    }
+}
