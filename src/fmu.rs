@@ -68,7 +68,14 @@ impl ActuatorFmu {
             let mut state = crate::simulation::equilibrium_of_electromechanics(&model, self.v_da);
             state[index::P1] = self.p1_start;
             state[index::P2] = self.p2_start;
-            Simulation::from_state(model, state, self.v_da, self.x_s, self.start_time, self.tolerance)
+            Simulation::from_state(
+                model,
+                state,
+                self.v_da,
+                self.x_s,
+                self.start_time,
+                self.tolerance,
+            )
         };
         simulation.set_command_rate(self.v_da_rate)?;
         simulation.set_stopper_rate(self.x_s_rate)?;
@@ -152,7 +159,10 @@ impl CoSimModel for ActuatorFmu {
             },
             vr::P1_START | vr::P2_START => {
                 if !(value.is_finite() && value > 0.0) {
-                    return Err(format!("{} = {value} Pa is invalid: must be finite and > 0", variable_name(value_reference)));
+                    return Err(format!(
+                        "{} = {value} Pa is invalid: must be finite and > 0",
+                        variable_name(value_reference)
+                    ));
                 }
                 if value_reference == vr::P1_START {
                     self.p1_start = value;
@@ -168,7 +178,9 @@ impl CoSimModel for ActuatorFmu {
     fn get_boolean(&self, value_reference: u32) -> Result<bool, String> {
         match value_reference {
             vr::START_AT_EQUILIBRIUM => Ok(self.start_at_equilibrium),
-            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
+            _ => Err(format!(
+                "no Boolean variable with value reference {value_reference}"
+            )),
         }
     }
 
@@ -178,11 +190,18 @@ impl CoSimModel for ActuatorFmu {
                 self.start_at_equilibrium = value;
                 Ok(())
             }
-            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
+            _ => Err(format!(
+                "no Boolean variable with value reference {value_reference}"
+            )),
         }
     }
 
-    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64, _stop_time: Option<f64>) -> Result<(), String> {
+    fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        _stop_time: Option<f64>,
+    ) -> Result<(), String> {
         if let Some(t) = tolerance {
             if !(t.is_finite() && t > 0.0 && t < 1.0) {
                 return Err(format!("tolerance = {t} is invalid: must be in (0, 1)"));
@@ -191,7 +210,9 @@ impl CoSimModel for ActuatorFmu {
             self.tolerance = t.max(1e-12);
         }
         if !start_time.is_finite() {
-            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
+            return Err(format!(
+                "startTime = {start_time} s is invalid: must be finite"
+            ));
         }
         self.start_time = start_time;
         Ok(())
@@ -202,7 +223,12 @@ impl CoSimModel for ActuatorFmu {
         Ok(())
     }
 
-    fn set_real_input_derivative(&mut self, value_reference: u32, order: i32, value: f64) -> Result<(), String> {
+    fn set_real_input_derivative(
+        &mut self,
+        value_reference: u32,
+        order: i32,
+        value: f64,
+    ) -> Result<(), String> {
         if order != 1 {
             return Err(format!(
                 "input derivative of order {order} for {} is not supported: only order 1",
@@ -235,7 +261,10 @@ impl CoSimModel for ActuatorFmu {
             .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
         simulation.step(step_size).map_err(|failure| match failure {
             StepFailure::InvalidRequest(message) => StepError::Error(message),
-            StepFailure::Integration { message, time } => StepError::Discard { message, last_successful_time: time },
+            StepFailure::Integration { message, time } => StepError::Discard {
+                message,
+                last_successful_time: time,
+            },
         })
     }
 
@@ -251,7 +280,16 @@ impl CoSimModel for ActuatorFmu {
         for &value_reference in Parameters::VALUE_REFERENCES {
             w.f64(self.params.get(value_reference).unwrap_or(f64::NAN));
         }
-        for v in [self.v_da, self.x_s, self.v_da_rate, self.x_s_rate, self.p1_start, self.p2_start, self.tolerance, self.start_time] {
+        for v in [
+            self.v_da,
+            self.x_s,
+            self.v_da_rate,
+            self.x_s_rate,
+            self.p1_start,
+            self.p2_start,
+            self.tolerance,
+            self.start_time,
+        ] {
             w.f64(v);
         }
         w.u32(self.start_at_equilibrium as u32);
@@ -259,14 +297,29 @@ impl CoSimModel for ActuatorFmu {
             None => w.u32(0),
             Some(s) => {
                 w.u32(1);
-                for v in [s.time, s.v_da, s.x_s, s.v_da_rate, s.x_s_rate, s.relative_tolerance, s.integrator.next_step, s.integrator.max_step] {
+                for v in [
+                    s.time,
+                    s.v_da,
+                    s.x_s,
+                    s.v_da_rate,
+                    s.x_s_rate,
+                    s.relative_tolerance,
+                    s.integrator.next_step,
+                    s.integrator.max_step,
+                ] {
                     w.f64(v);
                 }
                 for k in 0..N_STATES {
                     w.f64(s.state[k]);
                 }
                 let st = &s.statistics;
-                for v in [st.steps, st.rejected, st.rhs_evaluations, st.jacobians, st.newton_failures] {
+                for v in [
+                    st.steps,
+                    st.rejected,
+                    st.rhs_evaluations,
+                    st.jacobians,
+                    st.newton_failures,
+                ] {
                     w.u64(v);
                 }
             }
@@ -305,7 +358,8 @@ impl CoSimModel for ActuatorFmu {
         restored.start_at_equilibrium = r.u32()? != 0;
         if r.u32()? == 1 {
             let model = Actuator::new(restored.params.clone())?;
-            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step] = [(); 8].map(|_| r.f64()).map(|v| v.unwrap_or(f64::NAN));
+            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step] =
+                [(); 8].map(|_| r.f64()).map(|v| v.unwrap_or(f64::NAN));
             let mut state = State::zeros();
             for k in 0..N_STATES {
                 state[k] = r.f64()?;
@@ -321,7 +375,9 @@ impl CoSimModel for ActuatorFmu {
             st.rhs_evaluations = r.u64()?;
             st.jacobians = r.u64()?;
             st.newton_failures = r.u64()?;
-            let finite = [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step].iter().all(|v| v.is_finite())
+            let finite = [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step]
+                .iter()
+                .all(|v| v.is_finite())
                 && state.iter().all(|v| v.is_finite());
             if !finite {
                 return Err("the state holds non-finite values".to_string());
@@ -330,7 +386,10 @@ impl CoSimModel for ActuatorFmu {
             restored.simulation = Some(simulation);
         }
         if r.at != bytes.len() {
-            return Err(format!("{} unexpected bytes after the state", bytes.len() - r.at));
+            return Err(format!(
+                "{} unexpected bytes after the state",
+                bytes.len() - r.at
+            ));
         }
         *self = restored;
         Ok(())
@@ -369,28 +428,43 @@ struct ByteReader<'a> {
 
 impl<'a> ByteReader<'a> {
     fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len()).ok_or_else(|| {
-            format!("the state is truncated: {} bytes, needed more than {}", self.bytes.len(), self.at)
-        })?;
+        let end = self
+            .at
+            .checked_add(n)
+            .filter(|&e| e <= self.bytes.len())
+            .ok_or_else(|| {
+                format!(
+                    "the state is truncated: {} bytes, needed more than {}",
+                    self.bytes.len(),
+                    self.at
+                )
+            })?;
         let slice = &self.bytes[self.at..end];
         self.at = end;
         Ok(slice)
     }
     fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
     }
     fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
     }
     fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
     }
     fn string(&mut self) -> Result<String, String> {
         let n = self.u32()? as usize;
         if n > 64 {
             return Err("the state's version string is implausibly long".to_string());
         }
-        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| "the state's version string is not UTF-8".to_string())
+        String::from_utf8(self.take(n)?.to_vec())
+            .map_err(|_| "the state's version string is not UTF-8".to_string())
     }
 }
 
@@ -418,7 +492,10 @@ mod tests {
             fmu.do_step(0.05, 0.05).unwrap();
         }
         for value_reference in [vr::F_ACT, vr::P1, vr::P2, vr::I, vr::X_JP] {
-            assert_eq!(a.get_real(value_reference).unwrap().to_bits(), b.get_real(value_reference).unwrap().to_bits());
+            assert_eq!(
+                a.get_real(value_reference).unwrap().to_bits(),
+                b.get_real(value_reference).unwrap().to_bits()
+            );
         }
     }
 
@@ -429,7 +506,10 @@ mod tests {
         let before = fmu.get_real(vr::F_ACT).unwrap();
         let mut truncated = bytes.clone();
         truncated.truncate(bytes.len() - 3);
-        assert!(fmu.deserialize(&truncated).unwrap_err().contains("truncated"));
+        assert!(fmu
+            .deserialize(&truncated)
+            .unwrap_err()
+            .contains("truncated"));
         let mut foreign = bytes.clone();
         foreign[0] ^= 0xff;
         assert!(fmu.deserialize(&foreign).is_err());

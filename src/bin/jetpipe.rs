@@ -12,7 +12,11 @@ use jetpipe::scenario;
 use jetpipe::simulation::{Simulation, DEFAULT_RELATIVE_TOLERANCE};
 
 #[derive(Parser)]
-#[command(name = "jetpipe", version, about = "Jet-pipe electropneumatic actuator (Henri 1994) as an FMI 2.0 FMU")]
+#[command(
+    name = "jetpipe",
+    version,
+    about = "Jet-pipe electropneumatic actuator (Henri 1994) as an FMI 2.0 FMU"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -71,13 +75,20 @@ fn run(cli: Cli) -> Result<(), String> {
             print!("{}", jetpipe::packaging::actuator_model_description());
             Ok(())
         }
-        Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
+        Command::Simulate {
+            step,
+            tolerance,
+            csv,
+        } => simulate(step, tolerance, csv),
     }
 }
 
 fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), String> {
     if !(step.is_finite() && step > 0.0 && step <= scenario::SAMPLE_PERIOD) {
-        return Err(format!("--step {step} is invalid: must be in (0, {}] s", scenario::SAMPLE_PERIOD));
+        return Err(format!(
+            "--step {step} is invalid: must be in (0, {}] s",
+            scenario::SAMPLE_PERIOD
+        ));
     }
     let substeps = (scenario::SAMPLE_PERIOD / step).round().max(1.0) as usize;
     let model = Actuator::new(Parameters::default())?;
@@ -90,17 +101,26 @@ fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), Strin
         sim.set_command(v)?;
         sim.set_stopper(x)?;
         for _ in 0..substeps {
-            sim.step(scenario::SAMPLE_PERIOD / substeps as f64).map_err(|e| format!("{e:?}"))?;
+            sim.step(scenario::SAMPLE_PERIOD / substeps as f64)
+                .map_err(|e| format!("{e:?}"))?;
         }
         rows.push((sim.time, sim.outputs()));
     }
     let elapsed = started.elapsed().as_secs_f64();
     let force = rows.iter().map(|r| r.1.f_act);
-    let (f_min, f_max) = force.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f), b.max(f)));
+    let (f_min, f_max) = force.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
+        (a.min(f), b.max(f))
+    });
     let last = rows.last().expect("at least the initial row").1;
     let st = sim.statistics;
-    println!("standard scenario: {} s, communication step {step} s, relative tolerance {tolerance:e}", scenario::DURATION);
-    println!("  F_act  min {f_min:.4} N  max {f_max:.4} N  final {:.6} N", last.f_act);
+    println!(
+        "standard scenario: {} s, communication step {step} s, relative tolerance {tolerance:e}",
+        scenario::DURATION
+    );
+    println!(
+        "  F_act  min {f_min:.4} N  max {f_max:.4} N  final {:.6} N",
+        last.f_act
+    );
     println!("  P1 final {:.1} Pa   P2 final {:.1} Pa", last.p1, last.p2);
     println!(
         "  work: {} steps ({} rejected), {} right-hand sides, {} Jacobians; {:.1} ms CPU ({:.0}x real time)",
@@ -114,7 +134,10 @@ fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), Strin
     if let Some(path) = csv {
         let mut text = String::from("time_s,F_act_N,P1_Pa,P2_Pa,i_A,x_jp_m\n");
         for (t, y) in &rows {
-            text.push_str(&format!("{t},{},{},{},{},{}\n", y.f_act, y.p1, y.p2, y.current, y.x_jp));
+            text.push_str(&format!(
+                "{t},{},{},{},{},{}\n",
+                y.f_act, y.p1, y.p2, y.current, y.x_jp
+            ));
         }
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         println!("  wrote {}", path.display());
