@@ -9,3 +9,5 @@ pub mod model_description;
 pub mod state;
 pub mod testing;
 pub mod types;
+#[cfg(test)]
+mod tests;
