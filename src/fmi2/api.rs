@@ -71,7 +71,12 @@ unsafe fn guarded<M: CoSimModel>(
         if !f.allowed_in(inst.state) {
             return inst.error(illegal_call_message(f, inst.state));
         }
-        if inst.should_log(fmi2OK, CAT_CALLS) {
+        // call tracing only for models that declare the "logCalls" category
+        let declared = M::info()
+            .log_categories
+            .iter()
+            .any(|(n, _)| *n == CAT_CALLS);
+        if declared && inst.should_log(fmi2OK, CAT_CALLS) {
             inst.log(fmi2OK, CAT_CALLS, f.name());
         }
         body(inst)

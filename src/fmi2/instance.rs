@@ -33,7 +33,8 @@ pub struct Instance<M: CoSimModel> {
     /// One flag per entry of `M::info().log_categories`.
     pub categories_enabled: Vec<bool>,
     pub state: State,
-    /// Status and time of the last `fmi2DoStep` that did not complete (fmi2Discard).
+    /// `last_successful_time` of the last `fmi2DoStep` that returned fmi2Discard (the
+    /// model's `time()` is what `fmi2GetRealStatus` reports).
     pub last_successful_time: Option<f64>,
     /// The text of the last message logged with fmi2Error or fmi2Fatal.
     pub last_error: Option<String>,

@@ -1,5 +1,38 @@
 //! A generic FMI 2.0 Co-Simulation layer: C ABI, state machine, logging, FMU state.
 //! It knows nothing about the model behind it: see [`model::CoSimModel`].
+//!
+//! # Using it
+//! * Implement [`model::CoSimModel`] (variable table in a [`model::ModelInfo`]).
+//! * Point `crate::ExportedModel` (in `lib.rs`) at the type: the literal C symbols in
+//!   `crate::fmu_exports` forward to [`api`] instantiated for it.
+//! * Write `modelDescription.xml` with
+//!   [`model_description::model_description_xml`]`(M::info())` (panics on a broken
+//!   table; [`model_description::try_model_description_xml`] returns the problems).
+//!
+//! # Modules
+//! * [`types`]: the C types of the FMI 2.0 headers.
+//! * [`state`]: the state machine and the table of legal calls per state.
+//! * [`instance`]: one FMU instance, logging (always `"%s"` + the text; fmi2Discard,
+//!   fmi2Error and fmi2Fatal are always passed to the logger, other statuses only when
+//!   logging is on for their category).
+//! * [`api`]: one generic function per FMI call (argument checks, `catch_unwind`).
+//! * [`fmu_state`]: FMU-state snapshots and their checksummed byte format.
+//! * [`model_description`]: the XML generator and table validation.
+//! * [`testing`]: a dummy first-order-lag model for tests.
+//!
+//! # Known limits
+//! * A freed instance or FMU state is detected by a cleared magic number at offset 0.
+//!   Reading freed memory is undefined behaviour; in practice the allocator overwrites
+//!   that word, so a double `fmi2FreeInstance` or a use after free is an fmi2Error in
+//!   the common case, not always (e.g. if the memory was reused for a new instance).
+//! * Only synchronous stepping: `fmi2CancelStep` is always an illegal call, the
+//!   `stepInProgress` state does not exist, `fmi2GetStatus` answers fmi2Discard.
+//! * After a panic the instance is `fatal`; only `fmi2FreeInstance` is accepted. Other
+//!   instances are unaffected (there is no shared state). The default Rust panic hook
+//!   still prints the panic to stderr.
+//! * Argument and model errors return fmi2Error but do not move the instance to the
+//!   `error` state (the model contract says nothing was changed); a multi-value setter
+//!   stops at the first value the model rejects, earlier values stay set.
 
 pub mod api;
 pub mod fmu_state;
@@ -9,3 +42,6 @@ pub mod model_description;
 pub mod state;
 pub mod testing;
 pub mod types;
+
+#[cfg(test)]
+mod tests;

@@ -20,6 +20,7 @@ pub const VR_FROZEN: u32 = 13;
 /// Setting `u` to this value panics (to test that panics are caught).
 pub const PANIC_VALUE: f64 = -12345.678;
 
+#[allow(clippy::too_many_arguments)]
 const fn var(
     name: &'static str,
     value_reference: u32,
