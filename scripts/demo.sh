@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Build the FMU and simulate the standard scenario through FMPy:
+# prints a summary and writes dist/standard_scenario.csv and dist/standard_scenario.png.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+run() {
+    echo
+    echo "==> $*"
+    "$@"
+}
+
+run cargo run --release --bin jetpipe -- package
+run bash scripts/venv.sh
+run .venv/bin/python fmu_tests/run_standard_scenario.py dist/JetPipeActuator.fmu

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The project's test command: Rust unit tests, FMU packaging, then the FMPy/C test suite
+# in fmu_tests/ against dist/JetPipeActuator.fmu. Exits non-zero on the first failure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+run() {
+    echo
+    echo "==> $*"
+    "$@"
+}
+
+run cargo test --release
+run cargo run --release --bin jetpipe -- package
+if [ ! -f dist/JetPipeActuator.fmu ]; then
+    echo "test.sh: dist/JetPipeActuator.fmu was not written" >&2
+    exit 1
+fi
+run bash scripts/venv.sh
+run .venv/bin/python -m pytest fmu_tests -q
+echo
+echo "==> all tests passed"
