@@ -68,14 +68,7 @@ impl ActuatorFmu {
             let mut state = crate::simulation::equilibrium_of_electromechanics(&model, self.v_da);
             state[index::P1] = self.p1_start;
             state[index::P2] = self.p2_start;
-            Simulation::from_state(
-                model,
-                state,
-                self.v_da,
-                self.x_s,
-                self.start_time,
-                self.tolerance,
-            )
+            Simulation::from_state(model, state, self.v_da, self.x_s, self.start_time, self.tolerance)
         };
         simulation.set_command_rate(self.v_da_rate)?;
         simulation.set_stopper_rate(self.x_s_rate)?;
@@ -178,9 +171,7 @@ impl CoSimModel for ActuatorFmu {
     fn get_boolean(&self, value_reference: u32) -> Result<bool, String> {
         match value_reference {
             vr::START_AT_EQUILIBRIUM => Ok(self.start_at_equilibrium),
-            _ => Err(format!(
-                "no Boolean variable with value reference {value_reference}"
-            )),
+            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
         }
     }
 
@@ -190,9 +181,7 @@ impl CoSimModel for ActuatorFmu {
                 self.start_at_equilibrium = value;
                 Ok(())
             }
-            _ => Err(format!(
-                "no Boolean variable with value reference {value_reference}"
-            )),
+            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
         }
     }
 
@@ -210,9 +199,7 @@ impl CoSimModel for ActuatorFmu {
             self.tolerance = t.max(1e-12);
         }
         if !start_time.is_finite() {
-            return Err(format!(
-                "startTime = {start_time} s is invalid: must be finite"
-            ));
+            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
         }
         self.start_time = start_time;
         Ok(())
@@ -223,12 +210,7 @@ impl CoSimModel for ActuatorFmu {
         Ok(())
     }
 
-    fn set_real_input_derivative(
-        &mut self,
-        value_reference: u32,
-        order: i32,
-        value: f64,
-    ) -> Result<(), String> {
+    fn set_real_input_derivative(&mut self, value_reference: u32, order: i32, value: f64) -> Result<(), String> {
         if order != 1 {
             return Err(format!(
                 "input derivative of order {order} for {} is not supported: only order 1",
@@ -334,7 +316,9 @@ impl CoSimModel for ActuatorFmu {
         }
         let format = r.u32()?;
         if format != STATE_FORMAT_VERSION {
-            return Err(format!("state format version {format} is not supported (this model reads version {STATE_FORMAT_VERSION})"));
+            return Err(format!(
+                "state format version {format} is not supported (this model reads version {STATE_FORMAT_VERSION})"
+            ));
         }
         let version = r.string()?;
         if version != env!("CARGO_PKG_VERSION") {
@@ -386,10 +370,7 @@ impl CoSimModel for ActuatorFmu {
             restored.simulation = Some(simulation);
         }
         if r.at != bytes.len() {
-            return Err(format!(
-                "{} unexpected bytes after the state",
-                bytes.len() - r.at
-            ));
+            return Err(format!("{} unexpected bytes after the state", bytes.len() - r.at));
         }
         *self = restored;
         Ok(())
@@ -444,27 +425,20 @@ impl<'a> ByteReader<'a> {
         Ok(slice)
     }
     fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(
-            self.take(4)?.try_into().expect("4 bytes"),
-        ))
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
     }
     fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(
-            self.take(8)?.try_into().expect("8 bytes"),
-        ))
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
     }
     fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(
-            self.take(8)?.try_into().expect("8 bytes"),
-        ))
+        Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
     }
     fn string(&mut self) -> Result<String, String> {
         let n = self.u32()? as usize;
         if n > 64 {
             return Err("the state's version string is implausibly long".to_string());
         }
-        String::from_utf8(self.take(n)?.to_vec())
-            .map_err(|_| "the state's version string is not UTF-8".to_string())
+        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| "the state's version string is not UTF-8".to_string())
     }
 }
 
@@ -506,10 +480,7 @@ mod tests {
         let before = fmu.get_real(vr::F_ACT).unwrap();
         let mut truncated = bytes.clone();
         truncated.truncate(bytes.len() - 3);
-        assert!(fmu
-            .deserialize(&truncated)
-            .unwrap_err()
-            .contains("truncated"));
+        assert!(fmu.deserialize(&truncated).unwrap_err().contains("truncated"));
         let mut foreign = bytes.clone();
         foreign[0] ^= 0xff;
         assert!(fmu.deserialize(&foreign).is_err());

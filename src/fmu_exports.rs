@@ -5,8 +5,8 @@
 
 use crate::fmi2::api;
 use crate::fmi2::types::{
-    fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer,
-    fmi2Real, fmi2Status, fmi2StatusKind, fmi2String, fmi2Type, fmi2ValueReference,
+    fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status,
+    fmi2StatusKind, fmi2String, fmi2Type, fmi2ValueReference,
 };
 use crate::ExportedModel;
 use std::os::raw::c_char;
@@ -68,14 +68,7 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     stopTimeDefined: fmi2Boolean,
     stopTime: fmi2Real,
 ) -> fmi2Status {
-    api::setup_experiment::<ExportedModel>(
-        c,
-        toleranceDefined,
-        tolerance,
-        startTime,
-        stopTimeDefined,
-        stopTime,
-    )
+    api::setup_experiment::<ExportedModel>(c, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime)
 }
 
 #[no_mangle]
@@ -179,10 +172,7 @@ pub unsafe extern "C" fn fmi2SetString(
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
+pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
     api::get_fmu_state::<ExportedModel>(c, FMUstate)
 }
 
@@ -192,10 +182,7 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstat
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2FreeFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
+pub unsafe extern "C" fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
     api::free_fmu_state::<ExportedModel>(c, FMUstate)
 }
 
@@ -238,15 +225,7 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     dvKnown: *const fmi2Real,
     dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
-    api::get_directional_derivative::<ExportedModel>(
-        c,
-        vUnknown_ref,
-        nUnknown,
-        vKnown_ref,
-        nKnown,
-        dvKnown,
-        dvUnknown,
-    )
+    api::get_directional_derivative::<ExportedModel>(c, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown)
 }
 
 // ---- Co-Simulation functions ---------------------------------------------------------
@@ -294,20 +273,12 @@ pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetStatus(
-    c: fmi2Component,
-    s: fmi2StatusKind,
-    value: *mut fmi2Status,
-) -> fmi2Status {
+pub unsafe extern "C" fn fmi2GetStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Status) -> fmi2Status {
     api::get_status::<ExportedModel>(c, s, value)
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetRealStatus(
-    c: fmi2Component,
-    s: fmi2StatusKind,
-    value: *mut fmi2Real,
-) -> fmi2Status {
+pub unsafe extern "C" fn fmi2GetRealStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Real) -> fmi2Status {
     api::get_real_status::<ExportedModel>(c, s, value)
 }
 

@@ -158,11 +158,7 @@ impl Sdirk4 {
                     stats.steps += 1;
                     t = if final_step { t1 } else { t + h_try };
                     y = y_new;
-                    let mut factor = if error == 0.0 {
-                        5.0
-                    } else {
-                        0.9 * error.powf(-0.25)
-                    };
+                    let mut factor = if error == 0.0 { 5.0 } else { 0.9 * error.powf(-0.25) };
                     factor = factor.clamp(0.2, 5.0);
                     if last_rejected {
                         factor = factor.min(1.0);
@@ -307,15 +303,9 @@ mod tests {
             (&|i| aac(i), 1.0 / 24.0),
         ];
         for (k, (g, value)) in conditions.iter().enumerate() {
-            assert!(
-                (sum(&b, *g) - value).abs() < 1e-13,
-                "order condition {k} for b"
-            );
+            assert!((sum(&b, *g) - value).abs() < 1e-13, "order condition {k} for b");
             if k < 4 {
-                assert!(
-                    (sum(&B_HAT, *g) - value).abs() < 1e-13,
-                    "order condition {k} for b_hat"
-                );
+                assert!((sum(&B_HAT, *g) - value).abs() < 1e-13, "order condition {k} for b_hat");
             }
         }
     }

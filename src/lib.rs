@@ -11,6 +11,7 @@ pub mod fmi2;
 pub mod fmu;
 pub mod fmu_exports;
 pub mod integrator;
+pub mod linearization;
 pub mod packaging;
 pub mod physics;
 pub mod scenario;

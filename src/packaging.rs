@@ -72,24 +72,19 @@ pub fn write_fmu(out: &Path, library: &Path) -> Result<(), String> {
         )
     })?;
     if let Some(parent) = out.parent() {
-        std::fs::create_dir_all(parent)
-            .map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
+        std::fs::create_dir_all(parent).map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
     }
     // Write to a temporary file first so a failure never leaves half an FMU behind.
     let temporary = out.with_extension("fmu.partial");
     let result = (|| -> Result<(), Box<dyn std::error::Error>> {
         let file = std::fs::File::create(&temporary)?;
         let mut zip = zip::ZipWriter::new(file);
-        let options = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Deflated);
+        let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         zip.start_file("modelDescription.xml", options)?;
         zip.write_all(actuator_model_description().as_bytes())?;
         zip.add_directory("binaries/", options)?;
         zip.add_directory("binaries/linux64/", options)?;
-        zip.start_file(
-            format!("binaries/linux64/{}.so", MODEL_INFO.model_identifier),
-            options,
-        )?;
+        zip.start_file(format!("binaries/linux64/{}.so", MODEL_INFO.model_identifier), options)?;
         zip.write_all(&binary)?;
         zip.add_directory("documentation/", options)?;
         zip.start_file("documentation/index.html", options)?;
@@ -98,8 +93,7 @@ pub fn write_fmu(out: &Path, library: &Path) -> Result<(), String> {
         Ok(())
     })();
     match result {
-        Ok(()) => std::fs::rename(&temporary, out)
-            .map_err(|e| format!("cannot write {}: {e}", out.display())),
+        Ok(()) => std::fs::rename(&temporary, out).map_err(|e| format!("cannot write {}: {e}", out.display())),
         Err(e) => {
             let _ = std::fs::remove_file(&temporary);
             Err(format!("cannot write {}: {e}", out.display()))

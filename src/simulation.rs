@@ -83,25 +83,11 @@ impl Simulation {
         check_finite("v_DA", v_da, "V")?;
         model.params.check_stopper(x_s)?;
         let state = equilibrium(&model, v_da, x_s)?;
-        Ok(Self::from_state(
-            model,
-            state,
-            v_da,
-            x_s,
-            time,
-            relative_tolerance,
-        ))
+        Ok(Self::from_state(model, state, v_da, x_s, time, relative_tolerance))
     }
 
     /// A simulation from a given state.
-    pub fn from_state(
-        model: Actuator,
-        state: State,
-        v_da: f64,
-        x_s: f64,
-        time: f64,
-        relative_tolerance: f64,
-    ) -> Self {
+    pub fn from_state(model: Actuator, state: State, v_da: f64, x_s: f64, time: f64, relative_tolerance: f64) -> Self {
         Self {
             model,
             time,
@@ -133,10 +119,8 @@ impl Simulation {
             let gamma = self.model.params.gamma;
             let (v1_before, v2_before) = self.model.cylinder.volumes(self.x_s);
             let (v1_after, v2_after) = self.model.cylinder.volumes(x_s);
-            self.state[index::P1] =
-                pressure_after_volume_jump(gamma, self.state[index::P1], v1_before, v1_after);
-            self.state[index::P2] =
-                pressure_after_volume_jump(gamma, self.state[index::P2], v2_before, v2_after);
+            self.state[index::P1] = pressure_after_volume_jump(gamma, self.state[index::P1], v1_before, v1_after);
+            self.state[index::P2] = pressure_after_volume_jump(gamma, self.state[index::P2], v2_before, v2_after);
             self.x_s = x_s;
         }
         Ok(())
@@ -187,14 +171,10 @@ impl Simulation {
         };
         let tolerances = self.tolerances();
         let t_end = self.time + step;
-        match self.integrator.integrate(
-            &system,
-            self.time,
-            self.state,
-            t_end,
-            &tolerances,
-            &mut self.statistics,
-        ) {
+        match self
+            .integrator
+            .integrate(&system, self.time, self.state, t_end, &tolerances, &mut self.statistics)
+        {
             Ok(y) => {
                 self.state = y;
                 self.time = t_end;
@@ -223,9 +203,7 @@ fn check_finite(name: &str, value: f64, unit: &str) -> Result<(), String> {
     if value.is_finite() {
         Ok(())
     } else {
-        Err(format!(
-            "{name} = {value} {unit} is invalid: must be finite"
-        ))
+        Err(format!("{name} = {value} {unit} is invalid: must be finite"))
     }
 }
 
@@ -290,8 +268,7 @@ pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, Strin
         if r.amax() == 0.0 {
             break;
         }
-        let jac =
-            crate::integrator::finite_difference_jacobian(|q| rates(q[0], q[1]), &pressures, &r);
+        let jac = crate::integrator::finite_difference_jacobian(|q| rates(q[0], q[1]), &pressures, &r);
         let Some(delta) = jac.lu().solve(&(-r)) else {
             break;
         };
@@ -393,10 +370,7 @@ mod tests {
         let mut sim = Simulation::from_state(model.clone(), state, 2.5, 0.054, 0.0, 1e-8);
         let invariant = |s: &Simulation| {
             let (v1, v2) = s.model.cylinder.volumes(s.x_s);
-            (
-                s.state[index::P1] * v1.powf(1.4),
-                s.state[index::P2] * v2.powf(1.4),
-            )
+            (s.state[index::P1] * v1.powf(1.4), s.state[index::P2] * v2.powf(1.4))
         };
         let start = invariant(&sim);
         // Linear motion over a step (input derivative), then a jump, then back.
@@ -413,10 +387,7 @@ mod tests {
             );
         }
         sim.set_stopper(0.054).unwrap();
-        assert!(
-            (sim.state[index::P1] - 4e5).abs() < 1e-7 * 4e5
-                && (sim.state[index::P2] - 2e5).abs() < 1e-7 * 2e5
-        );
+        assert!((sim.state[index::P1] - 4e5).abs() < 1e-7 * 4e5 && (sim.state[index::P2] - 2e5).abs() < 1e-7 * 2e5);
     }
 
     #[test]
@@ -424,14 +395,9 @@ mod tests {
         let model = thesis_model();
         let command = |t: f64| 2.5 + 3.0 * (2.0 * std::f64::consts::PI * 0.3 * t).sin();
         let run = |substeps: usize| {
-            let mut sim = Simulation::at_equilibrium(
-                model.clone(),
-                command(0.0),
-                0.054,
-                0.0,
-                DEFAULT_RELATIVE_TOLERANCE,
-            )
-            .unwrap();
+            let mut sim =
+                Simulation::at_equilibrium(model.clone(), command(0.0), 0.054, 0.0, DEFAULT_RELATIVE_TOLERANCE)
+                    .unwrap();
             let mut forces = vec![];
             for k in 0..100 {
                 sim.set_command(command(0.01 * k as f64)).unwrap();
@@ -444,11 +410,7 @@ mod tests {
         };
         let coarse = run(1);
         let fine = run(100);
-        let worst = coarse
-            .iter()
-            .zip(&fine)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let worst = coarse.iter().zip(&fine).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(worst < 1e-4, "max |ΔF| = {worst} N");
     }
 

@@ -153,13 +153,7 @@ pub const UNITS: &[UnitDefinition] = &[
     },
 ];
 
-const fn input(
-    name: &'static str,
-    vr: u32,
-    unit: &'static str,
-    start: f64,
-    description: &'static str,
-) -> Variable {
+const fn input(name: &'static str, vr: u32, unit: &'static str, start: f64, description: &'static str) -> Variable {
     Variable {
         name,
         value_reference: vr,
@@ -174,12 +168,7 @@ const fn input(
     }
 }
 
-const fn output(
-    name: &'static str,
-    vr: u32,
-    unit: &'static str,
-    description: &'static str,
-) -> Variable {
+const fn output(name: &'static str, vr: u32, unit: &'static str, description: &'static str) -> Variable {
     Variable {
         name,
         value_reference: vr,
@@ -194,13 +183,7 @@ const fn output(
     }
 }
 
-const fn parameter(
-    name: &'static str,
-    vr: u32,
-    unit: &'static str,
-    start: f64,
-    description: &'static str,
-) -> Variable {
+const fn parameter(name: &'static str, vr: u32, unit: &'static str, start: f64, description: &'static str) -> Variable {
     Variable {
         name,
         value_reference: vr,
@@ -218,36 +201,113 @@ const fn parameter(
 /// Every variable of the FMU. Defaults: Table 3.1 of the thesis and MODEL.md.
 pub const VARIABLES: &[Variable] = &[
     input("v_DA", vr::V_DA, "V", 0.0, "D/A command voltage to the current driver"),
-    input("x_s", vr::X_S, "m", 0.054, "rod stopper position (valid while both chamber volumes are positive)"),
+    input(
+        "x_s",
+        vr::X_S,
+        "m",
+        0.054,
+        "rod stopper position (valid while both chamber volumes are positive)",
+    ),
     output("F_act", vr::F_ACT, "N", "actuator (tendon) force, (2.36)-(2.38)"),
     output("P1", vr::P1, "Pa", "absolute pressure of chamber 1 (charging side)"),
     output("P2", vr::P2, "Pa", "absolute pressure of chamber 2 (venting side)"),
     output("i", vr::I, "A", "coil current"),
-    output("x_jp", vr::X_JP, "m", "jet pipe tip position relative to rest, before the offset"),
-    parameter("P_s", vr::P_S, "Pa", 652_925.0, "supply pressure, absolute (551.6 kPa gauge)"),
+    output(
+        "x_jp",
+        vr::X_JP,
+        "m",
+        "jet pipe tip position relative to rest, before the offset",
+    ),
+    parameter(
+        "P_s",
+        vr::P_S,
+        "Pa",
+        652_925.0,
+        "supply pressure, absolute (551.6 kPa gauge)",
+    ),
     parameter("P_r", vr::P_R, "Pa", 101_325.0, "return pressure, absolute"),
     parameter("T", vr::T_GAS, "K", 293.15, "gas temperature, constant (2.6)"),
     parameter("gamma", vr::GAMMA, "1", 1.4, "isentropic exponent of air"),
     parameter("R_gas", vr::R_GAS, "J/(kg.K)", 287.0, "gas constant of air"),
     parameter("k_cd", vr::K_CD, "A/V", 0.04, "current driver gain (2.3)"),
     parameter("i_offset", vr::I_OFFSET, "A", 0.0, "current driver offset (2.3)"),
-    parameter("omega_cd", vr::OMEGA_CD, "rad/s", 7050.0, "current driver corner frequency (2.1)"),
+    parameter(
+        "omega_cd",
+        vr::OMEGA_CD,
+        "rad/s",
+        7050.0,
+        "current driver corner frequency (2.1)",
+    ),
     parameter("k_m", vr::K_M, "N/A", 1.946, "jet pipe motor constant (2.4)"),
-    parameter("omega_1", vr::OMEGA_1, "rad/s", 973.9, "jet pipe first-order corner (2.6)"),
-    parameter("omega_2", vr::OMEGA_2, "rad/s", 1856.7, "jet pipe natural frequency (2.6)"),
+    parameter(
+        "omega_1",
+        vr::OMEGA_1,
+        "rad/s",
+        973.9,
+        "jet pipe first-order corner (2.6)",
+    ),
+    parameter(
+        "omega_2",
+        vr::OMEGA_2,
+        "rad/s",
+        1856.7,
+        "jet pipe natural frequency (2.6)",
+    ),
     parameter("zeta_2", vr::ZETA_2, "1", 0.019, "jet pipe damping ratio (2.6)"),
-    parameter("x_jp_sat", vr::X_JP_SAT, "m", 0.5e-3, "saturation of the static jet pipe curve f3 (2.5)"),
-    parameter("F_jp_sat", vr::F_JP_SAT, "N", 0.45, "force scale of the static jet pipe curve f3 (2.5)"),
-    parameter("x_jp_offset", vr::X_JP_OFFSET, "m", 0.099e-3, "jet pipe offset from the receiver centre (2.7)"),
-    parameter("D_jp", vr::D_JP, "m", 0.9652e-3, "jet pipe exit and port diameter (2.5)"),
+    parameter(
+        "x_jp_sat",
+        vr::X_JP_SAT,
+        "m",
+        0.5e-3,
+        "saturation of the static jet pipe curve f3 (2.5)",
+    ),
+    parameter(
+        "F_jp_sat",
+        vr::F_JP_SAT,
+        "N",
+        0.45,
+        "force scale of the static jet pipe curve f3 (2.5)",
+    ),
+    parameter(
+        "x_jp_offset",
+        vr::X_JP_OFFSET,
+        "m",
+        0.099e-3,
+        "jet pipe offset from the receiver centre (2.7)",
+    ),
+    parameter(
+        "D_jp",
+        vr::D_JP,
+        "m",
+        0.9652e-3,
+        "jet pipe exit and port diameter (2.5)",
+    ),
     parameter("C_d", vr::C_D, "1", 0.696, "orifice discharge coefficient (2.18)"),
-    parameter("C_dm_A_lpp", vr::C_DM_A_LPP, "m2", -0.0475e-6, "leakage discharge slope times area (2.23)"),
-    parameter("C_db_A_lpp", vr::C_DB_A_LPP, "m2", 0.0971e-6, "leakage discharge offset times area (2.23)"),
+    parameter(
+        "C_dm_A_lpp",
+        vr::C_DM_A_LPP,
+        "m2",
+        -0.0475e-6,
+        "leakage discharge slope times area (2.23)",
+    ),
+    parameter(
+        "C_db_A_lpp",
+        vr::C_DB_A_LPP,
+        "m2",
+        0.0971e-6,
+        "leakage discharge offset times area (2.23)",
+    ),
     parameter("L_cyl", vr::L_CYL, "m", 78.0e-3, "cylinder length"),
     parameter("L_p", vr::L_P, "m", 8.0e-3, "piston length"),
     parameter("L_s", vr::L_S, "m", 7.0e-3, "stopper length"),
     parameter("L_sup", vr::L_SUP, "m", 11.0e-3, "support length"),
-    parameter("L_spring0", vr::L_SPRING0, "m", 69.1e-3, "unloaded spring length (2.37)"),
+    parameter(
+        "L_spring0",
+        vr::L_SPRING0,
+        "m",
+        69.1e-3,
+        "unloaded spring length (2.37)",
+    ),
     parameter("D_cyl", vr::D_CYL, "m", 15.875e-3, "cylinder bore"),
     parameter("k_spring", vr::K_SPRING, "N/m", 88.14, "spring rate (2.37)"),
     Variable {
@@ -262,6 +322,18 @@ pub const VARIABLES: &[Variable] = &[
         max: None,
         description: "initialise at the equilibrium of the initial inputs; if false, start from P1_start and P2_start",
     },
-    parameter("P1_start", vr::P1_START, "Pa", 101_325.0, "initial P1 when start_at_equilibrium is false"),
-    parameter("P2_start", vr::P2_START, "Pa", 101_325.0, "initial P2 when start_at_equilibrium is false"),
+    parameter(
+        "P1_start",
+        vr::P1_START,
+        "Pa",
+        101_325.0,
+        "initial P1 when start_at_equilibrium is false",
+    ),
+    parameter(
+        "P2_start",
+        vr::P2_START,
+        "Pa",
+        101_325.0,
+        "initial P2 when start_at_equilibrium is false",
+    ),
 ];

@@ -34,6 +34,18 @@ enum Command {
     },
     /// Print the model description generated from the variable table.
     ModelDescription,
+    /// Linearise at the equilibrium with the given force (§4.2.2): A, B, C, D, poles, zeros.
+    Linearize {
+        /// Actuator force of the operating point, N.
+        #[arg(long, default_value_t = 45.0)]
+        force: f64,
+        /// Stopper position of the operating point, m.
+        #[arg(long = "x-s", default_value_t = 0.054)]
+        x_s: f64,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Run the standard scenario in-process and print a summary.
     Simulate {
         /// Communication step in seconds.
@@ -63,9 +75,7 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::Package { out, library } => {
             let library = match library {
                 Some(path) => path,
-                None => std::env::current_exe()
-                    .map_err(|e| format!("cannot locate this executable: {e}"))?
-                    .with_file_name("libjetpipe.so"),
+                None => build_shared_library()?,
             };
             jetpipe::packaging::write_fmu(&out, &library)?;
             println!("wrote {}", out.display());
@@ -75,12 +85,68 @@ fn run(cli: Cli) -> Result<(), String> {
             print!("{}", jetpipe::packaging::actuator_model_description());
             Ok(())
         }
-        Command::Simulate {
-            step,
-            tolerance,
-            csv,
-        } => simulate(step, tolerance, csv),
+        Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
+        Command::Linearize { force, x_s, json } => linearize(force, x_s, json),
     }
+}
+
+/// `cargo run --bin jetpipe` builds the library as an rlib only; the FMU needs the cdylib,
+/// so build it (a no-op when it is up to date) with the same profile as this executable.
+fn build_shared_library() -> Result<PathBuf, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot locate this executable: {e}"))?;
+    let library = exe.with_file_name("libjetpipe.so");
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
+    if std::path::Path::new(manifest).is_file() {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
+        let mut command = std::process::Command::new(&cargo);
+        command.args(["build", "--lib", "--manifest-path", manifest]);
+        if !cfg!(debug_assertions) {
+            command.arg("--release");
+        }
+        // Put the library next to this executable, wherever the target directory is.
+        if let Some(target_dir) = exe.parent().and_then(|p| p.parent()) {
+            command.arg("--target-dir").arg(target_dir);
+        }
+        let status = command.status().map_err(|e| format!("cannot run {cargo}: {e}"))?;
+        if !status.success() {
+            return Err(format!("`{cargo} build --lib` failed ({status})"));
+        }
+    }
+    Ok(library)
+}
+
+fn linearize(force: f64, x_s: f64, json: bool) -> Result<(), String> {
+    if !force.is_finite() {
+        return Err(format!("--force {force} is invalid: must be finite"));
+    }
+    let model = Actuator::new(Parameters::default())?;
+    model.params.check_stopper(x_s)?;
+    let v = jetpipe::linearization::command_for_force(&model, force, x_s)?;
+    let lin = jetpipe::linearization::linearize(&model, v, x_s)?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&lin.to_json()).map_err(|e| e.to_string())?
+        );
+        return Ok(());
+    }
+    let op = &lin.operating_point;
+    println!(
+        "operating point: F_act = {:.4} N, x_s = {} m, v_DA = {:.6} V, i = {:.6} A, P1 = {:.0} Pa, P2 = {:.0} Pa",
+        op.f_act, op.x_s, op.v_da, op.current, op.p1, op.p2
+    );
+    println!("poles (rad/s):");
+    for p in &lin.poles {
+        println!("  {:12.4} {:+12.4}j", p.re, p.im);
+    }
+    println!("zeros (rad/s):");
+    for z in &lin.zeros {
+        println!("  {:12.4} {:+12.4}j", z.re, z.im);
+    }
+    if let Some(bw) = lin.bandwidth_hz() {
+        println!("open-loop -3 dB bandwidth of F_act/v_DA: {bw:.3} Hz");
+    }
+    Ok(())
 }
 
 fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), String> {
@@ -108,19 +174,14 @@ fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), Strin
     }
     let elapsed = started.elapsed().as_secs_f64();
     let force = rows.iter().map(|r| r.1.f_act);
-    let (f_min, f_max) = force.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
-        (a.min(f), b.max(f))
-    });
+    let (f_min, f_max) = force.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f), b.max(f)));
     let last = rows.last().expect("at least the initial row").1;
     let st = sim.statistics;
     println!(
         "standard scenario: {} s, communication step {step} s, relative tolerance {tolerance:e}",
         scenario::DURATION
     );
-    println!(
-        "  F_act  min {f_min:.4} N  max {f_max:.4} N  final {:.6} N",
-        last.f_act
-    );
+    println!("  F_act  min {f_min:.4} N  max {f_max:.4} N  final {:.6} N", last.f_act);
     println!("  P1 final {:.1} Pa   P2 final {:.1} Pa", last.p1, last.p2);
     println!(
         "  work: {} steps ({} rejected), {} right-hand sides, {} Jacobians; {:.1} ms CPU ({:.0}x real time)",
@@ -134,10 +195,7 @@ fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), Strin
     if let Some(path) = csv {
         let mut text = String::from("time_s,F_act_N,P1_Pa,P2_Pa,i_A,x_jp_m\n");
         for (t, y) in &rows {
-            text.push_str(&format!(
-                "{t},{},{},{},{},{}\n",
-                y.f_act, y.p1, y.p2, y.current, y.x_jp
-            ));
+            text.push_str(&format!("{t},{},{},{},{},{}\n", y.f_act, y.p1, y.p2, y.current, y.x_jp));
         }
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         println!("  wrote {}", path.display());

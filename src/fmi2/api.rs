@@ -51,7 +51,9 @@ fn drop_payload(payload: Box<dyn Any + Send>) {
 pub fn illegal_call_message(f: Function, s: State) -> String {
     let mut m = format!("{}: illegal call in state {}", f.name(), s.name());
     if f == Function::CancelStep {
-        m.push_str(" (fmi2CancelStep is only legal while an asynchronous fmi2DoStep is pending; this FMU steps synchronously)");
+        m.push_str(
+            " (fmi2CancelStep is only legal while an asynchronous fmi2DoStep is pending; this FMU steps synchronously)",
+        );
     }
     m
 }
@@ -72,10 +74,7 @@ unsafe fn guarded<M: CoSimModel>(
             return inst.error(illegal_call_message(f, inst.state));
         }
         // call tracing only for models that declare the "logCalls" category
-        let declared = M::info()
-            .log_categories
-            .iter()
-            .any(|(n, _)| *n == CAT_CALLS);
+        let declared = M::info().log_categories.iter().any(|(n, _)| *n == CAT_CALLS);
         if declared && inst.should_log(fmi2OK, CAT_CALLS) {
             inst.log(fmi2OK, CAT_CALLS, f.name());
         }
@@ -84,11 +83,7 @@ unsafe fn guarded<M: CoSimModel>(
     match result {
         Ok(status) => status,
         Err(payload) => {
-            let message = format!(
-                "{}: panic in the FMU: {}",
-                f.name(),
-                panic_message(&*payload)
-            );
+            let message = format!("{}: panic in the FMU: {}", f.name(), panic_message(&*payload));
             drop_payload(payload);
             if let Err(p) = catch_unwind(AssertUnwindSafe(|| {
                 let inst = &mut *(c as *mut Instance<M>);
@@ -162,16 +157,9 @@ fn variability_name(v: Variability) -> &'static str {
 }
 
 /// The variable with value reference `vr` and type `ty`, or a message naming the VR.
-pub fn lookup<M: CoSimModel>(
-    fname: &str,
-    vr: u32,
-    ty: VarType,
-) -> Result<&'static Variable, String> {
+pub fn lookup<M: CoSimModel>(fname: &str, vr: u32, ty: VarType) -> Result<&'static Variable, String> {
     let vars = M::info().variables;
-    if let Some(v) = vars
-        .iter()
-        .find(|v| v.value_reference == vr && v.var_type == ty)
-    {
+    if let Some(v) = vars.iter().find(|v| v.value_reference == vr && v.var_type == ty) {
         return Ok(v);
     }
     match vars.iter().find(|v| v.value_reference == vr) {
@@ -187,9 +175,7 @@ pub fn lookup<M: CoSimModel>(
 
 /// Whether `v` may be read in `state`: in `instantiated` only parameters and inputs.
 pub fn check_get(fname: &str, v: &Variable, state: State) -> Result<(), String> {
-    if state == State::Instantiated
-        && !matches!(v.causality, Causality::Parameter | Causality::Input)
-    {
+    if state == State::Instantiated && !matches!(v.causality, Causality::Parameter | Causality::Input) {
         return Err(format!(
             "{fname}: {} (value reference {}) is an {} and has no value in state {}",
             v.name,
@@ -215,9 +201,7 @@ pub fn check_set(fname: &str, v: &Variable, state: State) -> Result<(), String> 
                 causality_name(v.causality)
             ))
         }
-        (Causality::Parameter, Variability::Tunable) | (Causality::Input, _) => {
-            early || state == State::StepComplete
-        }
+        (Causality::Parameter, Variability::Tunable) | (Causality::Input, _) => early || state == State::StepComplete,
         (Causality::Parameter, _) => early,
     };
     if ok {
@@ -318,22 +302,12 @@ pub unsafe fn instantiate<M: CoSimModel>(
         Ok(c) => c,
         Err(payload) => {
             // nothing was allocated that survives; best effort to tell the importer
-            let message = format!(
-                "fmi2Instantiate: panic in the FMU: {}",
-                panic_message(&*payload)
-            );
+            let message = format!("fmi2Instantiate: panic in the FMU: {}", panic_message(&*payload));
             drop_payload(payload);
             if !functions.is_null() {
                 let _ = catch_unwind(AssertUnwindSafe(|| {
                     let cb = *functions;
-                    call_logger(
-                        cb.logger,
-                        cb.componentEnvironment,
-                        c"",
-                        fmi2Fatal,
-                        CAT_FATAL,
-                        &message,
-                    );
+                    call_logger(cb.logger, cb.componentEnvironment, c"", fmi2Fatal, CAT_FATAL, &message);
                 }));
             }
             std::ptr::null_mut()
@@ -432,9 +406,7 @@ pub unsafe fn setup_experiment<M: CoSimModel>(
         let stop = (stop_time_defined != 0).then_some(stop_time);
         if let Some(stop) = stop {
             if stop.is_nan() || stop < start_time {
-                return inst.error(format!(
-                    "{F}: stopTime = {stop} is before startTime = {start_time}"
-                ));
+                return inst.error(format!("{F}: stopTime = {stop} is before startTime = {start_time}"));
             }
         }
         let tol = (tolerance_defined != 0).then_some(tolerance);
@@ -525,8 +497,7 @@ unsafe fn get_values<M: CoSimModel, T>(
             Err(s) => return s,
         };
         for (&r, slot) in vrs.iter().zip(values.iter_mut()) {
-            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_get(fname, v, inst.state))
-            {
+            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_get(fname, v, inst.state)) {
                 return inst.error(m);
             }
             match read(&inst.model, r) {
@@ -559,8 +530,7 @@ unsafe fn set_values<M: CoSimModel, T: Copy>(
             Err(s) => return s,
         };
         for &r in vrs {
-            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_set(fname, v, inst.state))
-            {
+            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_set(fname, v, inst.state)) {
                 return inst.error(m);
             }
         }
@@ -581,15 +551,9 @@ pub unsafe fn get_real<M: CoSimModel>(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    get_values::<M, f64>(
-        c,
-        Function::GetReal,
-        VarType::Real,
-        vr,
-        nvr,
-        value,
-        |m, r| m.get_real(r),
-    )
+    get_values::<M, f64>(c, Function::GetReal, VarType::Real, vr, nvr, value, |m, r| {
+        m.get_real(r)
+    })
 }
 
 /// # Safety
@@ -600,15 +564,9 @@ pub unsafe fn get_integer<M: CoSimModel>(
     nvr: usize,
     value: *mut fmi2Integer,
 ) -> fmi2Status {
-    get_values::<M, fmi2Integer>(
-        c,
-        Function::GetInteger,
-        VarType::Integer,
-        vr,
-        nvr,
-        value,
-        |m, r| m.get_integer(r),
-    )
+    get_values::<M, fmi2Integer>(c, Function::GetInteger, VarType::Integer, vr, nvr, value, |m, r| {
+        m.get_integer(r)
+    })
 }
 
 /// # Safety
@@ -619,18 +577,9 @@ pub unsafe fn get_boolean<M: CoSimModel>(
     nvr: usize,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
-    get_values::<M, fmi2Boolean>(
-        c,
-        Function::GetBoolean,
-        VarType::Boolean,
-        vr,
-        nvr,
-        value,
-        |m, r| {
-            m.get_boolean(r)
-                .map(|b| if b { fmi2True } else { fmi2False })
-        },
-    )
+    get_values::<M, fmi2Boolean>(c, Function::GetBoolean, VarType::Boolean, vr, nvr, value, |m, r| {
+        m.get_boolean(r).map(|b| if b { fmi2True } else { fmi2False })
+    })
 }
 
 /// There are no String variables: `nvr == 0` is fine, anything else an error.
@@ -659,9 +608,7 @@ unsafe fn no_strings<M: CoSimModel, T>(
                         v.name,
                         type_name(v.var_type)
                     ),
-                    None => format!(
-                        "{fname}: unknown value reference {r} (this FMU has no String variables)"
-                    ),
+                    None => format!("{fname}: unknown value reference {r} (this FMU has no String variables)"),
                 };
                 inst.error(m)
             }
@@ -688,15 +635,9 @@ pub unsafe fn set_real<M: CoSimModel>(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    set_values::<M, f64>(
-        c,
-        Function::SetReal,
-        VarType::Real,
-        vr,
-        nvr,
-        value,
-        |m, r, x| m.set_real(r, x),
-    )
+    set_values::<M, f64>(c, Function::SetReal, VarType::Real, vr, nvr, value, |m, r, x| {
+        m.set_real(r, x)
+    })
 }
 
 /// # Safety
@@ -707,15 +648,9 @@ pub unsafe fn set_integer<M: CoSimModel>(
     nvr: usize,
     value: *const fmi2Integer,
 ) -> fmi2Status {
-    set_values::<M, fmi2Integer>(
-        c,
-        Function::SetInteger,
-        VarType::Integer,
-        vr,
-        nvr,
-        value,
-        |m, r, x| m.set_integer(r, x),
-    )
+    set_values::<M, fmi2Integer>(c, Function::SetInteger, VarType::Integer, vr, nvr, value, |m, r, x| {
+        m.set_integer(r, x)
+    })
 }
 
 /// # Safety
@@ -726,15 +661,9 @@ pub unsafe fn set_boolean<M: CoSimModel>(
     nvr: usize,
     value: *const fmi2Boolean,
 ) -> fmi2Status {
-    set_values::<M, fmi2Boolean>(
-        c,
-        Function::SetBoolean,
-        VarType::Boolean,
-        vr,
-        nvr,
-        value,
-        |m, r, x| m.set_boolean(r, x != fmi2False),
-    )
+    set_values::<M, fmi2Boolean>(c, Function::SetBoolean, VarType::Boolean, vr, nvr, value, |m, r, x| {
+        m.set_boolean(r, x != fmi2False)
+    })
 }
 
 /// # Safety
@@ -775,17 +704,12 @@ unsafe fn store_snapshot<M: CoSimModel>(
 }
 
 /// The live snapshot behind `s` made for model `M`, or an error message.
-unsafe fn snapshot_ref<'a, M: CoSimModel>(
-    fname: &str,
-    s: fmi2FMUstate,
-) -> Result<&'a Snapshot, String> {
+unsafe fn snapshot_ref<'a, M: CoSimModel>(fname: &str, s: fmi2FMUstate) -> Result<&'a Snapshot, String> {
     if s.is_null() {
         return Err(format!("{fname}: FMUstate is NULL"));
     }
     if !Snapshot::is_live(s) {
-        return Err(format!(
-            "{fname}: FMUstate is not a live FMU state (freed or foreign)"
-        ));
+        return Err(format!("{fname}: FMUstate is not a live FMU state (freed or foreign)"));
     }
     let snap = &*(s as *const Snapshot);
     if snap.guid != M::info().guid {
@@ -802,10 +726,7 @@ unsafe fn snapshot_ref<'a, M: CoSimModel>(
 ///
 /// # Safety
 /// `state` must point to NULL or to an FMU state returned earlier.
-pub unsafe fn get_fmu_state<M: CoSimModel>(
-    c: fmi2Component,
-    state: *mut fmi2FMUstate,
-) -> fmi2Status {
+pub unsafe fn get_fmu_state<M: CoSimModel>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
     guarded::<M>(c, Function::GetFMUstate, |inst| {
         const F: &str = "fmi2GetFMUstate";
         if state.is_null() {
@@ -843,10 +764,7 @@ pub unsafe fn set_fmu_state<M: CoSimModel>(c: fmi2Component, state: fmi2FMUstate
 ///
 /// # Safety
 /// `state` must be NULL or point to NULL or to an FMU state returned by this FMU.
-pub unsafe fn free_fmu_state<M: CoSimModel>(
-    c: fmi2Component,
-    state: *mut fmi2FMUstate,
-) -> fmi2Status {
+pub unsafe fn free_fmu_state<M: CoSimModel>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
     guarded::<M>(c, Function::FreeFMUstate, |inst| {
         const F: &str = "fmi2FreeFMUstate";
         if state.is_null() || (*state).is_null() {
@@ -959,9 +877,7 @@ pub unsafe fn get_directional_derivative<M: CoSimModel>(
     _dv_unknown: *mut fmi2Real,
 ) -> fmi2Status {
     guarded::<M>(c, Function::GetDirectionalDerivative, |inst| {
-        inst.error(
-            "fmi2GetDirectionalDerivative: not supported (providesDirectionalDerivative=\"false\")",
-        )
+        inst.error("fmi2GetDirectionalDerivative: not supported (providesDirectionalDerivative=\"false\")")
     })
 }
 
@@ -1002,10 +918,7 @@ pub unsafe fn set_real_input_derivatives<M: CoSimModel>(
                 Err(m) => return inst.error(m),
             };
             if v.causality != Causality::Input {
-                return inst.error(format!(
-                    "{F}: {} (value reference {r}) is not an input",
-                    v.name
-                ));
+                return inst.error(format!("{F}: {} (value reference {r}) is not an input", v.name));
             }
             if o < 1 {
                 return inst.error(format!(
@@ -1058,9 +971,7 @@ pub unsafe fn do_step<M: CoSimModel>(
     guarded::<M>(c, Function::DoStep, |inst| {
         const F: &str = "fmi2DoStep";
         if !(h.is_finite() && h > 0.0) {
-            return inst.error(format!(
-                "{F}: communicationStepSize = {h:e} must be finite and > 0"
-            ));
+            return inst.error(format!("{F}: communicationStepSize = {h:e} must be finite and > 0"));
         }
         let t = inst.model.time();
         let tol = 1e-9 * t.abs().max(1.0);
@@ -1149,11 +1060,7 @@ unsafe fn get_status_of<M: CoSimModel, T>(
 
 /// # Safety
 /// `value` must be writable.
-pub unsafe fn get_status<M: CoSimModel>(
-    c: fmi2Component,
-    s: fmi2StatusKind,
-    value: *mut fmi2Status,
-) -> fmi2Status {
+pub unsafe fn get_status<M: CoSimModel>(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Status) -> fmi2Status {
     get_status_of::<M, fmi2Status>(c, Function::GetStatus, s, value, |_, _| None)
 }
 
@@ -1161,11 +1068,7 @@ pub unsafe fn get_status<M: CoSimModel>(
 ///
 /// # Safety
 /// `value` must be writable.
-pub unsafe fn get_real_status<M: CoSimModel>(
-    c: fmi2Component,
-    s: fmi2StatusKind,
-    value: *mut fmi2Real,
-) -> fmi2Status {
+pub unsafe fn get_real_status<M: CoSimModel>(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Real) -> fmi2Status {
     get_status_of::<M, fmi2Real>(c, Function::GetRealStatus, s, value, |inst, k| {
         (k == fmi2LastSuccessfulTime).then(|| inst.model.time())
     })

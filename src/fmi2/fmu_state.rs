@@ -87,8 +87,7 @@ impl Snapshot {
         let guid = r.take(guid_len, "GUID")?;
         let code = r.take(1, "layer state")?[0];
         let n = r.u64("model byte count")?;
-        let n = usize::try_from(n)
-            .map_err(|_| format!("truncated serialized FMU state: model byte count {n}"))?;
+        let n = usize::try_from(n).map_err(|_| format!("truncated serialized FMU state: model byte count {n}"))?;
         let model_bytes = r.take(n, "model bytes")?.to_vec();
         let body_len = r.pos;
         let stored_crc = r.u32("checksum")?;
@@ -111,8 +110,8 @@ impl Snapshot {
                 String::from_utf8_lossy(guid)
             ));
         }
-        let state = State::from_code(code)
-            .ok_or_else(|| format!("invalid layer state code {code} in serialized FMU state"))?;
+        let state =
+            State::from_code(code).ok_or_else(|| format!("invalid layer state code {code} in serialized FMU state"))?;
         if state == State::Fatal {
             return Err("serialized FMU state is in the fatal state".to_owned());
         }
@@ -161,11 +160,7 @@ const fn crc_table() -> [u32; 256] {
         let mut c = i as u32;
         let mut k = 0;
         while k < 8 {
-            c = if c & 1 != 0 {
-                0xEDB8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
+            c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
             k += 1;
         }
         table[i] = c;
@@ -192,9 +187,6 @@ mod tests {
     fn crc32_known_values() {
         assert_eq!(crc32(b""), 0);
         assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
-        assert_eq!(
-            crc32(b"The quick brown fox jumps over the lazy dog"),
-            0x414F_A339
-        );
+        assert_eq!(crc32(b"The quick brown fox jumps over the lazy dog"), 0x414F_A339);
     }
 }

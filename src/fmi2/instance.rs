@@ -44,12 +44,7 @@ pub struct Instance<M: CoSimModel> {
 }
 
 impl<M: CoSimModel> Instance<M> {
-    pub fn new(
-        model: M,
-        instance_name: &str,
-        callbacks: Option<&fmi2CallbackFunctions>,
-        logging_on: bool,
-    ) -> Self {
+    pub fn new(model: M, instance_name: &str, callbacks: Option<&fmi2CallbackFunctions>, logging_on: bool) -> Self {
         let n = M::info().log_categories.len();
         Instance {
             magic: INSTANCE_MAGIC,
@@ -57,8 +52,7 @@ impl<M: CoSimModel> Instance<M> {
             instance_name: instance_name.to_owned(),
             instance_name_c: to_cstring(instance_name),
             logger: callbacks.and_then(|c| c.logger),
-            component_environment: callbacks
-                .map_or(std::ptr::null_mut(), |c| c.componentEnvironment),
+            component_environment: callbacks.map_or(std::ptr::null_mut(), |c| c.componentEnvironment),
             logging_on,
             categories_enabled: vec![logging_on; n],
             state: State::Instantiated,
@@ -93,11 +87,7 @@ impl<M: CoSimModel> Instance<M> {
         if status >= fmi2Discard {
             return true;
         }
-        match M::info()
-            .log_categories
-            .iter()
-            .position(|(name, _)| *name == category)
-        {
+        match M::info().log_categories.iter().position(|(name, _)| *name == category) {
             Some(i) => self.categories_enabled[i],
             None => self.logging_on,
         }
@@ -113,8 +103,7 @@ impl<M: CoSimModel> Instance<M> {
             return;
         }
         #[cfg(test)]
-        self.captured
-            .push((status, category.to_owned(), message.to_owned()));
+        self.captured.push((status, category.to_owned(), message.to_owned()));
         // SAFETY: the logger and environment come from the importer's callbacks.
         unsafe {
             call_logger(

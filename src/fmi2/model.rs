@@ -87,10 +87,7 @@ pub struct ModelInfo {
 pub enum StepError {
     /// The step could not be completed but the state up to `last_successful_time`
     /// is valid (`fmi2Discard`).
-    Discard {
-        message: String,
-        last_successful_time: f64,
-    },
+    Discard { message: String, last_successful_time: f64 },
     /// Invalid request; nothing was changed (`fmi2Error`).
     Error(String),
 }

@@ -39,39 +39,24 @@ pub fn validate_model_info(info: &ModelInfo) -> Result<(), Vec<String>> {
         }
         match (v.causality, v.variability) {
             (Causality::Parameter, Variability::Fixed | Variability::Tunable) => {}
-            (Causality::Parameter, _) => {
-                problems.push(format!("parameter {:?} must be fixed or tunable", v.name))
+            (Causality::Parameter, _) => problems.push(format!("parameter {:?} must be fixed or tunable", v.name)),
+            (Causality::Input | Causality::Output, Variability::Fixed | Variability::Tunable) => problems.push(
+                format!("{:?}: inputs and outputs must be discrete or continuous", v.name),
+            ),
+            (_, Variability::Continuous) if v.var_type != VarType::Real => {
+                problems.push(format!("{:?}: only Real variables can be continuous", v.name))
             }
-            (Causality::Input | Causality::Output, Variability::Fixed | Variability::Tunable) => {
-                problems.push(format!(
-                    "{:?}: inputs and outputs must be discrete or continuous",
-                    v.name
-                ))
-            }
-            (_, Variability::Continuous) if v.var_type != VarType::Real => problems.push(format!(
-                "{:?}: only Real variables can be continuous",
-                v.name
-            )),
             _ => {}
         }
         if has_start(v) {
             if !v.start.is_finite() {
-                problems.push(format!(
-                    "variable {:?}: start {} is not finite",
-                    v.name, v.start
-                ));
+                problems.push(format!("variable {:?}: start {} is not finite", v.name, v.start));
             }
             if v.min.is_some_and(|m| v.start < m) || v.max.is_some_and(|m| v.start > m) {
-                problems.push(format!(
-                    "variable {:?}: start {} outside [min, max]",
-                    v.name, v.start
-                ));
+                problems.push(format!("variable {:?}: start {} outside [min, max]", v.name, v.start));
             }
             if v.var_type != VarType::Real && v.start.fract() != 0.0 {
-                problems.push(format!(
-                    "variable {:?}: start {} is not an integer",
-                    v.name, v.start
-                ));
+                problems.push(format!("variable {:?}: start {} is not an integer", v.name, v.start));
             }
         }
     }
@@ -290,10 +275,6 @@ pub fn try_model_description_xml(info: &ModelInfo) -> Result<String, Vec<String>
 pub fn model_description_xml(info: &ModelInfo) -> String {
     match try_model_description_xml(info) {
         Ok(x) => x,
-        Err(problems) => panic!(
-            "invalid model info for {}: {}",
-            info.model_name,
-            problems.join("; ")
-        ),
+        Err(problems) => panic!("invalid model info for {}: {}", info.model_name, problems.join("; ")),
     }
 }

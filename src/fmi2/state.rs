@@ -86,16 +86,10 @@ pub const ERROR: Mask = 1 << 6;
 pub const FATAL: Mask = 1 << 7;
 
 /// Every state except `fatal`.
-const ALL_BUT_FATAL: Mask = INSTANTIATED
-    | INITIALIZATION_MODE
-    | STEP_COMPLETE
-    | STEP_FAILED
-    | STEP_CANCELED
-    | TERMINATED
-    | ERROR;
+const ALL_BUT_FATAL: Mask =
+    INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | STEP_CANCELED | TERMINATED | ERROR;
 /// States in which values can be read.
-const READABLE: Mask =
-    INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | STEP_CANCELED | TERMINATED | ERROR;
+const READABLE: Mask = INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | STEP_CANCELED | TERMINATED | ERROR;
 
 /// An FMI 2.0 function that takes an instance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -142,21 +136,9 @@ pub enum Function {
 /// * `fmi2CancelStep` is legal nowhere (no asynchronous stepping: `stepInProgress` is
 ///   never entered). It returns fmi2Error with the illegal-call message.
 pub const TABLE: &[(Function, &str, Mask)] = &[
-    (
-        Function::SetDebugLogging,
-        "fmi2SetDebugLogging",
-        ALL_BUT_FATAL,
-    ),
-    (
-        Function::FreeInstance,
-        "fmi2FreeInstance",
-        ALL_BUT_FATAL | FATAL,
-    ),
-    (
-        Function::SetupExperiment,
-        "fmi2SetupExperiment",
-        INSTANTIATED,
-    ),
+    (Function::SetDebugLogging, "fmi2SetDebugLogging", ALL_BUT_FATAL),
+    (Function::FreeInstance, "fmi2FreeInstance", ALL_BUT_FATAL | FATAL),
+    (Function::SetupExperiment, "fmi2SetupExperiment", INSTANTIATED),
     (
         Function::EnterInitializationMode,
         "fmi2EnterInitializationMode",
@@ -167,28 +149,12 @@ pub const TABLE: &[(Function, &str, Mask)] = &[
         "fmi2ExitInitializationMode",
         INITIALIZATION_MODE,
     ),
-    (
-        Function::Terminate,
-        "fmi2Terminate",
-        STEP_COMPLETE | STEP_FAILED,
-    ),
+    (Function::Terminate, "fmi2Terminate", STEP_COMPLETE | STEP_FAILED),
     (Function::Reset, "fmi2Reset", ALL_BUT_FATAL),
     (Function::GetReal, "fmi2GetReal", INSTANTIATED | READABLE),
-    (
-        Function::GetInteger,
-        "fmi2GetInteger",
-        INSTANTIATED | READABLE,
-    ),
-    (
-        Function::GetBoolean,
-        "fmi2GetBoolean",
-        INSTANTIATED | READABLE,
-    ),
-    (
-        Function::GetString,
-        "fmi2GetString",
-        INSTANTIATED | READABLE,
-    ),
+    (Function::GetInteger, "fmi2GetInteger", INSTANTIATED | READABLE),
+    (Function::GetBoolean, "fmi2GetBoolean", INSTANTIATED | READABLE),
+    (Function::GetString, "fmi2GetString", INSTANTIATED | READABLE),
     (
         Function::SetReal,
         "fmi2SetReal",
@@ -217,16 +183,8 @@ pub const TABLE: &[(Function, &str, Mask)] = &[
         "fmi2SerializedFMUstateSize",
         ALL_BUT_FATAL,
     ),
-    (
-        Function::SerializeFMUstate,
-        "fmi2SerializeFMUstate",
-        ALL_BUT_FATAL,
-    ),
-    (
-        Function::DeSerializeFMUstate,
-        "fmi2DeSerializeFMUstate",
-        ALL_BUT_FATAL,
-    ),
+    (Function::SerializeFMUstate, "fmi2SerializeFMUstate", ALL_BUT_FATAL),
+    (Function::DeSerializeFMUstate, "fmi2DeSerializeFMUstate", ALL_BUT_FATAL),
     (
         Function::GetDirectionalDerivative,
         "fmi2GetDirectionalDerivative",

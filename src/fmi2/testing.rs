@@ -6,9 +6,7 @@
 //! Magic behaviour for tests: setting `u` to [`PANIC_VALUE`] panics; a step with
 //! `|u| > 1e6` is discarded; a step longer than 1000 s is an error.
 
-use super::model::{
-    Causality, CoSimModel, ModelInfo, StepError, UnitDefinition, VarType, Variability, Variable,
-};
+use super::model::{Causality, CoSimModel, ModelInfo, StepError, UnitDefinition, VarType, Variability, Variable};
 
 pub const VR_U: u32 = 1;
 pub const VR_Y: u32 = 2;
@@ -215,11 +213,7 @@ impl CoSimModel for DummyModel {
             VR_TAU if value < 1e-6 => return Err(format!("tau = {value} must be >= 1e-6 s")),
             VR_TAU => self.tau = value,
             VR_Y0 => self.y0 = value,
-            _ => {
-                return Err(format!(
-                    "Real variable with value reference {vr} cannot be set"
-                ))
-            }
+            _ => return Err(format!("Real variable with value reference {vr} cannot be set")),
         }
         Ok(())
     }
@@ -259,12 +253,7 @@ impl CoSimModel for DummyModel {
         }
     }
 
-    fn setup_experiment(
-        &mut self,
-        _tolerance: Option<f64>,
-        start_time: f64,
-        _stop: Option<f64>,
-    ) -> Result<(), String> {
+    fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64, _stop: Option<f64>) -> Result<(), String> {
         self.time = start_time;
         Ok(())
     }
@@ -288,9 +277,7 @@ impl CoSimModel for DummyModel {
 
     fn do_step(&mut self, current_time: f64, step_size: f64) -> Result<(), StepError> {
         if step_size > 1000.0 {
-            return Err(StepError::Error(format!(
-                "step size {step_size} s is too long"
-            )));
+            return Err(StepError::Error(format!("step size {step_size} s is too long")));
         }
         if self.u.abs() > 1e6 {
             return Err(StepError::Discard {
@@ -341,10 +328,7 @@ impl CoSimModel for DummyModel {
             ));
         }
         if bytes[0] != DUMMY_BYTES_VERSION {
-            return Err(format!(
-                "dummy model state version {} unsupported",
-                bytes[0]
-            ));
+            return Err(format!("dummy model state version {} unsupported", bytes[0]));
         }
         let f = |i: usize| f64::from_le_bytes(bytes[1 + 8 * i..9 + 8 * i].try_into().unwrap());
         let n_sub = i32::from_le_bytes(bytes[49..53].try_into().unwrap());

@@ -24,10 +24,7 @@ type LogRecord = (fmi2Status, String, String, String);
 /// takes exactly the one string argument the layer always passes after `"%s"` and is
 /// called through the variadic pointer type: sound in practice on the two ABIs below,
 /// where a variadic pointer argument travels exactly like a named one.
-#[cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
-))]
+#[cfg(all(target_os = "linux", any(target_arch = "x86_64", target_arch = "aarch64")))]
 unsafe extern "C" fn test_logger(
     env: fmi2ComponentEnvironment,
     _name: fmi2String,
@@ -38,15 +35,11 @@ unsafe extern "C" fn test_logger(
 ) {
     let sink = &*(env as *const RefCell<Vec<LogRecord>>);
     let s = |p: *const c_char| CStr::from_ptr(p).to_string_lossy().into_owned();
-    sink.borrow_mut()
-        .push((status, s(category), s(format), s(arg)));
+    sink.borrow_mut().push((status, s(category), s(format), s(arg)));
 }
 
 fn callbacks(sink: &RefCell<Vec<LogRecord>>) -> fmi2CallbackFunctions {
-    #[cfg(all(
-        target_os = "linux",
-        any(target_arch = "x86_64", target_arch = "aarch64")
-    ))]
+    #[cfg(all(target_os = "linux", any(target_arch = "x86_64", target_arch = "aarch64")))]
     let logger: fmi2CallbackLogger = Some(unsafe {
         std::mem::transmute::<
             unsafe extern "C" fn(
@@ -57,20 +50,10 @@ fn callbacks(sink: &RefCell<Vec<LogRecord>>) -> fmi2CallbackFunctions {
                 fmi2String,
                 *const c_char,
             ),
-            unsafe extern "C" fn(
-                fmi2ComponentEnvironment,
-                fmi2String,
-                fmi2Status,
-                fmi2String,
-                fmi2String,
-                ...
-            ),
+            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...),
         >(test_logger)
     });
-    #[cfg(not(all(
-        target_os = "linux",
-        any(target_arch = "x86_64", target_arch = "aarch64")
-    )))]
+    #[cfg(not(all(target_os = "linux", any(target_arch = "x86_64", target_arch = "aarch64"))))]
     let logger: fmi2CallbackLogger = None;
     fmi2CallbackFunctions {
         logger,
@@ -162,9 +145,7 @@ unsafe fn call(f: Function, c: fmi2Component) -> fmi2Status {
             fs = boxed_snapshot();
             api::free_fmu_state::<M>(c, &mut fs)
         }
-        Function::SerializedFMUstateSize => {
-            api::serialized_fmu_state_size::<M>(c, boxed_snapshot(), &mut size)
-        }
+        Function::SerializedFMUstateSize => api::serialized_fmu_state_size::<M>(c, boxed_snapshot(), &mut size),
         Function::SerializeFMUstate => {
             let snap = boxed_snapshot();
             let mut buf = (*(snap as *const Snapshot)).to_bytes();
@@ -172,22 +153,11 @@ unsafe fn call(f: Function, c: fmi2Component) -> fmi2Status {
         }
         Function::DeSerializeFMUstate => {
             let bytes = (*(boxed_snapshot() as *const Snapshot)).to_bytes();
-            api::deserialize_fmu_state::<M>(
-                c,
-                bytes.as_ptr() as *const fmi2Byte,
-                bytes.len(),
-                &mut fs,
-            )
+            api::deserialize_fmu_state::<M>(c, bytes.as_ptr() as *const fmi2Byte, bytes.len(), &mut fs)
         }
-        Function::GetDirectionalDerivative => {
-            api::get_directional_derivative::<M>(c, &VR_Y, 1, &VR_U, 1, &1.0, &mut r)
-        }
-        Function::SetRealInputDerivatives => {
-            api::set_real_input_derivatives::<M>(c, &VR_U, 1, &1, &0.5)
-        }
-        Function::GetRealOutputDerivatives => {
-            api::get_real_output_derivatives::<M>(c, &VR_Y, 1, &1, &mut r)
-        }
+        Function::GetDirectionalDerivative => api::get_directional_derivative::<M>(c, &VR_Y, 1, &VR_U, 1, &1.0, &mut r),
+        Function::SetRealInputDerivatives => api::set_real_input_derivatives::<M>(c, &VR_U, 1, &1, &0.5),
+        Function::GetRealOutputDerivatives => api::get_real_output_derivatives::<M>(c, &VR_Y, 1, &1, &mut r),
         Function::DoStep => api::do_step::<M>(c, 0.0, 0.1, 1),
         Function::CancelStep => api::cancel_step::<M>(c),
         Function::GetStatus => api::get_status::<M>(c, fmi2DoStepStatus, &mut st),
@@ -235,11 +205,7 @@ fn null_and_dead_instances_are_errors_for_every_function() {
     let fake = Box::into_raw(Box::new([0u64; 64])) as fmi2Component;
     for f in Function::all() {
         unsafe {
-            let expected = if f == Function::FreeInstance {
-                fmi2OK
-            } else {
-                fmi2Error
-            };
+            let expected = if f == Function::FreeInstance { fmi2OK } else { fmi2Error };
             assert_eq!(call(f, null_mut()), expected, "{f:?} on NULL");
             assert_eq!(call(f, fake), fmi2Error, "{f:?} on a dead instance");
         }
@@ -277,13 +243,7 @@ fn instantiate_rejects_bad_arguments() {
         assert!(inst(null(), fmi2CoSimulation, g.as_ptr(), &cb).is_null());
         assert!(inst(c"a".as_ptr(), fmi2CoSimulation, g.as_ptr(), null()).is_null());
         let no_logger = fmi2CallbackFunctions { logger: None, ..cb };
-        assert!(inst(
-            c"a".as_ptr(),
-            fmi2CoSimulation,
-            c"{wrong}".as_ptr(),
-            &no_logger
-        )
-        .is_null());
+        assert!(inst(c"a".as_ptr(), fmi2CoSimulation, c"{wrong}".as_ptr(), &no_logger).is_null());
         // two live instances at once
         let a = inst(c"a".as_ptr(), fmi2CoSimulation, g.as_ptr(), &no_logger);
         let b = inst(c"b".as_ptr(), fmi2CoSimulation, g.as_ptr(), &no_logger);
@@ -293,10 +253,7 @@ fn instantiate_rejects_bad_arguments() {
         api::free_instance::<M>(a);
         api::free_instance::<M>(b);
     }
-    #[cfg(all(
-        target_os = "linux",
-        any(target_arch = "x86_64", target_arch = "aarch64")
-    ))]
+    #[cfg(all(target_os = "linux", any(target_arch = "x86_64", target_arch = "aarch64")))]
     {
         let log = sink.borrow();
         assert_eq!(log.len(), 5, "{log:?}"); // NULL functions and no logger: nothing to call
@@ -330,10 +287,7 @@ fn logger_gets_percent_s_and_filtering_follows_logging_on() {
 
         // unknown category: fmi2Error, nothing changes
         let cats = [c"logEvents".as_ptr(), c"nope".as_ptr()];
-        assert_eq!(
-            api::set_debug_logging::<M>(c, 1, 2, cats.as_ptr()),
-            fmi2Error
-        );
+        assert_eq!(api::set_debug_logging::<M>(c, 1, 2, cats.as_ptr()), fmi2Error);
         assert!(
             last_error(c).contains("unknown log category \"nope\""),
             "{}",
@@ -350,20 +304,12 @@ fn logger_gets_percent_s_and_filtering_follows_logging_on() {
         assert_eq!(api::set_debug_logging::<M>(c, 1, 1, null()), fmi2Error);
         api::free_instance::<M>(c);
     }
-    #[cfg(all(
-        target_os = "linux",
-        any(target_arch = "x86_64", target_arch = "aarch64")
-    ))]
+    #[cfg(all(target_os = "linux", any(target_arch = "x86_64", target_arch = "aarch64")))]
     {
         let log = sink.borrow();
         assert_eq!(
             log[0],
-            (
-                fmi2Error,
-                "logStatusError".into(),
-                "%s".into(),
-                "error %d %s".into()
-            )
+            (fmi2Error, "logStatusError".into(), "%s".into(), "error %d %s".into())
         );
         assert_eq!(log[1].0, fmi2Discard);
         assert!(log.iter().all(|r| r.2 == "%s"));
@@ -377,11 +323,7 @@ fn simulation_lifecycle() {
         let c = new_instance(&sink, false);
         assert_eq!(get_r(c, VR_TAU), (fmi2OK, 1.0)); // parameters readable when instantiated
         assert_eq!(get_r(c, VR_Y).0, fmi2Error); // outputs not
-        assert!(
-            last_error(c).contains("y (value reference 2)"),
-            "{}",
-            last_error(c)
-        );
+        assert!(last_error(c).contains("y (value reference 2)"), "{}", last_error(c));
         assert_eq!(set_r(c, VR_TAU, 0.5), fmi2OK);
         assert_eq!(set_r(c, VR_U, 1.0), fmi2OK);
         initialize(c);
@@ -393,22 +335,13 @@ fn simulation_lifecycle() {
         assert_eq!(st, fmi2OK);
         assert!((y - (1.0 - (-1.0f64 / 0.5).exp())).abs() < 1e-6, "{y}");
         let mut t = 0.0;
-        assert_eq!(
-            api::get_real_status::<M>(c, fmi2LastSuccessfulTime, &mut t),
-            fmi2OK
-        );
+        assert_eq!(api::get_real_status::<M>(c, fmi2LastSuccessfulTime, &mut t), fmi2OK);
         assert!((t - 1.0).abs() < 1e-12);
         let mut b = 7;
-        assert_eq!(
-            api::get_boolean_status::<M>(c, fmi2Terminated, &mut b),
-            fmi2OK
-        );
+        assert_eq!(api::get_boolean_status::<M>(c, fmi2Terminated, &mut b), fmi2OK);
         assert_eq!(b, fmi2False);
         let mut st = 0;
-        assert_eq!(
-            api::get_status::<M>(c, fmi2DoStepStatus, &mut st),
-            fmi2Discard
-        );
+        assert_eq!(api::get_status::<M>(c, fmi2DoStepStatus, &mut st), fmi2Discard);
         assert_eq!(api::get_status::<M>(c, 99, &mut st), fmi2Error);
         assert_eq!(
             api::get_real_status::<M>(c, fmi2LastSuccessfulTime, null_mut()),
@@ -432,11 +365,7 @@ fn do_step_checks_arguments_and_maps_step_errors() {
         initialize(c);
         for h in [0.0, -1.0, f64::NAN, f64::INFINITY] {
             assert_eq!(api::do_step::<M>(c, 0.0, h, 0), fmi2Error, "h = {h}");
-            assert!(
-                last_error(c).contains("communicationStepSize"),
-                "{}",
-                last_error(c)
-            );
+            assert!(last_error(c).contains("communicationStepSize"), "{}", last_error(c));
         }
         assert_eq!(api::do_step::<M>(c, 0.5, 0.1, 0), fmi2Error);
         assert!(
@@ -458,16 +387,10 @@ fn do_step_checks_arguments_and_maps_step_errors() {
         let log = &inst(c).captured;
         assert!(log.last().unwrap().2.contains("too large"), "{log:?}");
         let mut t = 0.0;
-        assert_eq!(
-            api::get_real_status::<M>(c, fmi2LastSuccessfulTime, &mut t),
-            fmi2OK
-        );
+        assert_eq!(api::get_real_status::<M>(c, fmi2LastSuccessfulTime, &mut t), fmi2OK);
         assert_eq!(t, t1);
         assert_eq!(api::do_step::<M>(c, t1, 0.1, 0), fmi2Error); // illegal in stepFailed
-        assert_eq!(
-            last_error(c),
-            illegal_call_message(Function::DoStep, State::StepFailed)
-        );
+        assert_eq!(last_error(c), illegal_call_message(Function::DoStep, State::StepFailed));
         assert_eq!(get_r(c, VR_Y).0, fmi2OK);
         assert_eq!(api::terminate::<M>(c), fmi2OK);
         assert_eq!(api::cancel_step::<M>(c), fmi2Error);
@@ -489,15 +412,9 @@ fn setters_and_getters_check_the_variable_table() {
         assert_eq!(set_r(c, 999, 1.0), fmi2Error);
         assert!(last_error(c).contains("unknown value reference 999"));
         assert_eq!(set_r(c, VR_N_SUB, 1.0), fmi2Error);
-        assert!(
-            last_error(c).contains("value reference 12 (n_sub) is a Integer variable, not Real")
-        );
+        assert!(last_error(c).contains("value reference 12 (n_sub) is a Integer variable, not Real"));
         assert_eq!(set_r(c, VR_TAU, 0.0), fmi2Error); // model rejects
-        assert!(
-            last_error(c).contains("fmi2SetReal: tau = 0"),
-            "{}",
-            last_error(c)
-        );
+        assert!(last_error(c).contains("fmi2SetReal: tau = 0"), "{}", last_error(c));
         assert_eq!(set_r(c, VR_TAU, f64::NAN), fmi2Error);
         assert_eq!(api::set_integer::<M>(c, &VR_N_SUB, 1, &0), fmi2Error);
         assert_eq!(api::set_integer::<M>(c, &VR_N_SUB, 1, &8), fmi2OK);
@@ -507,10 +424,7 @@ fn setters_and_getters_check_the_variable_table() {
         assert_eq!(b, fmi2True);
         // all VRs are checked before any value is written
         let vrs = [VR_TAU, VR_Y];
-        assert_eq!(
-            api::set_real::<M>(c, vrs.as_ptr(), 2, [3.0, 3.0].as_ptr()),
-            fmi2Error
-        );
+        assert_eq!(api::set_real::<M>(c, vrs.as_ptr(), 2, [3.0, 3.0].as_ptr()), fmi2Error);
         assert_eq!(get_r(c, VR_TAU), (fmi2OK, 1.0));
         // NULL arrays
         let mut x = 0.0;
@@ -519,25 +433,16 @@ fn setters_and_getters_check_the_variable_table() {
         assert_eq!(api::get_real::<M>(c, &VR_TAU, 1, null_mut()), fmi2Error);
         assert!(last_error(c).contains("value[] is NULL"));
         assert_eq!(api::get_real::<M>(c, null(), 0, null_mut()), fmi2OK);
-        assert_eq!(
-            api::set_real_input_derivatives::<M>(c, &VR_U, 1, null(), &x),
-            fmi2Error
-        );
+        assert_eq!(api::set_real_input_derivatives::<M>(c, &VR_U, 1, null(), &x), fmi2Error);
         // strings
         let mut s: fmi2String = null();
         assert_eq!(api::get_string::<M>(c, &VR_U, 1, &mut s), fmi2Error);
         assert!(last_error(c).contains("not String"));
         assert_eq!(api::set_string::<M>(c, &77, 1, &c"x".as_ptr()), fmi2Error);
         // input derivatives: inputs only, order >= 1
-        assert_eq!(
-            api::set_real_input_derivatives::<M>(c, &VR_TAU, 1, &1, &1.0),
-            fmi2Error
-        );
+        assert_eq!(api::set_real_input_derivatives::<M>(c, &VR_TAU, 1, &1, &1.0), fmi2Error);
         assert!(last_error(c).contains("not an input"));
-        assert_eq!(
-            api::set_real_input_derivatives::<M>(c, &VR_U, 1, &0, &1.0),
-            fmi2Error
-        );
+        assert_eq!(api::set_real_input_derivatives::<M>(c, &VR_U, 1, &0, &1.0), fmi2Error);
 
         initialize(c);
         assert_eq!(set_r(c, VR_Y0, 1.0), fmi2Error); // fixed parameter after initialization
@@ -547,10 +452,7 @@ fn setters_and_getters_check_the_variable_table() {
         assert_eq!(set_r(c, VR_U, 1.0), fmi2OK); // input
         assert_eq!(api::get_real::<M>(c, &VR_Y, 1, &mut x), fmi2OK);
         assert_eq!(api::set_boolean::<M>(c, &VR_FROZEN, 1, &0), fmi2OK);
-        assert_eq!(
-            api::set_real_input_derivatives::<M>(c, &VR_U, 1, &1, &2.0),
-            fmi2OK
-        );
+        assert_eq!(api::set_real_input_derivatives::<M>(c, &VR_U, 1, &1, &2.0), fmi2OK);
         assert_eq!(inst(c).model.du, 2.0);
         assert_eq!(api::do_step::<M>(c, 0.0, 0.5, 0), fmi2OK);
         assert!((get_r(c, VR_U).1 - 2.0).abs() < 1e-12);
@@ -582,16 +484,10 @@ fn panics_are_caught_and_make_the_instance_fatal() {
             "{msg}"
         );
         assert_eq!(get_r(c, VR_TAU).0, fmi2Error);
-        assert_eq!(
-            last_error(c),
-            illegal_call_message(Function::GetReal, State::Fatal)
-        );
+        assert_eq!(last_error(c), illegal_call_message(Function::GetReal, State::Fatal));
         assert_eq!(api::free_instance::<M>(c), fmi2OK);
     }
-    #[cfg(all(
-        target_os = "linux",
-        any(target_arch = "x86_64", target_arch = "aarch64")
-    ))]
+    #[cfg(all(target_os = "linux", any(target_arch = "x86_64", target_arch = "aarch64")))]
     assert!(sink
         .borrow()
         .iter()
@@ -620,10 +516,7 @@ fn fmu_state_get_set_free() {
         assert_eq!(api::do_step::<M>(c, 0.5, 0.25, 0), fmi2OK);
         assert_eq!(api::get_fmu_state::<M>(c, &mut fs), fmi2OK);
         assert_eq!(fs, before);
-        assert_eq!(
-            (*(fs as *const Snapshot)).model_bytes,
-            inst(c).model.serialize()
-        );
+        assert_eq!((*(fs as *const Snapshot)).model_bytes, inst(c).model.serialize());
         assert_eq!(api::free_fmu_state::<M>(c, &mut fs), fmi2OK);
         assert!(fs.is_null());
         assert_eq!(api::free_fmu_state::<M>(c, &mut fs), fmi2OK); // NULL: no-op
@@ -652,10 +545,7 @@ fn serialized_state_round_trip() {
         let mut fs: fmi2FMUstate = null_mut();
         assert_eq!(api::get_fmu_state::<M>(c, &mut fs), fmi2OK);
         let mut size = 0;
-        assert_eq!(
-            api::serialized_fmu_state_size::<M>(c, fs, &mut size),
-            fmi2OK
-        );
+        assert_eq!(api::serialized_fmu_state_size::<M>(c, fs, &mut size), fmi2OK);
         let mut bytes = vec![0u8; size];
         assert_eq!(
             api::serialize_fmu_state::<M>(c, fs, bytes.as_mut_ptr() as *mut fmi2Byte, size - 1),
@@ -719,18 +609,11 @@ fn serialized_state_rejects_corrupted_foreign_and_truncated_bytes() {
         good
     );
 
-    let err = |b: &[u8]| {
-        Snapshot::from_bytes::<M>(b)
-            .err()
-            .expect("must be rejected")
-    };
+    let err = |b: &[u8]| Snapshot::from_bytes::<M>(b).err().expect("must be rejected");
     assert!(err(&forge(b"NOTASTAT", 1, g, 3, &model)).contains("wrong magic"));
     assert!(err(&forge(STATE_MAGIC, 2, g, 3, &model)).contains("format version 2"));
     let e = err(&forge(STATE_MAGIC, 1, "{other-fmu}", 3, &model));
-    assert!(
-        e.contains("GUID mismatch") && e.contains("{other-fmu}"),
-        "{e}"
-    );
+    assert!(e.contains("GUID mismatch") && e.contains("{other-fmu}"), "{e}");
     assert!(err(&forge(STATE_MAGIC, 1, g, 0, &model)).contains("invalid layer state"));
     assert!(err(&forge(STATE_MAGIC, 1, g, 8, &model)).contains("fatal"));
     assert!(err(&forge(STATE_MAGIC, 1, g, 3, &model[..10])).contains("rejected by the model"));
@@ -745,10 +628,7 @@ fn serialized_state_rejects_corrupted_foreign_and_truncated_bytes() {
     }
     for n in 0..good.len() {
         let e = err(&good[..n]);
-        assert!(
-            e.contains("truncated") || e.contains("wrong magic"),
-            "{n}: {e}"
-        );
+        assert!(e.contains("truncated") || e.contains("wrong magic"), "{n}: {e}");
     }
     let mut long = good.clone();
     long.push(0);
@@ -765,17 +645,10 @@ fn serialized_state_rejects_corrupted_foreign_and_truncated_bytes() {
             fmi2Error
         );
         assert!(fs.is_null());
-        assert!(last_error(c)
-            .starts_with("fmi2DeSerializeFMUstate: serialized FMU state of another FMU"));
-        assert_eq!(
-            api::deserialize_fmu_state::<M>(c, null(), 0, &mut fs),
-            fmi2Error
-        );
+        assert!(last_error(c).starts_with("fmi2DeSerializeFMUstate: serialized FMU state of another FMU"));
+        assert_eq!(api::deserialize_fmu_state::<M>(c, null(), 0, &mut fs), fmi2Error);
         assert!(last_error(c).contains("truncated"));
-        assert_eq!(
-            api::deserialize_fmu_state::<M>(c, null(), 5, &mut fs),
-            fmi2Error
-        );
+        assert_eq!(api::deserialize_fmu_state::<M>(c, null(), 5, &mut fs), fmi2Error);
         api::free_instance::<M>(c);
     }
 }
@@ -788,21 +661,15 @@ fn model_description_lists_every_variable() {
     assert!(xml.contains(r#"canInterpolateInputs="true""#));
     assert!(xml.contains(r#"<ScalarVariable name="u" valueReference="1" description="input &lt;u&gt; &amp; &quot;target&quot;" causality="input" variability="continuous">"#));
     assert!(xml.contains(r#"<Real unit="1" start="0.0"/>"#));
-    assert!(
-        xml.contains(r#"<Real unit="s" start="1.0" min="1e-6"/>"#),
-        "{xml}"
-    );
+    assert!(xml.contains(r#"<Real unit="s" start="1.0" min="1e-6"/>"#), "{xml}");
     assert!(xml.contains(r#"<Integer start="4" min="1" max="1000"/>"#));
     assert!(xml.contains(r#"<Boolean start="false"/>"#));
     assert!(xml.contains("<Outputs>\n      <Unknown index=\"2\"/>\n    </Outputs>"));
     assert!(xml.contains("<InitialUnknowns>\n      <Unknown index=\"2\"/>\n    </InitialUnknowns>"));
     for v in M::info().variables {
         assert_eq!(
-            xml.matches(&format!(
-                r#"name="{}" valueReference="{}""#,
-                v.name, v.value_reference
-            ))
-            .count(),
+            xml.matches(&format!(r#"name="{}" valueReference="{}""#, v.name, v.value_reference))
+                .count(),
             1
         );
     }
@@ -820,9 +687,7 @@ fn model_description_of_the_actuator_table() {
     let xml = try_model_description_xml(&info).unwrap();
     assert!(xml.contains(r#"<ScalarVariable name="P_s" valueReference="100""#));
     assert!(xml.contains(r#"start="652925.0""#));
-    assert!(
-        xml.contains(r#"<Unit name="Pa">"#) && xml.contains(r#"<BaseUnit kg="1" m="-1" s="-2"/>"#)
-    );
+    assert!(xml.contains(r#"<Unit name="Pa">"#) && xml.contains(r#"<BaseUnit kg="1" m="-1" s="-2"/>"#));
     let outputs: Vec<usize> = info
         .variables
         .iter()
@@ -832,10 +697,7 @@ fn model_description_of_the_actuator_table() {
         .collect();
     assert_eq!(outputs, vec![3, 4, 5, 6, 7]);
     for i in outputs {
-        assert_eq!(
-            xml.matches(&format!(r#"<Unknown index="{i}"/>"#)).count(),
-            2
-        );
+        assert_eq!(xml.matches(&format!(r#"<Unknown index="{i}"/>"#)).count(), 2);
     }
 }
 
@@ -865,9 +727,7 @@ fn model_description_rejects_a_broken_table() {
     };
     let problems = validate_model_info(&info).unwrap_err();
     assert!(
-        problems
-            .iter()
-            .any(|p| p.contains("duplicate value reference 1")),
+        problems.iter().any(|p| p.contains("duplicate value reference 1")),
         "{problems:?}"
     );
     static DUPNAME: [Variable; 2] = [

@@ -54,12 +54,10 @@ pub type fmi2CallbackLogger = Option<
         ...
     ),
 >;
-pub type fmi2CallbackAllocateMemory =
-    Option<unsafe extern "C" fn(nobj: usize, size: usize) -> *mut c_void>;
+pub type fmi2CallbackAllocateMemory = Option<unsafe extern "C" fn(nobj: usize, size: usize) -> *mut c_void>;
 pub type fmi2CallbackFreeMemory = Option<unsafe extern "C" fn(obj: *mut c_void)>;
-pub type fmi2StepFinished = Option<
-    unsafe extern "C" fn(componentEnvironment: fmi2ComponentEnvironment, status: fmi2Status),
->;
+pub type fmi2StepFinished =
+    Option<unsafe extern "C" fn(componentEnvironment: fmi2ComponentEnvironment, status: fmi2Status)>;
 
 /// `fmi2CallbackFunctions`.
 #[repr(C)]
@@ -98,14 +96,8 @@ mod tests {
     #[test]
     fn layout_matches_the_header() {
         // five pointer-sized members, no padding
-        assert_eq!(
-            size_of::<fmi2CallbackFunctions>(),
-            5 * size_of::<*mut c_void>()
-        );
-        assert_eq!(
-            align_of::<fmi2CallbackFunctions>(),
-            align_of::<*mut c_void>()
-        );
+        assert_eq!(size_of::<fmi2CallbackFunctions>(), 5 * size_of::<*mut c_void>());
+        assert_eq!(align_of::<fmi2CallbackFunctions>(), align_of::<*mut c_void>());
         assert_eq!(size_of::<fmi2CallbackLogger>(), size_of::<*mut c_void>());
         assert_eq!(size_of::<fmi2Status>(), 4);
         assert_eq!(size_of::<fmi2ValueReference>(), 4);

@@ -110,14 +110,7 @@ impl Actuator {
     }
 
     /// dP1/dt and dP2/dt, (2.29).
-    pub fn pressure_rates(
-        &self,
-        x_jp: f64,
-        p1: f64,
-        p2: f64,
-        x_s: f64,
-        x_s_rate: f64,
-    ) -> (f64, f64) {
+    pub fn pressure_rates(&self, x_jp: f64, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
         let p = &self.params;
         let flows = self.mass_flows(x_jp, p1, p2);
         let (v1, v2) = self.cylinder.volumes(x_s);
@@ -171,11 +164,7 @@ impl Actuator {
         let c2 = 2.0 * p.zeta_2 * p.omega_2 + p.omega_1;
         let c3 = p.omega_2 * p.omega_2 + 2.0 * p.zeta_2 * p.omega_1 * p.omega_2;
         let c4 = p.omega_1 * p.omega_2 * p.omega_2;
-        let slope = jet_pipe::static_position_slope(
-            p.x_jp_sat,
-            p.f_jp_sat,
-            jet_pipe::tip_force(p.k_m, y[CURRENT]),
-        );
+        let slope = jet_pipe::static_position_slope(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, y[CURRENT]));
         jac[(JET_ACCELERATION, CURRENT)] = c4 * slope * p.k_m;
         jac[(JET_ACCELERATION, JET_POSITION)] = -c4;
         jac[(JET_ACCELERATION, JET_VELOCITY)] = -c3;
@@ -237,8 +226,7 @@ mod tests {
         let y = State::from([0.09, 2.1e-4, 0.03, -20.0, 4.0e5, 1.7e5]);
         let f = model.derivatives(&y, &u);
         let analytic = model.jacobian(&y, &u, &f);
-        let numeric =
-            crate::integrator::finite_difference_jacobian(|yy| model.derivatives(yy, &u), &y, &f);
+        let numeric = crate::integrator::finite_difference_jacobian(|yy| model.derivatives(yy, &u), &y, &f);
         for r in 0..N_STATES {
             for c in 0..N_STATES {
                 let (a, n) = (analytic[(r, c)], numeric[(r, c)]);

@@ -60,12 +60,7 @@ pub fn pressure_rate(
 
 /// Pressure after an instantaneous volume change with no flow: the exact limit of
 /// (2.29) over a vanishing time, P V^γ = const. The air in the chamber is conserved.
-pub fn pressure_after_volume_jump(
-    gamma: f64,
-    pressure: f64,
-    volume_before: f64,
-    volume_after: f64,
-) -> f64 {
+pub fn pressure_after_volume_jump(gamma: f64, pressure: f64, volume_before: f64, volume_after: f64) -> f64 {
     pressure * (volume_before / volume_after).powf(gamma)
 }
 
@@ -108,8 +103,7 @@ mod tests {
         for k in 0..n {
             // midpoint rule
             let v = v0 + dv * (k as f64 + 0.5) * dt;
-            let half =
-                p + 0.5 * dt * pressure_rate(gamma, 287.0, 293.15, v - 0.5 * dv * dt, dv, 0.0, p);
+            let half = p + 0.5 * dt * pressure_rate(gamma, 287.0, 293.15, v - 0.5 * dv * dt, dv, 0.0, p);
             p += dt * pressure_rate(gamma, 287.0, 293.15, v, dv, 0.0, half);
         }
         let jump = pressure_after_volume_jump(gamma, p0, v0, v1);

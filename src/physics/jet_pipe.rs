@@ -52,18 +52,14 @@ mod tests {
         assert!((static_position(xs, fs, 0.3) + static_position(xs, fs, -0.3)).abs() < 1e-18);
         assert!(static_position(xs, fs, 100.0) <= xs);
         let h = 1e-7;
-        let numeric =
-            (static_position(xs, fs, 0.2 + h) - static_position(xs, fs, 0.2 - h)) / (2.0 * h);
+        let numeric = (static_position(xs, fs, 0.2 + h) - static_position(xs, fs, 0.2 - h)) / (2.0 * h);
         assert!((numeric - static_position_slope(xs, fs, 0.2)).abs() < 1e-9);
     }
 
     #[test]
     fn dynamics_have_unity_dc_gain() {
         // At rest at the static position every derivative vanishes.
-        assert_eq!(
-            third_derivative(973.9, 1856.7, 0.019, 1e-4, 1e-4, 0.0, 0.0),
-            0.0
-        );
+        assert_eq!(third_derivative(973.9, 1856.7, 0.019, 1e-4, 1e-4, 0.0, 0.0), 0.0);
         assert!(third_derivative(973.9, 1856.7, 0.019, 1e-4, 0.0, 0.0, 0.0) > 0.0);
     }
 }

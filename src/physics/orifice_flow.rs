@@ -106,11 +106,7 @@ mod tests {
     #[test]
     fn constants_of_2_19_to_2_21() {
         let k = air();
-        assert!(
-            (k.critical_ratio - 0.5283).abs() < 1e-4,
-            "r_c = {}",
-            k.critical_ratio
-        );
+        assert!((k.critical_ratio - 0.5283).abs() < 1e-4, "r_c = {}", k.critical_ratio);
         assert!((k.c1 - 0.040418).abs() < 1e-5, "C1 = {}", k.c1);
         assert!((k.c2 - 0.156174).abs() < 1e-5, "C2 = {}", k.c2);
     }

@@ -106,11 +106,7 @@ mod tests {
             } else {
                 0.0
             };
-            sum += if subtract {
-                (a1 - a0) - overlap
-            } else {
-                overlap
-            } * dy;
+            sum += if subtract { (a1 - a0) - overlap } else { overlap } * dy;
         }
         sum
     }

@@ -77,8 +77,7 @@ impl Default for Parameters {
             k_spring: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
-            *p.field_mut(vr)
-                .expect("every parameter value reference has a field") = table_start(vr);
+            *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
         }
         p
     }
@@ -170,9 +169,9 @@ impl Parameters {
     /// Set one parameter, checking its own bound. The message names the variable and value.
     pub fn set(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
         let name = variable_name(value_reference);
-        let (field, bound) = self.field_and_bound(value_reference).ok_or_else(|| {
-            format!("value reference {value_reference} is not a parameter of the model")
-        })?;
+        let (field, bound) = self
+            .field_and_bound(value_reference)
+            .ok_or_else(|| format!("value reference {value_reference} is not a parameter of the model"))?;
         let problem = if !value.is_finite() {
             Some("must be finite")
         } else {
@@ -264,10 +263,7 @@ mod tests {
         let e = p.set(vr::C_D, f64::NAN).unwrap_err();
         assert!(e.contains("C_d") && e.contains("NaN"), "{e}");
         assert!(p.set(vr::D_CYL, 0.0).is_err());
-        assert_eq!(
-            p.p_s, 652_925.0,
-            "a rejected value leaves the parameter unchanged"
-        );
+        assert_eq!(p.p_s, 652_925.0, "a rejected value leaves the parameter unchanged");
         let e = p.check_stopper(0.02).unwrap_err();
         assert!(e.contains("x_s") && e.contains("0.02"), "{e}");
     }
