@@ -23,25 +23,8 @@ fn exported_symbols_drive_a_simulation() {
             componentEnvironment: null_mut(),
         };
         let guid = CString::new(ExportedModel::info().guid).unwrap();
-        assert!(fmi2Instantiate(
-            c"x".as_ptr(),
-            fmi2CoSimulation,
-            c"{nope}".as_ptr(),
-            null(),
-            &cb,
-            0,
-            0
-        )
-        .is_null());
-        let c = fmi2Instantiate(
-            c"x".as_ptr(),
-            fmi2CoSimulation,
-            guid.as_ptr(),
-            null(),
-            &cb,
-            0,
-            0,
-        );
+        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, c"{nope}".as_ptr(), null(), &cb, 0, 0).is_null());
+        let c = fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, guid.as_ptr(), null(), &cb, 0, 0);
         assert!(!c.is_null());
         assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 1, 1.0), fmi2OK);
         assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
@@ -58,15 +41,9 @@ fn exported_symbols_drive_a_simulation() {
         let mut size = 0;
         assert_eq!(fmi2SerializedFMUstateSize(c, st, &mut size), fmi2OK);
         let mut bytes = vec![0 as fmi2Byte; size];
-        assert_eq!(
-            fmi2SerializeFMUstate(c, st, bytes.as_mut_ptr(), size),
-            fmi2OK
-        );
+        assert_eq!(fmi2SerializeFMUstate(c, st, bytes.as_mut_ptr(), size), fmi2OK);
         let mut st2: fmi2FMUstate = null_mut();
-        assert_eq!(
-            fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut st2),
-            fmi2OK
-        );
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut st2), fmi2OK);
         assert_eq!(fmi2SetFMUstate(c, st2), fmi2OK);
         assert_eq!(fmi2FreeFMUstate(c, &mut st), fmi2OK);
         assert_eq!(fmi2FreeFMUstate(c, &mut st2), fmi2OK);
