@@ -4,7 +4,7 @@
 use crate::fmi2::model::{CoSimModel, ModelInfo, StepError};
 use crate::physics::actuator::{index, Actuator, State, N_STATES};
 use crate::physics::parameters::{variable_name, Parameters};
-use crate::simulation::{Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+use crate::simulation::{Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 use crate::variables::{vr, UNITS, VARIABLES};
 
 /// Changes whenever the interface (variable table) changes.
@@ -288,6 +288,13 @@ impl CoSimModel for ActuatorFmu {
                     s.relative_tolerance,
                     s.integrator.next_step,
                     s.integrator.max_step,
+                    s.integrator.first_step,
+                    s.chamber_integrator.next_step,
+                    s.chamber_integrator.max_step,
+                    s.chamber_integrator.first_step,
+                    s.step_after_change,
+                    if s.input_changed { 1.0 } else { 0.0 },
+                    if s.method == Method::Split { 0.0 } else { 1.0 },
                 ] {
                     w.f64(v);
                 }
@@ -342,8 +349,12 @@ impl CoSimModel for ActuatorFmu {
         restored.start_at_equilibrium = r.u32()? != 0;
         if r.u32()? == 1 {
             let model = Actuator::new(restored.params.clone())?;
-            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step] =
-                [(); 8].map(|_| r.f64()).map(|v| v.unwrap_or(f64::NAN));
+            let mut values = [0.0; 15];
+            for v in values.iter_mut() {
+                *v = r.f64()?;
+            }
+            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step, first_step, chamber_next, chamber_max, chamber_first, after_change, changed, method] =
+                values;
             let mut state = State::zeros();
             for k in 0..N_STATES {
                 state[k] = r.f64()?;
@@ -353,15 +364,36 @@ impl CoSimModel for ActuatorFmu {
             simulation.x_s_rate = x_s_rate;
             simulation.integrator.next_step = next_step;
             simulation.integrator.max_step = max_step;
+            simulation.integrator.first_step = first_step;
+            simulation.chamber_integrator.next_step = chamber_next;
+            simulation.chamber_integrator.max_step = chamber_max;
+            simulation.chamber_integrator.first_step = chamber_first;
+            simulation.step_after_change = after_change;
+            simulation.input_changed = changed != 0.0;
+            if method != 0.0 {
+                simulation.method = Method::Monolithic;
+            }
             let st = &mut simulation.statistics;
             st.steps = r.u64()?;
             st.rejected = r.u64()?;
             st.rhs_evaluations = r.u64()?;
             st.jacobians = r.u64()?;
             st.newton_failures = r.u64()?;
-            let finite = [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step]
-                .iter()
-                .all(|v| v.is_finite())
+            let finite = [
+                time,
+                v_da,
+                x_s,
+                v_da_rate,
+                x_s_rate,
+                rtol,
+                next_step,
+                first_step,
+                chamber_next,
+                chamber_first,
+                after_change,
+            ]
+            .iter()
+            .all(|v| v.is_finite())
                 && state.iter().all(|v| v.is_finite());
             if !finite {
                 return Err("the state holds non-finite values".to_string());

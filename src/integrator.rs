@@ -99,6 +99,8 @@ const MIN_STEP: f64 = 1e-14;
 pub struct Sdirk4 {
     pub next_step: f64,
     pub max_step: f64,
+    /// Size of the first accepted step of the last `integrate` call.
+    pub first_step: f64,
 }
 
 impl Default for Sdirk4 {
@@ -106,6 +108,7 @@ impl Default for Sdirk4 {
         Self {
             next_step: 1e-5,
             max_step: f64::INFINITY,
+            first_step: 1e-5,
         }
     }
 }
@@ -144,6 +147,8 @@ impl Sdirk4 {
         let mut y = y0;
         let mut h = self.next_step.min(self.max_step).max(MIN_STEP);
         let mut last_rejected = false;
+        let mut first_accepted = None;
+        let mut previous_error: f64 = 1.0;
         let span = t1 - t0;
         while t1 - t > 1e-15 * span.abs().max(t1.abs()) {
             let remaining = t1 - t;
@@ -156,9 +161,19 @@ impl Sdirk4 {
             match self.attempt(system, t, &y, h_try, tol, stats) {
                 Attempt::Accepted { y_new, error } => {
                     stats.steps += 1;
+                    if first_accepted.is_none() {
+                        first_accepted = Some(h_try);
+                    }
                     t = if final_step { t1 } else { t + h_try };
                     y = y_new;
-                    let mut factor = if error == 0.0 { 5.0 } else { 0.9 * error.powf(-0.25) };
+                    // PI step-size control (Gustafsson): the previous error damps the
+                    // oscillation of the step size that an oscillating forcing provokes.
+                    let mut factor = if error == 0.0 {
+                        5.0
+                    } else {
+                        0.9 * error.powf(-0.7 / 4.0) * previous_error.powf(0.4 / 4.0)
+                    };
+                    previous_error = error.max(1e-4);
                     factor = factor.clamp(0.2, 5.0);
                     if last_rejected {
                         factor = factor.min(1.0);
@@ -198,6 +213,9 @@ impl Sdirk4 {
             }
         }
         self.next_step = h;
+        if let Some(first) = first_accepted {
+            self.first_step = first;
+        }
         Ok(y)
     }
 

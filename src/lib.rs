@@ -7,6 +7,7 @@
 //! * [`fmu`]: the actuator behind that layer; [`fmu_exports`]: the exported `fmi2*` symbols;
 //! * [`variables`]: the table of FMU variables from which the model description comes.
 
+pub mod electromechanics;
 pub mod fmi2;
 pub mod fmu;
 pub mod fmu_exports;
