@@ -18,6 +18,7 @@
 
 use nalgebra::Complex;
 
+use crate::physics::effects::{PrandtlIshlinskii, PLAY_OPERATORS};
 use crate::physics::jet_pipe;
 use crate::physics::parameters::Parameters;
 
@@ -46,6 +47,8 @@ pub struct ElectromechanicalPropagator {
     inverse: [[C64; 3]; 3],
     /// V⁻¹ b with b = [0, 0, ω1ω2²].
     beta: [C64; 3],
+    /// The jet_pipe_hysteresis operator between f3 and the dynamics (inactive when off).
+    hysteresis: PrandtlIshlinskii,
 }
 
 /// Largest |ε|/ρ (jump over the distance to tanh's nearest pole) for which the series is used.
@@ -120,11 +123,22 @@ impl ElectromechanicalPropagator {
             lambda,
             inverse,
             beta,
+            hysteresis: PrandtlIshlinskii::new(p.hysteresis_width),
         })
     }
 
     /// The trajectory over a step starting from `start` with command v_DA(s) = v_da + v_da_rate·s.
-    pub fn trajectory(&self, start: &ElectromechanicalState, v_da: f64, v_da_rate: f64) -> Trajectory<'_> {
+    ///
+    /// `plays` are the hysteresis operator's play states at the start; the current is
+    /// monotone in time except at most at one turning point (with a moving command), so
+    /// the plays at any instant follow from their start values in at most two moves.
+    pub fn trajectory(
+        &self,
+        start: &ElectromechanicalState,
+        v_da: f64,
+        v_da_rate: f64,
+        plays: &[f64; PLAY_OPERATORS],
+    ) -> Trajectory<'_> {
         let static_current = self.k_cd * v_da + self.i_offset;
         let ramp = self.k_cd * v_da_rate;
         // i(s) = ī(0) + ramp·(s − 1/ω) + δ e^{−ω s}
@@ -136,25 +150,84 @@ impl ElectromechanicalPropagator {
             q0[k] = self.inverse[k][0] * z[0] + self.inverse[k][1] * z[1] + self.inverse[k][2] * z[2];
         }
         let mut series = Vec::new();
-        if ramp == 0.0 {
+        // i'(s) = ramp − ω δ e^{−ω s} vanishes once at most.
+        let ratio = ramp / (self.omega_cd * delta);
+        let turning_point = (ratio > 0.0 && ratio < 1.0).then(|| -ratio.ln() / self.omega_cd);
+        let linear_hysteresis = if ramp == 0.0 && self.hysteresis.is_active() {
+            self.hysteresis_as_linear(start.current, base, plays)
+        } else {
+            None
+        };
+        if ramp == 0.0 && (!self.hysteresis.is_active() || linear_hysteresis.is_some()) {
             let centre = self.k_m * base / self.f_sat;
             let epsilon = self.k_m * delta / self.f_sat;
             let radius = (centre * centre + std::f64::consts::FRAC_PI_2.powi(2)).sqrt();
             if epsilon.abs() <= SERIES_RATIO_LIMIT * radius {
                 series = tanh_series(centre, epsilon, MAX_SERIES_TERMS);
+                let (constant, slope) = linear_hysteresis.unwrap_or((0.0, 1.0));
                 for a in series.iter_mut() {
-                    *a *= self.x_sat;
+                    *a *= self.x_sat * slope;
                 }
+                series[0] += constant;
             }
         }
-        Trajectory {
+        let mut trajectory = Trajectory {
             propagator: self,
             base,
             ramp,
             delta,
             q0,
             series,
+            plays: *plays,
+            turning_point,
+            settled: None,
+            kinks: vec![],
+        };
+        if trajectory.series.is_empty() {
+            trajectory.kinks = trajectory.find_kinks();
         }
+        if trajectory.series.is_empty() && ramp == 0.0 {
+            // |δ| e^{−ω s} below 1e-15 A: the input is constant to rounding.
+            let settled = (delta.abs() / 1e-15).ln().max(0.0) / self.omega_cd;
+            let integral = trajectory.quadrature(settled);
+            trajectory.settled = Some((settled, integral, trajectory.jet_input(settled)));
+        }
+        trajectory
+    }
+}
+
+impl ElectromechanicalPropagator {
+    /// With a held command the static position moves monotonically from f3(i(0)) to
+    /// f3(ī). If no play of the hysteresis operator starts to move on the way, the
+    /// operator's output is affine in the static position, u = C + f·x̄ (f the fraction of
+    /// plays being dragged), and the closed-form series still applies: returns (C, f).
+    fn hysteresis_as_linear(
+        &self,
+        current: f64,
+        static_current: f64,
+        plays: &[f64; PLAY_OPERATORS],
+    ) -> Option<(f64, f64)> {
+        let x_bar = |i: f64| jet_pipe::static_position(self.x_sat, self.f_sat, jet_pipe::tip_force(self.k_m, i));
+        let (from, to) = (x_bar(current), x_bar(static_current));
+        let rising = to >= from;
+        let (mut constant, mut dragged) = (0.0, 0usize);
+        for (p, r) in plays.iter().zip(&self.hysteresis.half_widths) {
+            // Where the play is pushed from: the edge of its band on the moving side.
+            let edge = if rising { from - r } else { from + r };
+            let engaged = if rising { *p <= edge } else { *p >= edge };
+            if engaged {
+                dragged += 1;
+                constant += if rising { -r } else { *r };
+            } else {
+                let engages_at = if rising { p + r } else { p - r };
+                if (rising && engages_at < to) || (!rising && engages_at > to) {
+                    return None;
+                }
+                constant += p;
+            }
+        }
+        let n = PLAY_OPERATORS as f64;
+        Some((constant / n, dragged as f64 / n))
     }
 }
 
@@ -191,6 +264,17 @@ pub struct Trajectory<'a> {
     q0: [C64; 3],
     /// x_sat·aₙ when the closed-form series applies; empty otherwise.
     series: Vec<f64>,
+    /// Hysteresis play states at the start of the step.
+    plays: [f64; PLAY_OPERATORS],
+    /// For a held command integrated by quadrature: the time after which the current
+    /// transient no longer moves the jet pipe input, the modal integrals up to then, and
+    /// the input from then on.
+    settled: Option<(f64, [C64; 3], f64)>,
+    /// Where the current stops rising and starts falling or back, if within the step.
+    turning_point: Option<f64>,
+    /// Instants where the quadrature's integrand has a kink (the turning point, plays of
+    /// the hysteresis operator starting to move): panels end there.
+    kinks: Vec<f64>,
 }
 
 impl Trajectory<'_> {
@@ -199,9 +283,105 @@ impl Trajectory<'_> {
         self.base + self.ramp * s + self.delta * (-self.propagator.omega_cd * s).exp()
     }
 
-    fn jet_input(&self, s: f64) -> f64 {
+    fn static_position(&self, s: f64) -> f64 {
         let p = self.propagator;
         jet_pipe::static_position(p.x_sat, p.f_sat, jet_pipe::tip_force(p.k_m, self.current(s)))
+    }
+
+    /// The hysteresis operator's play states at `s` (all at f3's output when it is off).
+    pub fn plays_at(&self, s: f64) -> [f64; PLAY_OPERATORS] {
+        let operator = &self.propagator.hysteresis;
+        if !operator.is_active() {
+            return [self.static_position(s); PLAY_OPERATORS];
+        }
+        let mut plays = self.plays;
+        if let Some(turn) = self.turning_point.filter(|&turn| turn < s) {
+            operator.advance(&mut plays, self.static_position(turn));
+        }
+        operator.advance(&mut plays, self.static_position(s));
+        plays
+    }
+
+    fn jet_input(&self, s: f64) -> f64 {
+        if self.propagator.hysteresis.is_active() {
+            PrandtlIshlinskii::output(&self.plays_at(s))
+        } else {
+            self.static_position(s)
+        }
+    }
+
+    /// Kinks of the jet pipe input for a held command: the instants at which plays of the
+    /// hysteresis operator start to move (the static position is monotone, so each is
+    /// found by bisection), plus the current's turning point.
+    fn find_kinks(&self) -> Vec<f64> {
+        let mut kinks: Vec<f64> = self.turning_point.into_iter().collect();
+        let operator = &self.propagator.hysteresis;
+        if operator.is_active() && self.ramp == 0.0 {
+            let settle = (self.delta.abs() / 1e-15).ln().max(0.0) / self.propagator.omega_cd;
+            let (from, to) = (self.static_position(0.0), self.static_position(settle));
+            let rising = to >= from;
+            for (p, r) in self.plays.iter().zip(&operator.half_widths) {
+                let engages_at = if rising { p + r } else { p - r };
+                let inside = if rising {
+                    engages_at > from && engages_at < to
+                } else {
+                    engages_at < from && engages_at > to
+                };
+                if !inside {
+                    continue;
+                }
+                let (mut lo, mut hi) = (0.0, settle);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    let passed = if rising {
+                        self.static_position(mid) >= engages_at
+                    } else {
+                        self.static_position(mid) <= engages_at
+                    };
+                    if passed {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                kinks.push(0.5 * (lo + hi));
+            }
+        }
+        kinks.sort_by(|a, b| a.total_cmp(b));
+        kinks
+    }
+
+    /// ∫₀ˢ e^{λ(s−σ)} u(σ) dσ for each mode by composite Gauss–Legendre quadrature on
+    /// panels of at most [`PANEL`] that end at every kink of u.
+    fn quadrature(&self, s: f64) -> [C64; 3] {
+        let p = self.propagator;
+        let mut integral = [C64::new(0.0, 0.0); 3];
+        if s <= 0.0 {
+            return integral;
+        }
+        let mut start = 0.0;
+        for end in self
+            .kinks
+            .iter()
+            .copied()
+            .filter(|&k| k > 0.0 && k < s)
+            .chain(std::iter::once(s))
+        {
+            let panels = ((end - start) / PANEL).ceil().max(1.0) as usize;
+            let width = (end - start) / panels as f64;
+            for j in 0..panels {
+                let centre = start + (j as f64 + 0.5) * width;
+                for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
+                    let sigma = centre + 0.5 * width * node;
+                    let u = self.jet_input(sigma) * weight * 0.5 * width;
+                    for k in 0..3 {
+                        integral[k] += (p.lambda[k] * (s - sigma)).exp() * u;
+                    }
+                }
+            }
+            start = end;
+        }
+        integral
     }
 
     /// Modal coordinates at `s`.
@@ -230,19 +410,15 @@ impl Trajectory<'_> {
                 }
                 decay_n *= decay;
             }
-        } else if s > 0.0 {
-            let panels = (s / PANEL).ceil().max(1.0) as usize;
-            let width = s / panels as f64;
-            for j in 0..panels {
-                let centre = (j as f64 + 0.5) * width;
-                for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
-                    let sigma = centre + 0.5 * width * node;
-                    let u = self.jet_input(sigma) * weight * 0.5 * width;
-                    for k in 0..3 {
-                        integral[k] += (p.lambda[k] * (s - sigma)).exp() * u;
-                    }
-                }
+        } else if let Some((settled, at_settled, u_final)) = self.settled.filter(|(settled, _, _)| s > *settled) {
+            // Past the current transient the input is constant: carry the integral up to
+            // the settling time forward and add the constant input's part exactly.
+            for k in 0..3 {
+                let carry = (p.lambda[k] * (s - settled)).exp();
+                integral[k] = carry * at_settled[k] + (carry - 1.0) / p.lambda[k] * u_final;
             }
+        } else {
+            integral = self.quadrature(s);
         }
         for k in 0..3 {
             q[k] = growth[k] * self.q0[k] + p.beta[k] * integral[k];
@@ -255,7 +431,7 @@ impl Trajectory<'_> {
     pub fn ringing_amplitude(&self, s: f64) -> f64 {
         let p = self.propagator;
         let q = self.modes(s);
-        let u_rest = jet_pipe::static_position(p.x_sat, p.f_sat, jet_pipe::tip_force(p.k_m, self.base + self.ramp * s));
+        let u_rest = self.jet_input(s);
         2.0 * (q[1] + p.beta[1] * u_rest / p.lambda[1]).norm()
     }
 
@@ -364,7 +540,7 @@ mod tests {
         let y0 = SVector::<f64, 4>::new(start.current, start.position, start.velocity, start.acceleration);
         // small jump (series), large jump (quadrature), and a ramp (quadrature)
         for (v, rate) in [(1.3, 0.0), (10.0, 0.0), (-8.0, 0.0), (1.0, 400.0)] {
-            let trajectory = propagator.trajectory(&start, v, rate);
+            let trajectory = propagator.trajectory(&start, v, rate, &[start.position; PLAY_OPERATORS]);
             for s in [1e-5, 3e-4, 2e-3, 1e-2] {
                 let exact = trajectory.state(s);
                 let y = reference(&p, y0, v, rate, s);

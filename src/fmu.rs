@@ -3,8 +3,9 @@
 
 use crate::fmi2::model::{CoSimModel, ModelInfo, StepError};
 use crate::physics::actuator::{index, Actuator, State, N_STATES};
+use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::parameters::{variable_name, Parameters};
-use crate::simulation::{Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+use crate::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 use crate::variables::{vr, UNITS, VARIABLES};
 
 /// Changes whenever the interface (variable table) changes.
@@ -105,7 +106,7 @@ impl CoSimModel for ActuatorFmu {
         match value_reference {
             vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, |s| s.v_da)),
             vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, |s| s.x_s)),
-            vr::F_ACT | vr::P1 | vr::P2 | vr::I | vr::X_JP => {
+            vr::F_ACT | vr::F_MEAS | vr::P1 | vr::P2 | vr::I | vr::X_JP => {
                 let computed;
                 let simulation = match &self.simulation {
                     Some(s) => s,
@@ -117,6 +118,7 @@ impl CoSimModel for ActuatorFmu {
                 let y = simulation.outputs();
                 Ok(match value_reference {
                     vr::F_ACT => y.f_act,
+                    vr::F_MEAS => y.f_meas,
                     vr::P1 => y.p1,
                     vr::P2 => y.p2,
                     vr::I => y.current,
@@ -301,6 +303,17 @@ impl CoSimModel for ActuatorFmu {
                 for k in 0..N_STATES {
                     w.f64(s.state[k]);
                 }
+                for p in s.plays {
+                    w.f64(p);
+                }
+                w.f64(s.stopper_velocity);
+                w.f64(s.x_s_at_last_step);
+                w.u32(s.command_history.len() as u32);
+                for change in &s.command_history {
+                    w.f64(change.time);
+                    w.f64(change.v_da);
+                    w.f64(change.rate);
+                }
                 let st = &s.statistics;
                 for v in [
                     st.steps,
@@ -359,6 +372,26 @@ impl CoSimModel for ActuatorFmu {
             for k in 0..N_STATES {
                 state[k] = r.f64()?;
             }
+            let mut plays = [0.0; PLAY_OPERATORS];
+            for p in plays.iter_mut() {
+                *p = r.f64()?;
+            }
+            let stopper_velocity = r.f64()?;
+            let x_s_at_last_step = r.f64()?;
+            let changes = r.u32()? as usize;
+            if changes > bytes.len() / 24 {
+                return Err(format!(
+                    "the state claims {changes} command changes, more than its length holds"
+                ));
+            }
+            let mut command_history = Vec::with_capacity(changes);
+            for _ in 0..changes {
+                command_history.push(CommandChange {
+                    time: r.f64()?,
+                    v_da: r.f64()?,
+                    rate: r.f64()?,
+                });
+            }
             let mut simulation = Simulation::from_state(model, state, v_da, x_s, time, rtol);
             simulation.v_da_rate = v_da_rate;
             simulation.x_s_rate = x_s_rate;
@@ -369,6 +402,10 @@ impl CoSimModel for ActuatorFmu {
             simulation.chamber_integrator.max_step = chamber_max;
             simulation.chamber_integrator.first_step = chamber_first;
             simulation.step_after_change = after_change;
+            simulation.plays = plays;
+            simulation.stopper_velocity = stopper_velocity;
+            simulation.x_s_at_last_step = x_s_at_last_step;
+            simulation.command_history = command_history;
             simulation.input_changed = changed != 0.0;
             if method != 0.0 {
                 simulation.method = Method::Monolithic;

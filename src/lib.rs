@@ -17,6 +17,7 @@ pub mod packaging;
 pub mod physics;
 pub mod scenario;
 pub mod simulation;
+pub mod synthetic_bench;
 pub mod variables;
 
 /// The model behind the exported FMI symbols in [`fmu_exports`].

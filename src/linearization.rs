@@ -40,7 +40,7 @@ pub struct LinearModel {
 pub fn command_for_force(model: &Actuator, force: f64, x_s: f64) -> Result<f64, String> {
     let f = |v: f64| -> Result<f64, String> {
         let y = equilibrium(model, v, x_s)?;
-        Ok(model.outputs(&y, x_s).f_act)
+        Ok(model.outputs(&y, x_s, 0.0).f_act)
     };
     let (mut lo, mut hi) = (-10.0, 10.0);
     let (f_lo, f_hi) = (f(lo)?, f(hi)?);
@@ -71,6 +71,7 @@ pub fn linearize(model: &Actuator, v_da: f64, x_s: f64) -> Result<LinearModel, S
         v_da,
         x_s,
         x_s_rate: 0.0,
+        plays: None,
     };
     let mut a = model.jacobian(&y0, &u, &model.derivatives(&y0, &u));
     // Central differences for the chamber rows (the integrator's Jacobian is one-sided).
@@ -90,7 +91,7 @@ pub fn linearize(model: &Actuator, v_da: f64, x_s: f64) -> Result<LinearModel, S
     }
     let mut b = SVector::<f64, N_STATES>::zeros();
     b[index::CURRENT] = model.params.omega_cd * model.params.k_cd;
-    let outputs = model.outputs(&y0, x_s);
+    let outputs = model.outputs(&y0, x_s, 0.0);
     let on_spring_floor = outputs.f_act > model.piston_area * (y0[index::P1] - y0[index::P2]);
     let mut c = SVector::<f64, N_STATES>::zeros();
     if !on_spring_floor {

@@ -13,6 +13,7 @@ use crate::integrator::{finite_difference_jacobian, IntegrationFailure, OdeSyste
 use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::current_driver;
+use crate::physics::effects::PLAY_OPERATORS;
 
 /// The default relative tolerance (also the model description's default experiment).
 pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-6;
@@ -31,6 +32,7 @@ struct StepSystem<'a> {
     v_da_rate: f64,
     x_s: f64,
     x_s_rate: f64,
+    plays: Option<[f64; PLAY_OPERATORS]>,
 }
 
 impl StepSystem<'_> {
@@ -40,6 +42,7 @@ impl StepSystem<'_> {
             v_da: self.v_da + self.v_da_rate * dt,
             x_s: self.x_s + self.x_s_rate * dt,
             x_s_rate: self.x_s_rate,
+            plays: self.plays,
         }
     }
 }
@@ -124,7 +127,22 @@ pub struct Simulation {
     /// next step after a change starts, instead of the long steps that suit the end of a
     /// quiet interval.
     pub step_after_change: f64,
+    /// Play operators of the jet_pipe_hysteresis effect (all at f3's output when it is off).
+    pub plays: [f64; PLAY_OPERATORS],
+    /// Commands of the recent past, for the transport_delay effect.
+    pub command_history: Vec<CommandChange>,
+    /// Mean stopper velocity over the last step (for piston friction).
+    pub stopper_velocity: f64,
+    pub x_s_at_last_step: f64,
     propagator: Option<ElectromechanicalPropagator>,
+}
+
+/// From `time` on, the command was `v_da` + `rate`·(t − `time`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommandChange {
+    pub time: f64,
+    pub v_da: f64,
+    pub rate: f64,
 }
 
 impl Simulation {
@@ -145,6 +163,7 @@ impl Simulation {
     /// A simulation from a given state.
     pub fn from_state(model: Actuator, state: State, v_da: f64, x_s: f64, time: f64, relative_tolerance: f64) -> Self {
         let propagator = ElectromechanicalPropagator::new(&model.params);
+        let x_bar = model.static_jet_position(state[index::CURRENT]);
         Self {
             model,
             time,
@@ -164,12 +183,20 @@ impl Simulation {
             statistics: Statistics::default(),
             input_changed: false,
             step_after_change: 1e-5,
+            plays: [x_bar; PLAY_OPERATORS],
+            command_history: vec![CommandChange {
+                time: f64::NEG_INFINITY,
+                v_da,
+                rate: 0.0,
+            }],
+            stopper_velocity: 0.0,
+            x_s_at_last_step: x_s,
             propagator,
         }
     }
 
     pub fn outputs(&self) -> Outputs {
-        self.model.outputs(&self.state, self.x_s)
+        self.model.outputs(&self.state, self.x_s, self.stopper_velocity)
     }
 
     pub fn set_command(&mut self, v_da: f64) -> Result<(), String> {
@@ -183,7 +210,7 @@ impl Simulation {
     pub fn set_stopper(&mut self, x_s: f64) -> Result<(), String> {
         self.model.params.check_stopper(x_s)?;
         if x_s != self.x_s {
-            let gamma = self.model.params.gamma;
+            let gamma = self.model.polytropic_exponent;
             let (v1_before, v2_before) = self.model.cylinder.volumes(self.x_s);
             let (v1_after, v2_after) = self.model.cylinder.volumes(x_s);
             self.state[index::P1] = pressure_after_volume_jump(gamma, self.state[index::P1], v1_before, v1_after);
@@ -263,6 +290,73 @@ impl Simulation {
             })?;
         }
         let t_end = self.time + step;
+        for (duration, v, v_rate) in self.command_segments(step) {
+            self.advance(duration, v, v_rate).map_err(|failure| {
+                self.v_da_rate = 0.0;
+                self.x_s_rate = 0.0;
+                failure
+            })?;
+        }
+        self.time = t_end;
+        self.x_s = x_s_end;
+        self.v_da += self.v_da_rate * step;
+        self.v_da_rate = 0.0;
+        self.x_s_rate = 0.0;
+        self.input_changed = false;
+        self.stopper_velocity = (self.x_s - self.x_s_at_last_step) / step;
+        self.x_s_at_last_step = self.x_s;
+        Ok(())
+    }
+
+    /// The command the current driver sees over the next `step`: v_DA itself, or (with the
+    /// transport_delay effect) v_DA as it was `command_delay` earlier, as (duration,
+    /// value at the segment's start, rate) pieces.
+    fn command_segments(&mut self, step: f64) -> Vec<(f64, f64, f64)> {
+        let delay = self.model.params.command_delay;
+        if delay == 0.0 {
+            return vec![(step, self.v_da, self.v_da_rate)];
+        }
+        self.command_history.push(CommandChange {
+            time: self.time,
+            v_da: self.v_da,
+            rate: self.v_da_rate,
+        });
+        let (from, to) = (self.time - delay, self.time + step - delay);
+        // Forget what no later step can see.
+        while self.command_history.len() > 1 && self.command_history[1].time <= from {
+            self.command_history.remove(0);
+        }
+        let mut segments = vec![];
+        let mut start = from;
+        for (k, change) in self.command_history.iter().enumerate() {
+            let end = self.command_history.get(k + 1).map_or(to, |next| next.time.min(to));
+            if end <= start {
+                continue;
+            }
+            let value = if change.rate == 0.0 {
+                change.v_da
+            } else {
+                change.v_da + change.rate * (start - change.time)
+            };
+            segments.push((end - start, value, change.rate));
+            start = end;
+            if start >= to {
+                break;
+            }
+        }
+        // Rounding can leave the pieces a hair short of the step: give it to the last.
+        let covered: f64 = segments.iter().map(|s| s.0).sum();
+        if let Some(last) = segments.last_mut() {
+            last.0 += step - covered;
+        }
+        segments
+    }
+
+    /// Integrate `duration` seconds with the command `v` + `v_rate`·s seen by the current
+    /// driver; the stopper moves at `x_s_rate`.
+    fn advance(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<(), StepFailure> {
+        let t0 = self.time;
+        let t_end = t0 + duration;
         let outcome = match (self.method, &self.propagator) {
             (Method::Split, Some(propagator)) => {
                 let start = ElectromechanicalState {
@@ -271,11 +365,11 @@ impl Simulation {
                     velocity: self.state[index::JET_VELOCITY],
                     acceleration: self.state[index::JET_ACCELERATION],
                 };
-                let trajectory = propagator.trajectory(&start, self.v_da, self.v_da_rate);
+                let trajectory = propagator.trajectory(&start, v, v_rate, &self.plays);
                 let system = ChamberSystem {
                     model: &self.model,
                     trajectory: &trajectory,
-                    t0: self.time,
+                    t0,
                     x_s: self.x_s,
                     x_s_rate: self.x_s_rate,
                 };
@@ -285,7 +379,6 @@ impl Simulation {
                     absolute: SVector::<f64, 2>::new(scale[index::P1], scale[index::P2]) * self.local_tolerance(),
                 };
                 let pressures = SVector::<f64, 2>::new(self.state[index::P1], self.state[index::P2]);
-                let t0 = self.time;
                 let combine = |s: f64, p: SVector<f64, 2>| {
                     let em = trajectory.state(s);
                     State::from([em.current, em.position, em.velocity, em.acceleration, p[0], p[1]])
@@ -293,8 +386,8 @@ impl Simulation {
                 // While the jet pipe rings enough to matter, keep steps below a quarter of
                 // its period: a longer step samples the 295 Hz forcing too sparsely for the
                 // embedded error estimate to notice what it misses.
-                let ringing_until = self.ringing_until(&trajectory, step);
-                let changed = self.input_changed || self.v_da_rate != 0.0 || self.x_s_rate != 0.0;
+                let ringing_until = self.ringing_until(&trajectory, duration);
+                let changed = self.input_changed || v_rate != 0.0 || self.x_s_rate != 0.0;
                 if changed {
                     self.chamber_integrator.next_step =
                         self.chamber_integrator.next_step.min(2.0 * self.step_after_change);
@@ -314,7 +407,7 @@ impl Simulation {
                     );
                     self.chamber_integrator.max_step = unlimited;
                     match first {
-                        Ok(p) if ringing_until < step => self.chamber_integrator.integrate(
+                        Ok(p) if ringing_until < duration => self.chamber_integrator.integrate(
                             &system,
                             t_split,
                             p,
@@ -331,8 +424,13 @@ impl Simulation {
                 if changed {
                     self.step_after_change = self.chamber_integrator.first_step;
                 }
+                let reached = match &result {
+                    Ok(_) => duration,
+                    Err(f) => f.time - t0,
+                };
+                self.plays = trajectory.plays_at(reached);
                 match result {
-                    Ok(p) => Ok(combine(step, p)),
+                    Ok(p) => Ok(combine(duration, p)),
                     Err(f) => Err(IntegrationFailure {
                         message: f.message,
                         time: f.time,
@@ -343,26 +441,34 @@ impl Simulation {
             _ => {
                 let system = StepSystem {
                     model: &self.model,
-                    t0: self.time,
-                    v_da: self.v_da,
-                    v_da_rate: self.v_da_rate,
+                    t0,
+                    v_da: v,
+                    v_da_rate: v_rate,
                     x_s: self.x_s,
                     x_s_rate: self.x_s_rate,
+                    plays: self.hysteresis_plays(),
                 };
                 let tolerances = self.tolerances();
-                self.integrator
-                    .integrate(&system, self.time, self.state, t_end, &tolerances, &mut self.statistics)
+                let result =
+                    self.integrator
+                        .integrate(&system, t0, self.state, t_end, &tolerances, &mut self.statistics);
+                if self.model.hysteresis.is_active() {
+                    // Plays follow the static position monotonically within the step.
+                    let y = match &result {
+                        Ok(y) => *y,
+                        Err(f) => f.state,
+                    };
+                    let x_bar = self.model.static_jet_position(y[index::CURRENT]);
+                    self.model.hysteresis.advance(&mut self.plays, x_bar);
+                }
+                result
             }
         };
         match outcome {
             Ok(y) => {
                 self.state = y;
                 self.time = t_end;
-                self.v_da += self.v_da_rate * step;
-                self.x_s = x_s_end;
-                self.v_da_rate = 0.0;
-                self.x_s_rate = 0.0;
-                self.input_changed = false;
+                self.x_s += self.x_s_rate * duration;
                 Ok(())
             }
             Err(failure) => {
@@ -377,6 +483,10 @@ impl Simulation {
                 })
             }
         }
+    }
+
+    fn hysteresis_plays(&self) -> Option<[f64; PLAY_OPERATORS]> {
+        self.model.hysteresis.is_active().then_some(self.plays)
     }
 }
 
@@ -418,6 +528,7 @@ pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, Strin
         v_da_rate: 0.0,
         x_s,
         x_s_rate: 0.0,
+        plays: None,
     };
     let tolerances = Tolerances {
         relative: 1e-8,
@@ -598,28 +709,134 @@ mod tests {
     #[test]
     fn split_and_monolithic_methods_agree() {
         // The exact jet pipe propagation plus chamber integration against the six-state
-        // SDIRK4 on the same inputs, including big command jumps and stopper motion.
-        let model = thesis_model();
-        let run = |method: Method| {
-            let mut sim = Simulation::at_equilibrium(model.clone(), 0.0, 0.054, 0.0, 1e-8).unwrap();
-            sim.method = method;
-            let mut forces = vec![];
-            for k in 0..60 {
-                let (v, x) = crate::scenario::standard_inputs(k);
-                sim.set_command(if k % 20 == 10 { 10.0 } else { v }).unwrap();
-                sim.set_stopper(x).unwrap();
-                sim.set_stopper_rate(if k % 7 == 3 { 0.05 } else { 0.0 }).unwrap();
-                sim.step(0.01).unwrap();
-                forces.push((sim.outputs().f_act, sim.state[index::JET_POSITION]));
+        // SDIRK4 on the same inputs, including big command jumps and stopper motion, with
+        // and without the hysteresis operator (closed-form and quadrature paths).
+        for model in [thesis_model(), with(|p| p.hysteresis_width = 0.16e-3)] {
+            let run = |method: Method| {
+                let mut sim = Simulation::at_equilibrium(model.clone(), 0.0, 0.054, 0.0, 1e-8).unwrap();
+                sim.method = method;
+                let mut forces = vec![];
+                for k in 0..60 {
+                    let (v, x) = crate::scenario::standard_inputs(k);
+                    sim.set_command(if k % 20 == 10 { 10.0 } else { v }).unwrap();
+                    sim.set_stopper(x).unwrap();
+                    sim.set_stopper_rate(if k % 7 == 3 { 0.05 } else { 0.0 }).unwrap();
+                    sim.step(0.01).unwrap();
+                    forces.push((sim.outputs().f_act, sim.state[index::JET_POSITION]));
+                }
+                forces
+            };
+            let split = run(Method::Split);
+            let monolithic = run(Method::Monolithic);
+            for (k, (a, b)) in split.iter().zip(&monolithic).enumerate() {
+                assert!((a.0 - b.0).abs() < 1e-5, "sample {k}: F {} vs {}", a.0, b.0);
+                assert!((a.1 - b.1).abs() < 1e-10, "sample {k}: x_jp {} vs {}", a.1, b.1);
             }
-            forces
-        };
-        let split = run(Method::Split);
-        let monolithic = run(Method::Monolithic);
-        for (k, (a, b)) in split.iter().zip(&monolithic).enumerate() {
-            assert!((a.0 - b.0).abs() < 1e-5, "sample {k}: F {} vs {}", a.0, b.0);
-            assert!((a.1 - b.1).abs() < 1e-10, "sample {k}: x_jp {} vs {}", a.1, b.1);
         }
+    }
+
+    fn with(change: impl Fn(&mut Parameters)) -> Actuator {
+        let mut p = Parameters::default();
+        change(&mut p);
+        Actuator::new(p).unwrap()
+    }
+
+    /// Force after holding `v` for `hold` seconds, having come from `from`.
+    fn settled_force(model: &Actuator, from: f64, v: f64, hold: f64) -> f64 {
+        let mut sim = Simulation::at_equilibrium(model.clone(), from, 0.054, 0.0, 1e-6).unwrap();
+        // a slow ramp so hysteresis sees a monotone sweep
+        for k in 1..=100 {
+            sim.set_command(from + (v - from) * k as f64 / 100.0).unwrap();
+            sim.step(0.01).unwrap();
+        }
+        sim.step(hold).unwrap();
+        sim.outputs().f_act
+    }
+
+    #[test]
+    fn effects_are_off_by_default_and_each_changes_what_it_should() {
+        let thesis = thesis_model();
+        // jet_pipe_hysteresis: at the same command the force is higher coming down than
+        // going up (the tip lags the command by the play widths).
+        let hysteretic = with(|p| p.hysteresis_width = 0.16e-3);
+        let up = settled_force(&hysteretic, -4.0, 0.5, 2.0);
+        let down = settled_force(&hysteretic, 6.0, 0.5, 2.0);
+        let plain_up = settled_force(&thesis, -4.0, 0.5, 2.0);
+        let plain_down = settled_force(&thesis, 6.0, 0.5, 2.0);
+        // (the plain model is still settling from opposite sides: allow a tenth of the loop)
+        assert!(
+            (plain_up - plain_down).abs() < 0.1 * (down - up),
+            "hysteresis without the effect: {plain_up} {plain_down}"
+        );
+        assert!(down - up > 1.0, "hysteresis loop: up {up} N, down {down} N");
+        // supply_pressure_drop lowers the saturated force; dead_volume does not change statics.
+        let full = settled_force(&thesis, 0.0, 10.0, 2.0);
+        let dropped = settled_force(&with(|p| p.supply_resistance = 3e8), 0.0, 10.0, 2.0);
+        assert!(dropped < full - 1.0, "supply drop: {dropped} vs {full}");
+        let dead = with(|p| {
+            p.dead_volume_1 = 3e-6;
+            p.dead_volume_2 = 3e-6;
+        });
+        assert!((settled_force(&dead, 0.0, 2.5, 3.0) - settled_force(&thesis, 0.0, 2.5, 3.0)).abs() < 1e-3);
+        // dead_volume and heat_transfer slow the pressure response to a command step.
+        let response = |model: &Actuator| {
+            let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-6).unwrap();
+            let start = sim.outputs().f_act;
+            sim.set_command(2.5).unwrap();
+            sim.step(0.05).unwrap();
+            sim.outputs().f_act - start
+        };
+        let base = response(&thesis);
+        assert!(
+            response(&dead) < 0.9 * base,
+            "dead volume: {} vs {base}",
+            response(&dead)
+        );
+        let isothermal = with(|p| p.heat_transfer_fraction = 1.0);
+        assert!(
+            response(&isothermal) < 0.9 * base,
+            "heat transfer: {} vs {base}",
+            response(&isothermal)
+        );
+        // transport_delay: nothing happens until the delay has passed.
+        let delayed = with(|p| p.command_delay = 0.02);
+        let mut sim = Simulation::at_equilibrium(delayed, 1.0, 0.054, 0.0, 1e-6).unwrap();
+        let i0 = sim.outputs().current;
+        sim.set_command(2.5).unwrap();
+        for _ in 0..19 {
+            sim.step(0.001).unwrap();
+        }
+        assert!(
+            (sim.outputs().current - i0).abs() < 1e-12,
+            "current moved before the delay"
+        );
+        sim.step(0.005).unwrap();
+        assert!(
+            sim.outputs().current > i0 + 0.05,
+            "current did not follow after the delay"
+        );
+        // piston_friction: the rod force drops by F_c while the stopper extends.
+        let friction = with(|p| p.friction_coulomb = 1.5);
+        let run = |model: Actuator| {
+            let mut sim = Simulation::at_equilibrium(model, 2.5, 0.054, 0.0, 1e-6).unwrap();
+            sim.set_stopper_rate(0.01).unwrap();
+            sim.step(0.01).unwrap();
+            sim.outputs().f_act
+        };
+        assert!((run(thesis.clone()) - run(friction) - 1.5).abs() < 1e-9);
+        // sensor_offset_gain
+        let sensor = with(|p| {
+            p.force_sensor_offset = 0.7;
+            p.force_sensor_gain = 1.02;
+        });
+        let y = Simulation::at_equilibrium(sensor, 2.5, 0.054, 0.0, 1e-6)
+            .unwrap()
+            .outputs();
+        assert!((y.f_meas - (0.7 + 1.02 * y.f_act)).abs() < 1e-12);
+        let y = Simulation::at_equilibrium(thesis, 2.5, 0.054, 0.0, 1e-6)
+            .unwrap()
+            .outputs();
+        assert_eq!(y.f_meas, y.f_act);
     }
 
     #[test]

@@ -13,6 +13,7 @@ pub mod vr {
     pub const P2: u32 = 12;
     pub const I: u32 = 13;
     pub const X_JP: u32 = 14;
+    pub const F_MEAS: u32 = 15;
 
     pub const P_S: u32 = 100;
     pub const P_R: u32 = 101;
@@ -44,6 +45,17 @@ pub mod vr {
     pub const START_AT_EQUILIBRIUM: u32 = 200;
     pub const P1_START: u32 = 201;
     pub const P2_START: u32 = 202;
+
+    // Effects the thesis model lacks (MODEL.md), all off at their start values.
+    pub const HYSTERESIS_WIDTH: u32 = 300;
+    pub const FRICTION_COULOMB: u32 = 310;
+    pub const DEAD_VOLUME_1: u32 = 320;
+    pub const DEAD_VOLUME_2: u32 = 321;
+    pub const SUPPLY_RESISTANCE: u32 = 330;
+    pub const HEAT_TRANSFER_FRACTION: u32 = 340;
+    pub const COMMAND_DELAY: u32 = 350;
+    pub const FORCE_SENSOR_OFFSET: u32 = 360;
+    pub const FORCE_SENSOR_GAIN: u32 = 361;
 }
 
 pub const UNITS: &[UnitDefinition] = &[
@@ -151,6 +163,30 @@ pub const UNITS: &[UnitDefinition] = &[
         a: 0,
         k: 0,
     },
+    UnitDefinition {
+        name: "m3",
+        kg: 0,
+        m: 3,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "s",
+        kg: 0,
+        m: 0,
+        s: 1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Pa.s/kg",
+        kg: 0,
+        m: -1,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
 ];
 
 const fn input(name: &'static str, vr: u32, unit: &'static str, start: f64, description: &'static str) -> Variable {
@@ -211,7 +247,8 @@ pub const VARIABLES: &[Variable] = &[
     output("F_act", vr::F_ACT, "N", "actuator (tendon) force, (2.36)-(2.38)"),
     output("P1", vr::P1, "Pa", "absolute pressure of chamber 1 (charging side)"),
     output("P2", vr::P2, "Pa", "absolute pressure of chamber 2 (venting side)"),
-    output("i", vr::I, "A", "coil current"),
+        output("i", vr::I, "A", "coil current"),
+    output("F_meas", vr::F_MEAS, "N", "force as read by a sensor with the sensor_offset_gain effect: offset + gain * F_act"),
     output(
         "x_jp",
         vr::X_JP,
@@ -334,6 +371,14 @@ pub const VARIABLES: &[Variable] = &[
         vr::P2_START,
         "Pa",
         101_325.0,
-        "initial P2 when start_at_equilibrium is false",
-    ),
+        "initial P2 when start_at_equilibrium is false"),
+    parameter("hysteresis_width", vr::HYSTERESIS_WIDTH, "m", 0.0, "jet_pipe_hysteresis: separation of the rising and falling branches of the static tip position in large sweeps (Prandtl-Ishlinskii operator after f3; 0 = off)"),
+    parameter("friction_coulomb", vr::FRICTION_COULOMB, "N", 0.0, "piston_friction: Coulomb friction opposing stopper motion, (2.35) (0 = off)"),
+    parameter("dead_volume_1", vr::DEAD_VOLUME_1, "m3", 0.0, "dead_volume: port and line volume added to chamber 1 (0 = off)"),
+    parameter("dead_volume_2", vr::DEAD_VOLUME_2, "m3", 0.0, "dead_volume: port and line volume added to chamber 2 (0 = off)"),
+    parameter("supply_resistance", vr::SUPPLY_RESISTANCE, "Pa.s/kg", 0.0, "supply_pressure_drop: the supply pressure at the jet pipe falls by this times the supply mass flow (0 = off)"),
+    parameter("heat_transfer_fraction", vr::HEAT_TRANSFER_FRACTION, "1", 0.0, "heat_transfer: chambers polytropic with n = gamma - fraction*(gamma - 1): 0 adiabatic as the thesis, 1 isothermal"),
+    parameter("command_delay", vr::COMMAND_DELAY, "s", 0.0, "transport_delay: the current driver sees v_DA delayed by this time (0 = off)"),
+    parameter("force_sensor_offset", vr::FORCE_SENSOR_OFFSET, "N", 0.0, "sensor_offset_gain: offset of F_meas (0 = off)"),
+    parameter("force_sensor_gain", vr::FORCE_SENSOR_GAIN, "1", 1.0, "sensor_offset_gain: gain of F_meas (1 = off)"),
 ];

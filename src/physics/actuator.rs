@@ -6,6 +6,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::chambers::{pressure_rate, CylinderGeometry};
+use super::effects::{self, PrandtlIshlinskii, PLAY_OPERATORS};
 use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
@@ -31,6 +32,9 @@ pub struct Inputs {
     pub v_da: f64,
     pub x_s: f64,
     pub x_s_rate: f64,
+    /// Play states of the jet_pipe_hysteresis effect at the start of the step (`None`
+    /// when the effect is off).
+    pub plays: Option<[f64; PLAY_OPERATORS]>,
 }
 
 /// The mass flows of (2.24)–(2.25), kg/s.
@@ -63,6 +67,8 @@ pub struct Outputs {
     pub p2: f64,
     pub current: f64,
     pub x_jp: f64,
+    /// The force a sensor with the sensor_offset_gain effect reads.
+    pub f_meas: f64,
 }
 
 /// The thesis model with fixed parameters; derived constants computed once.
@@ -72,6 +78,9 @@ pub struct Actuator {
     pub flow: FlowConstants,
     pub cylinder: CylinderGeometry,
     pub piston_area: f64,
+    pub hysteresis: PrandtlIshlinskii,
+    /// Polytropic exponent of the chambers: γ unless the heat_transfer effect is on.
+    pub polytropic_exponent: f64,
 }
 
 impl Actuator {
@@ -80,11 +89,15 @@ impl Actuator {
         let flow = params.flow_constants();
         let cylinder = params.cylinder();
         let piston_area = cylinder.piston_area();
+        let hysteresis = PrandtlIshlinskii::new(params.hysteresis_width);
+        let polytropic_exponent = effects::polytropic_exponent(params.gamma, params.heat_transfer_fraction);
         Ok(Self {
             params,
             flow,
             cylinder,
             piston_area,
+            hysteresis,
+            polytropic_exponent,
         })
     }
 
@@ -100,10 +113,21 @@ impl Actuator {
         let p = &self.params;
         let a = self.areas(x_jp);
         let k = &self.flow;
+        let supply = |p_supply: f64| {
+            (
+                mass_flow(k, p.c_d * a.supply_1, p_supply, p1),
+                mass_flow(k, p.c_d * a.supply_2, p_supply, p2),
+            )
+        };
+        let p_supply = effects::supply_pressure_at_jet(p.p_s, p.supply_resistance, |ps| {
+            let (s1, s2) = supply(ps);
+            s1 + s2
+        });
+        let (supply_1, supply_2) = supply(p_supply);
         MassFlows {
-            supply_1: mass_flow(k, p.c_d * a.supply_1, p.p_s, p1),
+            supply_1,
             return_1: mass_flow(k, p.c_d * a.return_1, p1, p.p_r),
-            supply_2: mass_flow(k, p.c_d * a.supply_2, p.p_s, p2),
+            supply_2,
             return_2: mass_flow(k, p.c_d * a.return_2, p2, p.p_r),
             leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
         }
@@ -116,8 +140,24 @@ impl Actuator {
         let (v1, v2) = self.cylinder.volumes(x_s);
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
         (
-            pressure_rate(p.gamma, p.r_gas, p.temperature, v1, dv1, flows.net_1(), p1),
-            pressure_rate(p.gamma, p.r_gas, p.temperature, v2, dv2, flows.net_2(), p2),
+            pressure_rate(
+                self.polytropic_exponent,
+                p.r_gas,
+                p.temperature,
+                v1,
+                dv1,
+                flows.net_1(),
+                p1,
+            ),
+            pressure_rate(
+                self.polytropic_exponent,
+                p.r_gas,
+                p.temperature,
+                v2,
+                dv2,
+                flows.net_2(),
+                p2,
+            ),
         )
     }
 
@@ -132,7 +172,7 @@ impl Actuator {
         use index::*;
         let p = &self.params;
         let static_current = current_driver::static_current(p.k_cd, p.i_offset, u.v_da);
-        let x_bar = self.static_jet_position(y[CURRENT]);
+        let x_bar = self.jet_input(y[CURRENT], u.plays.as_ref());
         let (dp1, dp2) = self.pressure_rates(y[JET_POSITION], y[P1], y[P2], u.x_s, u.x_s_rate);
         State::from([
             current_driver::current_rate(p.omega_cd, static_current, y[CURRENT]),
@@ -190,11 +230,26 @@ impl Actuator {
         piston::spring_force(p.k_spring, p.l_spring0, p.l_s, p.l_p, x_s)
     }
 
-    pub fn outputs(&self, y: &State, x_s: f64) -> Outputs {
+    /// Input of the jet pipe dynamics: f3 of the tip force, through the hysteresis
+    /// operator when that effect is on (plays moved monotonically from `plays`).
+    pub fn jet_input(&self, current: f64, plays: Option<&[f64; PLAY_OPERATORS]>) -> f64 {
+        let x_bar = self.static_jet_position(current);
+        match plays {
+            Some(plays) if self.hysteresis.is_active() => self.hysteresis.output_after(plays, x_bar),
+            _ => x_bar,
+        }
+    }
+
+    /// Outputs for a state; `stopper_velocity` only matters with the piston_friction effect.
+    pub fn outputs(&self, y: &State, x_s: f64, stopper_velocity: f64) -> Outputs {
         use index::*;
-        let pressure_force = piston::pressure_force(self.piston_area, y[P1], y[P2]);
+        let p = &self.params;
+        let pressure_force = piston::pressure_force(self.piston_area, y[P1], y[P2])
+            - effects::friction_force(p.friction_coulomb, stopper_velocity);
+        let f_act = piston::actuator_force(pressure_force, self.spring_force(x_s));
         Outputs {
-            f_act: piston::actuator_force(pressure_force, self.spring_force(x_s)),
+            f_act,
+            f_meas: effects::sensor_reading(p.force_sensor_offset, p.force_sensor_gain, f_act),
             p1: y[P1],
             p2: y[P2],
             current: y[CURRENT],
@@ -222,6 +277,7 @@ mod tests {
             v_da: 2.5,
             x_s: 0.054,
             x_s_rate: 0.01,
+            plays: None,
         };
         let y = State::from([0.09, 2.1e-4, 0.03, -20.0, 4.0e5, 1.7e5]);
         let f = model.derivatives(&y, &u);

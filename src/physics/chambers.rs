@@ -11,6 +11,9 @@ pub struct CylinderGeometry {
     pub l_s: f64,
     pub l_sup: f64,
     pub d_cyl: f64,
+    /// Port and line volumes of each chamber (the `dead_volume` effect; 0 in the thesis).
+    pub dead_volume_1: f64,
+    pub dead_volume_2: f64,
 }
 
 impl CylinderGeometry {
@@ -24,11 +27,15 @@ impl CylinderGeometry {
         x_s - (self.l_p + self.l_s + self.l_sup)
     }
 
-    /// Chamber volumes (V1, V2), (2.30)–(2.31): V1 = A_p x_p, V2 = A_p (L_cyl − x_p − L_p).
+    /// Chamber volumes (V1, V2), (2.30)–(2.31): V1 = A_p x_p, V2 = A_p (L_cyl − x_p − L_p),
+    /// plus the dead volumes of the `dead_volume` effect (zero in the thesis model).
     pub fn volumes(&self, x_s: f64) -> (f64, f64) {
         let a_p = self.piston_area();
         let x_p = self.piston_position(x_s);
-        (a_p * x_p, a_p * (self.l_cyl - x_p - self.l_p))
+        (
+            a_p * x_p + self.dead_volume_1,
+            a_p * (self.l_cyl - x_p - self.l_p) + self.dead_volume_2,
+        )
     }
 
     /// Rates of change of the volumes for a stopper velocity: (A_p ẋ_s, −A_p ẋ_s).
@@ -75,6 +82,8 @@ mod tests {
             l_s: 7e-3,
             l_sup: 11e-3,
             d_cyl: 15.875e-3,
+            dead_volume_1: 0.0,
+            dead_volume_2: 0.0,
         }
     }
 

@@ -10,11 +10,13 @@
 //! | orifice and leakage flow | [`orifice_flow`] | (2.18)–(2.23) |
 //! | chambers | [`chambers`] | (2.24)–(2.32) |
 //! | piston force and spring | [`piston`] | (2.36)–(2.38) |
+//! | effects the thesis model lacks (off by default) | [`effects`] | MODEL.md |
 //! | the assembled six-state model | [`actuator`] | (4.1) |
 
 pub mod actuator;
 pub mod chambers;
 pub mod current_driver;
+pub mod effects;
 pub mod jet_pipe;
 pub mod orifice_flow;
 pub mod orifice_geometry;

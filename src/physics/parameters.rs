@@ -34,6 +34,16 @@ pub struct Parameters {
     pub l_spring0: f64,
     pub d_cyl: f64,
     pub k_spring: f64,
+    /// Effects the thesis model lacks; each is off at its default (see [`super::effects`]).
+    pub hysteresis_width: f64,
+    pub friction_coulomb: f64,
+    pub dead_volume_1: f64,
+    pub dead_volume_2: f64,
+    pub supply_resistance: f64,
+    pub heat_transfer_fraction: f64,
+    pub command_delay: f64,
+    pub force_sensor_offset: f64,
+    pub force_sensor_gain: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -75,6 +85,15 @@ impl Default for Parameters {
             l_spring0: 0.0,
             d_cyl: 0.0,
             k_spring: 0.0,
+            hysteresis_width: 0.0,
+            friction_coulomb: 0.0,
+            dead_volume_1: 0.0,
+            dead_volume_2: 0.0,
+            supply_resistance: 0.0,
+            heat_transfer_fraction: 0.0,
+            command_delay: 0.0,
+            force_sensor_offset: 0.0,
+            force_sensor_gain: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -90,6 +109,7 @@ enum Bound {
     NonNegative,
     Finite,
     GreaterThanOne,
+    UnitInterval,
 }
 
 impl Parameters {
@@ -121,6 +141,15 @@ impl Parameters {
         vr::L_SPRING0,
         vr::D_CYL,
         vr::K_SPRING,
+        vr::HYSTERESIS_WIDTH,
+        vr::FRICTION_COULOMB,
+        vr::DEAD_VOLUME_1,
+        vr::DEAD_VOLUME_2,
+        vr::SUPPLY_RESISTANCE,
+        vr::HEAT_TRANSFER_FRACTION,
+        vr::COMMAND_DELAY,
+        vr::FORCE_SENSOR_OFFSET,
+        vr::FORCE_SENSOR_GAIN,
     ];
 
     fn field_and_bound(&mut self, value_reference: u32) -> Option<(&mut f64, Bound)> {
@@ -152,6 +181,15 @@ impl Parameters {
             vr::L_SPRING0 => (&mut self.l_spring0, NonNegative),
             vr::D_CYL => (&mut self.d_cyl, Positive),
             vr::K_SPRING => (&mut self.k_spring, NonNegative),
+            vr::HYSTERESIS_WIDTH => (&mut self.hysteresis_width, NonNegative),
+            vr::FRICTION_COULOMB => (&mut self.friction_coulomb, NonNegative),
+            vr::DEAD_VOLUME_1 => (&mut self.dead_volume_1, NonNegative),
+            vr::DEAD_VOLUME_2 => (&mut self.dead_volume_2, NonNegative),
+            vr::SUPPLY_RESISTANCE => (&mut self.supply_resistance, NonNegative),
+            vr::HEAT_TRANSFER_FRACTION => (&mut self.heat_transfer_fraction, UnitInterval),
+            vr::COMMAND_DELAY => (&mut self.command_delay, NonNegative),
+            vr::FORCE_SENSOR_OFFSET => (&mut self.force_sensor_offset, Finite),
+            vr::FORCE_SENSOR_GAIN => (&mut self.force_sensor_gain, Positive),
             _ => return None,
         })
     }
@@ -179,6 +217,7 @@ impl Parameters {
                 Bound::Positive if value <= 0.0 => Some("must be > 0"),
                 Bound::NonNegative if value < 0.0 => Some("must be >= 0"),
                 Bound::GreaterThanOne if value <= 1.0 => Some("must be > 1"),
+                Bound::UnitInterval if !(0.0..=1.0).contains(&value) => Some("must be in [0, 1]"),
                 _ => None,
             }
         };
@@ -213,6 +252,8 @@ impl Parameters {
             l_s: self.l_s,
             l_sup: self.l_sup,
             d_cyl: self.d_cyl,
+            dead_volume_1: self.dead_volume_1,
+            dead_volume_2: self.dead_volume_2,
         }
     }
 

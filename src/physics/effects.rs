@@ -1,0 +1,215 @@
+//! Effects the thesis model lacks (MODEL.md, "Effects the thesis model lacks"). Each is
+//! off at its parameter's default, and then the model is the thesis model exactly.
+//!
+//! | name | parameter(s) | where it acts |
+//! |---|---|---|
+//! | `jet_pipe_hysteresis` | `hysteresis_width` (m) | Prandtl–Ishlinskii operator on f3's output, before the jet pipe dynamics (§3.2.1–3.2.2) |
+//! | `piston_friction` | `friction_coulomb` (N) | rod force while the stopper moves, (2.33)–(2.35) |
+//! | `dead_volume` | `dead_volume_1`, `dead_volume_2` (m³) | added to (2.30)–(2.31) |
+//! | `supply_pressure_drop` | `supply_resistance` (Pa·s/kg) | supply pressure at the jet pipe (§2.6) |
+//! | `heat_transfer` | `heat_transfer_fraction` (1) | polytropic exponent in (2.29) |
+//! | `transport_delay` | `command_delay` (s) | command seen by the current driver |
+//! | `sensor_offset_gain` | `force_sensor_offset` (N), `force_sensor_gain` (1) | the `F_meas` output |
+
+/// The names of the effects, as reports and parameters use them.
+pub const EFFECT_NAMES: [&str; 7] = [
+    "jet_pipe_hysteresis",
+    "piston_friction",
+    "dead_volume",
+    "supply_pressure_drop",
+    "heat_transfer",
+    "transport_delay",
+    "sensor_offset_gain",
+];
+
+/// Number of play operators of the Prandtl–Ishlinskii hysteresis operator.
+pub const PLAY_OPERATORS: usize = 16;
+
+/// A Prandtl–Ishlinskii operator: the mean of [`PLAY_OPERATORS`] play (backlash)
+/// operators whose half-widths are the quantiles of an exponential distribution. Unlike
+/// Frame's model (§3.2.2), it predicts minor loops: after a reversal the output stays
+/// put until the input has moved by the smallest width, then bends onto the new branch
+/// as more plays are dragged along, and a closed minor loop returns to where it began.
+/// In a large sweep the two branches are `width` apart (mean half-width = width/2), and
+/// the output's slope far from reversals is the input's (unit total weight).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrandtlIshlinskii {
+    pub half_widths: [f64; PLAY_OPERATORS],
+}
+
+impl PrandtlIshlinskii {
+    pub fn new(width: f64) -> Self {
+        let mut half_widths = [0.0; PLAY_OPERATORS];
+        let mut sum = 0.0;
+        for (k, r) in half_widths.iter_mut().enumerate() {
+            let q = (k as f64 + 0.5) / PLAY_OPERATORS as f64;
+            *r = -(1.0 - q).ln();
+            sum += *r;
+        }
+        // Scale so the mean half-width is exactly width/2.
+        let scale = if sum > 0.0 {
+            0.5 * width * PLAY_OPERATORS as f64 / sum
+        } else {
+            0.0
+        };
+        for r in half_widths.iter_mut() {
+            *r *= scale;
+        }
+        Self { half_widths }
+    }
+
+    pub fn is_active(&self) -> bool {
+        self.half_widths.iter().any(|&r| r > 0.0)
+    }
+
+    /// Play states after the input moves monotonically to `input`.
+    pub fn advance(&self, plays: &mut [f64; PLAY_OPERATORS], input: f64) {
+        for (p, r) in plays.iter_mut().zip(&self.half_widths) {
+            *p = p.clamp(input - r, input + r);
+        }
+    }
+
+    /// Output for plays that moved monotonically from `plays` to `input` (the plays
+    /// themselves are not changed).
+    pub fn output_after(&self, plays: &[f64; PLAY_OPERATORS], input: f64) -> f64 {
+        let sum: f64 = plays
+            .iter()
+            .zip(&self.half_widths)
+            .map(|(p, r)| p.clamp(input - r, input + r))
+            .sum();
+        sum / PLAY_OPERATORS as f64
+    }
+
+    pub fn output(plays: &[f64; PLAY_OPERATORS]) -> f64 {
+        plays.iter().sum::<f64>() / PLAY_OPERATORS as f64
+    }
+}
+
+/// Polytropic exponent of the chambers: γ for adiabatic chambers (the thesis, (2.29)),
+/// 1 for isothermal ones; `fraction` goes linearly between them.
+pub fn polytropic_exponent(gamma: f64, heat_transfer_fraction: f64) -> f64 {
+    gamma - heat_transfer_fraction * (gamma - 1.0)
+}
+
+/// Coulomb friction on the rod force, opposing the stopper velocity (2.35); zero at rest
+/// (stiction holds whatever force the pressures give, and the prescribed stopper does not
+/// stick).
+pub fn friction_force(friction_coulomb: f64, stopper_velocity: f64) -> f64 {
+    if stopper_velocity.abs() < 1e-9 {
+        0.0
+    } else {
+        friction_coulomb * stopper_velocity.signum()
+    }
+}
+
+/// What a force sensor with an offset and a gain error reads.
+pub fn sensor_reading(offset: f64, gain: f64, force: f64) -> f64 {
+    offset + gain * force
+}
+
+/// Supply pressure at the jet pipe when a supply line of resistance `resistance` (Pa·s/kg)
+/// carries the supply mass flow `supply_flow(p)` drawn at that pressure: the root of
+/// p = P_s − R ṁ(p), found by the secant method (ṁ rises with p, so the root is unique).
+pub fn supply_pressure_at_jet(p_s: f64, resistance: f64, supply_flow: impl Fn(f64) -> f64) -> f64 {
+    if resistance == 0.0 {
+        return p_s;
+    }
+    let residual = |p: f64| p - p_s + resistance * supply_flow(p);
+    let (mut a, mut fa) = (p_s, residual(p_s));
+    if fa <= 0.0 {
+        return p_s;
+    }
+    let mut b = p_s - fa;
+    let mut fb = residual(b);
+    for _ in 0..30 {
+        if fb == fa {
+            break;
+        }
+        let c = b - fb * (b - a) / (fb - fa);
+        a = b;
+        fa = fb;
+        b = c.clamp(0.0, p_s);
+        fb = residual(b);
+        if fb.abs() < 1e-9 * p_s {
+            break;
+        }
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sweep(op: &PrandtlIshlinskii, plays: &mut [f64; PLAY_OPERATORS], from: f64, to: f64) -> Vec<(f64, f64)> {
+        (0..=200)
+            .map(|k| {
+                let x = from + (to - from) * k as f64 / 200.0;
+                op.advance(plays, x);
+                (x, PrandtlIshlinskii::output(plays))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn large_sweeps_have_branches_width_apart() {
+        let width = 0.16e-3;
+        let op = PrandtlIshlinskii::new(width);
+        let mut plays = [0.0; PLAY_OPERATORS];
+        sweep(&op, &mut plays, 0.0, -1e-3);
+        let rising = sweep(&op, &mut plays, -1e-3, 1e-3);
+        let falling = sweep(&op, &mut plays, 1e-3, -1e-3);
+        // At x = 0 on both branches, far from the reversals:
+        let up = rising[100].1;
+        let down = falling[100].1;
+        assert!(
+            ((down - up) - width).abs() < 1e-3 * width,
+            "separation {} vs {width}",
+            down - up
+        );
+    }
+
+    #[test]
+    fn minor_loops_close_and_stay_inside_the_major_loop() {
+        let op = PrandtlIshlinskii::new(0.16e-3);
+        let mut plays = [0.0; PLAY_OPERATORS];
+        sweep(&op, &mut plays, 0.0, -1e-3);
+        sweep(&op, &mut plays, -1e-3, 0.2e-3);
+        let before = PrandtlIshlinskii::output(&plays);
+        let saved = plays;
+        sweep(&op, &mut plays, 0.2e-3, 0.05e-3);
+        sweep(&op, &mut plays, 0.05e-3, 0.2e-3);
+        // Return-point memory: the minor loop closes where it began.
+        assert!((PrandtlIshlinskii::output(&plays) - before).abs() < 1e-15);
+        for (a, b) in plays.iter().zip(&saved) {
+            assert!((a - b).abs() < 1e-18, "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn zero_width_is_the_identity() {
+        let op = PrandtlIshlinskii::new(0.0);
+        assert!(!op.is_active());
+        let mut plays = [0.0; PLAY_OPERATORS];
+        op.advance(&mut plays, 3e-4);
+        assert_eq!(PrandtlIshlinskii::output(&plays), 3e-4);
+    }
+
+    #[test]
+    fn supply_drop_solves_its_equation() {
+        // Choked supply flow ∝ p: p = P_s − R k p ⇒ p = P_s / (1 + R k).
+        let (p_s, r, k) = (652_925.0, 2e8, 1e-10);
+        let p = supply_pressure_at_jet(p_s, r, |p| k * p);
+        assert!((p - p_s / (1.0 + r * k)).abs() < 1e-6 * p_s, "{p}");
+        assert_eq!(supply_pressure_at_jet(p_s, 0.0, |p| k * p), p_s);
+    }
+
+    #[test]
+    fn other_effects_are_off_at_their_defaults() {
+        assert_eq!(polytropic_exponent(1.4, 0.0), 1.4);
+        assert_eq!(polytropic_exponent(1.4, 1.0), 1.0);
+        assert_eq!(friction_force(0.0, 0.3), 0.0);
+        assert_eq!(friction_force(2.0, -0.3), -2.0);
+        assert_eq!(sensor_reading(0.0, 1.0, 45.0), 45.0);
+    }
+}

@@ -1,0 +1,1070 @@
+//! Independent synthetic bench: the test oracle for the diagnosis of bench recordings.
+//!
+//! This module writes recordings in the format of `MODEL.md` ("Measured data") following the
+//! protocol of `bench/README.md`, from its own implementation of the thesis model (Henri 1994,
+//! §2.2–2.7) plus optional physical effects the thesis model lacks. It deliberately shares no
+//! code with the model under test (`physics`, `simulation`, `integrator`, `electromechanics`,
+//! `fmu`): equations are re-derived from the specification, integrated by classical fixed-step
+//! RK4 (20 µs), and every effect uses a form that differs from the obvious one.
+//!
+//! Forms of the effects (all off by default; with all off the model is the thesis model):
+//!
+//! * `jet_pipe_hysteresis` (`hysteresis_width`, m): a Bouc–Wen state z (n = 1) driven by the static
+//!   jet-pipe position x̄ = f3(k_m i): ż = A ẋ̄ − β |ẋ̄| z − γ ẋ̄ |z| with A = 0.5, β = 0.75/w,
+//!   γ = 0.25/w, so that z saturates at ±w/2 after a large sweep; the jet pipe dynamics are
+//!   driven by x̄ − z (rising branch w/2 below the midpoint line, falling branch w/2 above it:
+//!   full separation w). Minor loops arise by themselves. The history before the recording is a
+//!   falling approach (z = −w/2), as when the command goes from 0 V down to the first command.
+//! * `piston_friction` (`friction_coulomb` = F_c, N): Stribeck curve on the stopper velocity v,
+//!   F_f = [F_c + (F_s − F_c) exp(−(v/v_s)²)] tanh(v/v_ε) + b v with F_s = 1.5 F_c,
+//!   v_s = 5 mm/s, v_ε = 0.2 mm/s, b = F_c · 1 s/m; F_act = max(A_p(P1 − P2) − F_f, F_spring).
+//!   Zero while the stopper is still.
+//! * `dead_volume` (`dead_volume_1`, `dead_volume_2`, m³): a side volume per chamber (lines,
+//!   transducer port) joined to the chamber through a short laminar line, ṁ = (P_i − P_di)/R_l,
+//!   R_l = γ R T τ_l / V_d with τ_l = 1 ms, so the line fills in about 1 ms and the volume acts as
+//!   added volume below ≈ 100 Hz. The side volume follows (2.29) at temperature T.
+//! * `supply_pressure_drop` (`supply_resistance` = R_s, Pa·s/kg): a plenum of 2 cm³ (enlarged
+//!   automatically only when R_s is so small that RK4 would need it) between P_s and the jet
+//!   pipe, fed through a compressible orifice of C_d A = sqrt(ṁ_nom / (ρ_s R_s)),
+//!   ṁ_nom = 2.0e-4 kg/s, ρ_s = P_s/(R T); for an incompressible orifice dΔp/dṁ = 2Δp/ṁ, so this
+//!   gives dP/dṁ = R_s at ṁ_nom (a drop of R_s ṁ_nom / 2 there). The jet-pipe supply flows are
+//!   drawn from the plenum, at the plenum pressure.
+//! * `heat_transfer` (α, 0..1): for α > 0 each chamber gets a temperature state and the energy
+//!   equation Ṗ = (γ/V)(R Σ ṁ_k T_k,up − P V̇) + P (T_w − T)/(T τ_th),
+//!   Ṫ = T (Ṗ/P + V̇/V) − R T² ṁ/(P V), with the wall at 293.15 K and
+//!   τ_th = 0.5 ms · 1000^(1−α) / α (α = 1: 0.5 ms, nearly isothermal up to ≈ 100 Hz;
+//!   α = 0.5: 32 ms; α = 0.25: 0.36 s). Outflows leave at the chamber temperature, inflows
+//!   arrive at the upstream temperature (supply at T). α = 0 is exactly (2.29) at constant T.
+//! * `transport_delay` (`command_delay`, s): the current driver sees the D/A output delayed,
+//!   the zero-order-hold history evaluated at t − τ (the logged v_da is the undelayed command).
+//! * `sensor_offset_gain`: logged force = gain · F_act + offset (before noise and quantisation).
+//!
+//! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
+//! zero and the compressible law's value at 20 Pa (continuous, Lipschitz).
+
+use std::f64::consts::PI;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+/// Effects beyond the thesis model. `Default` switches every effect off.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchEffects {
+    /// Full separation (m) of the rising and falling branches of the static jet pipe position.
+    pub hysteresis_width: f64,
+    /// Coulomb friction level (N) of the piston; stiction 1.5×, see module docs.
+    pub friction_coulomb: f64,
+    /// Dead volume (m³) joined to chamber 1.
+    pub dead_volume_1: f64,
+    /// Dead volume (m³) joined to chamber 2.
+    pub dead_volume_2: f64,
+    /// Supply line resistance (Pa·s/kg), dP/dṁ at the nominal flow 2e-4 kg/s.
+    pub supply_resistance: f64,
+    /// Heat exchange of the chambers with the wall, 0 (adiabatic, (2.29)) .. 1 (nearly isothermal).
+    pub heat_transfer: f64,
+    /// Delay (s) of the command seen by the current driver.
+    pub command_delay: f64,
+    /// Force sensor offset (N).
+    pub force_sensor_offset: f64,
+    /// Force sensor gain (1 = none).
+    pub force_sensor_gain: f64,
+}
+
+impl Default for BenchEffects {
+    fn default() -> Self {
+        Self {
+            hysteresis_width: 0.0,
+            friction_coulomb: 0.0,
+            dead_volume_1: 0.0,
+            dead_volume_2: 0.0,
+            supply_resistance: 0.0,
+            heat_transfer: 0.0,
+            command_delay: 0.0,
+            force_sensor_offset: 0.0,
+            force_sensor_gain: 1.0,
+        }
+    }
+}
+
+/// Constants of the thesis model with the defaults of `MODEL.md` (SI units).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchParams {
+    pub p_supply: f64,
+    pub p_return: f64,
+    pub temperature: f64,
+    pub gamma: f64,
+    pub r_gas: f64,
+    pub k_cd: f64,
+    pub i_offset: f64,
+    pub omega_cd: f64,
+    pub k_m: f64,
+    pub omega_1: f64,
+    pub omega_2: f64,
+    pub zeta_2: f64,
+    pub x_jp_sat: f64,
+    pub f_jp_sat: f64,
+    pub x_jp_offset: f64,
+    pub d_jp: f64,
+    pub c_d: f64,
+    pub c_dm_a_lpp: f64,
+    pub c_db_a_lpp: f64,
+    pub l_cyl: f64,
+    pub l_p: f64,
+    pub l_s: f64,
+    pub l_sup: f64,
+    pub l_spring0: f64,
+    pub d_cyl: f64,
+    pub k_spring: f64,
+}
+
+impl Default for BenchParams {
+    fn default() -> Self {
+        Self {
+            p_supply: 652_925.0,
+            p_return: 101_325.0,
+            temperature: 293.15,
+            gamma: 1.4,
+            r_gas: 287.0,
+            k_cd: 0.04,
+            i_offset: 0.0,
+            omega_cd: 7050.0,
+            k_m: 1.946,
+            omega_1: 973.9,
+            omega_2: 1856.7,
+            zeta_2: 0.019,
+            x_jp_sat: 0.5e-3,
+            f_jp_sat: 0.45,
+            x_jp_offset: 0.099e-3,
+            d_jp: 0.9652e-3,
+            c_d: 0.696,
+            c_dm_a_lpp: -0.0475e-6,
+            c_db_a_lpp: 0.0971e-6,
+            l_cyl: 78e-3,
+            l_p: 8e-3,
+            l_s: 7e-3,
+            l_sup: 11e-3,
+            l_spring0: 69.1e-3,
+            d_cyl: 15.875e-3,
+            k_spring: 88.14,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry: circle overlaps (own closed forms, checked against grid integration in the tests)
+// ---------------------------------------------------------------------------------------------
+
+/// Overlap of two circles of equal radius `r` whose centres are `d` apart: r²(θ − sin θ),
+/// θ the central angle of the common chord.
+fn lens_equal(d: f64, r: f64) -> f64 {
+    let d = d.abs();
+    if d >= 2.0 * r {
+        return 0.0;
+    }
+    let theta = 2.0 * (d / (2.0 * r)).acos();
+    r * r * (theta - theta.sin())
+}
+
+/// Overlap of a circle of radius `a` with a circle of radius `b ≥ a`, centres `d` apart: the sum
+/// of the two circular segments cut by the common chord, each r²(φ − sin φ cos φ) with φ the
+/// half angle seen from its centre.
+fn lens_general(d: f64, a: f64, b: f64) -> f64 {
+    let d = d.abs();
+    if d >= a + b {
+        return 0.0;
+    }
+    if d <= b - a {
+        return PI * a * a;
+    }
+    let ca = ((d * d + a * a - b * b) / (2.0 * d * a)).clamp(-1.0, 1.0);
+    let cb = ((d * d + b * b - a * a) / (2.0 * d * b)).clamp(-1.0, 1.0);
+    let (pa, pb) = (ca.acos(), cb.acos());
+    a * a * (pa - pa.sin() * ca) + b * b * (pb - pb.sin() * cb)
+}
+
+/// Supply and return areas of ports 1 and 2 at jet pipe absolute position `x`:
+/// (A_s1, A_r1, A_s2, A_r2).
+fn port_areas(x: f64, d_jp: f64) -> (f64, f64, f64, f64) {
+    let r = 0.5 * d_jp;
+    let a_port = PI * r * r;
+    let (d1, d2) = (x - d_jp, x + d_jp);
+    let a_s1 = lens_equal(d1, r);
+    let a_s2 = lens_equal(d2, r);
+    let a_r1 = (a_port - lens_general(d1, r, 3.0 * r)).max(0.0);
+    let a_r2 = (a_port - lens_general(d2, r, 3.0 * r)).max(0.0);
+    (a_s1, a_r1, a_s2, a_r2)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Model
+// ---------------------------------------------------------------------------------------------
+
+const NS: usize = 12;
+type State = [f64; NS];
+const S_I: usize = 0; // coil current
+const S_X1: usize = 1; // output of the first-order jet pipe lag
+const S_XJP: usize = 2; // jet pipe position (before offset)
+const S_VJP: usize = 3; // its velocity
+const S_Z: usize = 4; // Bouc–Wen hysteresis state
+const S_P1: usize = 5;
+const S_P2: usize = 6;
+const S_T1: usize = 7;
+const S_T2: usize = 8;
+const S_PD1: usize = 9; // dead volume pressures
+const S_PD2: usize = 10;
+const S_PPL: usize = 11; // supply plenum pressure
+
+/// Integration step (s): 50 steps per 1 ms command/log period.
+const H: f64 = 20e-6;
+const STEPS_PER_SAMPLE: usize = 50;
+const SAMPLE: f64 = 1e-3;
+/// Below this pressure difference the orifice law is the secant line through zero.
+const DP_LIN: f64 = 20.0;
+const M_DOT_NOMINAL: f64 = 2.0e-4;
+const PLENUM_VOLUME: f64 = 2e-6;
+const LINE_TAU: f64 = 1e-3;
+const TAU_ISO: f64 = 0.5e-3;
+
+struct Model {
+    p: BenchParams,
+    e: BenchEffects,
+    a_p: f64,
+    l_dead: f64, // L_p + L_s + L_sup
+    r_crit: f64,
+    c1: f64,
+    c2: f64,
+    inv_gamma: f64,
+    // effects
+    hyst: bool,
+    bw_a: f64,
+    bw_beta: f64,
+    bw_gamma: f64,
+    heat: bool,
+    inv_tau_th: f64,
+    dead1: bool,
+    dead2: bool,
+    g_line1: f64, // 1/R_line
+    g_line2: f64,
+    supply: bool,
+    cda_supply: f64,
+    v_plenum: f64,
+}
+
+impl Model {
+    fn new(p: &BenchParams, e: &BenchEffects) -> Self {
+        let g = p.gamma;
+        let rt = p.r_gas * p.temperature;
+        let a_p = PI * p.d_cyl * p.d_cyl / 4.0;
+        let w = e.hysteresis_width;
+        let hyst = w > 0.0;
+        let heat = e.heat_transfer > 0.0;
+        let alpha = e.heat_transfer.clamp(0.0, 1.0);
+        let inv_tau_th = if heat {
+            alpha / (TAU_ISO * 1000f64.powf(1.0 - alpha))
+        } else {
+            0.0
+        };
+        let dead1 = e.dead_volume_1 > 0.0;
+        let dead2 = e.dead_volume_2 > 0.0;
+        let g_line = |v: f64| if v > 0.0 { v / (g * rt * LINE_TAU) } else { 0.0 };
+        let supply = e.supply_resistance > 0.0;
+        let rho_s = p.p_supply / rt;
+        let cda_supply = if supply {
+            (M_DOT_NOMINAL / (rho_s * e.supply_resistance)).sqrt()
+        } else {
+            0.0
+        };
+        // Plenum: 2 cm³, or larger if the linear-zone conductances would make RK4 marginal.
+        let rho_max = p.p_supply.max(p.p_return) / rt;
+        let slope = |cda: f64| cda * (2.0 * rho_max / DP_LIN).sqrt();
+        let port_max = p.c_d * PI * p.d_jp * p.d_jp / 4.0;
+        let v_needed = g * rt * H * (slope(cda_supply) + 2.0 * slope(port_max)) / 1.0;
+        let v_plenum = PLENUM_VOLUME.max(v_needed);
+        Self {
+            p: p.clone(),
+            e: e.clone(),
+            a_p,
+            l_dead: p.l_p + p.l_s + p.l_sup,
+            r_crit: (2.0 / (g + 1.0)).powf(g / (g - 1.0)),
+            c1: (g / p.r_gas * (2.0 / (g + 1.0)).powf((g + 1.0) / (g - 1.0))).sqrt(),
+            c2: (g / p.r_gas * (2.0 / (g - 1.0))).sqrt(),
+            inv_gamma: 1.0 / g,
+            hyst,
+            bw_a: 0.5,
+            bw_beta: if hyst { 0.75 / w } else { 0.0 },
+            bw_gamma: if hyst { 0.25 / w } else { 0.0 },
+            heat,
+            inv_tau_th,
+            dead1,
+            dead2,
+            g_line1: g_line(e.dead_volume_1),
+            g_line2: g_line(e.dead_volume_2),
+            supply,
+            cda_supply,
+            v_plenum,
+        }
+    }
+
+    /// Compressible orifice flow (2.18)–(2.22) from `pu` to `pd` (pu > pd), ≥ 0.
+    #[inline]
+    fn flow_down(&self, cda: f64, pu: f64, tu: f64, pd: f64) -> f64 {
+        let r = pd / pu;
+        let k = cda * pu / tu.sqrt();
+        if r <= self.r_crit {
+            k * self.c1
+        } else {
+            // r^(2/γ) − r^((γ+1)/γ) = a (a − r), a = r^(1/γ)
+            let a = r.powf(self.inv_gamma);
+            k * self.c2 * (a * (a - r)).max(0.0).sqrt()
+        }
+    }
+
+    /// Signed mass flow from side a to side b through C_d·A = `cda`, regularised near Δp = 0.
+    #[inline]
+    fn orifice(&self, cda: f64, pa: f64, ta: f64, pb: f64, tb: f64) -> f64 {
+        if cda <= 0.0 {
+            return 0.0;
+        }
+        let (pu, tu, pd, s) = if pa >= pb {
+            (pa, ta, pb, 1.0)
+        } else {
+            (pb, tb, pa, -1.0)
+        };
+        let dp = pu - pd;
+        if dp >= DP_LIN {
+            s * self.flow_down(cda, pu, tu, pd)
+        } else {
+            s * self.flow_down(cda, pu, tu, pu - DP_LIN) * (dp / DP_LIN)
+        }
+    }
+
+    fn volumes(&self, xs: f64) -> (f64, f64) {
+        let xp = xs - self.l_dead;
+        let v1 = self.a_p * xp + 0.0;
+        let v2 = self.a_p * (self.p.l_cyl - xp - self.p.l_p);
+        (v1, v2)
+    }
+
+    fn static_position(&self, i: f64) -> f64 {
+        self.p.x_jp_sat * (self.p.k_m * i / self.p.f_jp_sat).tanh()
+    }
+
+    fn spring_force(&self, xs: f64) -> f64 {
+        self.p.k_spring * (self.p.l_spring0 - (xs - self.p.l_s - self.p.l_p))
+    }
+
+    fn friction(&self, v: f64) -> f64 {
+        let fc = self.e.friction_coulomb;
+        if fc <= 0.0 {
+            return 0.0;
+        }
+        let fs = 1.5 * fc;
+        let (v_s, v_eps, b) = (5e-3, 0.2e-3, fc * 1.0);
+        (fc + (fs - fc) * (-(v / v_s) * (v / v_s)).exp()) * (v / v_eps).tanh() + b * v
+    }
+
+    /// True actuator force (2.36)–(2.38) with friction.
+    fn force(&self, y: &State, xs: f64, xs_dot: f64) -> f64 {
+        let fp = self.a_p * (y[S_P1] - y[S_P2]) - self.friction(xs_dot);
+        fp.max(self.spring_force(xs))
+    }
+
+    /// Time derivatives.
+    fn rhs(&self, y: &State, v_cmd: f64, xs: f64, xs_dot: f64, dy: &mut State) {
+        let p = &self.p;
+        let t0 = p.temperature;
+        let rt = p.r_gas * t0;
+        // current driver (2.1)–(2.3)
+        let i = y[S_I];
+        let di = p.omega_cd * (p.k_cd * v_cmd + p.i_offset - i);
+        dy[S_I] = di;
+        // static jet pipe curve f3 and hysteresis
+        let u = p.k_m * i / p.f_jp_sat;
+        let th = u.tanh();
+        let xbar = p.x_jp_sat * th;
+        let mut target = xbar;
+        if self.hyst {
+            let xbar_dot = p.x_jp_sat * (1.0 - th * th) * p.k_m * di / p.f_jp_sat;
+            let z = y[S_Z];
+            dy[S_Z] = self.bw_a * xbar_dot - self.bw_beta * xbar_dot.abs() * z - self.bw_gamma * xbar_dot * z.abs();
+            target -= z;
+        } else {
+            dy[S_Z] = 0.0;
+        }
+        // jet pipe: first-order lag then second-order mode, unity DC gain
+        dy[S_X1] = p.omega_1 * (target - y[S_X1]);
+        dy[S_XJP] = y[S_VJP];
+        dy[S_VJP] = p.omega_2 * p.omega_2 * (y[S_X1] - y[S_XJP]) - 2.0 * p.zeta_2 * p.omega_2 * y[S_VJP];
+        // orifice areas
+        let x_abs = y[S_XJP] + p.x_jp_offset;
+        let (a_s1, a_r1, a_s2, a_r2) = port_areas(x_abs, p.d_jp);
+        let (p1, p2) = (y[S_P1], y[S_P2]);
+        let (t1, t2) = if self.heat { (y[S_T1], y[S_T2]) } else { (t0, t0) };
+        let ps = if self.supply { y[S_PPL] } else { p.p_supply };
+        let pr = p.p_return;
+        let m_s1 = self.orifice(p.c_d * a_s1, ps, t0, p1, t1);
+        let m_r1 = self.orifice(p.c_d * a_r1, p1, t1, pr, t0);
+        let m_s2 = self.orifice(p.c_d * a_s2, ps, t0, p2, t2);
+        let m_r2 = self.orifice(p.c_d * a_r2, p2, t2, pr, t0);
+        // leakage past the piston (2.23), positive 1 → 2
+        let (pu, pd) = if p1 >= p2 { (p1, p2) } else { (p2, p1) };
+        let cda_l = (p.c_dm_a_lpp * (pd / pu) + p.c_db_a_lpp).max(0.0);
+        let m_l = self.orifice(cda_l, p1, t1, p2, t2);
+        // dead volumes (side branches), positive chamber → branch
+        let m_d1 = if self.dead1 {
+            (p1 - y[S_PD1]) * self.g_line1
+        } else {
+            0.0
+        };
+        let m_d2 = if self.dead2 {
+            (p2 - y[S_PD2]) * self.g_line2
+        } else {
+            0.0
+        };
+        dy[S_PD1] = if self.dead1 {
+            p.gamma * rt * m_d1 / self.e.dead_volume_1
+        } else {
+            0.0
+        };
+        dy[S_PD2] = if self.dead2 {
+            p.gamma * rt * m_d2 / self.e.dead_volume_2
+        } else {
+            0.0
+        };
+        // supply plenum
+        if self.supply {
+            let m_in = self.orifice(self.cda_supply, p.p_supply, t0, ps, t0);
+            dy[S_PPL] = p.gamma * rt * (m_in - m_s1 - m_s2) / self.v_plenum;
+        } else {
+            dy[S_PPL] = 0.0;
+        }
+        // chambers
+        let (v1, v2) = self.volumes(xs);
+        let (dv1, dv2) = (self.a_p * xs_dot, -self.a_p * xs_dot);
+        let m1 = m_s1 - m_r1 - m_l - m_d1;
+        let m2 = m_s2 - m_r2 + m_l - m_d2;
+        if !self.heat {
+            dy[S_P1] = p.gamma / v1 * (rt * m1 - p1 * dv1);
+            dy[S_P2] = p.gamma / v2 * (rt * m2 - p2 * dv2);
+            dy[S_T1] = 0.0;
+            dy[S_T2] = 0.0;
+        } else {
+            // enthalpy flux Σ ṁ_k T_k,up (inflows at their source temperature, outflows at T_i)
+            let up = |m: f64, t_src: f64, t_own: f64| if m > 0.0 { m * t_src } else { m * t_own };
+            let h1 = up(m_s1, t0, t1) + up(-m_r1, t0, t1) + up(-m_l, t2, t1) + up(-m_d1, t0, t1);
+            let h2 = up(m_s2, t0, t2) + up(-m_r2, t0, t2) + up(m_l, t1, t2) + up(-m_d2, t0, t2);
+            let chamber = |pc: f64, tc: f64, v: f64, dv: f64, m: f64, h: f64| {
+                let dp = p.gamma / v * (p.r_gas * h - pc * dv) + pc * (t0 - tc) / tc * self.inv_tau_th;
+                let dt = tc * (dp / pc + dv / v) - p.r_gas * tc * tc * m / (pc * v);
+                (dp, dt)
+            };
+            let (dp1, dt1) = chamber(p1, t1, v1, dv1, m1, h1);
+            let (dp2, dt2) = chamber(p2, t2, v2, dv2, m2, h2);
+            dy[S_P1] = dp1;
+            dy[S_P2] = dp2;
+            dy[S_T1] = dt1;
+            dy[S_T2] = dt2;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Protocol (bench/README.md)
+// ---------------------------------------------------------------------------------------------
+
+/// Length of the bench protocol (s).
+pub const PROTOCOL_DURATION: f64 = 80.0;
+/// Stopper position outside segment E (m).
+pub const STOPPER_HOME: f64 = 0.054;
+
+fn piecewise_linear(t: f64, pts: &[(f64, f64)]) -> f64 {
+    if t <= pts[0].0 {
+        return pts[0].1;
+    }
+    for w in pts.windows(2) {
+        let ((t0, v0), (t1, v1)) = (w[0], w[1]);
+        if t <= t1 {
+            return v0 + (v1 - v0) * (t - t0) / (t1 - t0);
+        }
+    }
+    pts[pts.len() - 1].1
+}
+
+/// The commanded voltage of the protocol at time `t` (before D/A quantisation).
+pub fn protocol_command(t: f64) -> f64 {
+    if t < 20.0 {
+        // A: triangle −4 → 10 → −4 V at 1.4 V/s
+        let tt = t.max(0.0);
+        if tt <= 10.0 {
+            -4.0 + 1.4 * tt
+        } else {
+            10.0 - 1.4 * (tt - 10.0)
+        }
+    } else if t < 35.0 {
+        piecewise_linear(
+            t,
+            &[
+                (20.0, -4.0),
+                (23.0, 6.0),
+                (25.0, 2.0),
+                (28.0, 8.0),
+                (30.0, 4.0),
+                (33.0, 10.0),
+                (35.0, 2.5),
+            ],
+        )
+    } else if t < 50.0 {
+        // C: logarithmic chirp 0.2 → 30 Hz over 15 s around 2.5 V, amplitude 1 V
+        let (f0, f1, tc) = (0.2, 30.0, 15.0);
+        let k: f64 = f1 / f0;
+        let tau = t - 35.0;
+        let phase = 2.0 * PI * f0 * tc / k.ln() * (k.powf(tau / tc) - 1.0);
+        2.5 + phase.sin()
+    } else if t < 60.0 {
+        const STEPS: [f64; 5] = [1.0, 4.0, 2.0, 6.0, 1.0];
+        STEPS[(((t - 50.0) / 2.0).floor() as usize).min(4)]
+    } else {
+        2.5
+    }
+}
+
+/// Stopper position (m) and velocity (m/s) of the protocol at time `t`.
+pub fn protocol_stopper(t: f64) -> (f64, f64) {
+    let a = 0.010;
+    if t < 60.0 {
+        (STOPPER_HOME, 0.0)
+    } else if t < 70.0 {
+        let w = 2.0 * PI * 0.5;
+        (
+            STOPPER_HOME + a * (w * (t - 60.0)).sin(),
+            a * w * (w * (t - 60.0)).cos(),
+        )
+    } else {
+        let w = 2.0 * PI * 1.5;
+        (
+            STOPPER_HOME + a * (w * (t - 70.0)).sin(),
+            a * w * (w * (t - 70.0)).cos(),
+        )
+    }
+}
+
+/// 12-bit D/A over ±10 V.
+pub fn quantise_da(v: f64) -> f64 {
+    let lsb = 20.0 / 4096.0;
+    let code = ((v + 10.0) / lsb).round().clamp(0.0, 4095.0);
+    -10.0 + code * lsb
+}
+
+fn quantise_force(f: f64) -> f64 {
+    let lsb = 1000.0 / 65536.0;
+    let code = ((f + 500.0) / lsb).round().clamp(0.0, 65535.0);
+    -500.0 + code * lsb
+}
+
+fn quantise_pressure(p: f64) -> f64 {
+    let lsb = 1.0e6 / 65536.0;
+    (p / lsb).round().clamp(0.0, 65535.0) * lsb
+}
+
+fn quantise_stopper(x: f64) -> f64 {
+    (x * 1e6).round() * 1e-6
+}
+
+// ---------------------------------------------------------------------------------------------
+// Noise: splitmix64-seeded xorshift64* with Box–Muller
+// ---------------------------------------------------------------------------------------------
+
+struct Rng {
+    s: u64,
+    spare: Option<f64>,
+}
+
+impl Rng {
+    fn new(seed: u64) -> Self {
+        let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        Self {
+            s: if z == 0 { 0x2545_F491_4F6C_DD1D } else { z },
+            spare: None,
+        }
+    }
+    fn next_u64(&mut self) -> u64 {
+        let mut x = self.s;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        self.s = x;
+        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    /// Uniform in (0, 1).
+    fn uniform(&mut self) -> f64 {
+        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        if let Some(z) = self.spare.take() {
+            return z;
+        }
+        let (u1, u2) = (self.uniform(), self.uniform());
+        let r = (-2.0 * u1.ln()).sqrt();
+        let a = 2.0 * PI * u2;
+        self.spare = Some(r * a.sin());
+        r * a.cos()
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Simulation
+// ---------------------------------------------------------------------------------------------
+
+/// Options of a run (the public [`generate`] uses the bench values).
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Sensor noise (force 0.05 N rms, pressures 150 Pa rms); `None` for noiseless runs.
+    pub noise_seed: Option<u64>,
+    /// Quantise the logged signals like the bench A/Ds.
+    pub quantise: bool,
+    /// Simulated time before t = 0 at the first command (s): settling plus the 3 s hold.
+    pub pre_time: f64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self {
+            noise_seed: None,
+            quantise: true,
+            pre_time: 8.0,
+        }
+    }
+}
+
+/// Run a recording of `n_samples` rows at 1 kHz. `command(t)` gives the un-quantised command at
+/// the sample instants (it is D/A-quantised and held for 1 ms); `stopper(t)` the stopper position
+/// and velocity at any time. Before t = 0 the first command and stopper position are held.
+pub fn simulate<C, S>(
+    params: &BenchParams,
+    effects: &BenchEffects,
+    command: C,
+    stopper: S,
+    n_samples: usize,
+    opts: &RunOptions,
+) -> Vec<[f64; 6]>
+where
+    C: Fn(f64) -> f64,
+    S: Fn(f64) -> (f64, f64),
+{
+    let m = Model::new(params, effects);
+    let cmds: Vec<f64> = (0..n_samples.max(1))
+        .map(|k| quantise_da(command(k as f64 * SAMPLE)))
+        .collect();
+    let delay = effects.command_delay.max(0.0);
+    let cmd_at = |t: f64| -> f64 {
+        let te = t - delay;
+        if te < 0.0 {
+            return cmds[0];
+        }
+        let k = (te / SAMPLE).floor() as usize;
+        cmds[k.min(cmds.len() - 1)]
+    };
+    let stop_at = |t: f64| if t < 0.0 { stopper(0.0).0 } else { stopper(t).0 };
+    let stopv_at = |t: f64| if t < 0.0 { 0.0 } else { stopper(t).1 };
+
+    // initial state at the first command: static jet pipe, pressures at mid values
+    let mut y: State = [0.0; NS];
+    let i0 = params.k_cd * cmds[0] + params.i_offset;
+    y[S_I] = i0;
+    if m.hyst {
+        y[S_Z] = -0.5 * effects.hysteresis_width; // falling approach
+    }
+    let x0 = m.static_position(i0) - y[S_Z];
+    y[S_X1] = x0;
+    y[S_XJP] = x0;
+    let pm = 0.5 * (params.p_supply + params.p_return);
+    y[S_P1] = pm;
+    y[S_P2] = pm;
+    y[S_T1] = params.temperature;
+    y[S_T2] = params.temperature;
+    y[S_PD1] = pm;
+    y[S_PD2] = pm;
+    y[S_PPL] = params.p_supply;
+
+    let pre_steps = (opts.pre_time / H).round() as i64;
+    let mut step: i64 = -pre_steps;
+    let mut k1 = [0.0; NS];
+    let mut k2 = [0.0; NS];
+    let mut k3 = [0.0; NS];
+    let mut k4 = [0.0; NS];
+    let mut tmp = [0.0; NS];
+    let eps = 1e-6 * H;
+    let mut do_step = |y: &mut State, n: i64| {
+        let t_lo = n as f64 * H;
+        let t_hi = (n + 1) as f64 * H;
+        // inputs evaluated inside the step (left/right limits at its ends)
+        let inp = |t: f64| {
+            let te = t.clamp(t_lo + eps, t_hi - eps);
+            (cmd_at(te), stop_at(te), stopv_at(te))
+        };
+        let (v, xs, xd) = inp(t_lo);
+        m.rhs(y, v, xs, xd, &mut k1);
+        let (v, xs, xd) = inp(t_lo + 0.5 * H);
+        for j in 0..NS {
+            tmp[j] = y[j] + 0.5 * H * k1[j];
+        }
+        m.rhs(&tmp, v, xs, xd, &mut k2);
+        for j in 0..NS {
+            tmp[j] = y[j] + 0.5 * H * k2[j];
+        }
+        m.rhs(&tmp, v, xs, xd, &mut k3);
+        let (v, xs, xd) = inp(t_hi);
+        for j in 0..NS {
+            tmp[j] = y[j] + H * k3[j];
+        }
+        m.rhs(&tmp, v, xs, xd, &mut k4);
+        for j in 0..NS {
+            y[j] += H / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+        }
+    };
+    while step < 0 {
+        do_step(&mut y, step);
+        step += 1;
+    }
+
+    let mut rng = opts.noise_seed.map(Rng::new);
+    let mut rows = Vec::with_capacity(n_samples);
+    for (k, &cmd) in cmds.iter().enumerate().take(n_samples) {
+        let t = k as f64 * SAMPLE;
+        let (xs, xd) = stopper(t);
+        let f_true = m.force(&y, xs, xd);
+        let mut f = effects.force_sensor_gain * f_true + effects.force_sensor_offset;
+        let (mut p1, mut p2) = (y[S_P1], y[S_P2]);
+        if let Some(r) = rng.as_mut() {
+            f += 0.05 * r.normal();
+            p1 += 150.0 * r.normal();
+            p2 += 150.0 * r.normal();
+        }
+        let mut row = [t, cmd, xs, f, p1, p2];
+        if opts.quantise {
+            row[2] = quantise_stopper(xs);
+            row[3] = quantise_force(f);
+            row[4] = quantise_pressure(p1);
+            row[5] = quantise_pressure(p2);
+        }
+        rows.push(row);
+        for _ in 0..STEPS_PER_SAMPLE {
+            do_step(&mut y, step);
+            step += 1;
+        }
+    }
+    rows
+}
+
+/// A bench recording of the protocol of `bench/README.md`, truncated to `duration` s (≤ 80):
+/// rows (time_s, v_da_V, x_s_m, force_N, p1_Pa, p2_Pa) at 1 kHz with noise from `seed`.
+pub fn generate(effects: &BenchEffects, seed: u64, duration: f64) -> Vec<[f64; 6]> {
+    let n = (duration.clamp(0.0, PROTOCOL_DURATION) / SAMPLE).round() as usize;
+    let opts = RunOptions {
+        noise_seed: Some(seed),
+        ..RunOptions::default()
+    };
+    simulate(
+        &BenchParams::default(),
+        effects,
+        protocol_command,
+        protocol_stopper,
+        n,
+        &opts,
+    )
+}
+
+/// Write rows in the format of the bench recordings (header and number formatting).
+pub fn write_csv(rows: &[[f64; 6]], path: impl AsRef<Path>) -> std::io::Result<()> {
+    let mut w = BufWriter::new(std::fs::File::create(path)?);
+    writeln!(w, "time_s,v_da_V,x_s_m,force_N,p1_Pa,p2_Pa")?;
+    for r in rows {
+        writeln!(
+            w,
+            "{:.3},{:.6},{:.6},{:.4},{:.1},{:.1}",
+            r[0], r[1], r[2], r[3], r[4], r[5]
+        )?;
+    }
+    w.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area_numeric(cx_a: f64, ra: f64, cx_b: f64, rb: f64) -> f64 {
+        // grid integration of the overlap of two discs centred on the x axis
+        let n = 1200;
+        let (x0, x1) = ((cx_a - ra).max(cx_b - rb), (cx_a + ra).min(cx_b + rb));
+        if x1 <= x0 {
+            return 0.0;
+        }
+        let dx = (x1 - x0) / n as f64;
+        let mut s = 0.0;
+        for k in 0..n {
+            let x = x0 + (k as f64 + 0.5) * dx;
+            let ha = (ra * ra - (x - cx_a).powi(2)).max(0.0).sqrt();
+            let hb = (rb * rb - (x - cx_b).powi(2)).max(0.0).sqrt();
+            s += 2.0 * ha.min(hb) * dx;
+        }
+        s
+    }
+
+    #[test]
+    fn areas_match_numerical_integration() {
+        let d = 0.9652e-3;
+        let r = d / 2.0;
+        for k in -40..=40 {
+            let x = k as f64 * 0.05e-3;
+            let (s1, r1, s2, r2) = port_areas(x, d);
+            let n_s1 = area_numeric(d, r, x, r);
+            let n_s2 = area_numeric(-d, r, x, r);
+            let n_r1 = PI * r * r - area_numeric(d, r, x, 3.0 * r);
+            let n_r2 = PI * r * r - area_numeric(-d, r, x, 3.0 * r);
+            let tol = 2e-4 * PI * r * r;
+            assert!((s1 - n_s1).abs() < tol, "A_s1 at {x}: {s1} vs {n_s1}");
+            assert!((s2 - n_s2).abs() < tol, "A_s2 at {x}");
+            assert!((r1 - n_r1).abs() < tol, "A_r1 at {x}: {r1} vs {n_r1}");
+            assert!((r2 - n_r2).abs() < tol, "A_r2 at {x}");
+            // symmetry
+            let (s1m, r1m, _, _) = port_areas(-x, d);
+            assert!((s1m - s2).abs() < 1e-18 && (r1m - r2).abs() < 1e-18);
+        }
+        let (s1, r1, s2, r2) = port_areas(0.0, d);
+        assert!(s1.abs() < 1e-15 && r1.abs() < 1e-15 && s2.abs() < 1e-15 && r2.abs() < 1e-15);
+    }
+
+    fn clean() -> RunOptions {
+        RunOptions {
+            noise_seed: None,
+            quantise: false,
+            pre_time: 6.0,
+        }
+    }
+
+    /// Noiseless static force at a constant command and stopper (last sample of a short run).
+    fn static_force(params: &BenchParams, e: &BenchEffects, v: f64) -> f64 {
+        let rows = simulate(params, e, |_| v, |_| (STOPPER_HOME, 0.0), 2, &clean());
+        rows[1][3]
+    }
+
+    #[test]
+    fn static_force_is_bounded_and_rises_with_command() {
+        let p = BenchParams::default();
+        let e = BenchEffects::default();
+        let a_p = PI * p.d_cyl * p.d_cyl / 4.0;
+        let f_spring = p.k_spring * (p.l_spring0 - (STOPPER_HOME - p.l_s - p.l_p));
+        let f_max = a_p * (p.p_supply - p.p_return);
+        let mut last = f_spring - 1e-9;
+        for v in [-4.0, 0.0, 2.0, 4.0, 6.0, 10.0] {
+            let f = static_force(&p, &e, v);
+            assert!(f >= f_spring - 1e-9 && f <= f_max, "v={v}: F={f}");
+            assert!(f >= last, "force must rise with command: v={v} F={f} last={last}");
+            last = f;
+        }
+        assert!(
+            last > 90.0,
+            "full command must give most of the rated force, got {last}"
+        );
+        // no supply pressure: only the spring
+        let p0 = BenchParams {
+            p_supply: p.p_return,
+            ..p.clone()
+        };
+        let f = static_force(&p0, &e, 5.0);
+        assert!((f - f_spring).abs() < 1e-9, "P_s = P_r: {f} vs {f_spring}");
+    }
+
+    fn run_custom<C: Fn(f64) -> f64, S: Fn(f64) -> (f64, f64)>(
+        e: &BenchEffects,
+        c: C,
+        s: S,
+        n: usize,
+    ) -> Vec<[f64; 6]> {
+        simulate(&BenchParams::default(), e, c, s, n, &clean())
+    }
+
+    #[test]
+    fn friction_lowers_force_while_extending() {
+        let s = |t: f64| {
+            let w = 2.0 * PI * 1.5;
+            (STOPPER_HOME + 0.01 * (w * t).sin(), 0.01 * w * (w * t).cos())
+        };
+        let base = run_custom(&BenchEffects::default(), |_| 2.5, s, 700);
+        let fr = run_custom(
+            &BenchEffects {
+                friction_coulomb: 2.0,
+                ..Default::default()
+            },
+            |_| 2.5,
+            s,
+            700,
+        );
+        let (mut ext, mut ret) = (0, 0);
+        for k in 0..700 {
+            let xd = s(base[k][0]).1;
+            if xd > 0.02 {
+                assert!(fr[k][3] < base[k][3] - 1.9, "t={} extending", base[k][0]);
+                ext += 1;
+            } else if xd < -0.02 {
+                assert!(fr[k][3] > base[k][3] + 1.9, "t={} retracting", base[k][0]);
+                ret += 1;
+            }
+        }
+        assert!(ext > 50 && ret > 50);
+    }
+
+    #[test]
+    fn hysteresis_lags_the_command() {
+        // triangle −8 → 10 → −8 V over 4 s
+        let c = |t: f64| {
+            if t < 2.0 {
+                -8.0 + 9.0 * t
+            } else {
+                10.0 - 9.0 * (t - 2.0)
+            }
+        };
+        let hs = BenchEffects {
+            hysteresis_width: 0.16e-3,
+            ..Default::default()
+        };
+        let base = run_custom(&BenchEffects::default(), c, |_| (STOPPER_HOME, 0.0), 4000);
+        let hy = run_custom(&hs, c, |_| (STOPPER_HOME, 0.0), 4000);
+        // at 2 V rising (t = 1.111 s) the force is lower, falling (t = 2.889 s) higher
+        assert!(
+            hy[1111][3] < base[1111][3] - 1.0,
+            "rising {} vs {}",
+            hy[1111][3],
+            base[1111][3]
+        );
+        assert!(
+            hy[2889][3] > base[2889][3] + 1.0,
+            "falling {} vs {}",
+            hy[2889][3],
+            base[2889][3]
+        );
+    }
+
+    fn step_cmd(t: f64) -> f64 {
+        if t < 0.1 {
+            2.0
+        } else {
+            5.0
+        }
+    }
+
+    #[test]
+    fn dead_volume_slows_the_step_but_keeps_the_static_force() {
+        let base = run_custom(&BenchEffects::default(), step_cmd, |_| (STOPPER_HOME, 0.0), 1500);
+        let dv = BenchEffects {
+            dead_volume_1: 5e-6,
+            dead_volume_2: 5e-6,
+            ..Default::default()
+        };
+        let d = run_custom(&dv, step_cmd, |_| (STOPPER_HOME, 0.0), 1500);
+        let rise = |r: &Vec<[f64; 6]>| r[130][3] - r[99][3];
+        assert!(rise(&d) < 0.8 * rise(&base), "dead {} base {}", rise(&d), rise(&base));
+        assert!(
+            (d[1499][3] - base[1499][3]).abs() < 0.3,
+            "{} vs {}",
+            d[1499][3],
+            base[1499][3]
+        );
+    }
+
+    #[test]
+    fn supply_resistance_lowers_high_force() {
+        let p = BenchParams::default();
+        let f0 = static_force(&p, &BenchEffects::default(), 8.0);
+        let f1 = static_force(
+            &p,
+            &BenchEffects {
+                supply_resistance: 2e8,
+                ..Default::default()
+            },
+            8.0,
+        );
+        assert!(f1 < f0 - 0.5, "{f1} vs {f0}");
+    }
+
+    #[test]
+    fn heat_transfer_softens_the_pressure_response() {
+        let base = run_custom(&BenchEffects::default(), step_cmd, |_| (STOPPER_HOME, 0.0), 200);
+        let ht = run_custom(
+            &BenchEffects {
+                heat_transfer: 1.0,
+                ..Default::default()
+            },
+            step_cmd,
+            |_| (STOPPER_HOME, 0.0),
+            200,
+        );
+        let rise = |r: &Vec<[f64; 6]>| r[110][4] - r[99][4];
+        assert!(rise(&ht) < 0.85 * rise(&base), "{} vs {}", rise(&ht), rise(&base));
+        // same equilibrium before the step
+        assert!((ht[99][3] - base[99][3]).abs() < 0.05);
+    }
+
+    #[test]
+    fn command_delay_postpones_the_response() {
+        let base = run_custom(&BenchEffects::default(), step_cmd, |_| (STOPPER_HOME, 0.0), 130);
+        let dl = run_custom(
+            &BenchEffects {
+                command_delay: 0.008,
+                ..Default::default()
+            },
+            step_cmd,
+            |_| (STOPPER_HOME, 0.0),
+            130,
+        );
+        // before the delayed step arrives nothing has changed
+        assert!((dl[107][4] - dl[99][4]).abs() < 1.0);
+        assert!(base[107][4] - base[99][4] > 100.0);
+        // the delayed response is the base response shifted by 8 samples
+        assert!(
+            (dl[125][4] - base[117][4]).abs() < 5.0,
+            "{} vs {}",
+            dl[125][4],
+            base[117][4]
+        );
+    }
+
+    #[test]
+    fn sensor_offset_and_gain_apply_to_force_only() {
+        let base = run_custom(&BenchEffects::default(), step_cmd, |_| (STOPPER_HOME, 0.0), 150);
+        let e = BenchEffects {
+            force_sensor_offset: 1.5,
+            force_sensor_gain: 1.05,
+            ..Default::default()
+        };
+        let s = run_custom(&e, step_cmd, |_| (STOPPER_HOME, 0.0), 150);
+        for k in 0..150 {
+            assert!((s[k][3] - (1.05 * base[k][3] + 1.5)).abs() < 1e-9);
+            assert_eq!(s[k][4], base[k][4]);
+        }
+    }
+
+    #[test]
+    fn deterministic_for_a_seed() {
+        let e = BenchEffects::default();
+        let a = generate(&e, 7, 0.3);
+        let b = generate(&e, 7, 0.3);
+        let c = generate(&e, 8, 0.3);
+        assert_eq!(a.len(), 300);
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        assert!((a[0][1] - (-3.999023)).abs() < 1e-6);
+        assert!((a[0][3] - 2.653).abs() < 0.3, "{}", a[0][3]);
+    }
+
+    #[test]
+    fn protocol_is_continuous_where_it_should_be() {
+        assert!((protocol_command(10.0) - 10.0).abs() < 1e-12);
+        assert!((protocol_command(19.999) - protocol_command(20.0)).abs() < 0.01);
+        assert!((protocol_command(34.999) - protocol_command(35.0)).abs() < 0.01);
+        assert!((protocol_stopper(70.0).0 - STOPPER_HOME).abs() < 1e-12);
+        assert!((protocol_stopper(60.5).0 - 0.064).abs() < 1e-9);
+    }
+}
