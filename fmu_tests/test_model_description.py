@@ -14,6 +14,7 @@ INTERFACE = {
     "P2": ("output", "Pa", 12, None),
     "i": ("output", "A", 13, None),
     "x_jp": ("output", "m", 14, None),
+    "F_meas": ("output", "N", 15, None),
 }
 
 # MODEL.md defaults and Table 3.1 of the thesis, with their units.
@@ -44,6 +45,17 @@ PARAMETERS = {
     "L_spring0": (0.0691, "m"),
     "D_cyl": (0.015875, "m"),
     "k_spring": (88.14, "N/m"),
+    # the effects of MODEL.md, all off at their start values
+    "hysteresis_width": (0.0, "m"),
+    "hysteresis_deadband": (0.0, "m"),
+    "friction_coulomb": (0.0, "N"),
+    "dead_volume_1": (0.0, "m3"),
+    "dead_volume_2": (0.0, "m3"),
+    "supply_resistance": (0.0, "Pa.s/kg"),
+    "heat_transfer_fraction": (0.0, "1"),
+    "command_delay": (0.0, "s"),
+    "force_sensor_offset": (0.0, "N"),
+    "force_sensor_gain": (1.0, "1"),
 }
 
 

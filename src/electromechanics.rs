@@ -123,7 +123,7 @@ impl ElectromechanicalPropagator {
             lambda,
             inverse,
             beta,
-            hysteresis: PrandtlIshlinskii::new(p.hysteresis_width),
+            hysteresis: PrandtlIshlinskii::new(p.hysteresis_width, p.hysteresis_deadband),
         })
     }
 

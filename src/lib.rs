@@ -7,6 +7,7 @@
 //! * [`fmu`]: the actuator behind that layer; [`fmu_exports`]: the exported `fmi2*` symbols;
 //! * [`variables`]: the table of FMU variables from which the model description comes.
 
+pub mod diagnosis;
 pub mod electromechanics;
 pub mod fmi2;
 pub mod fmu;
@@ -15,6 +16,9 @@ pub mod integrator;
 pub mod linearization;
 pub mod packaging;
 pub mod physics;
+pub mod plots;
+pub mod recording;
+pub mod replay;
 pub mod scenario;
 pub mod simulation;
 pub mod synthetic_bench;

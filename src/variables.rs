@@ -48,6 +48,7 @@ pub mod vr {
 
     // Effects the thesis model lacks (MODEL.md), all off at their start values.
     pub const HYSTERESIS_WIDTH: u32 = 300;
+    pub const HYSTERESIS_DEADBAND: u32 = 301;
     pub const FRICTION_COULOMB: u32 = 310;
     pub const DEAD_VOLUME_1: u32 = 320;
     pub const DEAD_VOLUME_2: u32 = 321;
@@ -373,6 +374,7 @@ pub const VARIABLES: &[Variable] = &[
         101_325.0,
         "initial P2 when start_at_equilibrium is false"),
     parameter("hysteresis_width", vr::HYSTERESIS_WIDTH, "m", 0.0, "jet_pipe_hysteresis: separation of the rising and falling branches of the static tip position in large sweeps (Prandtl-Ishlinskii operator after f3; 0 = off)"),
+        parameter("hysteresis_deadband", vr::HYSTERESIS_DEADBAND, "m", 0.0, "jet_pipe_hysteresis: travel of the static tip position after a reversal before the hysteretic output moves (smallest play width, at most hysteresis_width)"),
     parameter("friction_coulomb", vr::FRICTION_COULOMB, "N", 0.0, "piston_friction: Coulomb friction opposing stopper motion, (2.35) (0 = off)"),
     parameter("dead_volume_1", vr::DEAD_VOLUME_1, "m3", 0.0, "dead_volume: port and line volume added to chamber 1 (0 = off)"),
     parameter("dead_volume_2", vr::DEAD_VOLUME_2, "m3", 0.0, "dead_volume: port and line volume added to chamber 2 (0 = off)"),

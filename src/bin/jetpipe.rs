@@ -46,6 +46,23 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Compare a bench recording with the model, find the effects it lacks, report before/after.
+    Diagnose {
+        /// The recording (CSV: time_s, v_da_V, x_s_m, force_N[, p1_Pa, p2_Pa]).
+        recording: PathBuf,
+        /// Where to write the JSON report (written only if the diagnosis succeeds).
+        #[arg(long)]
+        report: PathBuf,
+        /// JSON object of FMU parameter values to start from instead of the thesis's.
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Re-identify jet pipe offset, C_d and leakage (§3.3.1) first.
+        #[arg(long)]
+        calibrate: bool,
+        /// Directory for SVG plots of the residuals and force/current loops.
+        #[arg(long)]
+        plots: Option<PathBuf>,
+    },
     /// Run the standard scenario in-process and print a summary.
     Simulate {
         /// Communication step in seconds.
@@ -87,6 +104,13 @@ fn run(cli: Cli) -> Result<(), String> {
         }
         Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
         Command::Linearize { force, x_s, json } => linearize(force, x_s, json),
+        Command::Diagnose {
+            recording,
+            report,
+            params,
+            calibrate,
+            plots,
+        } => diagnose(&recording, &report, params.as_deref(), calibrate, plots.as_deref()),
     }
 }
 
@@ -113,6 +137,82 @@ fn build_shared_library() -> Result<PathBuf, String> {
         }
     }
     Ok(library)
+}
+
+/// Parameters from a JSON object of FMU parameter names and values.
+fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String> {
+    let mut p = Parameters::default();
+    let Some(path) = path else { return Ok(p) };
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: not valid JSON: {e}", path.display()))?;
+    let object = value
+        .as_object()
+        .ok_or_else(|| format!("{}: expected a JSON object of parameter values", path.display()))?;
+    for (name, v) in object {
+        let variable = jetpipe::variables::VARIABLES
+            .iter()
+            .find(|var| var.name == name && var.causality == jetpipe::fmi2::model::Causality::Parameter)
+            .ok_or_else(|| format!("{}: '{name}' is not a parameter of the model", path.display()))?;
+        let x = v
+            .as_f64()
+            .ok_or_else(|| format!("{}: '{name}' must be a number, got {v}", path.display()))?;
+        p.set(variable.value_reference, x)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    p.validate().map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(p)
+}
+
+fn diagnose(
+    recording_path: &std::path::Path,
+    report: &std::path::Path,
+    params: Option<&std::path::Path>,
+    calibrate: bool,
+    plots: Option<&std::path::Path>,
+) -> Result<(), String> {
+    let started = Instant::now();
+    let base = read_parameters(params)?;
+    let recording = jetpipe::recording::Recording::read(recording_path, &base)?;
+    let mut progress = |line: &str| eprintln!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
+    let diagnosis = jetpipe::diagnosis::diagnose(&recording, &base, calibrate, &mut progress)?;
+    let name = recording_path.display().to_string();
+    let json = diagnosis.to_json(&name);
+    if let Some(dir) = plots {
+        jetpipe::plots::write_diagnosis_plots(dir, &recording, &diagnosis)?;
+        eprintln!("plots written to {}", dir.display());
+    }
+    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
+    // Write beside the target and rename: an existing report is never left half-written.
+    let temporary = report.with_extension("json.partial");
+    std::fs::write(&temporary, text).map_err(|e| format!("cannot write {}: {e}", temporary.display()))?;
+    std::fs::rename(&temporary, report).map_err(|e| format!("cannot write {}: {e}", report.display()))?;
+    println!(
+        "{name}: {} samples, noise floor {:.4} N",
+        diagnosis.samples, diagnosis.noise_floor
+    );
+    println!(
+        "  before: force RMS {:.4} N (held-out {:.4} N)",
+        diagnosis.before.rms, diagnosis.before.heldout_rms
+    );
+    if diagnosis.effects.is_empty() {
+        println!("  no effect added: the thesis model explains the recording to within its noise");
+    }
+    for (fit, evidence) in &diagnosis.effects {
+        let values: Vec<String> = fit.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
+        println!("  + {} ({})", fit.name, values.join(", "));
+        println!("    {evidence}");
+    }
+    println!(
+        "  after:  force RMS {:.4} N (held-out {:.4} N)",
+        diagnosis.after.rms, diagnosis.after.heldout_rms
+    );
+    println!(
+        "  report: {} ({:.1} s)",
+        report.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 fn linearize(force: f64, x_s: f64, json: bool) -> Result<(), String> {

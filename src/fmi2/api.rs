@@ -2,8 +2,9 @@
 //! forwards each exported C symbol to one of these.
 //!
 //! Every function that takes an instance:
-//! * returns fmi2Error for a NULL instance (nothing dereferenced) or one whose magic
-//!   number is gone (freed; see [`Instance::is_live`] for the limits of that check);
+//! * returns fmi2Error for a NULL, freed or foreign instance: the handle is looked up in
+//!   the registry of live handles before anything is dereferenced (see
+//!   [`Instance::is_live`]); there is no logger to report it to;
 //! * runs its whole body inside `catch_unwind`: a panic is logged with its message, the
 //!   instance goes to the `fatal` state and the call returns fmi2Fatal;
 //! * checks the call against [`state::TABLE`]: an illegal call logs
@@ -295,8 +296,7 @@ pub unsafe fn instantiate<M: CoSimModel>(
             ));
             return std::ptr::null_mut();
         }
-        let inst = Instance::new(M::instantiate(), name, Some(&callbacks), logging_on != 0);
-        Box::into_raw(Box::new(inst)) as fmi2Component
+        Instance::new(M::instantiate(), name, Some(&callbacks), logging_on != 0).into_component()
     }));
     match result {
         Ok(c) => c,
@@ -315,9 +315,9 @@ pub unsafe fn instantiate<M: CoSimModel>(
     }
 }
 
-/// `fmi2FreeInstance`. NULL is a no-op (fmi2OK). A pointer whose magic number is gone
-/// (already freed, in the common case) returns fmi2Error without touching it; the
-/// exported `void` function drops the status.
+/// `fmi2FreeInstance`. NULL is a no-op (fmi2OK). A pointer that is not a live instance
+/// (already freed, or never one) returns fmi2Error without touching it; the exported
+/// `void` function drops the status.
 ///
 /// # Safety
 /// `c` must be NULL or come from [`instantiate`] for `M`; see [`Instance::is_live`].
@@ -327,6 +327,7 @@ pub unsafe fn free_instance<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
     }
     guarded::<M>(c, Function::FreeInstance, |inst| {
         inst.kill();
+        unregister_handle(c, HandleKind::Instance);
         drop(Box::from_raw(inst as *mut Instance<M>));
         fmi2OK
     })
@@ -691,7 +692,7 @@ unsafe fn store_snapshot<M: CoSimModel>(
 ) -> fmi2Status {
     let old = *slot;
     if old.is_null() {
-        *slot = Box::into_raw(Box::new(snap)) as fmi2FMUstate;
+        *slot = snap.into_raw();
         fmi2OK
     } else if Snapshot::is_live(old) {
         *(old as *mut Snapshot) = snap;
@@ -773,9 +774,7 @@ pub unsafe fn free_fmu_state<M: CoSimModel>(c: fmi2Component, state: *mut fmi2FM
         if let Err(m) = snapshot_ref::<M>(F, *state) {
             return inst.error(m);
         }
-        let mut snap = Box::from_raw(*state as *mut Snapshot);
-        snap.kill();
-        drop(snap);
+        Snapshot::free_raw(*state);
         *state = std::ptr::null_mut();
         fmi2OK
     })
@@ -978,6 +977,11 @@ pub unsafe fn do_step<M: CoSimModel>(
         if !current.is_finite() || (current - t).abs() > tol {
             return inst.error(format!(
                 "{F}: currentCommunicationPoint = {current:?} does not match the FMU's time {t:?} (tolerance {tol:e})"
+            ));
+        }
+        if t + h <= t {
+            return inst.error(format!(
+                "{F}: communicationStepSize = {h:e} is below the resolution of the time {t:?}: the step would not advance it"
             ));
         }
         match inst.model.do_step(current, h) {

@@ -13,6 +13,7 @@
 //! | n | `CoSimModel::serialize()` |
 //! | 4 | CRC-32 (IEEE, as zlib) of everything before it |
 
+use super::instance::{is_registered_handle, register_handle, unregister_handle, HandleKind};
 use super::model::CoSimModel;
 use super::state::State;
 
@@ -41,10 +42,31 @@ impl Snapshot {
         }
     }
 
+    /// Whether `p` is a live FMU state: registered when it was boxed and not yet freed
+    /// (checked without reading `*p`), with its magic number intact.
+    ///
     /// # Safety
-    /// Same caveat as `Instance::is_live`: `p` must be null or readable.
+    /// None beyond the FMI contract (see `Instance::is_live`).
     pub unsafe fn is_live(p: *const std::ffi::c_void) -> bool {
-        !p.is_null() && std::ptr::read_volatile(p as *const u64) == SNAPSHOT_MAGIC
+        is_registered_handle(p, HandleKind::Snapshot) && std::ptr::read_volatile(p as *const u64) == SNAPSHOT_MAGIC
+    }
+
+    /// Box the snapshot and register it: the `fmi2FMUstate` handed to the importer.
+    pub fn into_raw(self) -> *mut std::ffi::c_void {
+        let p = Box::into_raw(Box::new(self)) as *mut std::ffi::c_void;
+        register_handle(p, HandleKind::Snapshot);
+        p
+    }
+
+    /// Free a snapshot made by [`Snapshot::into_raw`].
+    ///
+    /// # Safety
+    /// `p` must be live ([`Snapshot::is_live`]) and not used afterwards.
+    pub unsafe fn free_raw(p: *mut std::ffi::c_void) {
+        unregister_handle(p, HandleKind::Snapshot);
+        let mut snap = Box::from_raw(p as *mut Snapshot);
+        snap.kill();
+        drop(snap);
     }
 
     pub fn kill(&mut self) {

@@ -1,6 +1,9 @@
 //! One FMU instance: the model plus everything the layer keeps about it, and logging.
 
+use std::collections::BTreeSet;
 use std::ffi::{CStr, CString};
+use std::os::raw::c_void;
+use std::sync::Mutex;
 
 use super::model::CoSimModel;
 use super::state::State;
@@ -8,6 +11,46 @@ use super::types::*;
 
 /// Marks a live [`Instance`]; cleared by `fmi2FreeInstance`.
 pub const INSTANCE_MAGIC: u64 = 0x4649_4D32_494E_5354; // "FIM2INST"
+
+/// What a registered address is: kept apart so an FMU state is never taken for an instance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum HandleKind {
+    Instance,
+    Snapshot,
+}
+
+/// Addresses of every live instance and FMU state of this process. A handle is checked
+/// here before it is dereferenced, so a NULL, freed (double `fmi2FreeInstance`,
+/// `fmi2FreeFMUstate` twice through a copy of the pointer) or foreign pointer is rejected
+/// without reading the memory it points to. The lock is held only for the set operation.
+static LIVE_HANDLES: Mutex<BTreeSet<(usize, HandleKind)>> = Mutex::new(BTreeSet::new());
+
+fn live_handles() -> std::sync::MutexGuard<'static, BTreeSet<(usize, HandleKind)>> {
+    // a set of integers cannot be left inconsistent by a panic: ignore poisoning
+    LIVE_HANDLES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Record `p` as a live handle of this kind.
+pub fn register_handle(p: *const c_void, kind: HandleKind) {
+    live_handles().insert((p as usize, kind));
+}
+
+/// Forget `p`; whether it was registered.
+pub fn unregister_handle(p: *const c_void, kind: HandleKind) -> bool {
+    let mut set = live_handles();
+    let removed = set.remove(&(p as usize, kind));
+    if set.is_empty() {
+        // an emptied BTreeSet keeps its root node: release it, so that no allocation
+        // outlives the last handle (and a dlclose'd library leaves no block behind)
+        *set = BTreeSet::new();
+    }
+    removed
+}
+
+/// Whether `p` is a live handle of this kind (no memory behind `p` is read).
+pub fn is_registered_handle(p: *const c_void, kind: HandleKind) -> bool {
+    !p.is_null() && live_handles().contains(&(p as usize, kind))
+}
 
 /// Log categories the layer itself uses.
 pub const CAT_ERROR: &str = "logStatusError";
@@ -63,15 +106,23 @@ impl<M: CoSimModel> Instance<M> {
         }
     }
 
-    /// Whether `c` points to a live instance (magic number intact).
+    /// Whether `c` is a live instance: registered by `fmi2Instantiate` and not yet freed
+    /// (checked in the handle registry, without reading `*c`), with its magic number
+    /// intact.
     ///
     /// # Safety
-    /// `c` must be null or point to at least 8 readable bytes. A pointer to an instance
-    /// that was already freed is undefined behaviour to read; in practice the allocator
-    /// has reused or overwritten the first word, so the check catches a double
-    /// `fmi2FreeInstance` or a use after free in the common case, not always.
+    /// None beyond the FMI contract: a NULL, freed or foreign pointer is answered from the
+    /// registry without being dereferenced. The one case that cannot be told apart is a
+    /// freed address that the allocator has given to a new instance.
     pub unsafe fn is_live(c: fmi2Component) -> bool {
-        !c.is_null() && std::ptr::read_volatile(c as *const u64) == INSTANCE_MAGIC
+        is_registered_handle(c, HandleKind::Instance) && std::ptr::read_volatile(c as *const u64) == INSTANCE_MAGIC
+    }
+
+    /// Box the instance and register it: the `fmi2Component` handed to the importer.
+    pub fn into_component(self) -> fmi2Component {
+        let c = Box::into_raw(Box::new(self)) as fmi2Component;
+        register_handle(c, HandleKind::Instance);
+        c
     }
 
     /// Clear the magic number (just before the instance is dropped).

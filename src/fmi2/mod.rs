@@ -21,10 +21,11 @@
 //! * [`testing`]: a dummy first-order-lag model for tests.
 //!
 //! # Known limits
-//! * A freed instance or FMU state is detected by a cleared magic number at offset 0.
-//!   Reading freed memory is undefined behaviour; in practice the allocator overwrites
-//!   that word, so a double `fmi2FreeInstance` or a use after free is an fmi2Error in
-//!   the common case, not always (e.g. if the memory was reused for a new instance).
+//! * Instances and FMU states are recorded in a process-wide registry of live handles
+//!   (a mutex-protected set of addresses, locked only for the look-up): a NULL, freed or
+//!   foreign handle (a double `fmi2FreeInstance`, a use after free) is an fmi2Error
+//!   without its memory being read. The only case not caught: a freed address that the
+//!   allocator has meanwhile given to a new instance (or FMU state) is that new one.
 //! * Only synchronous stepping: `fmi2CancelStep` is always an illegal call, the
 //!   `stepInProgress` state does not exist, `fmi2GetStatus` answers fmi2Discard.
 //! * After a panic the instance is `fatal`; only `fmi2FreeInstance` is accepted. Other

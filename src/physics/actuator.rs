@@ -89,7 +89,7 @@ impl Actuator {
         let flow = params.flow_constants();
         let cylinder = params.cylinder();
         let piston_area = cylinder.piston_area();
-        let hysteresis = PrandtlIshlinskii::new(params.hysteresis_width);
+        let hysteresis = PrandtlIshlinskii::new(params.hysteresis_width, params.hysteresis_deadband);
         let polytropic_exponent = effects::polytropic_exponent(params.gamma, params.heat_transfer_fraction);
         Ok(Self {
             params,

@@ -3,7 +3,7 @@
 //!
 //! | name | parameter(s) | where it acts |
 //! |---|---|---|
-//! | `jet_pipe_hysteresis` | `hysteresis_width` (m) | Prandtl–Ishlinskii operator on f3's output, before the jet pipe dynamics (§3.2.1–3.2.2) |
+//! | `jet_pipe_hysteresis` | `hysteresis_width`, `hysteresis_deadband` (m) | Prandtl–Ishlinskii operator on f3's output, before the jet pipe dynamics (§3.2.1–3.2.2) |
 //! | `piston_friction` | `friction_coulomb` (N) | rod force while the stopper moves, (2.33)–(2.35) |
 //! | `dead_volume` | `dead_volume_1`, `dead_volume_2` (m³) | added to (2.30)–(2.31) |
 //! | `supply_pressure_drop` | `supply_resistance` (Pa·s/kg) | supply pressure at the jet pipe (§2.6) |
@@ -38,7 +38,10 @@ pub struct PrandtlIshlinskii {
 }
 
 impl PrandtlIshlinskii {
-    pub fn new(width: f64) -> Self {
+    /// `deadband` (≤ `width`) is the smallest play's full width: how far the input must
+    /// travel after a reversal before the output moves at all.
+    pub fn new(width: f64, deadband: f64) -> Self {
+        let deadband = deadband.clamp(0.0, width);
         let mut half_widths = [0.0; PLAY_OPERATORS];
         let mut sum = 0.0;
         for (k, r) in half_widths.iter_mut().enumerate() {
@@ -46,14 +49,15 @@ impl PrandtlIshlinskii {
             *r = -(1.0 - q).ln();
             sum += *r;
         }
-        // Scale so the mean half-width is exactly width/2.
+        // Scale the spread so the mean half-width is exactly width/2.
+        let spread = 0.5 * (width - deadband);
         let scale = if sum > 0.0 {
-            0.5 * width * PLAY_OPERATORS as f64 / sum
+            spread * PLAY_OPERATORS as f64 / sum
         } else {
             0.0
         };
         for r in half_widths.iter_mut() {
-            *r *= scale;
+            *r = 0.5 * deadband + *r * scale;
         }
         Self { half_widths }
     }
@@ -154,7 +158,7 @@ mod tests {
     #[test]
     fn large_sweeps_have_branches_width_apart() {
         let width = 0.16e-3;
-        let op = PrandtlIshlinskii::new(width);
+        let op = PrandtlIshlinskii::new(width, 0.0);
         let mut plays = [0.0; PLAY_OPERATORS];
         sweep(&op, &mut plays, 0.0, -1e-3);
         let rising = sweep(&op, &mut plays, -1e-3, 1e-3);
@@ -171,7 +175,7 @@ mod tests {
 
     #[test]
     fn minor_loops_close_and_stay_inside_the_major_loop() {
-        let op = PrandtlIshlinskii::new(0.16e-3);
+        let op = PrandtlIshlinskii::new(0.16e-3, 0.05e-3);
         let mut plays = [0.0; PLAY_OPERATORS];
         sweep(&op, &mut plays, 0.0, -1e-3);
         sweep(&op, &mut plays, -1e-3, 0.2e-3);
@@ -188,7 +192,7 @@ mod tests {
 
     #[test]
     fn zero_width_is_the_identity() {
-        let op = PrandtlIshlinskii::new(0.0);
+        let op = PrandtlIshlinskii::new(0.0, 0.0);
         assert!(!op.is_active());
         let mut plays = [0.0; PLAY_OPERATORS];
         op.advance(&mut plays, 3e-4);

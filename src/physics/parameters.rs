@@ -36,6 +36,7 @@ pub struct Parameters {
     pub k_spring: f64,
     /// Effects the thesis model lacks; each is off at its default (see [`super::effects`]).
     pub hysteresis_width: f64,
+    pub hysteresis_deadband: f64,
     pub friction_coulomb: f64,
     pub dead_volume_1: f64,
     pub dead_volume_2: f64,
@@ -86,6 +87,7 @@ impl Default for Parameters {
             d_cyl: 0.0,
             k_spring: 0.0,
             hysteresis_width: 0.0,
+            hysteresis_deadband: 0.0,
             friction_coulomb: 0.0,
             dead_volume_1: 0.0,
             dead_volume_2: 0.0,
@@ -142,6 +144,7 @@ impl Parameters {
         vr::D_CYL,
         vr::K_SPRING,
         vr::HYSTERESIS_WIDTH,
+        vr::HYSTERESIS_DEADBAND,
         vr::FRICTION_COULOMB,
         vr::DEAD_VOLUME_1,
         vr::DEAD_VOLUME_2,
@@ -182,6 +185,7 @@ impl Parameters {
             vr::D_CYL => (&mut self.d_cyl, Positive),
             vr::K_SPRING => (&mut self.k_spring, NonNegative),
             vr::HYSTERESIS_WIDTH => (&mut self.hysteresis_width, NonNegative),
+            vr::HYSTERESIS_DEADBAND => (&mut self.hysteresis_deadband, NonNegative),
             vr::FRICTION_COULOMB => (&mut self.friction_coulomb, NonNegative),
             vr::DEAD_VOLUME_1 => (&mut self.dead_volume_1, NonNegative),
             vr::DEAD_VOLUME_2 => (&mut self.dead_volume_2, NonNegative),
@@ -234,6 +238,12 @@ impl Parameters {
             return Err(format!(
                 "C_db_A_lpp + C_dm_A_lpp = {} m2 is invalid: the leakage area (2.23) must stay >= 0 for every pressure ratio",
                 self.c_db_a_lpp + self.c_dm_a_lpp
+            ));
+        }
+        if self.hysteresis_deadband > self.hysteresis_width {
+            return Err(format!(
+                "hysteresis_deadband = {} m is invalid: must not exceed hysteresis_width = {} m",
+                self.hysteresis_deadband, self.hysteresis_width
             ));
         }
         if self.l_cyl <= self.l_p {
