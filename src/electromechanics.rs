@@ -182,6 +182,7 @@ impl ElectromechanicalPropagator {
             turning_point,
             settled: None,
             kinks: vec![],
+            panel_ends: std::cell::RefCell::new(vec![]),
         };
         if trajectory.series.is_empty() {
             trajectory.kinks = trajectory.find_kinks();
@@ -275,6 +276,8 @@ pub struct Trajectory<'a> {
     /// Instants where the quadrature's integrand has a kink (the turning point, plays of
     /// the hysteresis operator starting to move): panels end there.
     kinks: Vec<f64>,
+    /// Panel ends and the modal integrals up to them, filled as queries need them.
+    panel_ends: std::cell::RefCell<Vec<(f64, [C64; 3])>>,
 }
 
 impl Trajectory<'_> {
@@ -351,37 +354,50 @@ impl Trajectory<'_> {
         kinks
     }
 
-    /// ∫₀ˢ e^{λ(s−σ)} u(σ) dσ for each mode by composite Gauss–Legendre quadrature on
-    /// panels of at most [`PANEL`] that end at every kink of u.
-    fn quadrature(&self, s: f64) -> [C64; 3] {
+    /// ∫ₐᵇ e^{λ(b−σ)} u(σ) dσ for each mode by an 8-point Gauss–Legendre rule.
+    fn panel(&self, a: f64, b: f64) -> [C64; 3] {
         let p = self.propagator;
         let mut integral = [C64::new(0.0, 0.0); 3];
-        if s <= 0.0 {
-            return integral;
-        }
-        let mut start = 0.0;
-        for end in self
-            .kinks
-            .iter()
-            .copied()
-            .filter(|&k| k > 0.0 && k < s)
-            .chain(std::iter::once(s))
-        {
-            let panels = ((end - start) / PANEL).ceil().max(1.0) as usize;
-            let width = (end - start) / panels as f64;
-            for j in 0..panels {
-                let centre = start + (j as f64 + 0.5) * width;
-                for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
-                    let sigma = centre + 0.5 * width * node;
-                    let u = self.jet_input(sigma) * weight * 0.5 * width;
-                    for k in 0..3 {
-                        integral[k] += (p.lambda[k] * (s - sigma)).exp() * u;
-                    }
-                }
+        let (centre, half) = (0.5 * (a + b), 0.5 * (b - a));
+        for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
+            let sigma = centre + half * node;
+            let u = self.jet_input(sigma) * weight * half;
+            for k in 0..3 {
+                integral[k] += (p.lambda[k] * (b - sigma)).exp() * u;
             }
-            start = end;
         }
         integral
+    }
+
+    /// ∫₀ˢ e^{λ(s−σ)} u(σ) dσ for each mode: composite Gauss–Legendre on panels of at most
+    /// [`PANEL`] that end at every kink of u. The integrals at panel ends are kept, so a
+    /// query costs one panel however far into the step it is.
+    fn quadrature(&self, s: f64) -> [C64; 3] {
+        let lambda = self.propagator.lambda;
+        let carry = |integral: &[C64; 3], from: f64, to: f64, add: [C64; 3]| {
+            let mut out = add;
+            for k in 0..3 {
+                out[k] += (lambda[k] * (to - from)).exp() * integral[k];
+            }
+            out
+        };
+        let mut table = self.panel_ends.borrow_mut();
+        if table.is_empty() {
+            table.push((0.0, [C64::new(0.0, 0.0); 3]));
+        }
+        loop {
+            let (end, integral) = *table.last().expect("the table starts with 0");
+            let next_kink = self.kinks.iter().copied().find(|&k| k > end * (1.0 + 1e-12) + 1e-15);
+            let next = next_kink.map_or(end + PANEL, |k| k.min(end + PANEL));
+            if next > s {
+                break;
+            }
+            let value = carry(&integral, end, next, self.panel(end, next));
+            table.push((next, value));
+        }
+        let j = table.partition_point(|(end, _)| *end <= s).saturating_sub(1);
+        let (end, integral) = table[j];
+        carry(&integral, end, s, self.panel(end, s))
     }
 
     /// Modal coordinates at `s`.

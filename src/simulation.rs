@@ -428,7 +428,10 @@ impl Simulation {
                     Ok(_) => duration,
                     Err(f) => f.time - t0,
                 };
-                self.plays = trajectory.plays_at(reached);
+                let plays = trajectory.plays_at(reached);
+                if plays.iter().all(|p| p.is_finite()) {
+                    self.plays = plays;
+                }
                 match result {
                     Ok(p) => Ok(combine(duration, p)),
                     Err(f) => Err(IntegrationFailure {
@@ -471,7 +474,7 @@ impl Simulation {
                 self.x_s += self.x_s_rate * duration;
                 Ok(())
             }
-            Err(failure) => {
+            Err(failure) if failure.state.iter().all(|v| v.is_finite()) => {
                 let elapsed = failure.time - self.time;
                 self.state = failure.state;
                 self.v_da += self.v_da_rate * elapsed;
@@ -482,6 +485,11 @@ impl Simulation {
                     time: failure.time,
                 })
             }
+            // Never keep a non-finite state: stay where the step started.
+            Err(failure) => Err(StepFailure::Integration {
+                message: failure.message,
+                time: self.time,
+            }),
         }
     }
 

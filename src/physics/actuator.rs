@@ -119,7 +119,7 @@ impl Actuator {
                 mass_flow(k, p.c_d * a.supply_2, p_supply, p2),
             )
         };
-        let p_supply = effects::supply_pressure_at_jet(p.p_s, p.supply_resistance, |ps| {
+        let p_supply = effects::supply_pressure_at_jet(p.p_s, p.supply_resistance, p1.min(p2), |ps| {
             let (s1, s2) = supply(ps);
             s1 + s2
         });

@@ -113,32 +113,47 @@ pub fn sensor_reading(offset: f64, gain: f64, force: f64) -> f64 {
 
 /// Supply pressure at the jet pipe when a supply line of resistance `resistance` (Pa·s/kg)
 /// carries the supply mass flow `supply_flow(p)` drawn at that pressure: the root of
-/// p = P_s − R ṁ(p), found by the secant method (ṁ rises with p, so the root is unique).
-pub fn supply_pressure_at_jet(p_s: f64, resistance: f64, supply_flow: impl Fn(f64) -> f64) -> f64 {
+/// p = P_s − R ṁ(p). ṁ rises with p, and at `lowest` (the lower chamber pressure) no air
+/// leaves the supply, so the root lies in [lowest, P_s]; the Illinois variant of regula
+/// falsi finds it without leaving the bracket, however large R is.
+pub fn supply_pressure_at_jet(p_s: f64, resistance: f64, lowest: f64, supply_flow: impl Fn(f64) -> f64) -> f64 {
     if resistance == 0.0 {
         return p_s;
     }
     let residual = |p: f64| p - p_s + resistance * supply_flow(p);
-    let (mut a, mut fa) = (p_s, residual(p_s));
-    if fa <= 0.0 {
+    let (mut a, mut fa) = (lowest.min(p_s), residual(lowest.min(p_s)));
+    let (mut b, mut fb) = (p_s, residual(p_s));
+    if fb <= 0.0 {
         return p_s;
     }
-    let mut b = p_s - fa;
-    let mut fb = residual(b);
-    for _ in 0..30 {
-        if fb == fa {
-            break;
+    if fa >= 0.0 {
+        return a;
+    }
+        let mut side = 0;
+    for iteration in 0..200 {
+        // Every third iteration bisect, so the bracket halves whatever the curvature.
+        let c = if iteration % 3 == 2 { 0.5 * (a + b) } else { (a * fb - b * fa) / (fb - fa) };
+        let fc = residual(c);
+        if fc.abs() < 1e-10 * p_s || (b - a).abs() < 1e-12 * p_s {
+            return c;
         }
-        let c = b - fb * (b - a) / (fb - fa);
-        a = b;
-        fa = fb;
-        b = c.clamp(0.0, p_s);
-        fb = residual(b);
-        if fb.abs() < 1e-9 * p_s {
-            break;
+        if fc > 0.0 {
+            b = c;
+            fb = fc;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        } else {
+            a = c;
+            fa = fc;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
         }
     }
-    b
+    0.5 * (a + b)
 }
 
 #[cfg(test)]
@@ -203,9 +218,13 @@ mod tests {
     fn supply_drop_solves_its_equation() {
         // Choked supply flow ∝ p: p = P_s − R k p ⇒ p = P_s / (1 + R k).
         let (p_s, r, k) = (652_925.0, 2e8, 1e-10);
-        let p = supply_pressure_at_jet(p_s, r, |p| k * p);
+        let p = supply_pressure_at_jet(p_s, r, 0.0, |p| k * p);
         assert!((p - p_s / (1.0 + r * k)).abs() < 1e-6 * p_s, "{p}");
-        assert_eq!(supply_pressure_at_jet(p_s, 0.0, |p| k * p), p_s);
+        assert_eq!(supply_pressure_at_jet(p_s, 0.0, 0.0, |p| k * p), p_s);
+        // An enormous resistance: the jet sees (almost) the chamber pressure, never less.
+        let chamber = 3e5;
+        let p = supply_pressure_at_jet(p_s, 1e300, chamber, |p| k * (p - chamber));
+        assert!(p >= chamber && p < chamber + 1.0, "{p}");
     }
 
     #[test]
