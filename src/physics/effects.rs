@@ -129,10 +129,14 @@ pub fn supply_pressure_at_jet(p_s: f64, resistance: f64, lowest: f64, supply_flo
     if fa >= 0.0 {
         return a;
     }
-        let mut side = 0;
+    let mut side = 0;
     for iteration in 0..200 {
         // Every third iteration bisect, so the bracket halves whatever the curvature.
-        let c = if iteration % 3 == 2 { 0.5 * (a + b) } else { (a * fb - b * fa) / (fb - fa) };
+        let c = if iteration % 3 == 2 {
+            0.5 * (a + b)
+        } else {
+            (a * fb - b * fa) / (fb - fa)
+        };
         let fc = residual(c);
         if fc.abs() < 1e-10 * p_s || (b - a).abs() < 1e-12 * p_s {
             return c;

@@ -1,0 +1,59 @@
+"""The diagnosis's FMU start values reproduce its reported error through the FMU.
+
+A recording with an undeclared effect comes from the independent generator (benchgen);
+`jetpipe diagnose` names the effect and reports `fmu_start_values`. Setting those on the
+packaged FMU and replaying the recording through FMPy (command held between samples, the
+stopper moving linearly via fmi2SetRealInputDerivatives) must give the reported `after`
+error within 5 %.
+"""
+
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jetpipe_fmu import initialize, make_slave, release
+
+ROOT = Path(__file__).resolve().parent.parent
+BIN = ROOT / "target" / "release"
+
+
+def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values):
+    fmu = make_slave(unzipdir, model_description)
+    try:
+        initialize(fmu, vrs, inputs=(recording["v_da_V"][0], recording["x_s_m"][0]), parameters=start_values)
+        t, v, x = recording["time_s"], recording["v_da_V"], recording["x_s_m"]
+        force = np.empty(len(t))
+        vr_v, vr_x, vr_f = [vrs["v_DA"]], [vrs["x_s"]], [vrs["F_meas"]]
+        for k in range(len(t)):
+            force[k] = fmu.getReal(vr_f)[0]
+            if k + 1 == len(t):
+                break
+            dt = t[k + 1] - t[k]
+            fmu.setReal(vr_v, [v[k]])
+            fmu.setRealInputDerivatives(vr_x, [1], [(x[k + 1] - x[k]) / dt])
+            fmu.doStep(currentCommunicationPoint=t[k], communicationStepSize=dt)
+        return force
+    finally:
+        release(fmu)
+
+
+@pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
+                    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
+def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description, vrs, tmp_path):
+    recording_path = tmp_path / "friction.csv"
+    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "31",
+                    "--friction-coulomb", "2.5"], check=True, capture_output=True)
+    report_path = tmp_path / "report.json"
+    subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
+                   check=True, capture_output=True)
+    report = json.loads(report_path.read_text())
+    assert [e["name"] for e in report["effects"]][:1] == ["piston_friction"], report["effects"]
+    recording = np.genfromtxt(recording_path, delimiter=",", names=True)
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
+    rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
+    reported = report["after"]["force_rms_N"]
+    print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
+    assert abs(rms - reported) <= 0.05 * reported
