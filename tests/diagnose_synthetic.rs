@@ -217,3 +217,34 @@ fn two_effects_at_once() {
     );
     assert!(d.after.heldout_rms < 0.35 * d.before.heldout_rms);
 }
+
+#[test]
+fn calibration_re_identifies_the_static_parameters() {
+    // Start the diagnosis from a wrong discharge coefficient and jet pipe offset; with
+    // --calibrate it must find the generator's values again (§3.3.1's identification).
+    if !selected("calibrate") {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-calibrate", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("recording.csv");
+    write_csv(&generate(&BenchEffects::default(), 110, 80.0), &path).unwrap();
+    let mut wrong = Parameters::default();
+    wrong.c_d = 0.60;
+    wrong.x_jp_offset = 0.07e-3;
+    let recording = Recording::read(&path, &wrong).unwrap();
+    let d = diagnose(&recording, &wrong, true, &mut |line| println!("{line}")).unwrap();
+    let value = |name: &str| d.calibrated.iter().find(|(n, _)| *n == name).map(|(_, v)| *v).unwrap();
+    println!(
+        "calibrated: {:?}; after {:.4} N, noise {:.4} N",
+        d.calibrated, d.after.rms, d.noise_floor
+    );
+    assert!((value("C_d") - 0.696).abs() < 0.02, "C_d = {}", value("C_d"));
+    assert!(
+        (value("x_jp_offset") - 0.099e-3).abs() < 0.01e-3,
+        "x_jp_offset = {}",
+        value("x_jp_offset")
+    );
+    assert!(d.effects.is_empty(), "added {:?}", names(&d));
+    let _ = std::fs::remove_dir_all(&dir);
+}
