@@ -1,7 +1,7 @@
 //! Replaying a recording's inputs through the model: the command held between samples,
 //! the stopper moving linearly between samples (MODEL.md, "Measured data").
 
-use crate::physics::actuator::Actuator;
+use crate::physics::actuator::{Actuator, Outputs};
 use crate::recording::Recording;
 use crate::simulation::{Simulation, StepFailure};
 
@@ -17,6 +17,25 @@ pub struct Replay {
     pub steps: u64,
 }
 
+impl Replay {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            force: Vec::with_capacity(n),
+            p1: Vec::with_capacity(n),
+            p2: Vec::with_capacity(n),
+            current: Vec::with_capacity(n),
+            steps: 0,
+        }
+    }
+
+    fn record(&mut self, y: &Outputs) {
+        self.force.push(y.f_meas);
+        self.p1.push(y.p1);
+        self.p2.push(y.p2);
+        self.current.push(y.current);
+    }
+}
+
 /// Simulate `recording` from the equilibrium of its first sample (the bench holds the
 /// first command before t = 0). Samples in `0..end` only.
 pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usize) -> Result<Replay, String> {
@@ -28,19 +47,10 @@ pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usiz
         recording.time[0],
         tolerance,
     )?;
-    let mut out = Replay {
-        force: Vec::with_capacity(n),
-        p1: Vec::with_capacity(n),
-        p2: Vec::with_capacity(n),
-        current: Vec::with_capacity(n),
-        steps: 0,
-    };
+    let mut out = Replay::with_capacity(n);
     for k in 0..n {
         let y = sim.outputs();
-        out.force.push(y.f_meas);
-        out.p1.push(y.p1);
-        out.p2.push(y.p2);
-        out.current.push(y.current);
+        out.record(&y);
         if k + 1 == n {
             break;
         }
@@ -58,14 +68,15 @@ pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usiz
     Ok(out)
 }
 
+/// The chamber Jacobian of the fast replay is refreshed every this many steps.
+const JACOBIAN_REUSE: u64 = 8;
+
 /// A cheaper replay for fitting: one two-stage Rosenbrock step (ROS2, L-stable, order 2;
 /// Verwer et al. 1999) of the chamber pressures per sample interval, with the current
 /// driver and jet pipe still propagated exactly. No error control: the sample period
 /// (1 ms on the bench) is far below the chambers' time constants, and the accurate
 /// replay checks the final figures. Falls back to [`replay`] when the jet pipe has no
 /// modal form.
-const JACOBIAN_REUSE: u64 = 8;
-
 pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Result<Replay, String> {
     use crate::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState};
     use crate::physics::actuator::{index, State};
@@ -89,13 +100,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
     let mut velocity = 0.0;
     let delay = model.params.command_delay;
     let gamma = 1.0 + std::f64::consts::FRAC_1_SQRT_2;
-    let mut out = Replay {
-        force: Vec::with_capacity(n),
-        p1: Vec::with_capacity(n),
-        p2: Vec::with_capacity(n),
-        current: Vec::with_capacity(n),
-        steps: 0,
-    };
+    let mut out = Replay::with_capacity(n);
     // Index of the sample whose held command the current driver sees at time `at`.
     let seen = |at: f64, hint: usize| -> usize {
         let mut j = hint;
@@ -119,10 +124,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
             pressures[1],
         ]);
         let y = model.outputs(&state, x_s, velocity);
-        out.force.push(y.f_meas);
-        out.p1.push(y.p1);
-        out.p2.push(y.p2);
-        out.current.push(y.current);
+        out.record(&y);
         if k + 1 == n {
             break;
         }
