@@ -715,9 +715,45 @@ pub fn diagnose(
     for (name, values) in feats.names.iter().zip(&feats.values) {
         correlations.insert(name.to_string(), json!(correlation(&after_residual, values)));
     }
+    // The recording's own pressure level and the stopper velocity, where they exist.
+    let mean_pressure: Vec<f64> = after.p1.iter().zip(&after.p2).map(|(a, b)| 0.5 * (a + b)).collect();
+    correlations.insert(
+        "modelled mean chamber pressure".to_string(),
+        json!(correlation(&after_residual, &mean_pressure)),
+    );
+    let stopper_velocity: Vec<f64> = (0..recording.len())
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(1), (k + 1).min(recording.len() - 1));
+            if b > a {
+                (recording.x_s[b] - recording.x_s[a]) / (recording.time[b] - recording.time[a])
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    correlations.insert(
+        "stopper velocity dx_s/dt".to_string(),
+        json!(correlation(&after_residual, &stopper_velocity)),
+    );
+    // Errors by 10 s segment (the bench protocol's segments are 10–20 s long).
+    let mut by_segment = vec![];
+    let (t_first, t_last) = (recording.time[0], recording.time[recording.len() - 1]);
+    let mut from = t_first;
+    while from < t_last {
+        let to = (from + 10.0).min(t_last + 1e-9);
+        let inside: Vec<bool> = recording.time.iter().map(|&t| t >= from && t < to).collect();
+        by_segment.push(json!({
+            "from_s": from,
+            "to_s": to,
+            "before_rms_N": rms_where(&before.force, &recording.force, &inside, true),
+            "after_rms_N": rms_where(&after.force, &recording.force, &inside, true),
+        }));
+        from = to;
+    }
     let residual_tests = json!({
         "whiteness": {"lag1_autocorrelation": lag1, "ljung_box_q20": ljung_box, "white_at_5_percent": ljung_box < 31.41},
         "input_correlation": correlations,
+        "by_segment": by_segment,
     });
     Ok(Diagnosis {
         samples: recording.len(),
