@@ -177,6 +177,7 @@ impl ElectromechanicalPropagator {
             ramp,
             delta,
             q0,
+            series_form: SeriesForm::new(self, &q0, &series),
             series,
             plays: *plays,
             turning_point,
@@ -256,6 +257,83 @@ fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Vec<f64> {
     a
 }
 
+/// For a held command with the series form, each mode is
+///   q_k(s) = e^{λk s} (q_k(0) + β_k Σₙ aₙ/(λk + nω)) − β_k Σₙ aₙ rⁿ/(λk + nω),  r = e^{−ω s},
+/// so the position and its derivatives are two exponentials plus a real polynomial in r
+/// whose coefficients are summed over the modes once per step, not once per query.
+#[derive(Clone, Debug)]
+struct SeriesForm {
+    /// q_k(0) + β_k Σₙ aₙ/(λk + nω).
+    amplitude: [C64; 3],
+    /// Coefficients of rⁿ in the position, velocity and acceleration: −Re Σ_k λk^m β_k aₙ/(λk + nω).
+    polynomials: [Vec<f64>; 3],
+}
+
+impl SeriesForm {
+    /// `None` when some λk + nω nearly vanishes (the term grows like s e^{λs}): the
+    /// general per-query sum handles that case.
+    fn new(p: &ElectromechanicalPropagator, q0: &[C64; 3], series: &[f64]) -> Option<Self> {
+        if series.is_empty() {
+            return None;
+        }
+        let mut amplitude = *q0;
+        let mut polynomials = [
+            vec![0.0; series.len()],
+            vec![0.0; series.len()],
+            vec![0.0; series.len()],
+        ];
+        for (n, a) in series.iter().enumerate() {
+            let n_omega = n as f64 * p.omega_cd;
+            for k in 0..3 {
+                let denominator = p.lambda[k] + n_omega;
+                if denominator.norm() <= 1e-9 * p.omega_cd {
+                    return None;
+                }
+                let term = p.beta[k] * *a / denominator;
+                amplitude[k] += term;
+                polynomials[0][n] -= term.re;
+                polynomials[1][n] -= (p.lambda[k] * term).re;
+                polynomials[2][n] -= (p.lambda[k] * p.lambda[k] * term).re;
+            }
+        }
+        Some(Self { amplitude, polynomials })
+    }
+
+    /// The modal exponentials' parts e^{λk s}·amplitude_k, and r = e^{−ω s}.
+    fn growth(&self, p: &ElectromechanicalPropagator, s: f64) -> ([C64; 3], f64) {
+        let real = (p.lambda[0].re * s).exp();
+        let envelope = (p.lambda[1].re * s).exp();
+        let (sin, cos) = (p.lambda[1].im * s).sin_cos();
+        let oscillation = C64::new(envelope * cos, envelope * sin);
+        // λ2 = conj(λ1) by construction.
+        let g = [
+            self.amplitude[0] * real,
+            self.amplitude[1] * oscillation,
+            self.amplitude[2] * oscillation.conj(),
+        ];
+        (g, (-p.omega_cd * s).exp())
+    }
+
+    fn horner(coefficients: &[f64], r: f64) -> f64 {
+        coefficients.iter().rev().fold(0.0, |acc, c| acc * r + c)
+    }
+
+    fn position(&self, p: &ElectromechanicalPropagator, s: f64) -> f64 {
+        let (g, r) = self.growth(p, s);
+        (g[0] + g[1] + g[2]).re + Self::horner(&self.polynomials[0], r)
+    }
+
+    fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
+        let (g, r) = self.growth(p, s);
+        let l = &p.lambda;
+        [
+            (g[0] + g[1] + g[2]).re + Self::horner(&self.polynomials[0], r),
+            (l[0] * g[0] + l[1] * g[1] + l[2] * g[2]).re + Self::horner(&self.polynomials[1], r),
+            (l[0] * l[0] * g[0] + l[1] * l[1] * g[1] + l[2] * l[2] * g[2]).re + Self::horner(&self.polynomials[2], r),
+        ]
+    }
+}
+
 /// The current driver and jet pipe over one step, evaluable at any time within it.
 pub struct Trajectory<'a> {
     propagator: &'a ElectromechanicalPropagator,
@@ -265,6 +343,8 @@ pub struct Trajectory<'a> {
     q0: [C64; 3],
     /// x_sat·aₙ when the closed-form series applies; empty otherwise.
     series: Vec<f64>,
+    /// The same series summed in closed form, for fast evaluation (see [`SeriesForm`]).
+    series_form: Option<SeriesForm>,
     /// Hysteresis play states at the start of the step.
     plays: [f64; PLAY_OPERATORS],
     /// For a held command integrated by quadrature: the time after which the current
@@ -459,12 +539,24 @@ impl Trajectory<'_> {
 
     /// Jet pipe position at `s` seconds into the step.
     pub fn position(&self, s: f64) -> f64 {
+        if let Some(form) = &self.series_form {
+            return form.position(self.propagator, s);
+        }
         let q = self.modes(s);
         (q[0] + q[1] + q[2]).re
     }
 
     /// The full state at `s` seconds into the step.
     pub fn state(&self, s: f64) -> ElectromechanicalState {
+        if let Some(form) = &self.series_form {
+            let [position, velocity, acceleration] = form.derivatives(self.propagator, s);
+            return ElectromechanicalState {
+                current: self.current(s),
+                position,
+                velocity,
+                acceleration,
+            };
+        }
         let q = self.modes(s);
         let l = &self.propagator.lambda;
         ElectromechanicalState {
@@ -506,6 +598,40 @@ mod tests {
             for r in [0.0f64, 0.3, 0.9, 1.0] {
                 let sum: f64 = a.iter().enumerate().map(|(n, c)| c * r.powi(n as i32)).sum();
                 assert!((sum - (x0 + eps * r).tanh()).abs() < 1e-13, "x0 {x0} eps {eps} r {r}");
+            }
+        }
+    }
+
+    #[test]
+    fn summed_series_form_matches_the_per_mode_sum() {
+        let p = Parameters::default();
+        let propagator = ElectromechanicalPropagator::new(&p).unwrap();
+        let start = ElectromechanicalState {
+            current: 0.05,
+            position: 1.2e-4,
+            velocity: 0.02,
+            acceleration: -30.0,
+        };
+        for v in [1.3, 2.0, 3.1] {
+            let trajectory = propagator.trajectory(&start, v, 0.0, &[start.position; PLAY_OPERATORS]);
+            assert!(trajectory.series_form.is_some(), "v {v}: series form expected");
+            for s in [0.0, 1e-5, 3e-4, 2e-3, 1e-2, 0.3] {
+                let q = trajectory.modes(s);
+                let l = &propagator.lambda;
+                let by_modes = [
+                    (q[0] + q[1] + q[2]).re,
+                    (l[0] * q[0] + l[1] * q[1] + l[2] * q[2]).re,
+                    (l[0] * l[0] * q[0] + l[1] * l[1] * q[1] + l[2] * l[2] * q[2]).re,
+                ];
+                let fast = trajectory.state(s);
+                for (name, a, b, scale) in [
+                    ("x", fast.position, by_modes[0], 1e-3),
+                    ("v", fast.velocity, by_modes[1], 1.0),
+                    ("a", fast.acceleration, by_modes[2], 1e3),
+                ] {
+                    assert!((a - b).abs() < 1e-12 * scale, "v {v} s {s} {name}: {a} vs {b}");
+                }
+                assert_eq!(trajectory.position(s), fast.position);
             }
         }
     }

@@ -14,6 +14,7 @@ use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, Outputs, State
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::current_driver;
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::orifice_geometry::OrificeAreas;
 
 /// The default relative tolerance (also the model description's default experiment).
 pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-6;
@@ -63,23 +64,49 @@ struct ChamberSystem<'a> {
     t0: f64,
     x_s: f64,
     x_s_rate: f64,
+    /// The orifice areas at the last time asked for: Newton iterations and the Jacobian
+    /// evaluate many pressures at one stage time, and the jet pipe position and the areas
+    /// (four lens areas) cost more than the flows.
+    areas_at: std::cell::Cell<Option<(f64, OrificeAreas)>>,
 }
 
-impl ChamberSystem<'_> {
-    fn rates(&self, x_jp: f64, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+impl<'a> ChamberSystem<'a> {
+    fn new(model: &'a Actuator, trajectory: &'a Trajectory<'a>, t0: f64, x_s: f64, x_s_rate: f64) -> Self {
+        Self {
+            model,
+            trajectory,
+            t0,
+            x_s,
+            x_s_rate,
+            areas_at: std::cell::Cell::new(None),
+        }
+    }
+
+    fn areas(&self, t: f64) -> OrificeAreas {
+        match self.areas_at.get() {
+            Some((cached, areas)) if cached == t => areas,
+            _ => {
+                let areas = self.model.areas(self.trajectory.position(t - self.t0));
+                self.areas_at.set(Some((t, areas)));
+                areas
+            }
+        }
+    }
+
+    fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
         let x_s = self.x_s + self.x_s_rate * (t - self.t0);
-        let (a, b) = self.model.pressure_rates(x_jp, p[0], p[1], x_s, self.x_s_rate);
+        let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
         SVector::<f64, 2>::new(a, b)
     }
 }
 
 impl OdeSystem<2> for ChamberSystem<'_> {
     fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
-        self.rates(self.trajectory.position(t - self.t0), t, p)
+        self.rates(&self.areas(t), t, p)
     }
     fn jacobian(&self, t: f64, p: &SVector<f64, 2>, f_p: &SVector<f64, 2>) -> nalgebra::SMatrix<f64, 2, 2> {
-        let x_jp = self.trajectory.position(t - self.t0);
-        finite_difference_jacobian(|q| self.rates(x_jp, t, q), p, f_p)
+        let areas = self.areas(t);
+        finite_difference_jacobian(|q| self.rates(&areas, t, q), p, f_p)
     }
 }
 
@@ -366,13 +393,7 @@ impl Simulation {
                     acceleration: self.state[index::JET_ACCELERATION],
                 };
                 let trajectory = propagator.trajectory(&start, v, v_rate, &self.plays);
-                let system = ChamberSystem {
-                    model: &self.model,
-                    trajectory: &trajectory,
-                    t0,
-                    x_s: self.x_s,
-                    x_s_rate: self.x_s_rate,
-                };
+                let system = ChamberSystem::new(&self.model, &trajectory, t0, self.x_s, self.x_s_rate);
                 let scale = self.model.state_scales();
                 let tolerances = Tolerances {
                     relative: self.local_tolerance(),

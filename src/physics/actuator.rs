@@ -110,8 +110,13 @@ impl Actuator {
 
     /// Mass flows for a jet pipe position and chamber pressures, (2.18)–(2.23).
     pub fn mass_flows(&self, x_jp: f64, p1: f64, p2: f64) -> MassFlows {
+        self.mass_flows_through(&self.areas(x_jp), p1, p2)
+    }
+
+    /// [`Self::mass_flows`] for orifice areas already known (they depend on x_jp alone,
+    /// and the integrators evaluate many pressures at one jet pipe position).
+    pub fn mass_flows_through(&self, a: &OrificeAreas, p1: f64, p2: f64) -> MassFlows {
         let p = &self.params;
-        let a = self.areas(x_jp);
         let k = &self.flow;
         let supply = |p_supply: f64| {
             (
@@ -135,8 +140,20 @@ impl Actuator {
 
     /// dP1/dt and dP2/dt, (2.29).
     pub fn pressure_rates(&self, x_jp: f64, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
+        self.pressure_rates_through(&self.areas(x_jp), p1, p2, x_s, x_s_rate)
+    }
+
+    /// [`Self::pressure_rates`] for orifice areas already known.
+    pub fn pressure_rates_through(
+        &self,
+        areas: &OrificeAreas,
+        p1: f64,
+        p2: f64,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> (f64, f64) {
         let p = &self.params;
-        let flows = self.mass_flows(x_jp, p1, p2);
+        let flows = self.mass_flows_through(areas, p1, p2);
         let (v1, v2) = self.cylinder.volumes(x_s);
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
         (

@@ -32,6 +32,10 @@ pub fn circle_intersection_area(r1: f64, r2: f64, d: f64) -> f64 {
     let a1 = (d * d + r1 * r1 - r2 * r2) / (2.0 * d);
     let a2 = d - a1;
     let segment = |r: f64, a: f64| r * r * half_chord.atan2(a) - a * half_chord;
+    if r1 == r2 {
+        // Equal discs (the jet exit over a port): two equal segments, one arctangent.
+        return 2.0 * segment(r1, a1);
+    }
     segment(r1, a1) + segment(r2, a2)
 }
 
