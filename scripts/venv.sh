@@ -26,7 +26,7 @@ fi
 want="$(sha256sum "$REQ" | cut -d' ' -f1) $("$PYTHON" -c 'import sys; print("%d.%d" % sys.version_info[:2])' </dev/null)"
 
 if [ -x "$VENV/bin/python" ] && [ -f "$STAMP" ] && [ "$(cat "$STAMP")" = "$want" ] \
-    && "$VENV/bin/python" -c 'import fmpy, pytest, numpy, scipy, matplotlib' </dev/null >/dev/null 2>&1; then
+    && "$VENV/bin/python" -c 'import fmpy, pytest, numpy, scipy, matplotlib, dask, distributed' </dev/null >/dev/null 2>&1; then
     echo "==> $VENV is up to date with $REQ"
     exit 0
 fi

@@ -5,7 +5,8 @@
 //! * [`simulation`]: stepping between communication points (FMU, CLI and tests share it);
 //! * [`fmi2`]: the generic FMI 2.0 Co-Simulation layer, which knows nothing of pneumatics;
 //! * [`fmu`]: the actuator behind that layer; [`fmu_exports`]: the exported `fmi2*` symbols;
-//! * [`variables`]: the table of FMU variables from which the model description comes.
+//! * [`variables`]: the table of FMU variables from which the model description comes;
+//! * [`sweep`]: parameter sweeps of the standard scenario over all cores (`jetpipe sweep`).
 
 pub mod diagnosis;
 pub mod electromechanics;
@@ -21,6 +22,7 @@ pub mod recording;
 pub mod replay;
 pub mod scenario;
 pub mod simulation;
+pub mod sweep;
 pub mod synthetic_bench;
 pub mod variables;
 

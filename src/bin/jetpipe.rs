@@ -1,4 +1,5 @@
-//! `jetpipe`: package the FMU, print its model description, run the standard scenario.
+//! `jetpipe`: package the FMU, print its model description, run the standard scenario,
+//! sweep parameters over it.
 //! It drives the same library as the FMU; there is no second copy of the model.
 
 use std::path::PathBuf;
@@ -75,6 +76,38 @@ enum Command {
         #[arg(long)]
         csv: Option<PathBuf>,
     },
+    /// Run the standard scenario for every point of a parameter grid on all cores; write one
+    /// CSV row per run and print the speed-up over one thread.
+    Sweep {
+        /// NAME=START:STOP:N (N evenly spaced values), NAME=V1,V2,... or NAME=V, with NAME a
+        /// parameter of the FMU (e.g. C_d, P_s). Several --param give their Cartesian product.
+        #[arg(long = "param", value_name = "NAME=VALUES", required = true)]
+        params: Vec<String>,
+        /// Worker threads (default: every core this process may use).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// The CSV file to write.
+        #[arg(long, default_value = "sweep.csv")]
+        out: PathBuf,
+        /// Simulated seconds of the standard scenario (a multiple of 10 ms; default all 10 s).
+        #[arg(long, default_value_t = scenario::DURATION)]
+        duration: f64,
+        /// Communication step in seconds (divides 10 ms).
+        #[arg(long, default_value_t = scenario::SAMPLE_PERIOD)]
+        step: f64,
+        /// Relative tolerance of the integrator.
+        #[arg(long, default_value_t = DEFAULT_RELATIVE_TOLERANCE)]
+        tolerance: f64,
+        /// JSON object of FMU parameter values the grid starts from instead of the thesis's.
+        #[arg(long)]
+        base_params: Option<PathBuf>,
+        /// Time every run on one thread too (default: an evenly spaced subset of the runs).
+        #[arg(long, conflicts_with = "no_serial")]
+        compare_serial: bool,
+        /// Skip the one-thread reference run (no speed-up is printed).
+        #[arg(long)]
+        no_serial: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -103,6 +136,32 @@ fn run(cli: Cli) -> Result<(), String> {
             Ok(())
         }
         Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
+        Command::Sweep {
+            params,
+            threads,
+            out,
+            duration,
+            step,
+            tolerance,
+            base_params,
+            compare_serial,
+            no_serial,
+        } => {
+            let options = jetpipe::sweep::SweepOptions {
+                params,
+                threads,
+                out,
+                settings: jetpipe::sweep::RunSettings {
+                    duration,
+                    step,
+                    tolerance,
+                },
+                base: read_parameters(base_params.as_deref())?,
+                compare_serial,
+                no_serial,
+            };
+            jetpipe::sweep::run_command(&options, &mut std::io::stdout().lock())
+        }
         Command::Linearize { force, x_s, json } => linearize(force, x_s, json),
         Command::Diagnose {
             recording,
