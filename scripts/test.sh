@@ -16,6 +16,9 @@ if [ ! -f dist/JetPipeActuator.fmu ]; then
     echo "test.sh: dist/JetPipeActuator.fmu was not written" >&2
     exit 1
 fi
+run cargo test --release --target-dir target/fmus -p fmu_common -p tendon -p finger_joint -p joint_controller
+run cargo test --release --target-dir target/fmus -p antagonistic
+run cargo run --release --target-dir target/fmus -p antagonistic -- package
 run bash scripts/venv.sh
 run .venv/bin/python -m pytest fmu_tests -q
 echo

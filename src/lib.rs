@@ -4,14 +4,21 @@
 //! * [`integrator`]: the error-controlled stiff integrator, independent of the physics;
 //! * [`simulation`]: stepping between communication points (FMU, CLI and tests share it);
 //! * [`fmi2`]: the generic FMI 2.0 Co-Simulation layer, which knows nothing of pneumatics;
-//! * [`fmu`]: the actuator behind that layer; [`fmu_exports`]: the exported `fmi2*` symbols;
+//! * [`fmu`]: the actuator behind that layer; `fmu_exports`: the exported `fmi2*` symbols
+//!   (feature `actuator-exports`, on by default);
+//! * [`fmi2_cosimulation_exports!`]: the same symbols for any other model, for crates that
+//!   put another FMU on this layer (`fmus/` in the workspace);
 //! * [`variables`]: the table of FMU variables from which the model description comes;
 //! * [`sweep`]: parameter sweeps of the standard scenario over all cores (`jetpipe sweep`).
 
 pub mod diagnosis;
 pub mod electromechanics;
 pub mod fmi2;
+mod fmi2_exports_macro;
 pub mod fmu;
+/// Off only for crates that export another model's symbols (see the `actuator-exports`
+/// feature in Cargo.toml): a cdylib built on jetpipe's rlib would otherwise carry these too.
+#[cfg(feature = "actuator-exports")]
 pub mod fmu_exports;
 pub mod integrator;
 pub mod linearization;
@@ -26,5 +33,5 @@ pub mod sweep;
 pub mod synthetic_bench;
 pub mod variables;
 
-/// The model behind the exported FMI symbols in [`fmu_exports`].
+/// The model behind the exported FMI symbols in `fmu_exports`.
 pub type ExportedModel = fmu::ActuatorFmu;

@@ -65,6 +65,16 @@ relative tolerance of the integrator (default {tolerance:e}).</p>\n\
 
 /// Write the FMU archive to `out`, taking the compiled shared library from `library`.
 pub fn write_fmu(out: &Path, library: &Path) -> Result<(), String> {
+    write_model_fmu(out, library, &MODEL_INFO, &documentation_html(&MODEL_INFO))
+}
+
+/// Write the FMU archive of any model on the FMI layer to `out`: `modelDescription.xml`
+/// generated from `info`, the shared library `library` as
+/// `binaries/linux64/<modelIdentifier>.so`, and `documentation` as
+/// `documentation/index.html`. The other FMUs of the workspace (`fmus/`) are written with it.
+pub fn write_model_fmu(out: &Path, library: &Path, info: &ModelInfo, documentation: &str) -> Result<(), String> {
+    let model_description = crate::fmi2::model_description::try_model_description_xml(info)
+        .map_err(|problems| format!("invalid variable table of {}: {}", info.model_name, problems.join("; ")))?;
     let binary = std::fs::read(library).map_err(|e| {
         format!(
             "cannot read the shared library {}: {e} (build it with `cargo build --release`)",
@@ -81,14 +91,14 @@ pub fn write_fmu(out: &Path, library: &Path) -> Result<(), String> {
         let mut zip = zip::ZipWriter::new(file);
         let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         zip.start_file("modelDescription.xml", options)?;
-        zip.write_all(actuator_model_description().as_bytes())?;
+        zip.write_all(model_description.as_bytes())?;
         zip.add_directory("binaries/", options)?;
         zip.add_directory("binaries/linux64/", options)?;
-        zip.start_file(format!("binaries/linux64/{}.so", MODEL_INFO.model_identifier), options)?;
+        zip.start_file(format!("binaries/linux64/{}.so", info.model_identifier), options)?;
         zip.write_all(&binary)?;
         zip.add_directory("documentation/", options)?;
         zip.start_file("documentation/index.html", options)?;
-        zip.write_all(documentation_html(&MODEL_INFO).as_bytes())?;
+        zip.write_all(documentation.as_bytes())?;
         zip.finish()?;
         Ok(())
     })();

@@ -1,0 +1,252 @@
+//! The finger joint behind jetpipe's generic FMI layer. No FFI types here.
+
+use fmu_common::state_bytes::{ByteReader, ByteWriter};
+use fmu_common::Values;
+use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
+
+use crate::physics::{Inputs, Parameters, State};
+use crate::variables::{vr, UNITS, VARIABLES};
+
+/// Changes whenever the interface (variable table) changes.
+pub const GUID: &str = "{3e9a0c71-5f24-4d8b-b7c6-fingerjoint-0001}";
+
+pub static MODEL_INFO: ModelInfo = ModelInfo {
+    model_name: "FingerJoint",
+    model_identifier: "FingerJoint",
+    guid: GUID,
+    description: "One-degree finger joint pulled by two antagonistic tendons over a pulley (2N drive, Utah/MIT Dextrous Hand): inertia, damping, joint stops; outputs the tendon excursions",
+    author: "jetpipe project",
+    version: env!("CARGO_PKG_VERSION"),
+    generation_tool: concat!("jetpipe finger_joint ", env!("CARGO_PKG_VERSION")),
+    default_start_time: 0.0,
+    default_stop_time: 1.0,
+    default_tolerance: 1e-6,
+    default_step_size: 1e-3,
+    log_categories: fmu_common::LOG_CATEGORIES,
+    units: UNITS,
+    variables: VARIABLES,
+    can_interpolate_inputs: false,
+};
+
+#[derive(Clone, Debug)]
+pub struct FingerJointFmu {
+    values: Values,
+    start_time: f64,
+    running: Option<(Parameters, State)>,
+}
+
+impl FingerJointFmu {
+    pub fn parameters(&self) -> Result<Parameters, String> {
+        let v = |r| self.values.get(r);
+        let p = Parameters {
+            inertia: v(vr::J),
+            damping: v(vr::B),
+            radius: v(vr::R),
+            theta_min: v(vr::THETA_MIN),
+            theta_max: v(vr::THETA_MAX),
+            k_limit: v(vr::K_LIMIT),
+            c_limit: v(vr::C_LIMIT),
+            max_substep: v(vr::MAX_SUBSTEP),
+        };
+        p.check()?;
+        Ok(p)
+    }
+
+    fn inputs(&self) -> Inputs {
+        Inputs {
+            t_flexor: self.values.get(vr::T_FLEXOR),
+            t_extensor: self.values.get(vr::T_EXTENSOR),
+            tau_ext: self.values.get(vr::TAU_EXT),
+        }
+    }
+
+    fn initial(&self) -> Result<(Parameters, State), String> {
+        let p = self.parameters()?;
+        let s = State {
+            theta: self.values.get(vr::THETA_START),
+            omega: self.values.get(vr::OMEGA_START),
+            elapsed: 0.0,
+        };
+        Ok((p, s))
+    }
+}
+
+impl CoSimModel for FingerJointFmu {
+    fn info() -> &'static ModelInfo {
+        &MODEL_INFO
+    }
+
+    fn instantiate() -> Self {
+        Self {
+            values: Values::starts(VARIABLES),
+            start_time: 0.0,
+            running: None,
+        }
+    }
+
+    fn get_real(&self, value_reference: u32) -> Result<f64, String> {
+        let (p, s) = match value_reference {
+            vr::THETA..=vr::TAU_LIMIT => match &self.running {
+                Some((p, s)) => (p.clone(), s.clone()),
+                None => self.initial()?,
+            },
+            _ => return self.values.try_get(value_reference),
+        };
+        let r = p.radius;
+        Ok(match value_reference {
+            vr::THETA => s.theta,
+            vr::OMEGA => s.omega,
+            vr::X_FLEXOR => r * s.theta,
+            vr::V_FLEXOR => r * s.omega,
+            vr::X_EXTENSOR => -r * s.theta,
+            vr::V_EXTENSOR => -r * s.omega,
+            vr::TAU_TENDONS => self.inputs().tendon_torque(&p),
+            _ => p.limit_torque(s.theta, s.omega),
+        })
+    }
+
+    fn set_real(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
+        self.values.set(value_reference, value)
+    }
+
+    fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64, _stop: Option<f64>) -> Result<(), String> {
+        if !start_time.is_finite() {
+            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
+        }
+        self.start_time = start_time;
+        Ok(())
+    }
+
+    fn exit_initialization(&mut self) -> Result<(), String> {
+        self.running = Some(self.initial()?);
+        Ok(())
+    }
+
+    fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
+        let u = self.inputs();
+        let (p, s) = self
+            .running
+            .as_mut()
+            .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
+        let before = s.clone();
+        if let Err(message) = s.step(p, u, step_size) {
+            *s = before;
+            return Err(StepError::Error(message));
+        }
+        Ok(())
+    }
+
+    fn time(&self) -> f64 {
+        self.start_time + self.running.as_ref().map_or(0.0, |(_, s)| s.elapsed)
+    }
+
+    fn serialize(&self) -> Vec<u8> {
+        let mut w = ByteWriter::new(STATE_MAGIC, STATE_FORMAT_VERSION, env!("CARGO_PKG_VERSION"));
+        w.f64s(self.values.as_slice());
+        w.f64(self.start_time);
+        match &self.running {
+            None => w.u32(0),
+            Some((_, s)) => {
+                w.u32(1);
+                w.f64s(&[s.theta, s.omega, s.elapsed]);
+            }
+        }
+        w.0
+    }
+
+    fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let mut r = ByteReader::open(
+            bytes,
+            STATE_MAGIC,
+            STATE_FORMAT_VERSION,
+            env!("CARGO_PKG_VERSION"),
+            "FingerJoint",
+        )?;
+        let mut restored = Self::instantiate();
+        restored.values.restore(&r.f64s()?)?;
+        restored.start_time = r.f64()?;
+        if r.u32()? == 1 {
+            let v = r.f64s()?;
+            let [theta, omega, elapsed] = v[..] else {
+                return Err(format!("the state holds {} joint values, expected 3", v.len()));
+            };
+            if !v.iter().all(|x| x.is_finite()) {
+                return Err("the state holds non-finite values".to_string());
+            }
+            let p = restored.parameters()?;
+            restored.running = Some((p, State { theta, omega, elapsed }));
+        }
+        r.finish()?;
+        *self = restored;
+        Ok(())
+    }
+}
+
+const STATE_MAGIC: &[u8] = b"FingerJointState";
+const STATE_FORMAT_VERSION: u32 = 1;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use jetpipe::fmi2::model_description::model_description_xml;
+
+    #[test]
+    fn checked_in_model_description_is_the_generated_one() {
+        assert_eq!(
+            include_str!("../modelDescription.xml"),
+            model_description_xml(&MODEL_INFO),
+            "fmus/finger_joint/modelDescription.xml is stale: regenerate it with \
+             `cargo run --release -p antagonistic -- model-description FingerJoint > fmus/finger_joint/modelDescription.xml`"
+        );
+    }
+
+    #[test]
+    fn outputs_are_the_tendon_excursions() {
+        let mut fmu = FingerJointFmu::instantiate();
+        fmu.set_real(vr::THETA_START, 0.5).unwrap();
+        fmu.set_real(vr::OMEGA_START, -2.0).unwrap();
+        fmu.set_real(vr::T_FLEXOR, 30.0).unwrap();
+        fmu.set_real(vr::T_EXTENSOR, 20.0).unwrap();
+        fmu.exit_initialization().unwrap();
+        assert!((fmu.get_real(vr::X_FLEXOR).unwrap() - 0.005).abs() < 1e-15);
+        assert!((fmu.get_real(vr::X_EXTENSOR).unwrap() + 0.005).abs() < 1e-15);
+        assert!((fmu.get_real(vr::V_FLEXOR).unwrap() + 0.02).abs() < 1e-15);
+        assert!((fmu.get_real(vr::V_EXTENSOR).unwrap() - 0.02).abs() < 1e-15);
+        assert!((fmu.get_real(vr::TAU_TENDONS).unwrap() - 0.1).abs() < 1e-15);
+        for r in [vr::TAU_EXT, vr::K_LIMIT, vr::C_LIMIT, vr::B] {
+            assert!(fmu.get_real(r).is_ok());
+        }
+    }
+
+    #[test]
+    fn bad_values_are_rejected_with_the_name_and_not_applied() {
+        let mut fmu = FingerJointFmu::instantiate();
+        let e = fmu.set_real(vr::T_FLEXOR, f64::INFINITY).unwrap_err();
+        assert!(e.contains("T_flexor") && e.contains("inf"), "{e}");
+        let e = fmu.set_real(vr::J, -1.0).unwrap_err();
+        assert!(e.contains("J = -1 kg.m2"), "{e}");
+        assert_eq!(fmu.get_real(vr::J).unwrap(), 2.0e-4);
+        fmu.set_real(vr::THETA_MAX, -1.0).unwrap();
+        let e = fmu.exit_initialization().unwrap_err();
+        assert!(e.contains("theta_min") && e.contains("theta_max = -1 rad"), "{e}");
+    }
+
+    #[test]
+    fn serialized_state_continues_bit_identically() {
+        let mut a = FingerJointFmu::instantiate();
+        a.exit_initialization().unwrap();
+        a.set_real(vr::T_FLEXOR, 30.0).unwrap();
+        a.do_step(0.0, 1e-3).unwrap();
+        let bytes = a.serialize();
+        let mut b = FingerJointFmu::instantiate();
+        b.deserialize(&bytes).unwrap();
+        for fmu in [&mut a, &mut b] {
+            fmu.do_step(1e-3, 1e-3).unwrap();
+        }
+        assert_eq!(
+            a.get_real(vr::THETA).unwrap().to_bits(),
+            b.get_real(vr::THETA).unwrap().to_bits()
+        );
+        assert!(b.deserialize(&bytes[..10]).is_err());
+    }
+}

@@ -1,0 +1,284 @@
+//! The joint controller behind jetpipe's generic FMI layer. No FFI types here.
+
+use fmu_common::state_bytes::{ByteReader, ByteWriter};
+use fmu_common::Values;
+use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
+
+use crate::control::{Commands, Controller, Gains, Measurements};
+use crate::variables::{vr, UNITS, VARIABLES};
+
+/// Changes whenever the interface (variable table) changes.
+pub const GUID: &str = "{c41b7e02-9a6d-4f35-8c1e-jointcontroller-0001}";
+
+pub static MODEL_INFO: ModelInfo = ModelInfo {
+    model_name: "JointController",
+    model_identifier: "JointController",
+    guid: GUID,
+    description: "Antagonistic joint position controller with co-contraction (Jacobsen et al.) for two jet-pipe actuators: PID on the angle, tension distribution keeping both tendons above T_min, force loops with inverse static feedforward; sampled at the communication step",
+    author: "jetpipe project",
+    version: env!("CARGO_PKG_VERSION"),
+    generation_tool: concat!("jetpipe joint_controller ", env!("CARGO_PKG_VERSION")),
+    default_start_time: 0.0,
+    default_stop_time: 1.0,
+    default_tolerance: 1e-6,
+    default_step_size: 1e-3,
+    log_categories: fmu_common::LOG_CATEGORIES,
+    units: UNITS,
+    variables: VARIABLES,
+    can_interpolate_inputs: false,
+};
+
+#[derive(Clone, Debug)]
+pub struct JointControllerFmu {
+    values: Values,
+    start_time: f64,
+    elapsed: f64,
+    /// Gains, memory and the commands held since the last sample, from initialisation on.
+    running: Option<(Gains, Controller, Commands)>,
+}
+
+impl JointControllerFmu {
+    pub fn gains(&self) -> Result<Gains, String> {
+        let v = |r| self.values.get(r);
+        let g = Gains {
+            radius: v(vr::R),
+            t_co: v(vr::T_CO),
+            t_min: v(vr::T_MIN),
+            t_max: v(vr::T_MAX),
+            kp: v(vr::KP),
+            ki: v(vr::KI),
+            kd: v(vr::KD),
+            tau_i_max: v(vr::TAU_I_MAX),
+            k_force: v(vr::K_F),
+            k_feedforward: v(vr::K_FF),
+            v_min: v(vr::V_MIN),
+            v_max: v(vr::V_MAX),
+        };
+        g.check()?;
+        Ok(g)
+    }
+
+    fn measurements(&self) -> Measurements {
+        Measurements {
+            theta_ref: self.values.get(vr::THETA_REF),
+            theta: self.values.get(vr::THETA),
+            omega: self.values.get(vr::OMEGA),
+            f_flexor: self.values.get(vr::F_FLEXOR),
+            f_extensor: self.values.get(vr::F_EXTENSOR),
+        }
+    }
+
+    /// The first sample, taken at initialisation (no integration yet).
+    fn initial(&self) -> Result<(Gains, Controller, Commands), String> {
+        let g = self.gains()?;
+        let mut c = Controller::default();
+        let u = c.update(&g, &self.measurements(), 0.0);
+        Ok((g, c, u))
+    }
+}
+
+impl CoSimModel for JointControllerFmu {
+    fn info() -> &'static ModelInfo {
+        &MODEL_INFO
+    }
+
+    fn instantiate() -> Self {
+        Self {
+            values: Values::starts(VARIABLES),
+            start_time: 0.0,
+            elapsed: 0.0,
+            running: None,
+        }
+    }
+
+    fn get_real(&self, value_reference: u32) -> Result<f64, String> {
+        let u = match value_reference {
+            vr::V_DA_FLEXOR..=vr::TAU_REF => match &self.running {
+                Some((_, _, u)) => *u,
+                None => self.initial()?.2,
+            },
+            _ => return self.values.try_get(value_reference),
+        };
+        Ok(match value_reference {
+            vr::V_DA_FLEXOR => u.v_flexor,
+            vr::V_DA_EXTENSOR => u.v_extensor,
+            vr::T_FLEXOR_REF => u.t_flexor,
+            vr::T_EXTENSOR_REF => u.t_extensor,
+            _ => u.tau,
+        })
+    }
+
+    fn set_real(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
+        self.values.set(value_reference, value)
+    }
+
+    fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64, _stop: Option<f64>) -> Result<(), String> {
+        if !start_time.is_finite() {
+            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
+        }
+        self.start_time = start_time;
+        Ok(())
+    }
+
+    fn exit_initialization(&mut self) -> Result<(), String> {
+        self.running = Some(self.initial()?);
+        self.elapsed = 0.0;
+        Ok(())
+    }
+
+    fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
+        let m = self.measurements();
+        let (g, c, u) = self
+            .running
+            .as_mut()
+            .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
+        *u = c.update(g, &m, step_size);
+        self.elapsed += step_size;
+        Ok(())
+    }
+
+    fn time(&self) -> f64 {
+        self.start_time + self.elapsed
+    }
+
+    fn serialize(&self) -> Vec<u8> {
+        let mut w = ByteWriter::new(STATE_MAGIC, STATE_FORMAT_VERSION, env!("CARGO_PKG_VERSION"));
+        w.f64s(self.values.as_slice());
+        w.f64(self.start_time);
+        w.f64(self.elapsed);
+        match &self.running {
+            None => w.u32(0),
+            Some((_, c, u)) => {
+                w.u32(1);
+                w.f64s(&[c.integral, u.tau, u.t_flexor, u.t_extensor, u.v_flexor, u.v_extensor]);
+            }
+        }
+        w.0
+    }
+
+    fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let mut r = ByteReader::open(
+            bytes,
+            STATE_MAGIC,
+            STATE_FORMAT_VERSION,
+            env!("CARGO_PKG_VERSION"),
+            "JointController",
+        )?;
+        let mut restored = Self::instantiate();
+        restored.values.restore(&r.f64s()?)?;
+        restored.start_time = r.f64()?;
+        restored.elapsed = r.f64()?;
+        if r.u32()? == 1 {
+            let v = r.f64s()?;
+            let [integral, tau, t_flexor, t_extensor, v_flexor, v_extensor] = v[..] else {
+                return Err(format!("the state holds {} controller values, expected 6", v.len()));
+            };
+            if !v.iter().all(|x| x.is_finite()) {
+                return Err("the state holds non-finite values".to_string());
+            }
+            let g = restored.gains()?;
+            let u = Commands {
+                tau,
+                t_flexor,
+                t_extensor,
+                v_flexor,
+                v_extensor,
+            };
+            restored.running = Some((g, Controller { integral }, u));
+        }
+        r.finish()?;
+        *self = restored;
+        Ok(())
+    }
+}
+
+const STATE_MAGIC: &[u8] = b"JointControllerState";
+const STATE_FORMAT_VERSION: u32 = 1;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::{static_command, STATIC_FORCE_MAP};
+    use jetpipe::fmi2::model_description::model_description_xml;
+
+    #[test]
+    fn checked_in_model_description_is_the_generated_one() {
+        assert_eq!(
+            include_str!("../modelDescription.xml"),
+            model_description_xml(&MODEL_INFO),
+            "fmus/joint_controller/modelDescription.xml is stale: regenerate it with \
+             `cargo run --release -p antagonistic -- model-description JointController > fmus/joint_controller/modelDescription.xml`"
+        );
+    }
+
+    /// The feedforward table must be the actuator's own static curve: recompute it from
+    /// jetpipe's actuator FMU model (equilibrium at the default parameters).
+    #[test]
+    fn static_force_map_is_the_actuators_equilibrium() {
+        use jetpipe::fmu::ActuatorFmu;
+        use jetpipe::variables::vr as actuator;
+        for &(v, f) in STATIC_FORCE_MAP {
+            let mut a = ActuatorFmu::instantiate();
+            a.set_real(actuator::V_DA, v).unwrap();
+            a.exit_initialization().unwrap();
+            let force = a.get_real(actuator::F_ACT).unwrap();
+            assert!(
+                (force - f).abs() < 2e-3,
+                "v_DA = {v} V: table {f} N, actuator {force} N"
+            );
+        }
+    }
+
+    #[test]
+    fn initial_outputs_are_the_static_co_contraction() {
+        let mut fmu = JointControllerFmu::instantiate();
+        fmu.exit_initialization().unwrap();
+        let v = fmu.get_real(vr::V_DA_FLEXOR).unwrap();
+        assert!((v - static_command(25.0)).abs() < 1e-12);
+        assert_eq!(v, fmu.get_real(vr::V_DA_EXTENSOR).unwrap());
+        assert_eq!(fmu.get_real(vr::T_FLEXOR_REF).unwrap(), 25.0);
+    }
+
+    #[test]
+    fn outputs_are_held_until_the_next_sample() {
+        let mut fmu = JointControllerFmu::instantiate();
+        fmu.exit_initialization().unwrap();
+        let before = fmu.get_real(vr::V_DA_FLEXOR).unwrap();
+        fmu.set_real(vr::THETA_REF, 0.5).unwrap();
+        assert_eq!(fmu.get_real(vr::V_DA_FLEXOR).unwrap(), before);
+        fmu.do_step(0.0, 1e-3).unwrap();
+        assert!(fmu.get_real(vr::V_DA_FLEXOR).unwrap() > before);
+        assert!(fmu.get_real(vr::TAU_REF).unwrap() > 0.0);
+    }
+
+    #[test]
+    fn bad_values_are_rejected_with_the_name() {
+        let mut fmu = JointControllerFmu::instantiate();
+        let e = fmu.set_real(vr::THETA_REF, f64::NAN).unwrap_err();
+        assert!(e.contains("theta_ref") && e.contains("NaN"), "{e}");
+        let e = fmu.set_real(vr::K_FF, 2.0).unwrap_err();
+        assert!(e.contains("k_feedforward = 2"), "{e}");
+        fmu.set_real(vr::T_MIN, 0.0).unwrap();
+        let e = fmu.exit_initialization().unwrap_err();
+        assert!(e.contains("T_min = 0 N"), "{e}");
+    }
+
+    #[test]
+    fn serialized_state_continues_bit_identically() {
+        let mut a = JointControllerFmu::instantiate();
+        a.exit_initialization().unwrap();
+        a.set_real(vr::THETA_REF, 0.3).unwrap();
+        a.do_step(0.0, 1e-3).unwrap();
+        let bytes = a.serialize();
+        let mut b = JointControllerFmu::instantiate();
+        b.deserialize(&bytes).unwrap();
+        for fmu in [&mut a, &mut b] {
+            fmu.do_step(1e-3, 1e-3).unwrap();
+        }
+        assert_eq!(
+            a.get_real(vr::V_DA_FLEXOR).unwrap().to_bits(),
+            b.get_real(vr::V_DA_FLEXOR).unwrap().to_bits()
+        );
+        assert!(b.deserialize(&bytes[..bytes.len() - 2]).is_err());
+    }
+}
