@@ -174,7 +174,12 @@ def main():
             ratio = best[0] / rust_cost
             ratios.append(ratio)
             # An upper bound on a cost turns into a bound on the ratio.
-            bound = ">=" if rust_how == "<=" and best[1] == "=" else "<=" if best[1] == "<=" and rust_how == "=" else "~"
+            if rust_how == "<=" and best[1] == "=":
+                bound = ">="
+            elif best[1] == "<=" and rust_how == "=":
+                bound = "<="
+            else:
+                bound = "~"
             ratio_text = f"{bound}{ratio:.0f}x"
         print(f"{level:>10.0e} {cells[0]:>12} {cells[1]:>12} {cells[2]:>12} {ratio_text:>18}")
 

@@ -1,17 +1,23 @@
 //! What the three small FMUs of the antagonistic joint (`Tendon`, `FingerJoint`,
 //! `JointController`) share on top of jetpipe's generic FMI layer: a value store driven by the
 //! variable table (range checks with messages that name the variable), the versioned byte
-//! format of their FMU states, a monotone scalar solver for their implicit integrators, and
-//! the interface page of their archives. No FFI types here.
+//! format of their FMU states, a monotone scalar solver for their implicit integrators, the
+//! interface page of their archives, and what their `ModelInfo`, `CoSimModel` impls and
+//! interface tests would otherwise each repeat. No FFI types here.
 
 pub mod solve;
 pub mod state_bytes;
+pub mod testing;
 pub mod units;
 pub mod values;
 
 pub use values::Values;
 
-use jetpipe::fmi2::model::{Causality, ModelInfo, VarType};
+// For `model_info!`, so that its expansion does not depend on the caller's imports.
+#[doc(hidden)]
+pub use jetpipe as __jetpipe;
+
+use jetpipe::fmi2::model::{Causality, ModelInfo, StepError, VarType};
 
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -62,6 +68,67 @@ pub fn documentation_html(info: &ModelInfo, notes: &str) -> String {
         description = escape(info.description),
         version = info.version,
     )
+}
+
+/// The `ModelInfo` of one of these models, from what tells them apart; the author, default
+/// experiment, log categories and the lack of input interpolation are the same for all. A macro,
+/// not a function, so that `version` and `generation_tool` are the calling crate's.
+#[macro_export]
+macro_rules! model_info {
+    (
+        name: $name:expr,
+        guid: $guid:expr,
+        description: $description:expr,
+        units: $units:expr,
+        variables: $variables:expr $(,)?
+    ) => {
+        $crate::__jetpipe::fmi2::model::ModelInfo {
+            model_name: $name,
+            model_identifier: $name,
+            guid: $guid,
+            description: $description,
+            author: "jetpipe project",
+            version: env!("CARGO_PKG_VERSION"),
+            generation_tool: concat!("jetpipe ", env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION")),
+            default_start_time: 0.0,
+            default_stop_time: 1.0,
+            default_tolerance: 1e-6,
+            default_step_size: 1e-3,
+            log_categories: $crate::LOG_CATEGORIES,
+            units: $units,
+            variables: $variables,
+            can_interpolate_inputs: false,
+        }
+    };
+}
+
+/// `fmi2SetupExperiment`'s start time, for the models' `setup_experiment`.
+pub fn checked_start_time(start_time: f64) -> Result<f64, String> {
+    if !start_time.is_finite() {
+        return Err(format!("startTime = {start_time} s is invalid: must be finite"));
+    }
+    Ok(start_time)
+}
+
+/// The state a model has from initialisation on, for `do_step`.
+pub fn initialised<T>(running: &mut Option<T>) -> Result<&mut T, StepError> {
+    running
+        .as_mut()
+        .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))
+}
+
+/// Runs `step` on `state` and puts the state back if it fails: `fmi2Error` promises that
+/// nothing was changed.
+pub fn step_or_restore<S: Clone>(
+    state: &mut S,
+    step: impl FnOnce(&mut S) -> Result<(), String>,
+) -> Result<(), StepError> {
+    let before = state.clone();
+    if let Err(message) = step(state) {
+        *state = before;
+        return Err(StepError::Error(message));
+    }
+    Ok(())
 }
 
 /// The six log categories every model of this workspace declares (the layer's own).

@@ -2,6 +2,38 @@
 //! version, the crate version, then little-endian numbers. No pointers, so the bytes are
 //! valid in another process; every read checks the length so corrupted bytes give a message.
 
+/// What a model's state image starts with, and what `ByteReader` checks it against.
+pub struct StateFormat {
+    pub magic: &'static [u8],
+    pub version: u32,
+    pub crate_version: &'static str,
+    /// The model's name, for the message on foreign bytes.
+    pub model: &'static str,
+}
+
+impl StateFormat {
+    pub fn writer(&self) -> ByteWriter {
+        ByteWriter::new(self.magic, self.version, self.crate_version)
+    }
+
+    pub fn reader<'a>(&self, bytes: &'a [u8]) -> Result<ByteReader<'a>, String> {
+        ByteReader::open(bytes, self.magic, self.version, self.crate_version, self.model)
+    }
+}
+
+/// A model's `StateFormat`, with the calling crate's version (hence a macro).
+#[macro_export]
+macro_rules! state_format {
+    (magic: $magic:expr, version: $version:expr, model: $model:expr $(,)?) => {
+        $crate::state_bytes::StateFormat {
+            magic: $magic,
+            version: $version,
+            crate_version: env!("CARGO_PKG_VERSION"),
+            model: $model,
+        }
+    };
+}
+
 #[derive(Default)]
 pub struct ByteWriter(pub Vec<u8>);
 
@@ -25,6 +57,17 @@ impl ByteWriter {
         self.u32(vs.len() as u32);
         for &v in vs {
             self.f64(v);
+        }
+    }
+    /// A flag (0 or 1), then the numbers if there are any: the state a model has from
+    /// initialisation on.
+    pub fn optional_f64s<const N: usize>(&mut self, vs: Option<[f64; N]>) {
+        match vs {
+            None => self.u32(0),
+            Some(vs) => {
+                self.u32(1);
+                self.f64s(&vs);
+            }
         }
     }
 }
@@ -93,6 +136,21 @@ impl<'a> ByteReader<'a> {
         }
         (0..n).map(|_| self.f64()).collect()
     }
+    /// What `ByteWriter::optional_f64s` wrote: exactly `N` finite numbers if the flag is 1
+    /// (any other flag reads as none). `what` names them in the message on a wrong count.
+    pub fn optional_f64s<const N: usize>(&mut self, what: &str) -> Result<Option<[f64; N]>, String> {
+        if self.u32()? != 1 {
+            return Ok(None);
+        }
+        let v = self.f64s()?;
+        let vs: [f64; N] = v[..]
+            .try_into()
+            .map_err(|_| format!("the state holds {} {what} values, expected {N}", v.len()))?;
+        if !vs.iter().all(|x| x.is_finite()) {
+            return Err("the state holds non-finite values".to_string());
+        }
+        Ok(Some(vs))
+    }
     /// Every byte must have been read.
     pub fn finish(self) -> Result<(), String> {
         if self.at != self.bytes.len() {
@@ -124,5 +182,28 @@ mod tests {
         let mut r = ByteReader::open(&bytes[..bytes.len() - 3], b"M", 1, "0.1.0", "M").unwrap();
         r.f64s().unwrap();
         assert!(r.f64().unwrap_err().contains("truncated"));
+    }
+
+    #[test]
+    fn optional_numbers_round_trip_and_are_checked() {
+        let f = StateFormat {
+            magic: b"M",
+            version: 1,
+            crate_version: "0.1.0",
+            model: "M",
+        };
+        let mut w = f.writer();
+        w.optional_f64s::<2>(None);
+        w.optional_f64s(Some([1.0, 2.0]));
+        w.optional_f64s(Some([f64::NAN]));
+        let bytes = w.0;
+        let mut r = f.reader(&bytes).unwrap();
+        assert_eq!(r.optional_f64s::<2>("x").unwrap(), None);
+        assert!(r
+            .optional_f64s::<3>("x")
+            .unwrap_err()
+            .contains("2 x values, expected 3"));
+        assert!(r.optional_f64s::<1>("x").unwrap_err().contains("non-finite"));
+        r.finish().unwrap();
     }
 }

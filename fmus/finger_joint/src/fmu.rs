@@ -1,6 +1,6 @@
 //! The finger joint behind jetpipe's generic FMI layer. No FFI types here.
 
-use fmu_common::state_bytes::{ByteReader, ByteWriter};
+use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
 use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
 
@@ -10,22 +10,12 @@ use crate::variables::{vr, UNITS, VARIABLES};
 /// Changes whenever the interface (variable table) changes.
 pub const GUID: &str = "{3e9a0c71-5f24-4d8b-b7c6-fingerjoint-0001}";
 
-pub static MODEL_INFO: ModelInfo = ModelInfo {
-    model_name: "FingerJoint",
-    model_identifier: "FingerJoint",
+pub static MODEL_INFO: ModelInfo = fmu_common::model_info! {
+    name: "FingerJoint",
     guid: GUID,
     description: "One-degree finger joint pulled by two antagonistic tendons over a pulley (2N drive, Utah/MIT Dextrous Hand): inertia, damping, joint stops; outputs the tendon excursions",
-    author: "jetpipe project",
-    version: env!("CARGO_PKG_VERSION"),
-    generation_tool: concat!("jetpipe finger_joint ", env!("CARGO_PKG_VERSION")),
-    default_start_time: 0.0,
-    default_stop_time: 1.0,
-    default_tolerance: 1e-6,
-    default_step_size: 1e-3,
-    log_categories: fmu_common::LOG_CATEGORIES,
     units: UNITS,
     variables: VARIABLES,
-    can_interpolate_inputs: false,
 };
 
 #[derive(Clone, Debug)]
@@ -110,10 +100,7 @@ impl CoSimModel for FingerJointFmu {
     }
 
     fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64, _stop: Option<f64>) -> Result<(), String> {
-        if !start_time.is_finite() {
-            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
-        }
-        self.start_time = start_time;
+        self.start_time = fmu_common::checked_start_time(start_time)?;
         Ok(())
     }
 
@@ -124,16 +111,8 @@ impl CoSimModel for FingerJointFmu {
 
     fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
         let u = self.inputs();
-        let (p, s) = self
-            .running
-            .as_mut()
-            .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
-        let before = s.clone();
-        if let Err(message) = s.step(p, u, step_size) {
-            *s = before;
-            return Err(StepError::Error(message));
-        }
-        Ok(())
+        let (p, s) = fmu_common::initialised(&mut self.running)?;
+        fmu_common::step_or_restore(s, |s| s.step(p, u, step_size))
     }
 
     fn time(&self) -> f64 {
@@ -141,38 +120,19 @@ impl CoSimModel for FingerJointFmu {
     }
 
     fn serialize(&self) -> Vec<u8> {
-        let mut w = ByteWriter::new(STATE_MAGIC, STATE_FORMAT_VERSION, env!("CARGO_PKG_VERSION"));
+        let mut w = STATE_FORMAT.writer();
         w.f64s(self.values.as_slice());
         w.f64(self.start_time);
-        match &self.running {
-            None => w.u32(0),
-            Some((_, s)) => {
-                w.u32(1);
-                w.f64s(&[s.theta, s.omega, s.elapsed]);
-            }
-        }
+        w.optional_f64s(self.running.as_ref().map(|(_, s)| [s.theta, s.omega, s.elapsed]));
         w.0
     }
 
     fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let mut r = ByteReader::open(
-            bytes,
-            STATE_MAGIC,
-            STATE_FORMAT_VERSION,
-            env!("CARGO_PKG_VERSION"),
-            "FingerJoint",
-        )?;
+        let mut r = STATE_FORMAT.reader(bytes)?;
         let mut restored = Self::instantiate();
         restored.values.restore(&r.f64s()?)?;
         restored.start_time = r.f64()?;
-        if r.u32()? == 1 {
-            let v = r.f64s()?;
-            let [theta, omega, elapsed] = v[..] else {
-                return Err(format!("the state holds {} joint values, expected 3", v.len()));
-            };
-            if !v.iter().all(|x| x.is_finite()) {
-                return Err("the state holds non-finite values".to_string());
-            }
+        if let Some([theta, omega, elapsed]) = r.optional_f64s("joint")? {
             let p = restored.parameters()?;
             restored.running = Some((p, State { theta, omega, elapsed }));
         }
@@ -182,22 +142,24 @@ impl CoSimModel for FingerJointFmu {
     }
 }
 
-const STATE_MAGIC: &[u8] = b"FingerJointState";
-const STATE_FORMAT_VERSION: u32 = 1;
+const STATE_FORMAT: StateFormat =
+    fmu_common::state_format!(magic: b"FingerJointState", version: 1, model: "FingerJoint");
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use jetpipe::fmi2::model_description::model_description_xml;
 
-    #[test]
-    fn checked_in_model_description_is_the_generated_one() {
-        assert_eq!(
-            include_str!("../modelDescription.xml"),
-            model_description_xml(&MODEL_INFO),
-            "fmus/finger_joint/modelDescription.xml is stale: regenerate it with \
-             `cargo run --release -p antagonistic -- model-description FingerJoint > fmus/finger_joint/modelDescription.xml`"
-        );
+    fmu_common::interface_tests! {
+        info: MODEL_INFO,
+        dir: "fmus/finger_joint",
+        checked_in: include_str!("../modelDescription.xml"),
+        vrs: [
+            vr::T_FLEXOR, vr::T_EXTENSOR, vr::TAU_EXT,
+            vr::THETA, vr::OMEGA, vr::X_FLEXOR, vr::V_FLEXOR, vr::X_EXTENSOR, vr::V_EXTENSOR, vr::TAU_TENDONS,
+            vr::TAU_LIMIT,
+            vr::J, vr::B, vr::R, vr::THETA_MIN, vr::THETA_MAX, vr::K_LIMIT, vr::C_LIMIT, vr::THETA_START,
+            vr::OMEGA_START, vr::MAX_SUBSTEP,
+        ],
     }
 
     #[test]

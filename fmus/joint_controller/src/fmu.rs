@@ -1,6 +1,6 @@
 //! The joint controller behind jetpipe's generic FMI layer. No FFI types here.
 
-use fmu_common::state_bytes::{ByteReader, ByteWriter};
+use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
 use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
 
@@ -10,22 +10,12 @@ use crate::variables::{vr, UNITS, VARIABLES};
 /// Changes whenever the interface (variable table) changes.
 pub const GUID: &str = "{c41b7e02-9a6d-4f35-8c1e-jointcontroller-0001}";
 
-pub static MODEL_INFO: ModelInfo = ModelInfo {
-    model_name: "JointController",
-    model_identifier: "JointController",
+pub static MODEL_INFO: ModelInfo = fmu_common::model_info! {
+    name: "JointController",
     guid: GUID,
     description: "Antagonistic joint position controller with co-contraction (Jacobsen et al.) for two jet-pipe actuators: PID on the angle, tension distribution keeping both tendons above T_min, force loops with inverse static feedforward; sampled at the communication step",
-    author: "jetpipe project",
-    version: env!("CARGO_PKG_VERSION"),
-    generation_tool: concat!("jetpipe joint_controller ", env!("CARGO_PKG_VERSION")),
-    default_start_time: 0.0,
-    default_stop_time: 1.0,
-    default_tolerance: 1e-6,
-    default_step_size: 1e-3,
-    log_categories: fmu_common::LOG_CATEGORIES,
     units: UNITS,
     variables: VARIABLES,
-    can_interpolate_inputs: false,
 };
 
 #[derive(Clone, Debug)]
@@ -113,10 +103,7 @@ impl CoSimModel for JointControllerFmu {
     }
 
     fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64, _stop: Option<f64>) -> Result<(), String> {
-        if !start_time.is_finite() {
-            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
-        }
-        self.start_time = start_time;
+        self.start_time = fmu_common::checked_start_time(start_time)?;
         Ok(())
     }
 
@@ -128,10 +115,7 @@ impl CoSimModel for JointControllerFmu {
 
     fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
         let m = self.measurements();
-        let (g, c, u) = self
-            .running
-            .as_mut()
-            .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
+        let (g, c, u) = fmu_common::initialised(&mut self.running)?;
         *u = c.update(g, &m, step_size);
         self.elapsed += step_size;
         Ok(())
@@ -142,40 +126,25 @@ impl CoSimModel for JointControllerFmu {
     }
 
     fn serialize(&self) -> Vec<u8> {
-        let mut w = ByteWriter::new(STATE_MAGIC, STATE_FORMAT_VERSION, env!("CARGO_PKG_VERSION"));
+        let mut w = STATE_FORMAT.writer();
         w.f64s(self.values.as_slice());
         w.f64(self.start_time);
         w.f64(self.elapsed);
-        match &self.running {
-            None => w.u32(0),
-            Some((_, c, u)) => {
-                w.u32(1);
-                w.f64s(&[c.integral, u.tau, u.t_flexor, u.t_extensor, u.v_flexor, u.v_extensor]);
-            }
-        }
+        w.optional_f64s(
+            self.running
+                .as_ref()
+                .map(|(_, c, u)| [c.integral, u.tau, u.t_flexor, u.t_extensor, u.v_flexor, u.v_extensor]),
+        );
         w.0
     }
 
     fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let mut r = ByteReader::open(
-            bytes,
-            STATE_MAGIC,
-            STATE_FORMAT_VERSION,
-            env!("CARGO_PKG_VERSION"),
-            "JointController",
-        )?;
+        let mut r = STATE_FORMAT.reader(bytes)?;
         let mut restored = Self::instantiate();
         restored.values.restore(&r.f64s()?)?;
         restored.start_time = r.f64()?;
         restored.elapsed = r.f64()?;
-        if r.u32()? == 1 {
-            let v = r.f64s()?;
-            let [integral, tau, t_flexor, t_extensor, v_flexor, v_extensor] = v[..] else {
-                return Err(format!("the state holds {} controller values, expected 6", v.len()));
-            };
-            if !v.iter().all(|x| x.is_finite()) {
-                return Err("the state holds non-finite values".to_string());
-            }
+        if let Some([integral, tau, t_flexor, t_extensor, v_flexor, v_extensor]) = r.optional_f64s("controller")? {
             let g = restored.gains()?;
             let u = Commands {
                 tau,
@@ -192,23 +161,24 @@ impl CoSimModel for JointControllerFmu {
     }
 }
 
-const STATE_MAGIC: &[u8] = b"JointControllerState";
-const STATE_FORMAT_VERSION: u32 = 1;
+const STATE_FORMAT: StateFormat =
+    fmu_common::state_format!(magic: b"JointControllerState", version: 1, model: "JointController");
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::control::{static_command, STATIC_FORCE_MAP};
-    use jetpipe::fmi2::model_description::model_description_xml;
 
-    #[test]
-    fn checked_in_model_description_is_the_generated_one() {
-        assert_eq!(
-            include_str!("../modelDescription.xml"),
-            model_description_xml(&MODEL_INFO),
-            "fmus/joint_controller/modelDescription.xml is stale: regenerate it with \
-             `cargo run --release -p antagonistic -- model-description JointController > fmus/joint_controller/modelDescription.xml`"
-        );
+    fmu_common::interface_tests! {
+        info: MODEL_INFO,
+        dir: "fmus/joint_controller",
+        checked_in: include_str!("../modelDescription.xml"),
+        vrs: [
+            vr::THETA_REF, vr::THETA, vr::OMEGA, vr::F_FLEXOR, vr::F_EXTENSOR,
+            vr::V_DA_FLEXOR, vr::V_DA_EXTENSOR, vr::T_FLEXOR_REF, vr::T_EXTENSOR_REF, vr::TAU_REF,
+            vr::R, vr::T_CO, vr::T_MIN, vr::T_MAX, vr::KP, vr::KI, vr::KD, vr::TAU_I_MAX, vr::K_F, vr::K_FF,
+            vr::V_MIN, vr::V_MAX,
+        ],
     }
 
     /// The feedforward table must be the actuator's own static curve: recompute it from

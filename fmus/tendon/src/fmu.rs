@@ -1,6 +1,6 @@
 //! The tendon behind jetpipe's generic FMI layer. No FFI types here.
 
-use fmu_common::state_bytes::{ByteReader, ByteWriter};
+use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
 use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
 
@@ -10,22 +10,12 @@ use crate::variables::{vr, UNITS, VARIABLES};
 /// Changes whenever the interface (variable table) changes.
 pub const GUID: &str = "{8d3f52a4-1c7e-4b0a-9e21-tendon-0001}";
 
-pub static MODEL_INFO: ModelInfo = ModelInfo {
-    model_name: "Tendon",
-    model_identifier: "Tendon",
+pub static MODEL_INFO: ModelInfo = fmu_common::model_info! {
+    name: "Tendon",
     guid: GUID,
     description: "Tendon of a 2N tendon drive (Utah/MIT Dextrous Hand): rod mass at the actuator end, elastic tendon that goes slack instead of pushing, capstan friction of the pulleys; outputs the actuator's stopper position",
-    author: "jetpipe project",
-    version: env!("CARGO_PKG_VERSION"),
-    generation_tool: concat!("jetpipe tendon ", env!("CARGO_PKG_VERSION")),
-    default_start_time: 0.0,
-    default_stop_time: 1.0,
-    default_tolerance: 1e-6,
-    default_step_size: 1e-3,
-    log_categories: fmu_common::LOG_CATEGORIES,
     units: UNITS,
     variables: VARIABLES,
-    can_interpolate_inputs: false,
 };
 
 #[derive(Clone, Debug)]
@@ -122,10 +112,7 @@ impl CoSimModel for TendonFmu {
     }
 
     fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64, _stop: Option<f64>) -> Result<(), String> {
-        if !start_time.is_finite() {
-            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
-        }
-        self.start_time = start_time;
+        self.start_time = fmu_common::checked_start_time(start_time)?;
         Ok(())
     }
 
@@ -137,16 +124,8 @@ impl CoSimModel for TendonFmu {
     fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
         let f_act = self.values.get(vr::F_ACT);
         let joint = self.joint_end();
-        let (p, s) = self
-            .running
-            .as_mut()
-            .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
-        let before = s.clone();
-        if let Err(message) = s.step(p, f_act, joint, step_size) {
-            *s = before;
-            return Err(StepError::Error(message));
-        }
-        Ok(())
+        let (p, s) = fmu_common::initialised(&mut self.running)?;
+        fmu_common::step_or_restore(s, |s| s.step(p, f_act, joint, step_size))
     }
 
     fn time(&self) -> f64 {
@@ -154,38 +133,23 @@ impl CoSimModel for TendonFmu {
     }
 
     fn serialize(&self) -> Vec<u8> {
-        let mut w = ByteWriter::new(STATE_MAGIC, STATE_FORMAT_VERSION, env!("CARGO_PKG_VERSION"));
+        let mut w = STATE_FORMAT.writer();
         w.f64s(self.values.as_slice());
         w.f64(self.start_time);
-        match &self.running {
-            None => w.u32(0),
-            Some((_, s)) => {
-                w.u32(1);
-                w.f64s(&[s.x_a, s.v_a, s.joint.x, s.joint.v, s.slack_time, s.elapsed]);
-            }
-        }
+        w.optional_f64s(
+            self.running
+                .as_ref()
+                .map(|(_, s)| [s.x_a, s.v_a, s.joint.x, s.joint.v, s.slack_time, s.elapsed]),
+        );
         w.0
     }
 
     fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let mut r = ByteReader::open(
-            bytes,
-            STATE_MAGIC,
-            STATE_FORMAT_VERSION,
-            env!("CARGO_PKG_VERSION"),
-            "Tendon",
-        )?;
+        let mut r = STATE_FORMAT.reader(bytes)?;
         let mut restored = Self::instantiate();
         restored.values.restore(&r.f64s()?)?;
         restored.start_time = r.f64()?;
-        if r.u32()? == 1 {
-            let v = r.f64s()?;
-            let [x_a, v_a, x_j, v_j, slack_time, elapsed] = v[..] else {
-                return Err(format!("the state holds {} tendon values, expected 6", v.len()));
-            };
-            if !v.iter().all(|x| x.is_finite()) {
-                return Err("the state holds non-finite values".to_string());
-            }
+        if let Some([x_a, v_a, x_j, v_j, slack_time, elapsed]) = r.optional_f64s("tendon")? {
             let p = restored.parameters()?;
             let s = State {
                 x_a,
@@ -202,51 +166,22 @@ impl CoSimModel for TendonFmu {
     }
 }
 
-const STATE_MAGIC: &[u8] = b"TendonState";
-const STATE_FORMAT_VERSION: u32 = 1;
+const STATE_FORMAT: StateFormat = fmu_common::state_format!(magic: b"TendonState", version: 1, model: "Tendon");
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use jetpipe::fmi2::model_description::model_description_xml;
 
-    #[test]
-    fn checked_in_model_description_is_the_generated_one() {
-        assert_eq!(
-            include_str!("../modelDescription.xml"),
-            model_description_xml(&MODEL_INFO),
-            "fmus/tendon/modelDescription.xml is stale: regenerate it with \
-             `cargo run --release -p antagonistic -- model-description Tendon > fmus/tendon/modelDescription.xml`"
-        );
-    }
-
-    #[test]
-    fn every_vr_constant_is_in_the_table() {
-        for r in [
-            vr::F_ACT,
-            vr::X_JOINT,
-            vr::V_JOINT,
-            vr::T,
-            vr::T_ROD,
-            vr::X_S,
-            vr::V_ROD,
-            vr::STRETCH,
-            vr::SLACK_TIME,
-            vr::SLACK,
-            vr::M_ROD,
-            vr::C_ROD,
-            vr::K,
-            vr::C,
-            vr::CAPSTAN,
-            vr::V_FRICTION,
-            vr::X_S0,
-            vr::X_S_MIN,
-            vr::X_S_MAX,
+    fmu_common::interface_tests! {
+        info: MODEL_INFO,
+        dir: "fmus/tendon",
+        checked_in: include_str!("../modelDescription.xml"),
+        vrs: [
+            vr::F_ACT, vr::X_JOINT, vr::V_JOINT,
+            vr::T, vr::T_ROD, vr::X_S, vr::V_ROD, vr::STRETCH, vr::SLACK_TIME, vr::SLACK,
+            vr::M_ROD, vr::C_ROD, vr::K, vr::C, vr::CAPSTAN, vr::V_FRICTION, vr::X_S0, vr::X_S_MIN, vr::X_S_MAX,
             vr::MAX_SUBSTEP,
-        ] {
-            assert!(VARIABLES.iter().any(|v| v.value_reference == r), "{r}");
-        }
-        assert_eq!(VARIABLES.len(), 20);
+        ],
     }
 
     fn initialised(f_act: f64) -> TendonFmu {
