@@ -20,8 +20,9 @@ fn escape(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// `documentation/index.html`: the interface table and where the equations come from.
-pub fn documentation_html(info: &ModelInfo) -> String {
+/// `documentation/index.html` of any FMU on the FMI layer: name, description, `notes`
+/// (already HTML) and the interface table, from the variable table.
+pub fn documentation_page(info: &ModelInfo, notes: &str) -> String {
     let mut rows = String::new();
     for v in info.variables {
         let causality = match v.causality {
@@ -35,32 +36,49 @@ pub fn documentation_html(info: &ModelInfo) -> String {
             (_, VarType::Boolean) => (v.start != 0.0).to_string(),
             _ => format!("{}", v.start),
         };
+        let range = match (v.min, v.max) {
+            (None, None) => String::new(),
+            (lo, hi) => format!(
+                "[{}, {}]",
+                lo.map_or("-inf".to_string(), |x| x.to_string()),
+                hi.map_or("inf".to_string(), |x| x.to_string())
+            ),
+        };
         rows.push_str(&format!(
-            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
             escape(v.name),
             causality,
             escape(v.unit.unwrap_or("")),
             start,
+            range,
             escape(v.description)
         ));
     }
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n\
-<h1>{name}</h1>\n<p>{description}</p>\n\
-<p>FMI 2.0 Co-Simulation, version {version}. Equations and numbers follow P.D. Henri, <i>Study of a Jet Pipe \
+<h1>{name}</h1>\n<p>{description}</p>\n<p>FMI 2.0 Co-Simulation, version {version}.</p>\n{notes}\n\
+<table border=\"1\" cellpadding=\"3\"><tr><th>name</th><th>causality</th><th>unit</th><th>start</th>\
+<th>valid range</th><th>description</th></tr>\n{rows}</table>\n</body></html>\n",
+        name = info.model_identifier,
+        description = escape(info.description),
+        version = info.version,
+    )
+}
+
+/// The actuator's `documentation/index.html`: where the equations come from, and the behaviour
+/// an importer can rely on.
+pub fn documentation_html(info: &ModelInfo) -> String {
+    let notes = format!(
+        "<p>Equations and numbers follow P.D. Henri, <i>Study of a Jet Pipe \
 Electropneumatic Actuator</i> (1994): current driver (2.1)&ndash;(2.3), jet pipe (2.4)&ndash;(2.7), orifice areas \
 (2.8)&ndash;(2.17), orifice flow (2.18)&ndash;(2.23), chambers (2.24)&ndash;(2.32), force (2.36)&ndash;(2.38). \
 The FMU starts at the equilibrium of its initial inputs. A stopper position set between communication points \
 moves the stopper instantly and conserves the air in each chamber (P V<sup>&gamma;</sup> constant); with \
 fmi2SetRealInputDerivatives it moves linearly over the step. The tolerance of fmi2SetupExperiment is the \
-relative tolerance of the integrator (default {tolerance:e}).</p>\n\
-<table border=\"1\" cellpadding=\"3\"><tr><th>name</th><th>causality</th><th>unit</th><th>start</th><th>description</th></tr>\n\
-{rows}</table>\n</body></html>\n",
-        name = info.model_identifier,
-        description = escape(info.description),
-        version = info.version,
+relative tolerance of the integrator (default {tolerance:e}).</p>",
         tolerance = info.default_tolerance,
-    )
+    );
+    documentation_page(info, &notes)
 }
 
 /// Write the FMU archive to `out`, taking the compiled shared library from `library`.

@@ -52,7 +52,7 @@ pub fn write_fmus(dist: &Path, library_dir: &Path) -> Result<Vec<PathBuf>, Strin
         let library = library_dir.join(f.library);
         check_exports(&library)?;
         let out = dist.join(format!("{}.fmu", f.info.model_identifier));
-        let documentation = fmu_common::documentation_html(f.info, f.notes);
+        let documentation = jetpipe::packaging::documentation_page(f.info, f.notes);
         jetpipe::packaging::write_model_fmu(&out, &library, f.info, &documentation)?;
         written.push(out);
     }
