@@ -27,4 +27,5 @@ if [ -n "${BENCH_PLOT:-}" ]; then
     plot=(--plot "$BENCH_PLOT")
 fi
 run .venv/bin/python fmu_tests/work_precision.py --seconds 1 "${plot[@]}"
+run cargo run --release --quiet -p diffsol_compare --target-dir target/tools
 echo "load: $(uptime)"
