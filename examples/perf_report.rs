@@ -96,8 +96,16 @@ fn load_average() -> String {
         .unwrap_or_else(|_| "unknown".into())
 }
 
+/// Tolerance of the reference run that the accuracy columns compare with.
+const REFERENCE_TOLERANCE: f64 = 1e-10;
+
 struct Figures {
     scenario: Scenario,
+    /// max and RMS |F_act − F_ref| over the communication points, N.
+    max_force_error: f64,
+    rms_force_error: f64,
+    /// Smallest and largest reference force, N.
+    force_range: (f64, f64),
     init_cpu: f64,
     best_cpu: f64,
     median_cpu: f64,
@@ -142,7 +150,28 @@ fn measure(scenario: Scenario, runs: usize) -> Result<Figures, String> {
         black_box(&sim);
     }
     times.sort_by(f64::total_cmp);
+
+    // Accuracy of what was timed: the force at every communication point against the same
+    // scenario run at a tolerance four decades tighter.
+    let forces = |p: &Prepared| -> Result<Vec<f64>, String> {
+        let mut sim = p.initial.clone();
+        let mut out = Vec::with_capacity(scenario.steps());
+        p.run_on(&mut sim, |s| out.push(s.outputs().f_act))?;
+        Ok(out)
+    };
+    let reference = forces(&Prepared::new(scenario, &model, REFERENCE_TOLERANCE)?)?;
+    let timed = forces(&prepared)?;
+    let differences: Vec<f64> = timed.iter().zip(&reference).map(|(a, b)| (a - b).abs()).collect();
+    let max_force_error = differences.iter().copied().fold(0.0, f64::max);
+    let rms_force_error = (differences.iter().map(|d| d * d).sum::<f64>() / differences.len() as f64).sqrt();
+    let force_range = (
+        reference.iter().copied().fold(f64::INFINITY, f64::min),
+        reference.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    );
     Ok(Figures {
+        force_range,
+        max_force_error,
+        rms_force_error,
         scenario,
         init_cpu,
         best_cpu: times[0],
@@ -284,6 +313,25 @@ fn main() -> Result<(), String> {
     }
     println!("\n(steps, rejections, RHS and Jacobian evaluations are per simulated second; init is the");
     println!(" equilibrium start, not part of the 10 s)\n");
+
+    println!(
+        "accuracy of the timed runs: F_act at every communication point against a run at rtol {REFERENCE_TOLERANCE:e}"
+    );
+    println!(
+        "{:<12} {:>14} {:>14} {:>16}",
+        "scenario", "max |dF|", "RMS |dF|", "F_act range"
+    );
+    for f in &all {
+        println!(
+            "{:<12} {:>12.2e} N {:>12.2e} N {:>6.1}-{:.1} N",
+            f.scenario.name(),
+            f.max_force_error,
+            f.rms_force_error,
+            f.force_range.0,
+            f.force_range.1
+        );
+    }
+    println!();
 
     println!(
         "memory per instance (size_of::<Simulation>() = {} B):",

@@ -8,7 +8,7 @@
 pub const REGULARISATION_RATIO_BAND: f64 = 1e-5;
 
 /// Constants of (2.19)–(2.21) for one gas, precomputed once.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct FlowConstants {
     pub gamma: f64,
     /// Critical pressure ratio r_c, (2.19).
@@ -20,8 +20,9 @@ pub struct FlowConstants {
     /// 1/√T of the upstream gas (constant temperature, §2.6).
     pub inv_sqrt_temperature: f64,
     band_edge_f2: f64,
-    /// r^{1/γ} on the unchoked range, without a call to `powf`.
-    root: UnchokedRoot,
+    /// r^{1/γ} on the unchoked range, without a call to `powf`; shared, since every
+    /// simulation instance of one gas needs the same 0.9 kB table.
+    root: std::sync::Arc<UnchokedRoot>,
 }
 
 impl FlowConstants {
@@ -37,7 +38,7 @@ impl FlowConstants {
             c2,
             inv_sqrt_temperature: 1.0 / temperature.sqrt(),
             band_edge_f2,
-            root: UnchokedRoot::new(1.0 / gamma, critical_ratio),
+            root: UnchokedRoot::shared(1.0 / gamma, critical_ratio),
         }
     }
 
@@ -77,6 +78,7 @@ const ROOT_DEGREE: usize = 13;
 /// γ > 2, where r_c is small) `value` returns `None` and the caller uses `powf`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UnchokedRoot {
+    exponent: f64,
     start: f64,
     pieces_per_unit: f64,
     accurate: bool,
@@ -100,11 +102,33 @@ impl UnchokedRoot {
         }
         let worst_ratio = half / (start + half);
         Self {
+            exponent,
             start,
             pieces_per_unit: 1.0 / width,
             accurate: worst_ratio.powi(ROOT_DEGREE as i32 + 1) < 1e-16,
             coefficients,
         }
+    }
+
+    /// The table for (e, start), built once per process for the last few gases asked for,
+    /// so many instances share one (a sweep over γ rebuilds tables but keeps at most
+    /// `CACHED` alive in the cache).
+    pub fn shared(exponent: f64, start: f64) -> std::sync::Arc<Self> {
+        const CACHED: usize = 8;
+        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<UnchokedRoot>>> = std::sync::Mutex::new(Vec::new());
+        let key = |r: &UnchokedRoot| r.exponent.to_bits() == exponent.to_bits() && r.start.to_bits() == start.to_bits();
+        // A poisoned lock only means another thread panicked while holding it; the Vec
+        // is still valid.
+        let mut cache = CACHE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some(found) = cache.iter().find(|r| key(r)) {
+            return found.clone();
+        }
+        let built = std::sync::Arc::new(Self::new(exponent, start));
+        if cache.len() == CACHED {
+            cache.remove(0);
+        }
+        cache.push(built.clone());
+        built
     }
 
     /// r^e, or `None` outside [start, 1], for NaN, and when the fit is not accurate.
@@ -260,6 +284,8 @@ mod tests {
         assert_eq!(k.root.value(0.3), None);
         assert_eq!(k.root.value(f64::NAN), None);
         assert_eq!(k.root.value(1.0 + 1e-9), None);
+        // Instances of one gas share one table.
+        assert!(std::sync::Arc::ptr_eq(&k.root, &air().root));
         // A large γ (small r_c) falls back to powf rather than lose digits.
         let k = FlowConstants::new(5.0, 287.0, 293.15);
         assert_eq!(k.root.value(0.9), None);
