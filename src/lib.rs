@@ -25,6 +25,7 @@ pub mod linearization;
 pub mod packaging;
 pub mod physics;
 pub mod plots;
+pub mod polynomial;
 pub mod recording;
 pub mod replay;
 pub mod scenario;

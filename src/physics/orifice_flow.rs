@@ -1,5 +1,7 @@
 //! Compressible orifice flow, (2.18)–(2.22), and the leakage past the piston, (2.23).
 
+use crate::polynomial::{Piecewise, DEGREE};
+
 /// Width of the band of pressure ratios next to 1 in which the √(1 − r) law of (2.22) is
 /// replaced by a C¹ cubic through zero. The exact law has an infinite slope at equal
 /// pressures, which no implicit integrator can use; inside the band the pressure
@@ -20,9 +22,9 @@ pub struct FlowConstants {
     /// 1/√T of the upstream gas (constant temperature, §2.6).
     pub inv_sqrt_temperature: f64,
     band_edge_f2: f64,
-    /// r^{1/γ} on the unchoked range, without a call to `powf`; shared, since every
-    /// simulation instance of one gas needs the same 0.9 kB table.
-    root: std::sync::Arc<UnchokedRoot>,
+    /// f2(r)/√(1 − r) on the unchoked range, tabulated; shared, since every simulation
+    /// instance of one gas needs the same 2.3 kB table.
+    unchoked: std::sync::Arc<UnchokedFactor>,
 }
 
 impl FlowConstants {
@@ -38,7 +40,7 @@ impl FlowConstants {
             c2,
             inv_sqrt_temperature: 1.0 / temperature.sqrt(),
             band_edge_f2,
-            root: UnchokedRoot::shared(1.0 / gamma, critical_ratio),
+            unchoked: UnchokedFactor::shared(gamma, critical_ratio),
         }
     }
 
@@ -46,9 +48,12 @@ impl FlowConstants {
     pub fn f2(&self, ratio: f64) -> f64 {
         // Outside the band (1 − r ≥ band), tested without a division.
         if 1.0 - ratio >= REGULARISATION_RATIO_BAND {
-            // f2_exact's form with r^{1/γ} from the fitted root (within 1 ulp or so of powf).
-            let a = self.root.value(ratio).unwrap_or_else(|| ratio.powf(1.0 / self.gamma));
-            (a * (a - ratio)).max(0.0).sqrt()
+            // √(1 − r) and the tabulated factor are independent: the root overlaps the
+            // polynomial instead of following it.
+            match self.unchoked.value(ratio) {
+                Some(g) => (1.0 - ratio).sqrt() * g,
+                None => f2_exact(self.gamma, ratio),
+            }
         } else {
             // g(s) = (5s − s³)/4: g(0) = 0, g(1) = 1, g'(1) = 1/2 = d√s/ds at s = 1.
             let s = ((1.0 - ratio) / REGULARISATION_RATIO_BAND).clamp(0.0, 1.0);
@@ -64,69 +69,65 @@ pub fn f2_exact(gamma: f64, ratio: f64) -> f64 {
     (a * (a - ratio)).max(0.0).sqrt()
 }
 
-/// Pieces and degree of [`UnchokedRoot`].
-const ROOT_PIECES: usize = 32;
-const ROOT_DEGREE: usize = 8;
-// `UnchokedRoot::value` spells out Estrin's scheme for exactly this degree.
-const _: () = assert!(ROOT_DEGREE == 8);
+/// Pieces of [`UnchokedFactor`].
+const UNCHOKED_PIECES: usize = 32;
 
-/// r^e for r in [r_c, 1] (e = 1/γ) by piecewise polynomials, built once per gas.
+/// g(r) = f2(r)/√(1 − r) for r in [r_c, 1], by piecewise polynomials built once per gas.
 ///
-/// The flow law needs r^{1/γ} in every unchoked orifice, several times per right-hand side
-/// and millions of times per simulation, on the integrator's critical path: `powf` takes
-/// ~18 ns, a degree-8 polynomial by Estrin's scheme (four dependent multiply-adds) ~4 ns.
-/// Each piece is the Taylor polynomial of (c + w u)^e = c^e (1 + (w/c) u)^e about its centre
-/// c, in u ∈ [−1, 1]: its terms shrink like (w/c)^k, so Horner's rule is stable and the
-/// truncation error is below (w/c)^9. When that bound is not below 1e-16 (only for
-/// γ > 2, where r_c is small) `value` returns `None` and the caller uses `powf`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct UnchokedRoot {
-    exponent: f64,
-    start: f64,
-    pieces_per_unit: f64,
+/// The flow law evaluates f2 in every unchoked orifice, several times per right-hand side
+/// and millions of times per simulation, on the integrator's critical path: r^{1/γ} by
+/// `powf` takes ~18 ns before the root can start. g is analytic on [r_c, 1] (f2 vanishes
+/// like √(1 − r) at r = 1), so f2 = √(1 − r)·g(r) with g a degree-8 polynomial on each of
+/// 32 pieces, evaluated by Estrin's scheme while the root is computed. The interpolation
+/// nodes use g = √(a r expm1((1/γ − 1) ln r)/(1 − r)), a = r^{1/γ}, which has none of the
+/// cancellation of a − r near r = 1: the table is accurate to a few units in the last
+/// place where (2.22) as written loses digits like 1/(1 − r). Its truncation error is
+/// below (w/c)^9 for pieces of half-width w centred at c; when that bound is not below
+/// 1e-16 (only for γ > 2, where r_c is small) `value` returns `None` and the caller uses
+/// (2.22) directly.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnchokedFactor {
+    gamma: f64,
     accurate: bool,
-    coefficients: [[f64; ROOT_DEGREE + 1]; ROOT_PIECES],
+    pieces: Piecewise<UNCHOKED_PIECES>,
 }
 
-impl UnchokedRoot {
-    pub fn new(exponent: f64, start: f64) -> Self {
-        let width = (1.0 - start) / ROOT_PIECES as f64;
-        let half = 0.5 * width;
-        let mut coefficients = [[0.0; ROOT_DEGREE + 1]; ROOT_PIECES];
-        for (piece, taylor) in coefficients.iter_mut().enumerate() {
-            let centre = start + (piece as f64 + 0.5) * width;
-            let ratio = half / centre;
-            // binom(e, k) (w/c)^k c^e, by binom(e, k+1) = binom(e, k) (e − k)/(k + 1).
-            let mut term = centre.powf(exponent);
-            for (k, t) in taylor.iter_mut().enumerate() {
-                *t = term;
-                term *= (exponent - k as f64) / (k as f64 + 1.0) * ratio;
-            }
-        }
-        let worst_ratio = half / (start + half);
+/// g(r) = f2(r)/√(1 − r) without cancellation near r = 1, for building the table and testing.
+pub fn unchoked_factor(gamma: f64, ratio: f64) -> f64 {
+    if ratio == 1.0 {
+        // a − r ≈ (1 − 1/γ)(1 − r) as r → 1.
+        return (1.0 - 1.0 / gamma).sqrt();
+    }
+    let a = ratio.powf(1.0 / gamma);
+    let a_minus_r = ratio * ((1.0 / gamma - 1.0) * (ratio - 1.0).ln_1p()).exp_m1();
+    (a * a_minus_r / (1.0 - ratio)).max(0.0).sqrt()
+}
+
+impl UnchokedFactor {
+    pub fn new(gamma: f64, critical_ratio: f64) -> Self {
+        let pieces = Piecewise::interpolating(critical_ratio, 1.0, |r| unchoked_factor(gamma, r));
+        let half = 0.5 * (1.0 - critical_ratio) / UNCHOKED_PIECES as f64;
+        let worst_ratio = half / (critical_ratio + half);
         Self {
-            exponent,
-            start,
-            pieces_per_unit: 1.0 / width,
-            accurate: worst_ratio.powi(ROOT_DEGREE as i32 + 1) < 1e-16,
-            coefficients,
+            gamma,
+            accurate: worst_ratio.powi(DEGREE as i32 + 1) < 1e-16,
+            pieces,
         }
     }
 
-    /// The table for (e, start), built once per process for the last few gases asked for,
-    /// so many instances share one (a sweep over γ rebuilds tables but keeps at most
-    /// `CACHED` alive in the cache).
-    pub fn shared(exponent: f64, start: f64) -> std::sync::Arc<Self> {
+    /// The table for γ, built once per process for the last few gases asked for, so many
+    /// instances share one (a sweep over γ rebuilds tables but keeps at most `CACHED` alive
+    /// in the cache).
+    pub fn shared(gamma: f64, critical_ratio: f64) -> std::sync::Arc<Self> {
         const CACHED: usize = 8;
-        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<UnchokedRoot>>> = std::sync::Mutex::new(Vec::new());
-        let key = |r: &UnchokedRoot| r.exponent.to_bits() == exponent.to_bits() && r.start.to_bits() == start.to_bits();
+        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<UnchokedFactor>>> = std::sync::Mutex::new(Vec::new());
         // A poisoned lock only means another thread panicked while holding it; the Vec
         // is still valid.
         let mut cache = CACHE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        if let Some(found) = cache.iter().find(|r| key(r)) {
+        if let Some(found) = cache.iter().find(|t| t.gamma.to_bits() == gamma.to_bits()) {
             return found.clone();
         }
-        let built = std::sync::Arc::new(Self::new(exponent, start));
+        let built = std::sync::Arc::new(Self::new(gamma, critical_ratio));
         if cache.len() == CACHED {
             cache.remove(0);
         }
@@ -134,21 +135,13 @@ impl UnchokedRoot {
         built
     }
 
-    /// r^e, or `None` outside [start, 1], for NaN, and when the fit is not accurate.
+    /// g(r), or `None` outside [r_c, 1], for NaN, and when the table is not accurate.
+    #[inline]
     pub fn value(&self, ratio: f64) -> Option<f64> {
-        let x = (ratio - self.start) * self.pieces_per_unit;
-        if !(self.accurate && (0.0..=ROOT_PIECES as f64).contains(&x)) {
+        if !self.accurate {
             return None;
         }
-        let piece = (x as usize).min(ROOT_PIECES - 1);
-        let u = 2.0 * (x - piece as f64) - 1.0;
-        let c = &self.coefficients[piece];
-        // Estrin's scheme: short dependency chains instead of Horner's eight.
-        let u2 = u * u;
-        let u4 = u2 * u2;
-        let low = (c[0] + c[1] * u) + u2 * (c[2] + c[3] * u);
-        let high = (c[4] + c[5] * u) + u2 * (c[6] + c[7] * u);
-        Some(low + u4 * (high + u4 * c[8]))
+        self.pieces.value(ratio)
     }
 }
 
@@ -269,35 +262,41 @@ mod tests {
     }
 
     #[test]
-    fn fitted_root_matches_powf() {
+    fn tabulated_f2_matches_2_22() {
         for gamma in [1.4, 1.67, 1.3, 1.1, 1.01] {
             let k = FlowConstants::new(gamma, 287.0, 293.15);
-            assert!(k.root.accurate, "γ {gamma}");
-            let (mut worst_root, mut worst_f2) = (0.0f64, 0.0f64);
+            assert!(k.unchoked.accurate, "γ {gamma}");
+            let (mut worst_factor, mut worst_f2) = (0.0f64, 0.0f64);
             for j in 0..=100_000 {
                 let r = k.critical_ratio + (1.0 - k.critical_ratio) * j as f64 / 100_000.0;
-                let exact = r.powf(1.0 / gamma);
-                let fitted = k.root.value(r).expect("inside the fitted range");
-                worst_root = worst_root.max((fitted - exact).abs() / exact);
+                let accurate = unchoked_factor(gamma, r);
+                let tabulated = k.unchoked.value(r).expect("inside the tabulated range");
+                worst_factor = worst_factor.max((tabulated - accurate).abs() / (accurate * f64::EPSILON));
                 if r < 1.0 - REGULARISATION_RATIO_BAND {
-                    // f2 = √(a (a − r)): a relative error δ in a becomes δ (2a − r)/(2(a − r)),
-                    // which grows as r → 1; δ ≤ 1e-15 for the fit and for powf alike.
-                    let bound = 1e-15 * (1.0 + (2.0 * exact - r) / (exact - r));
-                    worst_f2 = worst_f2.max((k.f2(r) - f2_exact(gamma, r)).abs() / f2_exact(gamma, r) / bound);
+                    // (2.22) as written, √(a (a − r)), loses digits as r → 1: a relative error δ
+                    // in a becomes δ (2a − r)/(2(a − r)) in f2; δ ≤ 1e-15 for powf.
+                    let exact = f2_exact(gamma, r);
+                    let a = r.powf(1.0 / gamma);
+                    let bound = 1e-15 * (1.0 + (2.0 * a - r) / (a - r));
+                    worst_f2 = worst_f2.max((k.f2(r) - exact).abs() / exact / bound);
                 }
             }
-            assert!(worst_root < 1e-15, "γ {gamma}: r^(1/γ) off by {worst_root:e}");
-            assert!(worst_f2 < 1.0, "γ {gamma}: f2 off by {worst_f2} rounding bounds");
+            // Interpolation plus the conversion to monomials: a few units in the last place.
+            assert!(worst_factor <= 16.0, "γ {gamma}: g off by {worst_factor} ulp");
+            assert!(
+                worst_f2 < 1.0,
+                "γ {gamma}: f2 off by {worst_f2} rounding bounds of (2.22)"
+            );
         }
         let k = air();
-        assert_eq!(k.root.value(0.3), None);
-        assert_eq!(k.root.value(f64::NAN), None);
-        assert_eq!(k.root.value(1.0 + 1e-9), None);
+        assert_eq!(k.unchoked.value(0.3), None);
+        assert_eq!(k.unchoked.value(f64::NAN), None);
+        assert_eq!(k.unchoked.value(1.0 + 1e-9), None);
         // Instances of one gas share one table.
-        assert!(std::sync::Arc::ptr_eq(&k.root, &air().root));
-        // A large γ (small r_c) falls back to powf rather than lose digits.
+        assert!(std::sync::Arc::ptr_eq(&k.unchoked, &air().unchoked));
+        // A large γ (small r_c) falls back to (2.22) rather than lose digits.
         let k = FlowConstants::new(5.0, 287.0, 293.15);
-        assert_eq!(k.root.value(0.9), None);
+        assert_eq!(k.unchoked.value(0.9), None);
         assert_eq!(k.f2(0.9), f2_exact(5.0, 0.9));
     }
 
