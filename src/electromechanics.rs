@@ -54,6 +54,14 @@ pub struct ElectromechanicalPropagator {
 /// Largest |ε|/ρ (jump over the distance to tanh's nearest pole) for which the series is used.
 const SERIES_RATIO_LIMIT: f64 = 0.5;
 const MAX_SERIES_TERMS: usize = 64;
+/// Largest |k_m δ / F_jp_sat| (the current transient's share of tanh's argument) that a
+/// ramp's closed form neglects: its effect on the jet pipe is below 1e-15·x_jp_sat.
+const RAMP_TRANSIENT_LIMIT: f64 = 1e-15;
+/// Largest |β T| / ρ (the ramp's change of tanh's argument over the closed form's horizon,
+/// over the distance to tanh's nearest pole): the series terms shrink at least this fast.
+const RAMP_SERIES_RATIO: f64 = 0.2;
+/// Longest horizon of a ramp's closed form, s (queries beyond it use quadrature).
+const RAMP_MAX_HORIZON: f64 = 1.0;
 const PANEL: f64 = 1e-4;
 
 const GAUSS_NODES: [f64; 8] = [
@@ -171,12 +179,23 @@ impl ElectromechanicalPropagator {
                 series[0] += constant;
             }
         }
+        // A ramp whose current transient is below rounding (a ramp continued from the last
+        // step): the input is a power series in time and the response has a closed form.
+        let ramp_form = if ramp != 0.0
+            && !self.hysteresis.is_active()
+            && (self.k_m * delta / self.f_sat).abs() <= RAMP_TRANSIENT_LIMIT
+        {
+            RampForm::new(self, &q0, self.k_m * base / self.f_sat, self.k_m * ramp / self.f_sat)
+        } else {
+            None
+        };
         let mut trajectory = Trajectory {
             propagator: self,
             base,
             ramp,
             delta,
             q0,
+            ramp_form,
             series_form: SeriesForm::new(self, &q0, &series),
             series,
             plays: *plays,
@@ -301,17 +320,7 @@ impl SeriesForm {
 
     /// The modal exponentials' parts e^{λk s}·amplitude_k, and r = e^{−ω s}.
     fn growth(&self, p: &ElectromechanicalPropagator, s: f64) -> ([C64; 3], f64) {
-        let real = (p.lambda[0].re * s).exp();
-        let envelope = (p.lambda[1].re * s).exp();
-        let (sin, cos) = (p.lambda[1].im * s).sin_cos();
-        let oscillation = C64::new(envelope * cos, envelope * sin);
-        // λ2 = conj(λ1) by construction.
-        let g = [
-            self.amplitude[0] * real,
-            self.amplitude[1] * oscillation,
-            self.amplitude[2] * oscillation.conj(),
-        ];
-        (g, (-p.omega_cd * s).exp())
+        (modal_growth(p, &self.amplitude, s), (-p.omega_cd * s).exp())
     }
 
     fn horner(coefficients: &[f64], r: f64) -> f64 {
@@ -334,6 +343,134 @@ impl SeriesForm {
     }
 }
 
+/// For a command ramp once the current transient has died out (i(s) = i0 + ramp·s), the
+/// jet pipe input u(s) = x_sat tanh(α + β s) is a power series in τ = s/T, Σ bₙ τⁿ, on a
+/// horizon T short enough for it to converge fast. Each mode q' = λq + βu then has the
+/// polynomial particular solution q_p = −β Σ_j u⁽ʲ⁾/λ^{j+1} (a finite sum), so
+///   x(s) = Σ_k Re[(q_k(0) − q_p,k(0)) e^{λk s}] + P(τ),  P = Σ_j g_j u⁽ʲ⁾, g_j = −Re Σ_k β_k/λ_k^{j+1}:
+/// two exponentials plus a polynomial, like [`SeriesForm`], instead of quadrature on
+/// 0.1 ms panels.
+#[derive(Clone, Debug)]
+struct RampForm {
+    /// T, s: the form holds for 0 ≤ s ≤ T.
+    horizon: f64,
+    /// q_k(0) − q_p,k(0).
+    amplitude: [C64; 3],
+    /// P and its first two derivatives with respect to s, as polynomials in τ.
+    polynomials: [Vec<f64>; 3],
+    /// Each mode's particular solution q_p,k as a polynomial in τ.
+    particular_modes: [Vec<C64>; 3],
+}
+
+impl RampForm {
+    /// `alpha`, `beta`: tanh's argument α + β s. `None` when the series would need too
+    /// many terms.
+    fn new(p: &ElectromechanicalPropagator, q0: &[C64; 3], alpha: f64, beta: f64) -> Option<Self> {
+        let radius = (alpha * alpha + std::f64::consts::FRAC_PI_2.powi(2)).sqrt();
+        let horizon = RAMP_MAX_HORIZON.min(RAMP_SERIES_RATIO * radius / beta.abs());
+        let mut input = tanh_series(alpha, beta * horizon, MAX_SERIES_TERMS);
+        if input.len() >= MAX_SERIES_TERMS {
+            return None;
+        }
+        for b in input.iter_mut() {
+            *b *= p.x_sat;
+        }
+        let n = input.len();
+        // u^{(j)} in τ: (d/dτ)^j, and d/ds = (1/T) d/dτ.
+        let derivative = |c: &[f64]| -> Vec<f64> { (1..c.len()).map(|m| m as f64 * c[m]).collect() };
+        let mut amplitude = *q0;
+        let mut particular = vec![0.0; n];
+        let mut particular_modes = [
+            vec![C64::new(0.0, 0.0); n],
+            vec![C64::new(0.0, 0.0); n],
+            vec![C64::new(0.0, 0.0); n],
+        ];
+        let mut u_j = input.clone();
+        let mut scale = 1.0; // T^{-j}
+        let mut inverse_power = [C64::new(1.0, 0.0); 3]; // λ_k^{-(j+1)}, built below
+        for k in 0..3 {
+            inverse_power[k] = C64::new(1.0, 0.0) / p.lambda[k];
+        }
+        for _ in 0..n {
+            if u_j.is_empty() {
+                break;
+            }
+            let mut g = 0.0;
+            for k in 0..3 {
+                // q_p,k(0) = −β_k Σ_j u^{(j)}(0) λ_k^{−(j+1)}
+                amplitude[k] += p.beta[k] * inverse_power[k] * (u_j[0] * scale);
+                g -= (p.beta[k] * inverse_power[k]).re;
+            }
+            for (m, c) in u_j.iter().enumerate() {
+                particular[m] += g * scale * c;
+                for k in 0..3 {
+                    particular_modes[k][m] -= p.beta[k] * inverse_power[k] * (scale * c);
+                }
+            }
+            u_j = derivative(&u_j);
+            scale /= horizon;
+            for k in 0..3 {
+                inverse_power[k] /= p.lambda[k];
+            }
+        }
+        let velocity: Vec<f64> = derivative(&particular).iter().map(|c| c / horizon).collect();
+        let acceleration: Vec<f64> = derivative(&velocity).iter().map(|c| c / horizon).collect();
+        Some(Self {
+            horizon,
+            amplitude,
+            polynomials: [particular, velocity, acceleration],
+            particular_modes,
+        })
+    }
+
+    fn covers(&self, s: f64) -> bool {
+        (0.0..=self.horizon).contains(&s)
+    }
+
+    fn growth(&self, p: &ElectromechanicalPropagator, s: f64) -> [C64; 3] {
+        modal_growth(p, &self.amplitude, s)
+    }
+
+    fn position(&self, p: &ElectromechanicalPropagator, s: f64) -> f64 {
+        let g = self.growth(p, s);
+        (g[0] + g[1] + g[2]).re + SeriesForm::horner(&self.polynomials[0], s / self.horizon)
+    }
+
+    fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
+        let g = self.growth(p, s);
+        let (l, tau) = (&p.lambda, s / self.horizon);
+        [
+            (g[0] + g[1] + g[2]).re + SeriesForm::horner(&self.polynomials[0], tau),
+            (l[0] * g[0] + l[1] * g[1] + l[2] * g[2]).re + SeriesForm::horner(&self.polynomials[1], tau),
+            (l[0] * l[0] * g[0] + l[1] * l[1] * g[1] + l[2] * l[2] * g[2]).re
+                + SeriesForm::horner(&self.polynomials[2], tau),
+        ]
+    }
+
+    /// Modal coordinates: q_k(s) = amplitude_k e^{λk s} + q_p,k(s).
+    fn modes(&self, p: &ElectromechanicalPropagator, s: f64) -> [C64; 3] {
+        let tau = s / self.horizon;
+        let mut q = self.growth(p, s);
+        for (q_k, polynomial) in q.iter_mut().zip(&self.particular_modes) {
+            *q_k += polynomial.iter().rev().fold(C64::new(0.0, 0.0), |acc, c| acc * tau + c);
+        }
+        q
+    }
+}
+
+/// e^{λk s}·amplitude_k for the three modes (λ3 = conj(λ2), so one complex exponential).
+fn modal_growth(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s: f64) -> [C64; 3] {
+    let real = (p.lambda[0].re * s).exp();
+    let envelope = (p.lambda[1].re * s).exp();
+    let (sin, cos) = (p.lambda[1].im * s).sin_cos();
+    let oscillation = C64::new(envelope * cos, envelope * sin);
+    [
+        amplitude[0] * real,
+        amplitude[1] * oscillation,
+        amplitude[2] * oscillation.conj(),
+    ]
+}
+
 /// The current driver and jet pipe over one step, evaluable at any time within it.
 pub struct Trajectory<'a> {
     propagator: &'a ElectromechanicalPropagator,
@@ -345,6 +482,8 @@ pub struct Trajectory<'a> {
     series: Vec<f64>,
     /// The same series summed in closed form, for fast evaluation (see [`SeriesForm`]).
     series_form: Option<SeriesForm>,
+    /// The closed form for a ramp without a current transient (see [`RampForm`]).
+    ramp_form: Option<RampForm>,
     /// Hysteresis play states at the start of the step.
     plays: [f64; PLAY_OPERATORS],
     /// For a held command integrated by quadrature: the time after which the current
@@ -506,6 +645,8 @@ impl Trajectory<'_> {
                 }
                 decay_n *= decay;
             }
+        } else if let Some(form) = self.ramp_form.as_ref().filter(|f| f.covers(s)) {
+            return form.modes(p, s);
         } else if let Some((settled, at_settled, u_final)) = self.settled.filter(|(settled, _, _)| s > *settled) {
             // Past the current transient the input is constant: carry the integral up to
             // the settling time forward and add the constant input's part exactly.
@@ -542,14 +683,21 @@ impl Trajectory<'_> {
         if let Some(form) = &self.series_form {
             return form.position(self.propagator, s);
         }
+        if let Some(form) = self.ramp_form.as_ref().filter(|f| f.covers(s)) {
+            return form.position(self.propagator, s);
+        }
         let q = self.modes(s);
         (q[0] + q[1] + q[2]).re
     }
 
     /// The full state at `s` seconds into the step.
     pub fn state(&self, s: f64) -> ElectromechanicalState {
-        if let Some(form) = &self.series_form {
-            let [position, velocity, acceleration] = form.derivatives(self.propagator, s);
+        let closed_form = match (&self.series_form, &self.ramp_form) {
+            (Some(form), _) => Some(form.derivatives(self.propagator, s)),
+            (None, Some(form)) if form.covers(s) => Some(form.derivatives(self.propagator, s)),
+            _ => None,
+        };
+        if let Some([position, velocity, acceleration]) = closed_form {
             return ElectromechanicalState {
                 current: self.current(s),
                 position,
@@ -634,6 +782,73 @@ mod tests {
                 assert_eq!(trajectory.position(s), fast.position);
             }
         }
+    }
+
+    #[test]
+    fn ramp_form_matches_quadrature_and_a_tight_numerical_solution() {
+        let p = Parameters::default();
+        let propagator = ElectromechanicalPropagator::new(&p).unwrap();
+        for (v, rate) in [(1.0, 2.5), (4.0, -2.5), (2.5, 400.0), (-3.0, -60.0), (6.0, 1e-3)] {
+            // A ramp continued from the previous step: the current already lags it by rate/ω.
+            let current = p.k_cd * v + p.i_offset - p.k_cd * rate / p.omega_cd;
+            let start = ElectromechanicalState {
+                current,
+                position: 1.2e-4,
+                velocity: 0.02,
+                acceleration: -30.0,
+            };
+            let plays = [start.position; PLAY_OPERATORS];
+            let fast = propagator.trajectory(&start, v, rate, &plays);
+            let form = fast.ramp_form.as_ref().expect("ramp form expected");
+            // Up to 100 V/s (full scale in 0.1 s) one form covers a 10 ms step; faster ramps
+            // hand the rest of the step to quadrature.
+            assert!(
+                rate.abs() > 100.0 || form.horizon >= 0.01,
+                "v {v} rate {rate}: horizon {}",
+                form.horizon
+            );
+            let mut slow = propagator.trajectory(&start, v, rate, &plays);
+            slow.ramp_form = None;
+            let y0 = SVector::<f64, 4>::new(start.current, start.position, start.velocity, start.acceleration);
+            for s in [0.0, 1e-5, 3e-4, 2e-3, 7.3e-3, 1e-2] {
+                let (a, b) = (fast.state(s), slow.state(s));
+                for (name, x, y, scale) in [
+                    ("x", a.position, b.position, 1e-3),
+                    ("v", a.velocity, b.velocity, 1.0),
+                    ("a", a.acceleration, b.acceleration, 1e3),
+                ] {
+                    assert!(
+                        (x - y).abs() < 1e-13 * scale,
+                        "v {v} rate {rate} s {s} {name}: {x} vs {y}"
+                    );
+                }
+                assert_eq!(fast.position(s), a.position);
+                let (qa, qb) = (fast.modes(s), slow.modes(s));
+                for k in 0..3 {
+                    assert!((qa[k] - qb[k]).norm() < 1e-16, "v {v} rate {rate} s {s} mode {k}");
+                }
+                if s > 0.0 {
+                    let y = reference(&p, y0, v, rate, s);
+                    assert!(
+                        (a.position - y[1]).abs() < 1e-11,
+                        "v {v} rate {rate} s {s}: x {} vs {}",
+                        a.position,
+                        y[1]
+                    );
+                }
+            }
+        }
+        // With a current transient the quadrature stays in charge.
+        let start = ElectromechanicalState {
+            current: 0.05,
+            position: 1.2e-4,
+            velocity: 0.02,
+            acceleration: -30.0,
+        };
+        assert!(propagator
+            .trajectory(&start, 1.0, 2.5, &[start.position; PLAY_OPERATORS])
+            .ramp_form
+            .is_none());
     }
 
     /// The four electromechanical states of (4.1) with the command linear in time.
