@@ -305,7 +305,8 @@ impl SeriesForm {
             let n_omega = n as f64 * p.omega_cd;
             for k in 0..3 {
                 let denominator = p.lambda[k] + n_omega;
-                if denominator.norm() <= 1e-9 * p.omega_cd {
+                // Squared moduli: `norm` is a hypot call, and this runs per term and mode.
+                if denominator.norm_sqr() <= (1e-9 * p.omega_cd).powi(2) {
                     return None;
                 }
                 let term = p.beta[k] * *a / denominator;
@@ -637,7 +638,7 @@ impl Trajectory<'_> {
                 let n_omega = n as f64 * p.omega_cd;
                 for k in 0..3 {
                     let denominator = p.lambda[k] + n_omega;
-                    integral[k] += if denominator.norm() > 1e-9 * p.omega_cd {
+                    integral[k] += if denominator.norm_sqr() > (1e-9 * p.omega_cd).powi(2) {
                         (growth[k] - decay_n) / denominator * *a
                     } else {
                         growth[k] * s * *a
