@@ -286,6 +286,8 @@ struct SeriesForm {
     amplitude: [C64; 3],
     /// Coefficients of rⁿ in the position, velocity and acceleration: −Re Σ_k λk^m β_k aₙ/(λk + nω).
     polynomials: [Vec<f64>; 3],
+    /// Each mode's coefficients of rⁿ: −β_k aₙ/(λk + nω).
+    mode_polynomials: [Vec<C64>; 3],
 }
 
 impl SeriesForm {
@@ -301,6 +303,12 @@ impl SeriesForm {
             vec![0.0; series.len()],
             vec![0.0; series.len()],
         ];
+        let zero = C64::new(0.0, 0.0);
+        let mut mode_polynomials = [
+            vec![zero; series.len()],
+            vec![zero; series.len()],
+            vec![zero; series.len()],
+        ];
         for (n, a) in series.iter().enumerate() {
             let n_omega = n as f64 * p.omega_cd;
             for k in 0..3 {
@@ -314,9 +322,23 @@ impl SeriesForm {
                 polynomials[0][n] -= term.re;
                 polynomials[1][n] -= (p.lambda[k] * term).re;
                 polynomials[2][n] -= (p.lambda[k] * p.lambda[k] * term).re;
+                mode_polynomials[k][n] = -term;
             }
         }
-        Some(Self { amplitude, polynomials })
+        Some(Self {
+            amplitude,
+            polynomials,
+            mode_polynomials,
+        })
+    }
+
+    /// Modal coordinates: q_k(s) = amplitude_k e^{λk s} + Σₙ mode_polynomials[k][n] rⁿ.
+    fn modes(&self, p: &ElectromechanicalPropagator, s: f64) -> [C64; 3] {
+        let (mut q, r) = self.growth(p, s);
+        for (q_k, polynomial) in q.iter_mut().zip(&self.mode_polynomials) {
+            *q_k += polynomial.iter().rev().fold(C64::new(0.0, 0.0), |acc, c| acc * r + c);
+        }
+        q
     }
 
     /// The modal exponentials' parts e^{λk s}·amplitude_k, and r = e^{−ω s}.
@@ -622,6 +644,14 @@ impl Trajectory<'_> {
 
     /// Modal coordinates at `s`.
     fn modes(&self, s: f64) -> [C64; 3] {
+        match &self.series_form {
+            Some(form) => form.modes(self.propagator, s),
+            None => self.modes_by_sum(s),
+        }
+    }
+
+    /// Modal coordinates from the series term by term, the ramp form, or quadrature.
+    fn modes_by_sum(&self, s: f64) -> [C64; 3] {
         let p = self.propagator;
         let mut q = [C64::new(0.0, 0.0); 3];
         let mut integral = [C64::new(0.0, 0.0); 3];
@@ -765,7 +795,16 @@ mod tests {
             let trajectory = propagator.trajectory(&start, v, 0.0, &[start.position; PLAY_OPERATORS]);
             assert!(trajectory.series_form.is_some(), "v {v}: series form expected");
             for s in [0.0, 1e-5, 3e-4, 2e-3, 1e-2, 0.3] {
-                let q = trajectory.modes(s);
+                let q = trajectory.modes_by_sum(s);
+                let summed = trajectory.modes(s);
+                for k in 0..3 {
+                    assert!(
+                        (q[k] - summed[k]).norm() < 1e-16,
+                        "v {v} s {s} mode {k}: {} vs {}",
+                        q[k],
+                        summed[k]
+                    );
+                }
                 let l = &propagator.lambda;
                 let by_modes = [
                     (q[0] + q[1] + q[2]).re,
