@@ -22,8 +22,9 @@ pub struct FlowConstants {
     /// 1/√T of the upstream gas (constant temperature, §2.6).
     pub inv_sqrt_temperature: f64,
     band_edge_f2: f64,
-    /// f2(r)/√(1 − r) on the unchoked range, tabulated; shared, since every simulation
-    /// instance of one gas needs the same 2.3 kB table.
+    /// f2(r)/√(1 − r) on the unchoked range, tabulated (2.4 kB, built in ~30 µs). Owned by
+    /// the instance and shared with its clones; not cached process-wide, because an FMU
+    /// is unloaded with dlclose and a static's heap would then leak.
     unchoked: std::sync::Arc<UnchokedFactor>,
 }
 
@@ -40,7 +41,7 @@ impl FlowConstants {
             c2,
             inv_sqrt_temperature: 1.0 / temperature.sqrt(),
             band_edge_f2,
-            unchoked: UnchokedFactor::shared(gamma, critical_ratio),
+            unchoked: std::sync::Arc::new(UnchokedFactor::new(gamma, critical_ratio)),
         }
     }
 
@@ -113,26 +114,6 @@ impl UnchokedFactor {
             accurate: worst_ratio.powi(DEGREE as i32 + 1) < 1e-16,
             pieces,
         }
-    }
-
-    /// The table for γ, built once per process for the last few gases asked for, so many
-    /// instances share one (a sweep over γ rebuilds tables but keeps at most `CACHED` alive
-    /// in the cache).
-    pub fn shared(gamma: f64, critical_ratio: f64) -> std::sync::Arc<Self> {
-        const CACHED: usize = 8;
-        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<UnchokedFactor>>> = std::sync::Mutex::new(Vec::new());
-        // A poisoned lock only means another thread panicked while holding it; the Vec
-        // is still valid.
-        let mut cache = CACHE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        if let Some(found) = cache.iter().find(|t| t.gamma.to_bits() == gamma.to_bits()) {
-            return found.clone();
-        }
-        let built = std::sync::Arc::new(Self::new(gamma, critical_ratio));
-        if cache.len() == CACHED {
-            cache.remove(0);
-        }
-        cache.push(built.clone());
-        built
     }
 
     /// g(r), or `None` outside [r_c, 1], for NaN, and when the table is not accurate.
@@ -292,8 +273,8 @@ mod tests {
         assert_eq!(k.unchoked.value(0.3), None);
         assert_eq!(k.unchoked.value(f64::NAN), None);
         assert_eq!(k.unchoked.value(1.0 + 1e-9), None);
-        // Instances of one gas share one table.
-        assert!(std::sync::Arc::ptr_eq(&k.unchoked, &air().unchoked));
+        // Clones share the table.
+        assert!(std::sync::Arc::ptr_eq(&k.unchoked, &k.clone().unchoked));
         // A large γ (small r_c) falls back to (2.22) rather than lose digits.
         let k = FlowConstants::new(5.0, 287.0, 293.15);
         assert_eq!(k.unchoked.value(0.9), None);
