@@ -286,8 +286,8 @@ struct SeriesForm {
     amplitude: [C64; 3],
     /// Coefficients of rⁿ in the position, velocity and acceleration: −Re Σ_k λk^m β_k aₙ/(λk + nω).
     polynomials: [Vec<f64>; 3],
-    /// Each mode's coefficients of rⁿ: −β_k aₙ/(λk + nω).
-    mode_polynomials: [Vec<C64>; 3],
+    /// Coefficients of rⁿ of each mode k: −β_k aₙ/(λk + nω) (one allocation per step).
+    mode_polynomials: Vec<[C64; 3]>,
 }
 
 impl SeriesForm {
@@ -303,12 +303,7 @@ impl SeriesForm {
             vec![0.0; series.len()],
             vec![0.0; series.len()],
         ];
-        let zero = C64::new(0.0, 0.0);
-        let mut mode_polynomials = [
-            vec![zero; series.len()],
-            vec![zero; series.len()],
-            vec![zero; series.len()],
-        ];
+        let mut mode_polynomials = vec![[C64::new(0.0, 0.0); 3]; series.len()];
         for (n, a) in series.iter().enumerate() {
             let n_omega = n as f64 * p.omega_cd;
             for k in 0..3 {
@@ -322,7 +317,7 @@ impl SeriesForm {
                 polynomials[0][n] -= term.re;
                 polynomials[1][n] -= (p.lambda[k] * term).re;
                 polynomials[2][n] -= (p.lambda[k] * p.lambda[k] * term).re;
-                mode_polynomials[k][n] = -term;
+                mode_polynomials[n][k] = -term;
             }
         }
         Some(Self {
@@ -335,8 +330,12 @@ impl SeriesForm {
     /// Modal coordinates: q_k(s) = amplitude_k e^{λk s} + Σₙ mode_polynomials[k][n] rⁿ.
     fn modes(&self, p: &ElectromechanicalPropagator, s: f64) -> [C64; 3] {
         let (mut q, r) = self.growth(p, s);
-        for (q_k, polynomial) in q.iter_mut().zip(&self.mode_polynomials) {
-            *q_k += polynomial.iter().rev().fold(C64::new(0.0, 0.0), |acc, c| acc * r + c);
+        let zero = C64::new(0.0, 0.0);
+        let sum = self.mode_polynomials.iter().rev().fold([zero; 3], |acc, c| {
+            [acc[0] * r + c[0], acc[1] * r + c[1], acc[2] * r + c[2]]
+        });
+        for k in 0..3 {
+            q[k] += sum[k];
         }
         q
     }
