@@ -17,12 +17,17 @@
 //! ringing or the 7050 rad/s current transient.
 
 use nalgebra::Complex;
+use smallvec::SmallVec;
 
 use crate::physics::effects::{PrandtlIshlinskii, PLAY_OPERATORS};
 use crate::physics::jet_pipe;
 use crate::physics::parameters::Parameters;
 
 type C64 = Complex<f64>;
+
+/// Series coefficients: on the stack up to 16 terms (a command step of ordinary size needs
+/// fewer), so building a step's trajectory does not allocate.
+type Coefficients = SmallVec<[f64; 16]>;
 
 /// Current, jet pipe position and its first two derivatives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -157,7 +162,7 @@ impl ElectromechanicalPropagator {
         for k in 0..3 {
             q0[k] = self.inverse[k][0] * z[0] + self.inverse[k][1] * z[1] + self.inverse[k][2] * z[2];
         }
-        let mut series = Vec::new();
+        let mut series = Coefficients::new();
         // i'(s) = ramp − ω δ e^{−ω s} vanishes once at most.
         let ratio = ramp / (self.omega_cd * delta);
         let turning_point = (ratio > 0.0 && ratio < 1.0).then(|| -ratio.ln() / self.omega_cd);
@@ -253,14 +258,15 @@ impl ElectromechanicalPropagator {
 }
 
 /// Coefficients aₙ = cₙ εⁿ of tanh(x0 + ε r) = Σ aₙ rⁿ, truncated where they stop mattering.
-fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Vec<f64> {
-    let mut c = Vec::with_capacity(max_terms);
+fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Coefficients {
+    let mut c = Coefficients::new();
     c.push(x0.tanh());
     if epsilon == 0.0 {
         return c;
     }
     // y' = 1 − y²  ⇒  (n+1) c_{n+1} = [n = 0] − Σ_{k=0}^{n} c_k c_{n−k}
-    let mut a = vec![c[0]];
+    let mut a = Coefficients::new();
+    a.push(c[0]);
     let mut power = 1.0;
     for n in 0..max_terms - 1 {
         let convolution: f64 = (0..=n).map(|k| c[k] * c[n - k]).sum();
@@ -285,9 +291,9 @@ struct SeriesForm {
     /// q_k(0) + β_k Σₙ aₙ/(λk + nω).
     amplitude: [C64; 3],
     /// Coefficients of rⁿ in the position, velocity and acceleration: −Re Σ_k λk^m β_k aₙ/(λk + nω).
-    polynomials: [Vec<f64>; 3],
-    /// Coefficients of rⁿ of each mode k: −β_k aₙ/(λk + nω) (one allocation per step).
-    mode_polynomials: Vec<[C64; 3]>,
+    polynomials: [Coefficients; 3],
+    /// Coefficients of rⁿ of each mode k: −β_k aₙ/(λk + nω).
+    mode_polynomials: SmallVec<[[C64; 3]; 16]>,
 }
 
 impl SeriesForm {
@@ -298,12 +304,9 @@ impl SeriesForm {
             return None;
         }
         let mut amplitude = *q0;
-        let mut polynomials = [
-            vec![0.0; series.len()],
-            vec![0.0; series.len()],
-            vec![0.0; series.len()],
-        ];
-        let mut mode_polynomials = vec![[C64::new(0.0, 0.0); 3]; series.len()];
+        let zeros = || Coefficients::from_elem(0.0, series.len());
+        let mut polynomials = [zeros(), zeros(), zeros()];
+        let mut mode_polynomials: SmallVec<[[C64; 3]; 16]> = SmallVec::from_elem([C64::new(0.0, 0.0); 3], series.len());
         for (n, a) in series.iter().enumerate() {
             let n_omega = n as f64 * p.omega_cd;
             for k in 0..3 {
@@ -407,7 +410,7 @@ impl RampForm {
             vec![C64::new(0.0, 0.0); n],
             vec![C64::new(0.0, 0.0); n],
         ];
-        let mut u_j = input.clone();
+        let mut u_j = input.to_vec();
         let mut scale = 1.0; // T^{-j}
         let mut inverse_power = [C64::new(1.0, 0.0); 3]; // λ_k^{-(j+1)}, built below
         for k in 0..3 {
@@ -501,7 +504,7 @@ pub struct Trajectory<'a> {
     delta: f64,
     q0: [C64; 3],
     /// x_sat·aₙ when the closed-form series applies; empty otherwise.
-    series: Vec<f64>,
+    series: Coefficients,
     /// The same series summed in closed form, for fast evaluation (see [`SeriesForm`]).
     series_form: Option<SeriesForm>,
     /// The closed form for a ramp without a current transient (see [`RampForm`]).

@@ -338,10 +338,10 @@ impl Simulation {
     /// The command the current driver sees over the next `step`: v_DA itself, or (with the
     /// transport_delay effect) v_DA as it was `command_delay` earlier, as (duration,
     /// value at the segment's start, rate) pieces.
-    fn command_segments(&mut self, step: f64) -> Vec<(f64, f64, f64)> {
+    fn command_segments(&mut self, step: f64) -> smallvec::SmallVec<[(f64, f64, f64); 2]> {
         let delay = self.model.params.command_delay;
         if delay == 0.0 {
-            return vec![(step, self.v_da, self.v_da_rate)];
+            return smallvec::smallvec![(step, self.v_da, self.v_da_rate)];
         }
         self.command_history.push(CommandChange {
             time: self.time,
@@ -353,7 +353,7 @@ impl Simulation {
         while self.command_history.len() > 1 && self.command_history[1].time <= from {
             self.command_history.remove(0);
         }
-        let mut segments = vec![];
+        let mut segments: smallvec::SmallVec<[(f64, f64, f64); 2]> = smallvec::SmallVec::new();
         let mut start = from;
         for (k, change) in self.command_history.iter().enumerate() {
             let end = self.command_history.get(k + 1).map_or(to, |next| next.time.min(to));
