@@ -22,10 +22,8 @@ pub struct FlowConstants {
     /// 1/√T of the upstream gas (constant temperature, §2.6).
     pub inv_sqrt_temperature: f64,
     band_edge_f2: f64,
-    /// f2(r)/√(1 − r) on the unchoked range, tabulated (2.4 kB, built in ~30 µs). Owned by
-    /// the instance and shared with its clones; not cached process-wide, because an FMU
-    /// is unloaded with dlclose and a static's heap would then leak.
-    unchoked: std::sync::Arc<UnchokedFactor>,
+    /// f2(r)/√(1 − r) on the unchoked range, tabulated (2.3 kB, built in ~30 µs).
+    unchoked: FactorTable,
 }
 
 impl FlowConstants {
@@ -41,7 +39,7 @@ impl FlowConstants {
             c2,
             inv_sqrt_temperature: 1.0 / temperature.sqrt(),
             band_edge_f2,
-            unchoked: std::sync::Arc::new(UnchokedFactor::new(gamma, critical_ratio)),
+            unchoked: FactorTable::for_gas(gamma, critical_ratio),
         }
     }
 
@@ -68,6 +66,46 @@ impl FlowConstants {
 pub fn f2_exact(gamma: f64, ratio: f64) -> f64 {
     let a = ratio.powf(1.0 / gamma);
     (a * (a - ratio)).max(0.0).sqrt()
+}
+
+/// Where an instance's [`UnchokedFactor`] lives: air's (γ = 1.4, the default) is built once
+/// per process in static memory and shared by every instance; another gas's is owned by the
+/// instance and shared with its clones. No process-wide cache on the heap: an FMU is
+/// unloaded with dlclose, and the heap a static pointed to would then leak.
+#[derive(Clone, Debug)]
+pub enum FactorTable {
+    Air(&'static UnchokedFactor),
+    Owned(std::sync::Arc<UnchokedFactor>),
+}
+
+/// γ of air, whose table is shared.
+const AIR_GAMMA: f64 = 1.4;
+
+impl FactorTable {
+    pub fn for_gas(gamma: f64, critical_ratio: f64) -> Self {
+        if gamma == AIR_GAMMA {
+            static AIR: std::sync::OnceLock<UnchokedFactor> = std::sync::OnceLock::new();
+            Self::Air(AIR.get_or_init(|| UnchokedFactor::new(gamma, critical_ratio)))
+        } else {
+            Self::Owned(std::sync::Arc::new(UnchokedFactor::new(gamma, critical_ratio)))
+        }
+    }
+}
+
+impl std::ops::Deref for FactorTable {
+    type Target = UnchokedFactor;
+    fn deref(&self) -> &UnchokedFactor {
+        match self {
+            Self::Air(table) => table,
+            Self::Owned(table) => table,
+        }
+    }
+}
+
+impl PartialEq for FactorTable {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
 }
 
 /// Pieces of [`UnchokedFactor`].
@@ -273,8 +311,15 @@ mod tests {
         assert_eq!(k.unchoked.value(0.3), None);
         assert_eq!(k.unchoked.value(f64::NAN), None);
         assert_eq!(k.unchoked.value(1.0 + 1e-9), None);
-        // Clones share the table.
-        assert!(std::sync::Arc::ptr_eq(&k.unchoked, &k.clone().unchoked));
+        // Every instance for air shares one static table; another gas's is shared by clones.
+        assert!(std::ptr::eq(&*k.unchoked, &*air().unchoked));
+        assert!(matches!(k.unchoked, FactorTable::Air(_)));
+        let helium = FlowConstants::new(1.67, 2077.0, 293.15);
+        assert!(std::ptr::eq(&*helium.unchoked, &*helium.clone().unchoked));
+        assert!(!std::ptr::eq(
+            &*helium.unchoked,
+            &*FlowConstants::new(1.67, 2077.0, 293.15).unchoked
+        ));
         // A large γ (small r_c) falls back to (2.22) rather than lose digits.
         let k = FlowConstants::new(5.0, 287.0, 293.15);
         assert_eq!(k.unchoked.value(0.9), None);
