@@ -22,7 +22,7 @@ pub struct FlowConstants {
     /// 1/√T of the upstream gas (constant temperature, §2.6).
     pub inv_sqrt_temperature: f64,
     band_edge_f2: f64,
-    /// f2(r)/√(1 − r) on the unchoked range, tabulated (2.3 kB, built in ~30 µs).
+    /// f2(r)/√(1 − r) on the unchoked range, tabulated (2.3 kB).
     unchoked: FactorTable,
 }
 
@@ -122,8 +122,8 @@ const UNCHOKED_PIECES: usize = 32;
 /// cancellation of a − r near r = 1: the table is accurate to a few units in the last
 /// place where (2.22) as written loses digits like 1/(1 − r). Its truncation error is
 /// below (w/c)^9 for pieces of half-width w centred at c; when that bound is not below
-/// 1e-16 (only for γ > 2, where r_c is small) `value` returns `None` and the caller uses
-/// (2.22) directly.
+/// 1e-16 (for γ above about 1.72, beyond a monatomic gas's 5/3, where r_c is small) `value`
+/// returns `None` and the caller uses (2.22) directly.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UnchokedFactor {
     gamma: f64,
