@@ -696,10 +696,21 @@ impl Trajectory<'_> {
         q
     }
 
-    /// Amplitude (m) of the jet pipe's lightly damped oscillation about the rest position
-    /// of the static input at `s`: 2|q − q_rest| of the complex mode, q_rest = −β ū/λ.
+    /// Amplitude (m) of the jet pipe's lightly damped oscillation at `s`. Where the response
+    /// has a closed form this is exact: 2|c| e^{Re λ s} for the complex mode's homogeneous
+    /// part c e^{λ s}, what is left once the part that follows the input is taken off (for a
+    /// ramp, that part lags the input; it does not ring). Otherwise it is measured about the
+    /// rest position of the static input at `s`: 2|q − q_rest|, q_rest = −β ū/λ.
     pub fn ringing_amplitude(&self, s: f64) -> f64 {
         let p = self.propagator;
+        let homogeneous = match (&self.series_form, &self.ramp_form) {
+            (Some(form), _) => Some(form.amplitude[1]),
+            (None, Some(form)) if form.covers(s) => Some(form.amplitude[1]),
+            _ => None,
+        };
+        if let Some(c) = homogeneous {
+            return 2.0 * c.norm() * (p.lambda[1].re * s).exp();
+        }
         let q = self.modes(s);
         let u_rest = self.jet_input(s);
         2.0 * (q[1] + p.beta[1] * u_rest / p.lambda[1]).norm()
@@ -880,6 +891,35 @@ mod tests {
                 }
             }
         }
+        // A ramp followed long enough does not ring: the jet pipe lags it, and that lag is not
+        // taken for ringing (which would hold the chamber steps below a quarter period).
+        let rate = 2.5;
+        let current = p.k_cd * 1.0 + p.i_offset - p.k_cd * rate / p.omega_cd;
+        let x0 = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current));
+        let start = ElectromechanicalState {
+            current,
+            position: x0,
+            velocity: 0.0,
+            acceleration: 0.0,
+        };
+        let plays = [x0; PLAY_OPERATORS];
+        let first = propagator.trajectory(&start, 1.0, rate, &plays);
+        let fresh = first.ringing_amplitude(0.0);
+        let later = first.state(0.5);
+        let continued = propagator.trajectory(&later, 1.0 + 0.5 * rate, rate, &plays);
+        assert!(continued.ramp_form.is_some());
+        let q = continued.modes(0.0);
+        let about_static = 2.0 * (q[1] + propagator.beta[1] * continued.jet_input(0.0) / propagator.lambda[1]).norm();
+        let ringing = continued.ringing_amplitude(0.0);
+        assert!(
+            fresh > 0.0 && ringing < 1e-6 * fresh,
+            "{ringing:e} vs {fresh:e} at the start"
+        );
+        assert!(
+            about_static > 1e3 * ringing,
+            "lag {about_static:e}, ringing {ringing:e}"
+        );
+
         // With a current transient the quadrature stays in charge.
         let start = ElectromechanicalState {
             current: 0.05,
