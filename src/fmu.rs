@@ -321,6 +321,7 @@ impl CoSimModel for ActuatorFmu {
                     st.rhs_evaluations,
                     st.jacobians,
                     st.newton_failures,
+                    st.stiff_handovers,
                 ] {
                     w.u64(v);
                 }
@@ -416,6 +417,7 @@ impl CoSimModel for ActuatorFmu {
             st.rhs_evaluations = r.u64()?;
             st.jacobians = r.u64()?;
             st.newton_failures = r.u64()?;
+            st.stiff_handovers = r.u64()?;
             let finite = [
                 time,
                 v_da,

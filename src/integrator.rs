@@ -11,12 +11,26 @@
 //! Newton iterations use the Jacobian supplied by the system (one LU per step); the error
 //! estimate is filtered through (I − hγJ)⁻¹ (Hairer & Wanner IV.8) so stiff components do
 //! not cause spurious rejections.
+//!
+//! [`explicit`] holds Dormand–Prince 5(4) for systems that are stiff only now and then
+//! ([`Sdirk4::integrate_nonstiff_first`] hands over between the two), and both end their
+//! steps at the breakpoints a system reports ([`OdeSystem::breakpoint`]).
 
 use nalgebra::{Const, DimMin, SMatrix, SVector};
+
+pub mod explicit;
 
 /// A system y' = f(t, y) of `N` equations.
 pub trait OdeSystem<const N: usize> {
     fn rhs(&self, t: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
+
+    /// The first time in (t0, t1) at which f stops being smooth in t, if the system knows of
+    /// one (a kink or a fractional power in a forcing it computes exactly). The integrators
+    /// end a step there: their error estimates assume a smooth f inside a step and can
+    /// under-read the error across such a point by two orders of magnitude.
+    fn breakpoint(&self, _t0: f64, _t1: f64) -> Option<f64> {
+        None
+    }
 
     /// ∂f/∂y. The default is a forward difference; systems with known structure override it.
     fn jacobian(&self, t: f64, y: &SVector<f64, N>, f_y: &SVector<f64, N>) -> SMatrix<f64, N, N> {
@@ -57,6 +71,8 @@ pub struct Statistics {
     pub rhs_evaluations: u64,
     pub jacobians: u64,
     pub newton_failures: u64,
+    /// Times the explicit method found the system stiff and handed over to SDIRK4.
+    pub stiff_handovers: u64,
 }
 
 impl Statistics {
@@ -66,6 +82,7 @@ impl Statistics {
         self.rhs_evaluations += other.rhs_evaluations;
         self.jacobians += other.jacobians;
         self.newton_failures += other.newton_failures;
+        self.stiff_handovers += other.stiff_handovers;
     }
 }
 
@@ -101,7 +118,7 @@ const SLOPE_PREDICTOR: [[f64; 5]; 5] = [
 const B_HAT: [f64; 5] = [59.0 / 48.0, -17.0 / 96.0, 225.0 / 32.0, -85.0 / 12.0, 0.0];
 
 const MAX_NEWTON_ITERATIONS: usize = 8;
-const MIN_STEP: f64 = 1e-14;
+pub(crate) const MIN_STEP: f64 = 1e-14;
 
 /// The integrator: its only memory between calls is the step size to try next, which is
 /// part of the simulation state (it makes results reproducible after a state restore).
@@ -123,7 +140,7 @@ impl Default for Sdirk4 {
     }
 }
 
-fn error_norm<const N: usize>(
+pub(crate) fn error_norm<const N: usize>(
     e: &SVector<f64, N>,
     y0: &SVector<f64, N>,
     y1: &SVector<f64, N>,
@@ -161,20 +178,14 @@ impl Sdirk4 {
         let mut previous_error: f64 = 1.0;
         let span = t1 - t0;
         while t1 - t > 1e-15 * span.abs().max(t1.abs()) {
-            let remaining = t1 - t;
-            // Stretch a step that would leave a sliver to the end point.
-            let (h_try, final_step) = if h >= remaining * 0.999_999 || remaining - h < 1e-3 * h {
-                (remaining, true)
-            } else {
-                (h, false)
-            };
+            let (h_try, step_end, _) = step_towards(system, t, h, t1, span);
             match self.attempt(system, t, &y, h_try, tol, stats) {
                 Attempt::Accepted { y_new, error } => {
                     stats.steps += 1;
                     if first_accepted.is_none() {
                         first_accepted = Some(h_try);
                     }
-                    t = if final_step { t1 } else { t + h_try };
+                    t = step_end.unwrap_or(t + h_try);
                     y = y_new;
                     // PI step-size control (Gustafsson): the previous error damps the
                     // oscillation of the step size that an oscillating forcing provokes.
@@ -190,8 +201,9 @@ impl Sdirk4 {
                     }
                     last_rejected = false;
                     let proposed = (h_try * factor).min(self.max_step);
-                    // A step cut short to hit t1 says nothing about the natural step size.
-                    h = if final_step && h_try < h {
+                    // A step cut short to hit t1 or a breakpoint says nothing about the
+                    // natural step size.
+                    h = if step_end.is_some() && h_try < h {
                         h.max(proposed)
                     } else {
                         proposed
@@ -227,6 +239,55 @@ impl Sdirk4 {
             self.first_step = first;
         }
         Ok(y)
+    }
+
+    /// Integrate from (t0, y0) to t1 with Dormand–Prince 5(4) while the system is not stiff
+    /// and with SDIRK4 from where it becomes so (or where the explicit step collapses) to t1.
+    /// For systems that are mostly non-stiff, such as the chambers between their pressure
+    /// limits: no Newton iterations and no Jacobians there.
+    pub fn integrate_nonstiff_first<const N: usize, S: OdeSystem<N>>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: SVector<f64, N>,
+        t1: f64,
+        tol: &Tolerances<N>,
+        stats: &mut Statistics,
+    ) -> Result<SVector<f64, N>, IntegrationFailure<N>>
+    where
+        Const<N>: DimMin<Const<N>, Output = Const<N>>,
+    {
+        let mut memory = explicit::StepMemory {
+            next_step: self.next_step,
+            max_step: self.max_step,
+            first_step: None,
+        };
+        let outcome = explicit::integrate(
+            &explicit::DORMAND_PRINCE_54,
+            &mut memory,
+            system,
+            t0,
+            y0,
+            t1,
+            tol,
+            stats,
+        );
+        self.next_step = memory.next_step;
+        if let Some(first) = memory.first_step {
+            self.first_step = first;
+        }
+        match outcome {
+            Ok(y) => Ok(y),
+            Err(handover) => {
+                stats.stiff_handovers += 1;
+                let first = self.first_step;
+                let result = self.integrate(system, handover.time, handover.state, t1, tol, stats);
+                if memory.first_step.is_some() {
+                    self.first_step = first;
+                }
+                result
+            }
+        }
     }
 
     fn attempt<const N: usize, S: OdeSystem<N>>(
@@ -306,6 +367,31 @@ impl Sdirk4 {
         } else {
             Attempt::Rejected { error }
         }
+    }
+}
+
+/// The next step from `t` of at most `h` towards `t1`: its length, the time it ends at
+/// exactly when that is t1 or a breakpoint of the system (so that rounding cannot leave a
+/// sliver before it, nor put the end a hair on the wrong side of it), and whether it ends at
+/// a breakpoint.
+pub(crate) fn step_towards<const N: usize, S: OdeSystem<N>>(
+    system: &S,
+    t: f64,
+    h: f64,
+    t1: f64,
+    span: f64,
+) -> (f64, Option<f64>, bool) {
+    let remaining = t1 - t;
+    // Stretch a step that would leave a sliver to the end point.
+    let (h_try, end) = if h >= remaining * 0.999_999 || remaining - h < 1e-3 * h {
+        (remaining, t1)
+    } else {
+        (h, t + h)
+    };
+    match system.breakpoint(t, end) {
+        Some(b) if b > t + 1e-12 * span.abs() && b < end => (b - t, Some(b), true),
+        _ if end == t1 => (h_try, Some(t1), false),
+        _ => (h_try, None, false),
     }
 }
 

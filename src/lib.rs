@@ -1,7 +1,8 @@
 //! Jet-pipe electropneumatic actuator of the Utah/MIT Dextrous Hand (P.D. Henri, 1994).
 //!
 //! * [`physics`]: the thesis model, one module per physical part, equations cited by number;
-//! * [`integrator`]: the error-controlled stiff integrator, independent of the physics;
+//! * [`integrator`]: the error-controlled integrators (SDIRK4; Dormand–Prince 5(4) for the
+//!   non-stiff stretches, handing over to SDIRK4), independent of the physics;
 //! * [`simulation`]: stepping between communication points (FMU, CLI and tests share it);
 //! * [`fmi2`]: the generic FMI 2.0 Co-Simulation layer, which knows nothing of pneumatics;
 //! * [`fmu`]: the actuator behind that layer; `fmu_exports`: the exported `fmi2*` symbols

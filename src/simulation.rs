@@ -68,6 +68,9 @@ struct ChamberSystem<'a> {
     /// evaluate many pressures at one stage time, and the jet pipe position and the areas
     /// (four lens areas) cost more than the flows.
     areas_at: std::cell::Cell<Option<(f64, OrificeAreas)>>,
+    /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
+    /// question starts there.
+    stretch_at: std::cell::Cell<Option<(f64, i32)>>,
 }
 
 impl<'a> ChamberSystem<'a> {
@@ -79,6 +82,7 @@ impl<'a> ChamberSystem<'a> {
             x_s,
             x_s_rate,
             areas_at: std::cell::Cell::new(None),
+            stretch_at: std::cell::Cell::new(None),
         }
     }
 
@@ -93,6 +97,47 @@ impl<'a> ChamberSystem<'a> {
         }
     }
 
+    /// The time in (a, b] at which the jet pipe, in `stretch_a` at a and not at b, reaches
+    /// `tangency`: regula falsi (Illinois) on the exact trajectory, returning a time already
+    /// past the crossing (within 1e-12 s), so a step ending there does not contain it.
+    fn crossing_time(&self, mut a: f64, mut b: f64, tangency: f64, stretch_a: i32) -> f64 {
+        let gap = |t: f64| self.trajectory.position(t - self.t0) - tangency;
+        let (mut ga, mut gb) = (gap(a), gap(b));
+        let mut last_moved = 0;
+        for _ in 0..60 {
+            if b - a <= 1e-12 {
+                break;
+            }
+            let mut t = if ga != gb {
+                b - gb * (b - a) / (gb - ga)
+            } else {
+                0.5 * (a + b)
+            };
+            if !(t > a && t < b) {
+                t = 0.5 * (a + b);
+            }
+            let position = self.trajectory.position(t - self.t0);
+            let g = position - tangency;
+            let past = self.model.area_stretch(position) != stretch_a;
+            if past {
+                b = t;
+                gb = g;
+                if last_moved == 1 {
+                    ga *= 0.5;
+                }
+                last_moved = 1;
+            } else {
+                a = t;
+                ga = g;
+                if last_moved == -1 {
+                    gb *= 0.5;
+                }
+                last_moved = -1;
+            }
+        }
+        b
+    }
+
     fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
         let x_s = self.x_s + self.x_s_rate * (t - self.t0);
         let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
@@ -103,6 +148,29 @@ impl<'a> ChamberSystem<'a> {
 impl OdeSystem<2> for ChamberSystem<'_> {
     fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
         self.rates(&self.areas(t), t, p)
+    }
+    /// Where the jet pipe crosses a tangency of the orifice geometry: the areas, and so the
+    /// pressure rates, have a corner or a 3/2 power in time there. Looked for at the middle
+    /// and the end of the step (steps are at most a quarter of the ringing period, so only
+    /// a graze of a tangency can be missed, and a graze opens next to no area).
+    fn breakpoint(&self, t0: f64, t1: f64) -> Option<f64> {
+        let stretch = |t: f64| self.model.area_stretch(self.trajectory.position(t - self.t0));
+        let (mut a, mut stretch_a) = match self.stretch_at.get() {
+            Some((t, s)) if t == t0 => (t0, s),
+            _ => (t0, stretch(t0)),
+        };
+        for b in [0.5 * (t0 + t1), t1] {
+            let stretch_b = stretch(b);
+            if stretch_b != stretch_a {
+                let tangency = self.model.tangency_position(stretch_a, stretch_b);
+                let crossing = self.crossing_time(a, b, tangency, stretch_a);
+                self.stretch_at.set(Some((crossing, stretch(crossing))));
+                return Some(crossing);
+            }
+            (a, stretch_a) = (b, stretch_b);
+        }
+        self.stretch_at.set(Some((t1, stretch_a)));
+        None
     }
     fn jacobian(&self, t: f64, p: &SVector<f64, 2>, f_p: &SVector<f64, 2>) -> nalgebra::SMatrix<f64, 2, 2> {
         let areas = self.areas(t);
@@ -119,6 +187,17 @@ pub enum Method {
     /// All six states with the SDIRK4 integrator (kept for comparison, and used when the
     /// jet pipe has no modal form, e.g. ζ2 ≥ 1).
     Monolithic,
+}
+
+/// How the split method integrates the two chamber pressures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChamberMethod {
+    /// Dormand–Prince 5(4) while the chambers are not stiff, SDIRK4 from where they become
+    /// so to the end of the communication step. The chambers' own time constants are 3 ms
+    /// and slower in the standard scenarios, so this is the default: no Newton iterations.
+    NonStiffFirst,
+    /// SDIRK4 throughout (kept for comparison).
+    Sdirk4,
 }
 
 /// Why a step failed.
@@ -143,6 +222,7 @@ pub struct Simulation {
     pub x_s_rate: f64,
     pub relative_tolerance: f64,
     pub method: Method,
+    pub chamber_method: ChamberMethod,
     /// Step-size memory of the six-state integrator (monolithic method).
     pub integrator: Sdirk4,
     /// Step-size memory of the chamber integrator (split method).
@@ -205,6 +285,7 @@ impl Simulation {
             } else {
                 Method::Monolithic
             },
+            chamber_method: ChamberMethod::NonStiffFirst,
             integrator: Sdirk4::default(),
             chamber_integrator: Sdirk4::default(),
             statistics: Statistics::default(),
@@ -413,34 +494,38 @@ impl Simulation {
                     self.chamber_integrator.next_step =
                         self.chamber_integrator.next_step.min(2.0 * self.step_after_change);
                 }
+                let method = self.chamber_method;
+                let integrate = |integrator: &mut Sdirk4,
+                                 from: f64,
+                                 p: SVector<f64, 2>,
+                                 to: f64,
+                                 statistics: &mut Statistics| match method {
+                    ChamberMethod::NonStiffFirst => {
+                        integrator.integrate_nonstiff_first(&system, from, p, to, &tolerances, statistics)
+                    }
+                    ChamberMethod::Sdirk4 => integrator.integrate(&system, from, p, to, &tolerances, statistics),
+                };
                 let result = if ringing_until > 0.0 {
                     let (_, period) = trajectory.ringing_decay_and_period();
                     let unlimited = self.chamber_integrator.max_step;
                     self.chamber_integrator.max_step = 0.25 * period;
                     let t_split = t0 + ringing_until;
-                    let first = self.chamber_integrator.integrate(
-                        &system,
+                    let first = integrate(
+                        &mut self.chamber_integrator,
                         t0,
                         pressures,
                         t_split,
-                        &tolerances,
                         &mut self.statistics,
                     );
                     self.chamber_integrator.max_step = unlimited;
                     match first {
-                        Ok(p) if ringing_until < duration => self.chamber_integrator.integrate(
-                            &system,
-                            t_split,
-                            p,
-                            t_end,
-                            &tolerances,
-                            &mut self.statistics,
-                        ),
+                        Ok(p) if ringing_until < duration => {
+                            integrate(&mut self.chamber_integrator, t_split, p, t_end, &mut self.statistics)
+                        }
                         other => other,
                     }
                 } else {
-                    self.chamber_integrator
-                        .integrate(&system, t0, pressures, t_end, &tolerances, &mut self.statistics)
+                    integrate(&mut self.chamber_integrator, t0, pressures, t_end, &mut self.statistics)
                 };
                 if changed {
                     self.step_after_change = self.chamber_integrator.first_step;
@@ -762,6 +847,121 @@ mod tests {
                 assert!((a.1 - b.1).abs() < 1e-10, "sample {k}: x_jp {} vs {}", a.1, b.1);
             }
         }
+    }
+
+    /// Runs 0.6 s of the standard inputs with commands jumping to ±10 V every 0.1 s (the jet
+    /// pipe then swings across tangencies of the orifice geometry) with a chamber method.
+    fn forces_with(chamber_method: ChamberMethod, relative_tolerance: f64) -> (Vec<f64>, Statistics) {
+        let mut sim = Simulation::at_equilibrium(thesis_model(), 2.5, 0.054, 0.0, relative_tolerance).unwrap();
+        sim.chamber_method = chamber_method;
+        let mut forces = vec![];
+        for k in 0..60 {
+            let (v, x) = crate::scenario::standard_inputs(k);
+            let v = match k % 20 {
+                5 => 10.0,
+                15 => -10.0,
+                _ => v,
+            };
+            sim.set_command(v).unwrap();
+            sim.set_stopper(x).unwrap();
+            sim.step(0.01).unwrap();
+            forces.push(sim.outputs().f_act);
+        }
+        (forces, sim.statistics)
+    }
+
+    #[test]
+    fn explicit_chamber_steps_match_sdirk4_without_its_newton_iterations() {
+        let (reference, _) = forces_with(ChamberMethod::Sdirk4, 1e-10);
+        for rtol in [1e-6, 1e-8] {
+            let (explicit, work) = forces_with(ChamberMethod::NonStiffFirst, rtol);
+            let (implicit, implicit_work) = forces_with(ChamberMethod::Sdirk4, rtol);
+            let error = |f: &[f64]| f.iter().zip(&reference).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            // The tolerance times the force scale (up to ~70 N here).
+            assert!(
+                error(&explicit) < 100.0 * rtol,
+                "rtol {rtol}: explicit error {}",
+                error(&explicit)
+            );
+            assert!(
+                error(&implicit) < 100.0 * rtol,
+                "rtol {rtol}: SDIRK4 error {}",
+                error(&implicit)
+            );
+            assert_eq!(work.jacobians, 0, "{work:?}");
+            assert_eq!(work.stiff_handovers, 0, "{work:?}");
+            assert!(
+                work.rhs_evaluations < implicit_work.rhs_evaluations,
+                "{work:?} vs {implicit_work:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn steps_end_where_the_jet_pipe_crosses_a_tangency() {
+        let model = thesis_model();
+        let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
+        let propagator = sim.propagator.as_ref().unwrap();
+        let start = ElectromechanicalState {
+            current: sim.state[index::CURRENT],
+            position: sim.state[index::JET_POSITION],
+            velocity: sim.state[index::JET_VELOCITY],
+            acceleration: sim.state[index::JET_ACCELERATION],
+        };
+        let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
+        let system = ChamberSystem::new(&model, &trajectory, 1.0, sim.x_s, 0.0);
+        let stretch_at = |t: f64| model.area_stretch(trajectory.position(t - 1.0));
+        assert_ne!(stretch_at(1.0), stretch_at(1.002), "the swing must cross a tangency");
+        // Walk through 2 ms in 0.1 ms pieces, as an integrator would.
+        let mut t: f64 = 1.0;
+        let mut crossings = vec![];
+        while t < 1.002 {
+            let end = (t + 1e-4).min(1.002);
+            match system.breakpoint(t, end) {
+                Some(b) => {
+                    assert!(b > t && b < end, "{b} outside ({t}, {end})");
+                    crossings.push(b);
+                    t = b;
+                }
+                None => t = end,
+            }
+        }
+        assert!(!crossings.is_empty());
+        for &b in &crossings {
+            let (before, after) = (stretch_at(b - 1e-11), stretch_at(b));
+            assert_ne!(before, after, "no tangency at {b}");
+            let tangency = model.tangency_position(before, after);
+            let speed = (trajectory.position(b - 1.0 + 1e-9) - trajectory.position(b - 1.0)).abs() / 1e-9;
+            assert!(
+                (trajectory.position(b - 1.0) - tangency).abs() <= 2e-12 * speed + 1e-15,
+                "{b}"
+            );
+        }
+    }
+
+    #[test]
+    fn stiff_chambers_are_handed_over_to_sdirk4() {
+        // The stopper a hair from the top: chamber 1 is nearly empty, and its pressure time
+        // constant far below the step the jet pipe allows.
+        let model = thesis_model();
+        let (lo, hi) = model.params.cylinder().stopper_range();
+        let x_s = lo + 1e-5 * (hi - lo);
+        let run = |method: ChamberMethod, rtol: f64| {
+            let mut sim = Simulation::at_equilibrium(model.clone(), 2.5, x_s, 0.0, rtol).unwrap();
+            sim.chamber_method = method;
+            for k in 0..20 {
+                sim.set_command(if k % 2 == 0 { 4.0 } else { 1.0 }).unwrap();
+                sim.step(0.01).unwrap();
+            }
+            (sim.state[index::P1], sim.state[index::P2], sim.statistics)
+        };
+        let (p1, p2, work) = run(ChamberMethod::NonStiffFirst, 1e-6);
+        let (q1, q2, _) = run(ChamberMethod::Sdirk4, 1e-10);
+        assert!(work.stiff_handovers > 0, "{work:?}");
+        assert!(
+            (p1 - q1).abs() < 1e-5 * q1 && (p2 - q2).abs() < 1e-5 * q2,
+            "{p1} {p2} vs {q1} {q2}"
+        );
     }
 
     fn with(change: impl Fn(&mut Parameters)) -> Actuator {

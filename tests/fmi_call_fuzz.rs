@@ -1120,6 +1120,18 @@ impl Fuzz {
         } else if self.rng.chance(0.01) {
             Function::FreeInstance
         } else {
+            if rare && self.rng.chance(0.5) {
+                // rare states are brief: spend them on calls this sequence has not made there
+                let state = self.mirror.name();
+                let untried: Vec<Function> = ALL_FUNCTIONS
+                    .iter()
+                    .copied()
+                    .filter(|f| *f != Function::FreeInstance && !self.coverage.contains_key(&(f.name(), state)))
+                    .collect();
+                if !untried.is_empty() {
+                    return *self.rng.pick(&untried);
+                }
+            }
             let f = *self.rng.pick(&ALL_FUNCTIONS);
             if f == Function::FreeInstance || (f == Function::Reset && self.rng.chance(0.4)) {
                 Function::DoStep

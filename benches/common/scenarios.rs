@@ -207,6 +207,7 @@ pub fn work_between(before: &Statistics, after: &Statistics) -> Statistics {
         rhs_evaluations: after.rhs_evaluations - before.rhs_evaluations,
         jacobians: after.jacobians - before.jacobians,
         newton_failures: after.newton_failures - before.newton_failures,
+        stiff_handovers: after.stiff_handovers - before.stiff_handovers,
     }
 }
 

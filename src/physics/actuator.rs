@@ -8,7 +8,7 @@ use nalgebra::{SMatrix, SVector};
 use super::chambers::{pressure_rate, CylinderGeometry};
 use super::effects::{self, PrandtlIshlinskii, PLAY_OPERATORS};
 use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
-use super::orifice_geometry::{tabulated_orifice_areas, OrificeAreas};
+use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
 use super::{current_driver, jet_pipe, piston};
 
@@ -108,6 +108,20 @@ impl Actuator {
             self.params.d_jp,
             jet_pipe::absolute_position(x_jp, self.params.x_jp_offset),
         )
+    }
+
+    /// The stretch between tangencies of the orifice geometry that `x_jp` lies in: the areas
+    /// are analytic in x_jp within one ([`analytic_stretch`]).
+    pub fn area_stretch(&self, x_jp: f64) -> i32 {
+        analytic_stretch(
+            self.params.d_jp,
+            jet_pipe::absolute_position(x_jp, self.params.x_jp_offset),
+        )
+    }
+
+    /// The jet pipe position of the first tangency crossed going from stretch `from` to `to`.
+    pub fn tangency_position(&self, from: i32, to: i32) -> f64 {
+        first_tangency_between(self.params.d_jp, from, to) - self.params.x_jp_offset
     }
 
     /// Mass flows for a jet pipe position and chamber pressures, (2.18)–(2.23).

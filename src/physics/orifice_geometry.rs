@@ -91,6 +91,22 @@ pub fn orifice_areas(d_jp: f64, x_abs: f64) -> OrificeAreas {
     }
 }
 
+/// Which stretch between tangencies `x_abs` lies in. The four areas (2.8)–(2.17) are analytic
+/// in x_abs between consecutive multiples of D_jp and not across them: jet, port and flange
+/// circles touch at ξ = x_abs/D = 0, ±2, ±3 (a lens opens like the 3/2 power of the distance)
+/// and the jet lies right over a port at ξ = ±1 (a corner); beyond ±3D nothing changes.
+/// The integrators end their steps where the jet pipe crosses one of these.
+pub fn analytic_stretch(d_jp: f64, x_abs: f64) -> i32 {
+    (x_abs / d_jp).floor().clamp(-4.0, 3.0) as i32
+}
+
+/// The tangency between stretches `from` and `to` (adjacent or not) that a jet pipe moving from
+/// one to the other crosses first.
+pub fn first_tangency_between(d_jp: f64, from: i32, to: i32) -> f64 {
+    let boundary = if to > from { from + 1 } else { from };
+    boundary as f64 * d_jp
+}
+
 /// Pieces of each tabulated part of the areas.
 const AREA_PIECES: usize = 8;
 
