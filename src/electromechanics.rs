@@ -357,6 +357,13 @@ impl SeriesForm {
         (g[0] + g[1] + g[2]).re + Self::horner(&self.polynomials[0], r)
     }
 
+    /// Bounds on the position over [0, s_end].
+    fn position_bounds(&self, p: &ElectromechanicalPropagator, s_end: f64) -> (f64, f64) {
+        let (constant, transient) = constant_and_spread(&self.polynomials[0], 1.0);
+        let (lo, hi) = modal_bounds(p, &self.amplitude, s_end);
+        (lo + constant - transient, hi + constant + transient)
+    }
+
     fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
         let (g, r) = self.growth(p, s);
         let l = &p.lambda;
@@ -461,6 +468,13 @@ impl RampForm {
         (g[0] + g[1] + g[2]).re + SeriesForm::horner(&self.polynomials[0], s / self.horizon)
     }
 
+    /// Bounds on the position over [0, s_end], s_end within the horizon.
+    fn position_bounds(&self, p: &ElectromechanicalPropagator, s_end: f64) -> (f64, f64) {
+        let (constant, spread) = constant_and_spread(&self.polynomials[0], s_end / self.horizon);
+        let (lo, hi) = modal_bounds(p, &self.amplitude, s_end);
+        (lo + constant - spread, hi + constant + spread)
+    }
+
     fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
         let g = self.growth(p, s);
         let (l, tau) = (&p.lambda, s / self.horizon);
@@ -481,6 +495,32 @@ impl RampForm {
         }
         q
     }
+}
+
+/// A polynomial Σ cₙ zⁿ on 0 ≤ z ≤ z_max, as its constant c₀ and a bound Σ_{n≥1} |cₙ| z_maxⁿ
+/// on how far it moves from it.
+fn constant_and_spread(coefficients: &[f64], z_max: f64) -> (f64, f64) {
+    let Some((constant, rest)) = coefficients.split_first() else {
+        return (0.0, 0.0);
+    };
+    let mut power = 1.0;
+    let spread = rest
+        .iter()
+        .map(|c| {
+            power *= z_max;
+            c.abs() * power
+        })
+        .sum();
+    (*constant, spread)
+}
+
+/// Bounds over 0 ≤ s ≤ s_end on Re Σ_k amplitude_k e^{λk s}: the real mode moves
+/// monotonically between its ends, the decaying complex pair stays within its moduli.
+fn modal_bounds(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s_end: f64) -> (f64, f64) {
+    let real = amplitude[0].re;
+    let real_end = real * (p.lambda[0].re * s_end).exp();
+    let ringing = amplitude[1].norm() + amplitude[2].norm();
+    (real.min(real_end) - ringing, real.max(real_end) + ringing)
 }
 
 /// e^{λk s}·amplitude_k for the three modes (λ3 = conj(λ2), so one complex exponential).
@@ -734,6 +774,23 @@ impl Trajectory<'_> {
         (q[0] + q[1] + q[2]).re
     }
 
+    /// Bounds on the jet pipe position over [0, s_end] (m), where the response has a closed
+    /// form (`None` elsewhere). They hold with a margin for rounding, and are tight when the
+    /// jet pipe barely moves, which is when they are asked: a step whose bounds hold no
+    /// tangency of the orifice geometry needs no search for one.
+    pub fn position_bounds(&self, s_end: f64) -> Option<(f64, f64)> {
+        let p = self.propagator;
+        let (lo, hi) = if let Some(form) = &self.series_form {
+            form.position_bounds(p, s_end)
+        } else if let Some(form) = self.ramp_form.as_ref().filter(|f| f.covers(s_end)) {
+            form.position_bounds(p, s_end)
+        } else {
+            return None;
+        };
+        let margin = 1e-12 * (lo.abs() + hi.abs() + p.x_sat);
+        Some((lo - margin, hi + margin))
+    }
+
     /// The full state at `s` seconds into the step.
     pub fn state(&self, s: f64) -> ElectromechanicalState {
         let closed_form = match (&self.series_form, &self.ramp_form) {
@@ -835,6 +892,72 @@ mod tests {
                 assert_eq!(trajectory.position(s), fast.position);
             }
         }
+    }
+
+    #[test]
+    fn position_bounds_hold_the_trajectory_and_are_tight_when_it_barely_moves() {
+        let p = Parameters::default();
+        let propagator = ElectromechanicalPropagator::new(&p).unwrap();
+        let settled = |v: f64| {
+            let current = p.k_cd * v + p.i_offset;
+            let position = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current));
+            ElectromechanicalState {
+                current,
+                position,
+                velocity: 0.0,
+                acceleration: 0.0,
+            }
+        };
+        let swinging = ElectromechanicalState {
+            current: 0.05,
+            position: 1.2e-4,
+            velocity: 0.02,
+            acceleration: -30.0,
+        };
+        let ramp_start = |v: f64, rate: f64| ElectromechanicalState {
+            current: p.k_cd * v + p.i_offset - p.k_cd * rate / p.omega_cd,
+            ..swinging
+        };
+        let mut bounded = 0;
+        for (start, v, rate, duration) in [
+            (settled(2.0), 2.0, 0.0, 0.01),
+            (settled(2.0), 2.001, 0.0, 0.001),
+            (settled(2.0), -10.0, 0.0, 0.01),
+            (swinging, 1.3, 0.0, 0.002),
+            (swinging, 3.1, 0.0, 0.01),
+            (ramp_start(1.0, 2.5), 1.0, 2.5, 0.01),
+            (ramp_start(-3.0, -60.0), -3.0, -60.0, 0.01),
+        ] {
+            let trajectory = propagator.trajectory(&start, v, rate, &[start.position; PLAY_OPERATORS]);
+            let Some((lo, hi)) = trajectory.position_bounds(duration) else {
+                // A full-scale swing takes tanh outside its series' reach: no closed form.
+                assert_eq!(v, -10.0, "v {v} rate {rate}: bounds expected");
+                continue;
+            };
+            bounded += 1;
+            let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
+            for j in 0..=4000 {
+                let x = trajectory.position(duration * j as f64 / 4000.0);
+                (min, max) = (min.min(x), max.max(x));
+            }
+            assert!(
+                lo <= min && max <= hi,
+                "v {v} rate {rate}: [{min}, {max}] not in [{lo}, {hi}]"
+            );
+            // A settled jet pipe is bounded to within a nanometre, a small step's bounds are
+            // within an order of magnitude of its swing (the transient's terms and the modes
+            // that cancel them are bounded apart): ~1e-7 m against tangencies D apart.
+            if v == 2.0 {
+                assert!(hi - lo < 1e-9, "settled: [{lo}, {hi}]");
+            }
+            if v == 2.001 {
+                assert!(
+                    hi - lo < 8.0 * (max - min) + 1e-12,
+                    "small step: [{lo}, {hi}] vs [{min}, {max}]"
+                );
+            }
+        }
+        assert_eq!(bounded, 6);
     }
 
     #[test]

@@ -71,10 +71,23 @@ struct ChamberSystem<'a> {
     /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
     /// question starts there.
     stretch_at: std::cell::Cell<Option<(f64, i32)>>,
+    /// Whether the trajectory's position bounds over [t0, t0 + duration] lie within one
+    /// stretch of the orifice geometry (then no step inside has a breakpoint); found on the
+    /// first question.
+    tangency_free_until: std::cell::Cell<Option<f64>>,
+    duration: f64,
 }
 
 impl<'a> ChamberSystem<'a> {
-    fn new(model: &'a Actuator, trajectory: &'a Trajectory<'a>, t0: f64, x_s: f64, x_s_rate: f64) -> Self {
+    /// The chambers over [t0, t0 + duration].
+    fn new(
+        model: &'a Actuator,
+        trajectory: &'a Trajectory<'a>,
+        t0: f64,
+        duration: f64,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> Self {
         Self {
             model,
             trajectory,
@@ -83,7 +96,23 @@ impl<'a> ChamberSystem<'a> {
             x_s_rate,
             areas_at: std::cell::Cell::new(None),
             stretch_at: std::cell::Cell::new(None),
+            tangency_free_until: std::cell::Cell::new(None),
+            duration,
         }
+    }
+
+    /// The end of the time the jet pipe provably stays within one stretch (t0 if unknown).
+    fn tangency_free_until(&self) -> f64 {
+        if let Some(until) = self.tangency_free_until.get() {
+            return until;
+        }
+        let free = self
+            .trajectory
+            .position_bounds(self.duration)
+            .is_some_and(|(lo, hi)| self.model.area_stretch(lo) == self.model.area_stretch(hi));
+        let until = if free { self.t0 + self.duration } else { self.t0 };
+        self.tangency_free_until.set(Some(until));
+        until
     }
 
     fn areas(&self, t: f64) -> OrificeAreas {
@@ -154,6 +183,9 @@ impl OdeSystem<2> for ChamberSystem<'_> {
     /// and the end of the step (steps are at most a quarter of the ringing period, so only
     /// a graze of a tangency can be missed, and a graze opens next to no area).
     fn breakpoint(&self, t0: f64, t1: f64) -> Option<f64> {
+        if t1 <= self.tangency_free_until() {
+            return None;
+        }
         let stretch = |t: f64| self.model.area_stretch(self.trajectory.position(t - self.t0));
         let (mut a, mut stretch_a) = match self.stretch_at.get() {
             Some((t, s)) if t == t0 => (t0, s),
@@ -474,7 +506,7 @@ impl Simulation {
                     acceleration: self.state[index::JET_ACCELERATION],
                 };
                 let trajectory = propagator.trajectory(&start, v, v_rate, &self.plays);
-                let system = ChamberSystem::new(&self.model, &trajectory, t0, self.x_s, self.x_s_rate);
+                let system = ChamberSystem::new(&self.model, &trajectory, t0, duration, self.x_s, self.x_s_rate);
                 let scale = self.model.state_scales();
                 let tolerances = Tolerances {
                     relative: self.local_tolerance(),
@@ -909,7 +941,7 @@ mod tests {
             acceleration: sim.state[index::JET_ACCELERATION],
         };
         let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
-        let system = ChamberSystem::new(&model, &trajectory, 1.0, sim.x_s, 0.0);
+        let system = ChamberSystem::new(&model, &trajectory, 1.0, 0.002, sim.x_s, 0.0);
         let stretch_at = |t: f64| model.area_stretch(trajectory.position(t - 1.0));
         assert_ne!(stretch_at(1.0), stretch_at(1.002), "the swing must cross a tangency");
         // Walk through 2 ms in 0.1 ms pieces, as an integrator would.
