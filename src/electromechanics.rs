@@ -54,6 +54,19 @@ pub struct ElectromechanicalPropagator {
     beta: [C64; 3],
     /// The jet_pipe_hysteresis operator between f3 and the dynamics (inactive when off).
     hysteresis: PrandtlIshlinskii,
+    /// What each term of a current transient's series does to the modes: see [`SeriesWeight`].
+    /// Built once, so a step's trajectory costs multiplications instead of 3 complex
+    /// divisions per term; it stops before the first n where λk + nω nearly vanishes.
+    series_weights: Vec<SeriesWeight>,
+}
+
+/// For term aₙ e^{−nω s} of the jet pipe input: each mode's weight wₖ = β_k/(λk + nω) and
+/// the moments Re Σ_k λk^m wₖ (m = 0, 1, 2) that give its share of position, velocity and
+/// acceleration.
+#[derive(Clone, Debug, PartialEq)]
+struct SeriesWeight {
+    modes: [C64; 3],
+    moments: [f64; 3],
 }
 
 /// Largest |ε|/ρ (jump over the distance to tanh's nearest pole) for which the series is used.
@@ -126,6 +139,27 @@ impl ElectromechanicalPropagator {
         }
         let gain = p.omega_1 * p.omega_2 * p.omega_2;
         let beta = [inverse[0][2] * gain, inverse[1][2] * gain, inverse[2][2] * gain];
+        let mut series_weights = Vec::with_capacity(MAX_SERIES_TERMS);
+        'terms: for n in 0..MAX_SERIES_TERMS {
+            let n_omega = n as f64 * p.omega_cd;
+            let mut weight = SeriesWeight {
+                modes: [C64::new(0.0, 0.0); 3],
+                moments: [0.0; 3],
+            };
+            for k in 0..3 {
+                let denominator = lambda[k] + n_omega;
+                // Resonant: the term grows like s e^{λs}, which the series form does not hold.
+                if denominator.norm_sqr() <= (1e-9 * p.omega_cd).powi(2) {
+                    break 'terms;
+                }
+                let w = beta[k] / denominator;
+                weight.modes[k] = w;
+                weight.moments[0] += w.re;
+                weight.moments[1] += (lambda[k] * w).re;
+                weight.moments[2] += (lambda[k] * lambda[k] * w).re;
+            }
+            series_weights.push(weight);
+        }
         Some(Self {
             omega_cd: p.omega_cd,
             k_cd: p.k_cd,
@@ -137,6 +171,7 @@ impl ElectromechanicalPropagator {
             inverse,
             beta,
             hysteresis: PrandtlIshlinskii::new(p.hysteresis_width, p.hysteresis_deadband),
+            series_weights,
         })
     }
 
@@ -259,19 +294,22 @@ impl ElectromechanicalPropagator {
 
 /// Coefficients aₙ = cₙ εⁿ of tanh(x0 + ε r) = Σ aₙ rⁿ, truncated where they stop mattering.
 fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Coefficients {
-    let mut c = Coefficients::new();
-    c.push(x0.tanh());
-    if epsilon == 0.0 {
-        return c;
-    }
-    // y' = 1 − y²  ⇒  (n+1) c_{n+1} = [n = 0] − Σ_{k=0}^{n} c_k c_{n−k}
+    let max_terms = max_terms.min(MAX_SERIES_TERMS);
+    let mut c = [0.0; MAX_SERIES_TERMS];
+    c[0] = x0.tanh();
     let mut a = Coefficients::new();
     a.push(c[0]);
+    if epsilon == 0.0 {
+        return a;
+    }
+    // y' = 1 − y²  ⇒  (n+1) c_{n+1} = [n = 0] − Σ_{k=0}^{n} c_k c_{n−k}, the sum folded in half.
     let mut power = 1.0;
     for n in 0..max_terms - 1 {
-        let convolution: f64 = (0..=n).map(|k| c[k] * c[n - k]).sum();
+        let half: f64 = (0..(n + 1) / 2).map(|k| c[k] * c[n - k]).sum();
+        let middle = if n % 2 == 0 { c[n / 2] * c[n / 2] } else { 0.0 };
+        let convolution = 2.0 * half + middle;
         let next = ((if n == 0 { 1.0 } else { 0.0 }) - convolution) / (n + 1) as f64;
-        c.push(next);
+        c[n + 1] = next;
         power *= epsilon;
         let term = next * power;
         a.push(term);
@@ -292,51 +330,45 @@ struct SeriesForm {
     amplitude: [C64; 3],
     /// Coefficients of rⁿ in the position, velocity and acceleration: −Re Σ_k λk^m β_k aₙ/(λk + nω).
     polynomials: [Coefficients; 3],
-    /// Coefficients of rⁿ of each mode k: −β_k aₙ/(λk + nω).
-    mode_polynomials: SmallVec<[[C64; 3]; 16]>,
 }
 
 impl SeriesForm {
     /// `None` when some λk + nω nearly vanishes (the term grows like s e^{λs}): the
     /// general per-query sum handles that case.
     fn new(p: &ElectromechanicalPropagator, q0: &[C64; 3], series: &[f64]) -> Option<Self> {
-        if series.is_empty() {
+        if series.is_empty() || series.len() > p.series_weights.len() {
             return None;
         }
         let mut amplitude = *q0;
         let zeros = || Coefficients::from_elem(0.0, series.len());
         let mut polynomials = [zeros(), zeros(), zeros()];
-        let mut mode_polynomials: SmallVec<[[C64; 3]; 16]> = SmallVec::from_elem([C64::new(0.0, 0.0); 3], series.len());
-        for (n, a) in series.iter().enumerate() {
-            let n_omega = n as f64 * p.omega_cd;
+        for (n, (a, weight)) in series.iter().zip(&p.series_weights).enumerate() {
             for k in 0..3 {
-                let denominator = p.lambda[k] + n_omega;
-                // Squared moduli: `norm` is a hypot call, and this runs per term and mode.
-                if denominator.norm_sqr() <= (1e-9 * p.omega_cd).powi(2) {
-                    return None;
-                }
-                let term = p.beta[k] * *a / denominator;
-                amplitude[k] += term;
-                polynomials[0][n] -= term.re;
-                polynomials[1][n] -= (p.lambda[k] * term).re;
-                polynomials[2][n] -= (p.lambda[k] * p.lambda[k] * term).re;
-                mode_polynomials[n][k] = -term;
+                amplitude[k] += weight.modes[k] * *a;
+            }
+            for m in 0..3 {
+                polynomials[m][n] = -a * weight.moments[m];
             }
         }
-        Some(Self {
-            amplitude,
-            polynomials,
-            mode_polynomials,
-        })
+        Some(Self { amplitude, polynomials })
     }
 
-    /// Modal coordinates: q_k(s) = amplitude_k e^{λk s} + Σₙ mode_polynomials[k][n] rⁿ.
-    fn modes(&self, p: &ElectromechanicalPropagator, s: f64) -> [C64; 3] {
+    /// Modal coordinates: q_k(s) = amplitude_k e^{λk s} − Σₙ wₖ,ₙ aₙ rⁿ, for the `series` the
+    /// form was built from.
+    fn modes(&self, p: &ElectromechanicalPropagator, series: &[f64], s: f64) -> [C64; 3] {
         let (mut q, r) = self.growth(p, s);
         let zero = C64::new(0.0, 0.0);
-        let sum = self.mode_polynomials.iter().rev().fold([zero; 3], |acc, c| {
-            [acc[0] * r + c[0], acc[1] * r + c[1], acc[2] * r + c[2]]
-        });
+        let sum = series
+            .iter()
+            .zip(&p.series_weights)
+            .rev()
+            .fold([zero; 3], |acc, (a, w)| {
+                [
+                    acc[0] * r - w.modes[0] * *a,
+                    acc[1] * r - w.modes[1] * *a,
+                    acc[2] * r - w.modes[2] * *a,
+                ]
+            });
         for k in 0..3 {
             q[k] += sum[k];
         }
@@ -687,7 +719,7 @@ impl Trajectory<'_> {
     /// Modal coordinates at `s`.
     fn modes(&self, s: f64) -> [C64; 3] {
         match &self.series_form {
-            Some(form) => form.modes(self.propagator, s),
+            Some(form) => form.modes(self.propagator, &self.series, s),
             None => self.modes_by_sum(s),
         }
     }
