@@ -125,7 +125,7 @@ def main():
     reference, ref_cpu, _, y0 = rust(1e-10, args.seconds, step=1e-4, runs=1)
     print(f"reference: Rust, rtol 1e-10, 0.1 ms communication steps ({ref_cpu:.3f} s CPU)\n")
 
-    curves = {"Rust split SDIRK4": [], "SciPy LSODA": [], "SciPy Radau": []}
+    curves = {"Rust split DP5": [], "SciPy LSODA": [], "SciPy Radau": []}
     print(f"{'method':<18} {'rtol':>7} {'max |dF| N':>11} {'CPU s':>10} {'CPU s / sim s':>14} {'RHS evals':>10}")
 
     def report(name, rtol, forces, cpu, nfev):
@@ -135,7 +135,7 @@ def main():
 
     for rtol in RUST_TOLERANCES:
         forces, cpu, nfev, _ = rust(rtol, args.seconds)
-        report("Rust split SDIRK4", rtol, forces, cpu, nfev)
+        report("Rust split DP5", rtol, forces, cpu, nfev)
 
     spent = 0.0
     for method in ("LSODA", "Radau"):
@@ -156,7 +156,7 @@ def main():
             previous = cpu
             report(f"SciPy {method}", rtol, forces, cpu, nfev)
 
-    rust_curve = curves["Rust split SDIRK4"]
+    rust_curve = curves["Rust split DP5"]
     print("\nCPU time at equal accuracy (log-log interpolation; '<=' the loosest run already reaches it)")
     print(f"{'max |dF| N':>10} {'Rust s':>12} {'LSODA s':>12} {'Radau s':>12} {'SciPy best / Rust':>18}")
     ratios = []
