@@ -74,7 +74,7 @@ struct ChamberSystem<'a> {
     /// Whether the trajectory's position bounds over [t0, t0 + duration] lie within one
     /// stretch of the orifice geometry (then no step inside has a breakpoint); found on the
     /// first question.
-    tangency_free_until: std::cell::Cell<Option<f64>>,
+    tangency_free: std::cell::Cell<Option<bool>>,
     duration: f64,
 }
 
@@ -96,23 +96,22 @@ impl<'a> ChamberSystem<'a> {
             x_s_rate,
             areas_at: std::cell::Cell::new(None),
             stretch_at: std::cell::Cell::new(None),
-            tangency_free_until: std::cell::Cell::new(None),
+            tangency_free: std::cell::Cell::new(None),
             duration,
         }
     }
 
-    /// The end of the time the jet pipe provably stays within one stretch (t0 if unknown).
-    fn tangency_free_until(&self) -> f64 {
-        if let Some(until) = self.tangency_free_until.get() {
-            return until;
+    /// Whether the jet pipe provably stays within one stretch over the whole system's time.
+    fn tangency_free(&self) -> bool {
+        if let Some(free) = self.tangency_free.get() {
+            return free;
         }
         let free = self
             .trajectory
             .position_bounds(self.duration)
             .is_some_and(|(lo, hi)| self.model.area_stretch(lo) == self.model.area_stretch(hi));
-        let until = if free { self.t0 + self.duration } else { self.t0 };
-        self.tangency_free_until.set(Some(until));
-        until
+        self.tangency_free.set(Some(free));
+        free
     }
 
     fn areas(&self, t: f64) -> OrificeAreas {
@@ -183,7 +182,7 @@ impl OdeSystem<2> for ChamberSystem<'_> {
     /// and the end of the step (steps are at most a quarter of the ringing period, so only
     /// a graze of a tangency can be missed, and a graze opens next to no area).
     fn breakpoint(&self, t0: f64, t1: f64) -> Option<f64> {
-        if t1 <= self.tangency_free_until() {
+        if self.tangency_free() && t1 <= self.t0 + self.duration {
             return None;
         }
         let stretch = |t: f64| self.model.area_stretch(self.trajectory.position(t - self.t0));
