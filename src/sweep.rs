@@ -362,13 +362,22 @@ impl RunResult {
     }
 }
 
-/// CPU time consumed so far by the calling thread, from /proc/thread-self/schedstat (its first
-/// field is nanoseconds on a CPU). Wall time alone would count the time a run waited for a
-/// core, which on a loaded machine is most of what differs between serial and parallel runs.
+/// CPU time consumed so far by the calling thread. Wall time alone would count the time a run
+/// waited for a core, which on a loaded machine is most of what differs between serial and
+/// parallel runs. clock_gettime brings the thread's runtime up to date when asked;
+/// /proc/thread-self/schedstat, used before, advances only at scheduler ticks and read 0 for
+/// runs shorter than one.
+#[cfg(unix)]
 pub fn thread_cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(ns as f64 * 1e-9)
+    let mut now = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `now` is a valid, writable timespec for the duration of the call.
+    let status = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut now) };
+    (status == 0).then(|| now.tv_sec as f64 + now.tv_nsec as f64 * 1e-9)
+}
+
+#[cfg(not(unix))]
+pub fn thread_cpu_seconds() -> Option<f64> {
+    None
 }
 
 /// Simulate one point. Never panics: a panic inside the model becomes a failed run.

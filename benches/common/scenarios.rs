@@ -296,9 +296,5 @@ impl Feedforward {
 /// CPU time of the calling thread, s: the simulation is single-threaded, and unlike wall
 /// time this does not count the time other processes on the machine take from it.
 pub fn thread_cpu_seconds() -> f64 {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant libc knows.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    assert_eq!(rc, 0, "clock_gettime(CLOCK_THREAD_CPUTIME_ID) failed");
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+    jetpipe::sweep::thread_cpu_seconds().expect("a thread CPU clock (clock_gettime) on this platform")
 }
