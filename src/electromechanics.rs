@@ -354,7 +354,7 @@ impl SeriesForm {
             }
         }
         // Σ_{n≥1} |cₙ| rⁿ ≤ r Σ|cₙ| for r ≤ 1.
-        let transient: f64 = polynomials[0].iter().skip(1).map(|c| c.abs()).sum();
+        let (_, transient) = constant_and_spread(&polynomials[0], 1.0);
         let negligible = 1e-16 * p.x_sat;
         let transient_over = if transient <= negligible {
             0.0
