@@ -58,6 +58,8 @@ pub struct ElectromechanicalPropagator {
     /// Built once, so a step's trajectory costs multiplications instead of 3 complex
     /// divisions per term; it stops before the first n where λk + nω nearly vanishes.
     series_weights: Vec<SeriesWeight>,
+    /// The advances by cᵢh of the last few step sizes (see [`Trajectory::node_positions`]).
+    advances: AdvanceCache,
 }
 
 /// For term aₙ e^{−nω s} of the jet pipe input: each mode's weight wₖ = β_k/(λk + nω) and
@@ -172,6 +174,7 @@ impl ElectromechanicalPropagator {
             beta,
             hysteresis: PrandtlIshlinskii::new(p.hysteresis_width, p.hysteresis_deadband),
             series_weights,
+            advances: AdvanceCache::default(),
         })
     }
 
@@ -400,12 +403,19 @@ impl SeriesForm {
     }
 
     fn position(&self, p: &ElectromechanicalPropagator, s: f64) -> f64 {
-        if s >= self.transient_over {
-            let g = modal_growth(p, &self.amplitude, s);
-            return (g[0] + g[1] + g[2]).re + self.polynomials[0][0];
-        }
-        let (g, r) = self.growth(p, s);
-        (g[0] + g[1] + g[2]).re + Self::horner(&self.polynomials[0], r)
+        self.position_from(s, &p.exponentials(s, s < self.transient_over))
+    }
+
+    /// The position at `s` from the exponentials there (`decay` needed only before
+    /// `transient_over`).
+    fn position_from(&self, s: f64, e: &Exponentials) -> f64 {
+        let g = growth_from(&self.amplitude, e);
+        let polynomial = if s >= self.transient_over {
+            self.polynomials[0][0]
+        } else {
+            Self::horner(&self.polynomials[0], e.decay)
+        };
+        (g[0] + g[1] + g[2]).re + polynomial
     }
 
     /// Bounds on the position over [0, s_end].
@@ -515,7 +525,11 @@ impl RampForm {
     }
 
     fn position(&self, p: &ElectromechanicalPropagator, s: f64) -> f64 {
-        let g = self.growth(p, s);
+        self.position_from(s, &p.exponentials(s, false))
+    }
+
+    fn position_from(&self, s: f64, e: &Exponentials) -> f64 {
+        let g = growth_from(&self.amplitude, e);
         (g[0] + g[1] + g[2]).re + SeriesForm::horner(&self.polynomials[0], s / self.horizon)
     }
 
@@ -576,15 +590,118 @@ fn modal_bounds(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s_end: f6
 
 /// e^{λk s}·amplitude_k for the three modes (λ3 = conj(λ2), so one complex exponential).
 fn modal_growth(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s: f64) -> [C64; 3] {
-    let real = (p.lambda[0].re * s).exp();
-    let envelope = (p.lambda[1].re * s).exp();
-    let (sin, cos) = (p.lambda[1].im * s).sin_cos();
-    let oscillation = C64::new(envelope * cos, envelope * sin);
+    growth_from(amplitude, &p.exponentials(s, false))
+}
+
+fn growth_from(amplitude: &[C64; 3], e: &Exponentials) -> [C64; 3] {
     [
-        amplitude[0] * real,
-        amplitude[1] * oscillation,
-        amplitude[2] * oscillation.conj(),
+        amplitude[0] * e.real,
+        amplitude[1] * e.oscillation,
+        amplitude[2] * e.oscillation.conj(),
     ]
+}
+
+/// The exponentials a closed-form trajectory is made of, at one time s: e^{λ1 s} of the
+/// real mode, e^{λ2 s} of the ringing pair (λ3 = conj λ2) and the current transient's
+/// e^{−ω_cd s}. Those at s + δ are the products of those at s and at δ.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Exponentials {
+    real: f64,
+    oscillation: C64,
+    decay: f64,
+}
+
+impl Exponentials {
+    fn then(&self, advance: &Exponentials) -> Exponentials {
+        Exponentials {
+            real: self.real * advance.real,
+            oscillation: self.oscillation * advance.oscillation,
+            decay: self.decay * advance.decay,
+        }
+    }
+}
+
+impl ElectromechanicalPropagator {
+    /// The exponentials at `s`; `decay` is left at 0 unless `with_decay`.
+    fn exponentials(&self, s: f64, with_decay: bool) -> Exponentials {
+        let envelope = (self.lambda[1].re * s).exp();
+        let (sin, cos) = (self.lambda[1].im * s).sin_cos();
+        Exponentials {
+            real: (self.lambda[0].re * s).exp(),
+            oscillation: C64::new(envelope * cos, envelope * sin),
+            decay: if with_decay { (-self.omega_cd * s).exp() } else { 0.0 },
+        }
+    }
+
+    /// The exponentials at cᵢh for `nodes` cᵢ, if this step size was asked for before with
+    /// these nodes; a first request only records it and returns `None`. Stage positions
+    /// are then the product of the exponentials at the step's start and these, one set of
+    /// transcendental functions per step instead of one per stage, whenever the step size
+    /// recurs: as it does while the chambers' integrator is capped at a quarter of the
+    /// ringing period, and on its grid of step sizes otherwise.
+    fn with_advances<R>(&self, h: f64, nodes: &[f64], use_them: impl FnOnce(&[Exponentials]) -> R) -> Option<R> {
+        if nodes.len() > MAX_NODES {
+            return None;
+        }
+        let mut cache = self.advances.0.borrow_mut();
+        if cache.nodes[..cache.count] != *nodes {
+            cache.slots.clear();
+            cache.nodes[..nodes.len()].copy_from_slice(nodes);
+            cache.count = nodes.len();
+        }
+        if cache.slots.is_empty() {
+            cache.slots.resize(ADVANCE_SLOTS, (f64::NAN, None));
+        }
+        // Direct-mapped on the top mantissa bits and the low exponent bits, which tell the
+        // integrator's grid sizes apart.
+        let bits = h.to_bits();
+        let slot = &mut cache.slots[((bits >> 47) ^ (bits >> 52)) as usize % ADVANCE_SLOTS];
+        if slot.0 != h {
+            *slot = (h, None);
+            return None;
+        }
+        if slot.1.is_none() {
+            let mut advances = [Exponentials::default(); MAX_NODES];
+            for (advance, c) in advances.iter_mut().zip(nodes) {
+                *advance = self.exponentials(c * h, true);
+            }
+            slot.1 = Some(advances);
+        }
+        slot.1.as_ref().map(|advances| use_them(&advances[..nodes.len()]))
+    }
+}
+
+/// The closed form a trajectory's positions come from, when it has one.
+#[derive(Clone, Copy)]
+enum ClosedForm<'f> {
+    Series(&'f SeriesForm),
+    Ramp(&'f RampForm),
+}
+
+/// Most stages of one step [`Trajectory::node_positions`] takes: Dormand–Prince's six after
+/// the first.
+pub const MAX_NODES: usize = 6;
+/// Step sizes whose advances are kept (6.7 kB, allocated on first use): the chirp's
+/// error-controlled steps and the rest of each communication step come in about twenty.
+const ADVANCE_SLOTS: usize = 32;
+
+#[derive(Clone, Debug, Default)]
+struct AdvanceTable {
+    nodes: [f64; MAX_NODES],
+    count: usize,
+    /// (h, its advances once asked for a second time).
+    slots: Vec<(f64, Option<[Exponentials; MAX_NODES]>)>,
+}
+
+/// A memo inside the propagator: it changes no result, so two propagators that differ
+/// only in it are equal.
+#[derive(Clone, Debug, Default)]
+struct AdvanceCache(std::cell::RefCell<AdvanceTable>);
+
+impl PartialEq for AdvanceCache {
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 /// The current driver and jet pipe over one step, evaluable at any time within it.
@@ -813,6 +930,50 @@ impl Trajectory<'_> {
         (-l.re, 2.0 * std::f64::consts::PI / l.im.abs())
     }
 
+    /// Jet pipe positions at the stage offsets `offsets` (sᵢ = s0 + cᵢh up to rounding) of
+    /// one step of a one-step method from `s0` with size `h` and nodes cᵢ, into `out`.
+    /// Where the response has a closed form and `h` has come before, the exponentials are
+    /// taken once, at s0, and carried to each stage by a product with those at cᵢh (see
+    /// [`ElectromechanicalPropagator::with_advances`]); otherwise each is [`Self::position`].
+    /// The two agree to rounding (`node_positions_match_the_positions`).
+    pub fn node_positions(&self, s0: f64, h: f64, nodes: &[f64], offsets: &[f64], out: &mut [f64]) {
+        let p = self.propagator;
+        let form = match (&self.series_form, &self.ramp_form) {
+            (Some(form), _) => Some(ClosedForm::Series(form)),
+            (None, Some(form)) if form.covers(s0) && offsets.iter().all(|&s| form.covers(s)) => {
+                Some(ClosedForm::Ramp(form))
+            }
+            _ => None,
+        };
+        if let Some(form) = form {
+            let with_decay = match form {
+                ClosedForm::Series(series) => offsets.iter().any(|&s| s < series.transient_over),
+                ClosedForm::Ramp(_) => false,
+            };
+            let done = p.with_advances(h, nodes, |advances| {
+                let at_start = p.exponentials(s0, with_decay);
+                for ((x, &s), advance) in out.iter_mut().zip(offsets).zip(advances) {
+                    let e = at_start.then(advance);
+                    *x = match form {
+                        ClosedForm::Series(series) => series.position_from(s, &e),
+                        ClosedForm::Ramp(ramp) => ramp.position_from(s, &e),
+                    };
+                }
+            });
+            if done.is_some() {
+                return;
+            }
+        }
+        let mut last: Option<(f64, f64)> = None;
+        for (x, &s) in out.iter_mut().zip(offsets) {
+            *x = match last {
+                Some((at, position)) if at == s => position,
+                _ => self.position(s),
+            };
+            last = Some((s, *x));
+        }
+    }
+
     /// Jet pipe position at `s` seconds into the step.
     pub fn position(&self, s: f64) -> f64 {
         if let Some(form) = &self.series_form {
@@ -1036,6 +1197,76 @@ mod tests {
             }
         }
         assert_eq!(bounded, 6);
+    }
+
+    /// Stage positions carried from the step's start by the advances of a recurring step
+    /// size are the positions, to rounding: for a held command (with and without its
+    /// current transient over within the step), a ramp, and a case with no closed form.
+    #[test]
+    fn node_positions_match_the_positions() {
+        let p = Parameters::default();
+        let propagator = ElectromechanicalPropagator::new(&p).unwrap();
+        let swinging = ElectromechanicalState {
+            current: 0.05,
+            position: 1.2e-4,
+            velocity: 0.02,
+            acceleration: -30.0,
+        };
+        let ramp_start = |v: f64, rate: f64| ElectromechanicalState {
+            current: p.k_cd * v + p.i_offset - p.k_cd * rate / p.omega_cd,
+            ..swinging
+        };
+        let nodes = [0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
+        let mut fast_paths = 0;
+        // The case without a closed form first: it must not even record a step size.
+        for (start, v, rate, form) in [
+            (swinging, -10.0, 0.0, "none"),
+            (swinging, 3.1, 0.0, "series"),
+            (swinging, 1.3, 0.0, "series"),
+            (ramp_start(1.0, 2.5), 1.0, 2.5, "ramp"),
+        ] {
+            let trajectory = propagator.trajectory(&start, v, rate, &[start.position; PLAY_OPERATORS]);
+            match form {
+                "series" => assert!(trajectory.series_form.is_some()),
+                "ramp" => assert!(trajectory.ramp_form.is_some()),
+                _ => assert!(trajectory.series_form.is_none() && trajectory.ramp_form.is_none()),
+            }
+            // Early steps (transient alive) and late ones (past `transient_over` for the
+            // held commands), each asked for twice: the second time takes the advances.
+            for (s0, h) in [(0.0, 8.5e-5), (3.1e-4, 8.5e-5), (4.0e-3, 8.4e-4), (7.7e-3, 2.3e-3)] {
+                let offsets: Vec<f64> = nodes.iter().map(|c| s0 + c * h).collect();
+                for _ in 0..2 {
+                    let mut out = [0.0; 6];
+                    trajectory.node_positions(s0, h, &nodes, &offsets, &mut out);
+                    for (x, &s) in out.iter().zip(&offsets) {
+                        let exact = trajectory.position(s);
+                        assert!(
+                            (x - exact).abs() <= 1e-15 * p.x_jp_sat,
+                            "{form} v {v} s0 {s0} h {h} s {s}: {x} vs {exact}"
+                        );
+                    }
+                }
+                let cached = propagator
+                    .advances
+                    .0
+                    .borrow()
+                    .slots
+                    .iter()
+                    .any(|slot| slot.0 == h && slot.1.is_some());
+                assert_eq!(cached, form != "none", "{form} h {h}");
+                fast_paths += usize::from(cached);
+            }
+        }
+        assert_eq!(fast_paths, 12);
+        if let Some(form) = propagator
+            .trajectory(&swinging, 3.1, 0.0, &[0.0; PLAY_OPERATORS])
+            .series_form
+        {
+            // The first two steps above lie before the transient is over, the last after it
+            // and the third across it.
+            let over = form.transient_over;
+            assert!(over > 4.0e-3 && over < 4.0e-3 + 8.4e-4, "{over}");
+        }
     }
 
     #[test]

@@ -32,6 +32,12 @@ pub trait OdeSystem<const N: usize> {
         None
     }
 
+    /// Told, before an explicit step from `t` of size `h` evaluates its stages, their nodes
+    /// cᵢ and the times it will ask for f at (t + cᵢh, or the step's exact end). A system
+    /// whose forcing costs more than its dependence on y can work it out for all stages at
+    /// once here; the default does nothing.
+    fn prepare_stages(&self, _t: f64, _h: f64, _nodes: &[f64], _times: &[f64]) {}
+
     /// ∂f/∂y. The default is a forward difference; systems with known structure override it.
     fn jacobian(&self, t: f64, y: &SVector<f64, N>, f_y: &SVector<f64, N>) -> SMatrix<f64, N, N> {
         finite_difference_jacobian(|yy| self.rhs(t, yy), y, f_y)
@@ -228,7 +234,9 @@ impl Sdirk4 {
             if h < MIN_STEP.max(1e-14 * t.abs()) {
                 self.next_step = 1e-5;
                 return Err(IntegrationFailure {
-                    message: format!("step size fell below {MIN_STEP:e} s at t = {t} s: the solution is not smooth enough to integrate"),
+                    message: format!(
+                        "the step size fell below {MIN_STEP:e} s: the solution is not smooth enough to integrate"
+                    ),
                     time: t,
                     state: y,
                 });

@@ -60,7 +60,9 @@ impl<const PIECES: usize> Piecewise<PIECES> {
             return None;
         }
         let position = (x - self.start) * self.pieces_per_unit;
-        let k = (position as usize).min(PIECES - 1);
+        // 0 ≤ position ≤ PIECES here: through i32 the conversion is one instruction and
+        // a compare, without `as usize`'s handling of values at and above 2^63.
+        let k = (position as i32).min(PIECES as i32 - 1) as usize;
         Some(estrin(&self.coefficients[k], 2.0 * (position - k as f64) - 1.0))
     }
 }

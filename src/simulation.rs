@@ -8,7 +8,7 @@
 
 use nalgebra::SVector;
 
-use crate::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState, Trajectory};
+use crate::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState, Trajectory, MAX_NODES};
 use crate::integrator::{finite_difference_jacobian, IntegrationFailure, OdeSystem, Sdirk4, Statistics, Tolerances};
 use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
@@ -57,21 +57,27 @@ impl OdeSystem<N_STATES> for StepSystem<'_> {
     }
 }
 
-/// The chambers over one step, driven by the exactly known jet pipe trajectory.
+/// The chambers over one step, driven by the exactly known jet pipe trajectory. Its time
+/// is counted from the step's start, as the trajectory's is: a step size the integrator
+/// repeats (the cap, the rest of an equal communication step) is then the same to the last
+/// bit each time, which [`Trajectory::node_positions`] relies on.
 struct ChamberSystem<'a> {
     model: &'a Actuator,
     trajectory: &'a Trajectory<'a>,
-    t0: f64,
     x_s: f64,
     x_s_rate: f64,
     /// The orifice areas at the last time asked for: Newton iterations and the Jacobian
     /// evaluate many pressures at one stage time, and the jet pipe position and the areas
     /// (four lens areas) cost more than the flows.
     areas_at: std::cell::Cell<Option<(f64, OrificeAreas)>>,
+    /// The areas at the stage times of the current explicit step, worked out together in
+    /// [`OdeSystem::prepare_stages`]. An entry from an earlier step is still right: the
+    /// areas depend on the time alone.
+    stage_areas: std::cell::RefCell<StageAreas>,
     /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
     /// question starts there.
     stretch_at: std::cell::Cell<Option<(f64, i32)>>,
-    /// Whether the trajectory's position bounds over [t0, t0 + duration] lie within one
+    /// Whether the trajectory's position bounds over [0, duration] lie within one
     /// stretch of the orifice geometry (then no step inside has a breakpoint); found on the
     /// first question.
     tangency_free: std::cell::Cell<Option<bool>>,
@@ -79,22 +85,15 @@ struct ChamberSystem<'a> {
 }
 
 impl<'a> ChamberSystem<'a> {
-    /// The chambers over [t0, t0 + duration].
-    fn new(
-        model: &'a Actuator,
-        trajectory: &'a Trajectory<'a>,
-        t0: f64,
-        duration: f64,
-        x_s: f64,
-        x_s_rate: f64,
-    ) -> Self {
+    /// The chambers over [0, duration].
+    fn new(model: &'a Actuator, trajectory: &'a Trajectory<'a>, duration: f64, x_s: f64, x_s_rate: f64) -> Self {
         Self {
             model,
             trajectory,
-            t0,
             x_s,
             x_s_rate,
             areas_at: std::cell::Cell::new(None),
+            stage_areas: std::cell::RefCell::new(StageAreas::default()),
             stretch_at: std::cell::Cell::new(None),
             tangency_free: std::cell::Cell::new(None),
             duration,
@@ -115,10 +114,13 @@ impl<'a> ChamberSystem<'a> {
     }
 
     fn areas(&self, t: f64) -> OrificeAreas {
+        if let Some(areas) = self.stage_areas.borrow().at(t) {
+            return areas;
+        }
         match self.areas_at.get() {
             Some((cached, areas)) if cached == t => areas,
             _ => {
-                let areas = self.model.areas(self.trajectory.position(t - self.t0));
+                let areas = self.model.areas(self.trajectory.position(t));
                 self.areas_at.set(Some((t, areas)));
                 areas
             }
@@ -129,7 +131,7 @@ impl<'a> ChamberSystem<'a> {
     /// `tangency`: regula falsi (Illinois) on the exact trajectory, returning a time already
     /// past the crossing (within 1e-12 s), so a step ending there does not contain it.
     fn crossing_time(&self, mut a: f64, mut b: f64, tangency: f64, stretch_a: i32) -> f64 {
-        let gap = |t: f64| self.trajectory.position(t - self.t0) - tangency;
+        let gap = |t: f64| self.trajectory.position(t) - tangency;
         let (mut ga, mut gb) = (gap(a), gap(b));
         let mut last_moved = 0;
         for _ in 0..60 {
@@ -144,7 +146,7 @@ impl<'a> ChamberSystem<'a> {
             if !(t > a && t < b) {
                 t = 0.5 * (a + b);
             }
-            let position = self.trajectory.position(t - self.t0);
+            let position = self.trajectory.position(t);
             let g = position - tangency;
             let past = self.model.area_stretch(position) != stretch_a;
             if past {
@@ -167,9 +169,24 @@ impl<'a> ChamberSystem<'a> {
     }
 
     fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
-        let x_s = self.x_s + self.x_s_rate * (t - self.t0);
+        let x_s = self.x_s + self.x_s_rate * t;
         let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
         SVector::<f64, 2>::new(a, b)
+    }
+}
+
+/// Orifice areas at the stage times of one step.
+#[derive(Default)]
+struct StageAreas {
+    count: usize,
+    times: [f64; MAX_NODES],
+    areas: [OrificeAreas; MAX_NODES],
+}
+
+impl StageAreas {
+    fn at(&self, t: f64) -> Option<OrificeAreas> {
+        let i = self.times[..self.count].iter().position(|&time| time == t)?;
+        Some(self.areas[i])
     }
 }
 
@@ -177,15 +194,36 @@ impl OdeSystem<2> for ChamberSystem<'_> {
     fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
         self.rates(&self.areas(t), t, p)
     }
+    /// The jet pipe positions at all stages at once ([`Trajectory::node_positions`]), then
+    /// their areas (once for stages at the same position, like DP5's two at c = 1).
+    fn prepare_stages(&self, t: f64, h: f64, nodes: &[f64], times: &[f64]) {
+        let count = nodes.len().min(times.len());
+        if count > MAX_NODES {
+            return;
+        }
+        let mut positions = [0.0; MAX_NODES];
+        self.trajectory
+            .node_positions(t, h, &nodes[..count], &times[..count], &mut positions[..count]);
+        let mut table = self.stage_areas.borrow_mut();
+        for i in 0..count {
+            table.times[i] = times[i];
+            table.areas[i] = if i > 0 && positions[i] == positions[i - 1] {
+                table.areas[i - 1]
+            } else {
+                self.model.areas(positions[i])
+            };
+        }
+        table.count = count;
+    }
     /// Where the jet pipe crosses a tangency of the orifice geometry: the areas, and so the
     /// pressure rates, have a corner or a 3/2 power in time there. Looked for at the middle
     /// and the end of the step (steps are at most a quarter of the ringing period, so only
     /// a graze of a tangency can be missed, and a graze opens next to no area).
     fn breakpoint(&self, t0: f64, t1: f64) -> Option<f64> {
-        if self.tangency_free() && t1 <= self.t0 + self.duration {
+        if self.tangency_free() && t1 <= self.duration {
             return None;
         }
-        let stretch = |t: f64| self.model.area_stretch(self.trajectory.position(t - self.t0));
+        let stretch = |t: f64| self.model.area_stretch(self.trajectory.position(t));
         let (mut a, mut stretch_a) = match self.stretch_at.get() {
             Some((t, s)) if t == t0 => (t0, s),
             _ => (t0, stretch(t0)),
@@ -505,7 +543,7 @@ impl Simulation {
                     acceleration: self.state[index::JET_ACCELERATION],
                 };
                 let trajectory = propagator.trajectory(&start, v, v_rate, &self.plays);
-                let system = ChamberSystem::new(&self.model, &trajectory, t0, duration, self.x_s, self.x_s_rate);
+                let system = ChamberSystem::new(&self.model, &trajectory, duration, self.x_s, self.x_s_rate);
                 let scale = self.model.state_scales();
                 let tolerances = Tolerances {
                     relative: self.local_tolerance(),
@@ -540,10 +578,10 @@ impl Simulation {
                     let (_, period) = trajectory.ringing_decay_and_period();
                     let unlimited = self.chamber_integrator.max_step;
                     self.chamber_integrator.max_step = 0.25 * period;
-                    let t_split = t0 + ringing_until;
+                    let t_split = ringing_until;
                     let first = integrate(
                         &mut self.chamber_integrator,
-                        t0,
+                        0.0,
                         pressures,
                         t_split,
                         &mut self.statistics,
@@ -551,19 +589,25 @@ impl Simulation {
                     self.chamber_integrator.max_step = unlimited;
                     match first {
                         Ok(p) if ringing_until < duration => {
-                            integrate(&mut self.chamber_integrator, t_split, p, t_end, &mut self.statistics)
+                            integrate(&mut self.chamber_integrator, t_split, p, duration, &mut self.statistics)
                         }
                         other => other,
                     }
                 } else {
-                    integrate(&mut self.chamber_integrator, t0, pressures, t_end, &mut self.statistics)
+                    integrate(
+                        &mut self.chamber_integrator,
+                        0.0,
+                        pressures,
+                        duration,
+                        &mut self.statistics,
+                    )
                 };
                 if changed {
                     self.step_after_change = self.chamber_integrator.first_step;
                 }
                 let reached = match &result {
                     Ok(_) => duration,
-                    Err(f) => f.time - t0,
+                    Err(f) => f.time,
                 };
                 let plays = trajectory.plays_at(reached);
                 if plays.iter().all(|p| p.is_finite()) {
@@ -573,8 +617,8 @@ impl Simulation {
                     Ok(p) => Ok(combine(duration, p)),
                     Err(f) => Err(IntegrationFailure {
                         message: f.message,
-                        time: f.time,
-                        state: combine(f.time - t0, f.state),
+                        time: t0 + f.time,
+                        state: combine(f.time, f.state),
                     }),
                 }
             }
@@ -618,7 +662,7 @@ impl Simulation {
                 self.x_s += self.x_s_rate * elapsed;
                 self.time = failure.time;
                 Err(StepFailure::Integration {
-                    message: failure.message,
+                    message: format!("at t = {} s: {}", failure.time, failure.message),
                     time: failure.time,
                 })
             }
@@ -940,14 +984,15 @@ mod tests {
             acceleration: sim.state[index::JET_ACCELERATION],
         };
         let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
-        let system = ChamberSystem::new(&model, &trajectory, 1.0, 0.002, sim.x_s, 0.0);
-        let stretch_at = |t: f64| model.area_stretch(trajectory.position(t - 1.0));
-        assert_ne!(stretch_at(1.0), stretch_at(1.002), "the swing must cross a tangency");
+        // The chambers' time starts at the step's start, as the trajectory's does.
+        let system = ChamberSystem::new(&model, &trajectory, 0.002, sim.x_s, 0.0);
+        let stretch_at = |t: f64| model.area_stretch(trajectory.position(t));
+        assert_ne!(stretch_at(0.0), stretch_at(0.002), "the swing must cross a tangency");
         // Walk through 2 ms in 0.1 ms pieces, as an integrator would.
-        let mut t: f64 = 1.0;
+        let mut t: f64 = 0.0;
         let mut crossings = vec![];
-        while t < 1.002 {
-            let end = (t + 1e-4).min(1.002);
+        while t < 0.002 {
+            let end = (t + 1e-4).min(0.002);
             match system.breakpoint(t, end) {
                 Some(b) => {
                     assert!(b > t && b < end, "{b} outside ({t}, {end})");
@@ -962,9 +1007,9 @@ mod tests {
             let (before, after) = (stretch_at(b - 1e-11), stretch_at(b));
             assert_ne!(before, after, "no tangency at {b}");
             let tangency = model.tangency_position(before, after);
-            let speed = (trajectory.position(b - 1.0 + 1e-9) - trajectory.position(b - 1.0)).abs() / 1e-9;
+            let speed = (trajectory.position(b + 1e-9) - trajectory.position(b)).abs() / 1e-9;
             assert!(
-                (trajectory.position(b - 1.0) - tangency).abs() <= 2e-12 * speed + 1e-15,
+                (trajectory.position(b) - tangency).abs() <= 2e-12 * speed + 1e-15,
                 "{b}"
             );
         }

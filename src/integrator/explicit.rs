@@ -122,6 +122,24 @@ pub struct StepMemory {
     pub first_step: Option<f64>,
 }
 
+/// ln 1e-4: the PI controller's memory of the last error is at least 1e-4.
+const LN_ERROR_FLOOR: f64 = -9.210_340_371_976_182;
+
+/// Mantissa bits a step size keeps (32 evenly spaced sizes per octave, each less than
+/// 1/32 below the size asked for).
+const STEP_GRID_BITS: u32 = 5;
+
+/// `h` rounded down onto a grid of 32 step sizes per octave, unless it is the cap
+/// `max_step`. A system that works out its forcing for all stages of a step at once
+/// ([`OdeSystem::prepare_stages`]) can then reuse that work whenever a step size recurs,
+/// instead of meeting a new size at nearly every step.
+fn on_step_grid(h: f64, max_step: f64) -> f64 {
+    if h == max_step || !h.is_finite() || h <= 0.0 {
+        return h;
+    }
+    f64::from_bits(h.to_bits() & !((1u64 << (52 - STEP_GRID_BITS)) - 1))
+}
+
 /// Integrate from (t0, y0) towards t1 with `tableau`. Returns the state at t1, or a handover
 /// (last accepted time and state) when the system turned stiff or the step size collapsed.
 pub fn integrate<const N: usize, const S: usize, Sys: OdeSystem<N>>(
@@ -141,7 +159,9 @@ pub fn integrate<const N: usize, const S: usize, Sys: OdeSystem<N>>(
     let mut slope = system.rhs(t, &y);
     stats.rhs_evaluations += 1;
     let mut last_rejected = false;
-    let mut previous_error: f64 = 1e-4;
+    // ln of the last accepted error (at least 1e-4), kept as a logarithm so the PI
+    // controller takes one `ln` and one `exp` per step instead of two `powf`.
+    let mut ln_previous_error = LN_ERROR_FLOOR;
     let (mut stiff_count, mut non_stiff_count) = (0, 0);
     let mut last_breakpoint: Option<f64> = None;
     let span = t1 - t0;
@@ -153,6 +173,14 @@ pub fn integrate<const N: usize, const S: usize, Sys: OdeSystem<N>>(
         let i_stiff = tableau.stiffness_stage;
         let mut stiffness_stage = y;
         let mut y_new = y;
+        let mut stage_times = [t; S];
+        for (i, time) in stage_times.iter_mut().enumerate().skip(1) {
+            *time = match step_end {
+                Some(end) if i == S - 1 => end,
+                _ => t + tableau.c[i] * h_try,
+            };
+        }
+        system.prepare_stages(t, h_try, &tableau.c[1..], &stage_times[1..]);
         for i in 1..S {
             let mut stage = y;
             for j in 0..i {
@@ -160,11 +188,7 @@ pub fn integrate<const N: usize, const S: usize, Sys: OdeSystem<N>>(
                     stage += k[j] * (h_try * tableau.a[i][j]);
                 }
             }
-            let t_stage = match step_end {
-                Some(end) if i == S - 1 => end,
-                _ => t + tableau.c[i] * h_try,
-            };
-            k[i] = system.rhs(t_stage, &stage);
+            k[i] = system.rhs(stage_times[i], &stage);
             if i == i_stiff {
                 stiffness_stage = stage;
             }
@@ -207,18 +231,19 @@ pub fn integrate<const N: usize, const S: usize, Sys: OdeSystem<N>>(
             t = step_end.unwrap_or(t + h_try);
             y = y_new;
             slope = k[S - 1];
+            let ln_error = error.ln();
             let mut factor = if error == 0.0 {
                 5.0
             } else {
-                0.9 * error.powf(-0.7 * exponent) * previous_error.powf(0.4 * exponent)
+                0.9 * (exponent * (-0.7 * ln_error + 0.4 * ln_previous_error)).exp()
             };
-            previous_error = error.max(1e-4);
+            ln_previous_error = ln_error.max(LN_ERROR_FLOOR);
             factor = factor.clamp(0.2, 5.0);
             if last_rejected {
                 factor = factor.min(1.0);
             }
             last_rejected = false;
-            let mut proposed = (h_try * factor).min(memory.max_step);
+            let mut proposed = on_step_grid((h_try * factor).min(memory.max_step), memory.max_step);
             if to_breakpoint {
                 last_breakpoint = step_end;
             }
@@ -244,7 +269,7 @@ pub fn integrate<const N: usize, const S: usize, Sys: OdeSystem<N>>(
             } else {
                 0.25
             };
-            h = h_try * factor;
+            h = on_step_grid(h_try * factor, memory.max_step);
             if h < MIN_STEP.max(1e-12 * t.abs()) {
                 memory.next_step = 1e-5;
                 return Err(Handover { time: t, state: y });
@@ -314,6 +339,26 @@ mod tests {
         let fifth: f64 = b_hat.iter().zip(&pow(4)).map(|(x, y)| x * y).sum();
         assert!((fifth - 0.2).abs() > 1e-6);
         assert_eq!(t.c[t.stiffness_stage], t.c[s - 1]);
+    }
+
+    #[test]
+    fn step_sizes_go_onto_a_grid_of_32_per_octave_below_the_request() {
+        let cap = 8.461_678_959_015_4e-4;
+        let mut sizes = std::collections::BTreeSet::new();
+        for k in 0..10_000 {
+            let h = 1e-4 * (1.0 + 9.0 * k as f64 / 10_000.0);
+            let on_grid = on_step_grid(h, cap);
+            assert!(on_grid <= h && on_grid > h * (1.0 - 1.0 / 32.0), "{h} -> {on_grid}");
+            assert_eq!(on_step_grid(on_grid, cap), on_grid, "{on_grid} is not on the grid");
+            sizes.insert(on_grid.to_bits());
+        }
+        // From 1e-4 to 1e-3: log2(10) = 3.3 octaves of 32 sizes each (evenly spaced within
+        // an octave, so the partial octaves at the ends hold 11.6 and 0.8), and the size
+        // just below 1e-4.
+        assert!((107..=110).contains(&sizes.len()), "{} sizes", sizes.len());
+        assert_eq!(on_step_grid(cap, cap), cap);
+        assert_eq!(on_step_grid(f64::INFINITY, cap), f64::INFINITY);
+        assert_eq!(LN_ERROR_FLOOR, 1e-4f64.ln());
     }
 
     #[test]

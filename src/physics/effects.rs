@@ -116,10 +116,18 @@ pub fn sensor_reading(offset: f64, gain: f64, force: f64) -> f64 {
 /// p = P_s − R ṁ(p). ṁ rises with p, and at `lowest` (the lower chamber pressure) no air
 /// leaves the supply, so the root lies in [lowest, P_s]; the Illinois variant of regula
 /// falsi finds it without leaving the bracket, however large R is.
+#[inline]
 pub fn supply_pressure_at_jet(p_s: f64, resistance: f64, lowest: f64, supply_flow: impl Fn(f64) -> f64) -> f64 {
+    // Without the effect (the default) this is every right-hand side's first question:
+    // answered inline, the root search stays out of line.
     if resistance == 0.0 {
         return p_s;
     }
+    supply_pressure_through_line(p_s, resistance, lowest, supply_flow)
+}
+
+#[inline(never)]
+fn supply_pressure_through_line(p_s: f64, resistance: f64, lowest: f64, supply_flow: impl Fn(f64) -> f64) -> f64 {
     let residual = |p: f64| p - p_s + resistance * supply_flow(p);
     let (mut a, mut fa) = (lowest.min(p_s), residual(lowest.min(p_s)));
     let (mut b, mut fb) = (p_s, residual(p_s));

@@ -73,7 +73,7 @@ pub fn return_area_port2(d_jp: f64, x_abs: f64) -> f64 {
 }
 
 /// The four orifice areas at one tip position.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct OrificeAreas {
     pub supply_1: f64,
     pub return_1: f64,
