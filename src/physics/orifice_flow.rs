@@ -44,6 +44,7 @@ impl FlowConstants {
     }
 
     /// f2 of (2.22), regularised in the band next to r = 1.
+    #[inline]
     pub fn f2(&self, ratio: f64) -> f64 {
         // Outside the band (1 − r ≥ band), tested without a division.
         if 1.0 - ratio >= REGULARISATION_RATIO_BAND {
