@@ -74,6 +74,9 @@ struct ChamberSystem<'a> {
     /// [`OdeSystem::prepare_stages`]. An entry from an earlier step is still right: the
     /// areas depend on the time alone.
     stage_areas: std::cell::RefCell<StageAreas>,
+    /// The pressures and rates at the step's start (t = 0), asked for twice: by the ringing
+    /// test and by the integrator's first stage.
+    start_rates: std::cell::Cell<Option<(SVector<f64, 2>, SVector<f64, 2>)>>,
     /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
     /// question starts there.
     stretch_at: std::cell::Cell<Option<(f64, i32)>>,
@@ -94,6 +97,7 @@ impl<'a> ChamberSystem<'a> {
             x_s_rate,
             areas_at: std::cell::Cell::new(None),
             stage_areas: std::cell::RefCell::new(StageAreas::default()),
+            start_rates: std::cell::Cell::new(None),
             stretch_at: std::cell::Cell::new(None),
             tangency_free: std::cell::Cell::new(None),
             duration,
@@ -168,6 +172,20 @@ impl<'a> ChamberSystem<'a> {
         b
     }
 
+    /// The rates at t = 0, kept (see `start_rates`); out of line, so the stages' path stays
+    /// small enough to be inlined into the integrator.
+    #[inline(never)]
+    fn rates_at_start(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+        match self.start_rates.get() {
+            Some((pressures, rates)) if pressures == *p => rates,
+            _ => {
+                let rates = self.rates(&self.areas(0.0), 0.0, p);
+                self.start_rates.set(Some((*p, rates)));
+                rates
+            }
+        }
+    }
+
     fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
         let x_s = self.x_s + self.x_s_rate * t;
         let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
@@ -191,7 +209,11 @@ impl StageAreas {
 }
 
 impl OdeSystem<2> for ChamberSystem<'_> {
+    #[inline]
     fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+        if t == 0.0 {
+            return self.rates_at_start(p);
+        }
         self.rates(&self.areas(t), t, p)
     }
     /// The jet pipe positions at all stages at once ([`Trajectory::node_positions`]), then
@@ -422,8 +444,9 @@ impl Simulation {
     }
 
     /// How long into a step of length `step` the jet pipe's ringing still moves the
-    /// pressures by more than a hundredth of the tolerance (0 if never).
-    fn ringing_until(&self, trajectory: &Trajectory, step: f64) -> f64 {
+    /// pressures by more than a hundredth of the tolerance (0 if never). The pressure rates
+    /// at the start come from `system`, which keeps them for the integrator's first stage.
+    fn ringing_until(&self, system: &ChamberSystem, trajectory: &Trajectory, step: f64) -> f64 {
         let after_current_transient = step.min(5.0 / self.model.params.omega_cd);
         let amplitude = trajectory
             .ringing_amplitude(0.0)
@@ -438,7 +461,10 @@ impl Simulation {
             self.state[index::P2],
         );
         let h = 1e-7;
-        let (a0, b0) = self.model.pressure_rates(x_jp, p1, p2, self.x_s, self.x_s_rate);
+        // The system's rates at the start are at the trajectory's x(0), which is x_jp to
+        // rounding (an ulp, some 1e-13 of h).
+        let start = system.rhs(0.0, &SVector::<f64, 2>::new(p1, p2));
+        let (a0, b0) = (start[0], start[1]);
         let (a1, b1) = self.model.pressure_rates(x_jp + h, p1, p2, self.x_s, self.x_s_rate);
         let sensitivity = ((a1 - a0) / h).abs().max(((b1 - b0) / h).abs());
         // Pressure ripple ≈ ∂Ṗ/∂x · amplitude / ω_d.
@@ -557,7 +583,7 @@ impl Simulation {
                 // While the jet pipe rings enough to matter, keep steps below a quarter of
                 // its period: a longer step samples the 295 Hz forcing too sparsely for the
                 // embedded error estimate to notice what it misses.
-                let ringing_until = self.ringing_until(&trajectory, duration);
+                let ringing_until = self.ringing_until(&system, &trajectory, duration);
                 let changed = self.input_changed || v_rate != 0.0 || self.x_s_rate != 0.0;
                 if changed {
                     self.chamber_integrator.next_step =
@@ -1013,6 +1039,32 @@ mod tests {
                 "{b}"
             );
         }
+    }
+
+    /// The rates at t = 0 are kept for the pressures last asked about there, and only there.
+    #[test]
+    fn chambers_keep_the_rates_at_the_start_for_the_same_pressures_only() {
+        let model = thesis_model();
+        let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
+        let propagator = sim.propagator.as_ref().unwrap();
+        let start = ElectromechanicalState {
+            current: sim.state[index::CURRENT],
+            position: sim.state[index::JET_POSITION],
+            velocity: sim.state[index::JET_VELOCITY],
+            acceleration: sim.state[index::JET_ACCELERATION],
+        };
+        let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
+        let system = ChamberSystem::new(&model, &trajectory, 0.01, sim.x_s, 0.0);
+        let fresh = |t: f64, p: &SVector<f64, 2>| system.rates(&model.areas(trajectory.position(t)), t, p);
+        let p = SVector::<f64, 2>::new(sim.state[index::P1], sim.state[index::P2]);
+        let q = p * 1.01;
+        for pressures in [p, p, q, p, q, q] {
+            assert_eq!(system.rhs(0.0, &pressures), fresh(0.0, &pressures));
+        }
+        assert_eq!(system.start_rates.get().map(|(kept, _)| kept), Some(q));
+        assert_eq!(system.rhs(1e-3, &p), fresh(1e-3, &p));
+        assert_eq!(system.start_rates.get().map(|(kept, _)| kept), Some(q));
+        assert_ne!(system.rhs(0.0, &p), system.rhs(0.0, &q));
     }
 
     #[test]
