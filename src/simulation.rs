@@ -562,13 +562,7 @@ impl Simulation {
         let t_end = t0 + duration;
         let outcome = match (self.method, &self.propagator) {
             (Method::Split, Some(propagator)) => {
-                let start = ElectromechanicalState {
-                    current: self.state[index::CURRENT],
-                    position: self.state[index::JET_POSITION],
-                    velocity: self.state[index::JET_VELOCITY],
-                    acceleration: self.state[index::JET_ACCELERATION],
-                };
-                let trajectory = propagator.trajectory(&start, v, v_rate, &self.plays);
+                let trajectory = propagator.trajectory(&self.electromechanical_state(), v, v_rate, &self.plays);
                 let system = ChamberSystem::new(&self.model, &trajectory, duration, self.x_s, self.x_s_rate);
                 let scale = self.model.state_scales();
                 let tolerances = Tolerances {
@@ -697,6 +691,16 @@ impl Simulation {
                 message: failure.message,
                 time: self.time,
             }),
+        }
+    }
+
+    /// The current driver's and jet pipe's part of the state.
+    fn electromechanical_state(&self) -> ElectromechanicalState {
+        ElectromechanicalState {
+            current: self.state[index::CURRENT],
+            position: self.state[index::JET_POSITION],
+            velocity: self.state[index::JET_VELOCITY],
+            acceleration: self.state[index::JET_ACCELERATION],
         }
     }
 
@@ -1003,12 +1007,7 @@ mod tests {
         let model = thesis_model();
         let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
         let propagator = sim.propagator.as_ref().unwrap();
-        let start = ElectromechanicalState {
-            current: sim.state[index::CURRENT],
-            position: sim.state[index::JET_POSITION],
-            velocity: sim.state[index::JET_VELOCITY],
-            acceleration: sim.state[index::JET_ACCELERATION],
-        };
+        let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
         // The chambers' time starts at the step's start, as the trajectory's does.
         let system = ChamberSystem::new(&model, &trajectory, 0.002, sim.x_s, 0.0);
@@ -1047,12 +1046,7 @@ mod tests {
         let model = thesis_model();
         let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
         let propagator = sim.propagator.as_ref().unwrap();
-        let start = ElectromechanicalState {
-            current: sim.state[index::CURRENT],
-            position: sim.state[index::JET_POSITION],
-            velocity: sim.state[index::JET_VELOCITY],
-            acceleration: sim.state[index::JET_ACCELERATION],
-        };
+        let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
         let system = ChamberSystem::new(&model, &trajectory, 0.01, sim.x_s, 0.0);
         let fresh = |t: f64, p: &SVector<f64, 2>| system.rates(&model.areas(trajectory.position(t)), t, p);
