@@ -395,7 +395,8 @@ impl SeriesForm {
 
     /// The modal exponentials' parts e^{λk s}·amplitude_k, and r = e^{−ω s}.
     fn growth(&self, p: &ElectromechanicalPropagator, s: f64) -> ([C64; 3], f64) {
-        (modal_growth(p, &self.amplitude, s), (-p.omega_cd * s).exp())
+        let e = p.exponentials(s, true);
+        (growth_from(&self.amplitude, &e), e.decay)
     }
 
     fn horner(coefficients: &[f64], r: f64) -> f64 {
