@@ -679,11 +679,11 @@ enum ClosedForm<'f> {
     Ramp(&'f RampForm),
 }
 
-/// Most stages of one step [`Trajectory::node_positions`] takes: Dormand–Prince's six after
-/// the first.
-pub const MAX_NODES: usize = 6;
-/// Step sizes whose advances are kept (6.7 kB, allocated on first use): the chirp's
-/// error-controlled steps and the rest of each communication step come in about twenty.
+/// Most stages of one step [`Trajectory::node_positions`] takes: Verner's eight after the
+/// first (Dormand–Prince has six).
+pub const MAX_NODES: usize = 8;
+/// Step sizes whose advances are kept (8.7 kB, allocated on first use): the error-controlled
+/// steps and the rest of each communication step come in about twenty.
 const ADVANCE_SLOTS: usize = 32;
 
 #[derive(Clone, Debug, Default)]

@@ -12,7 +12,8 @@
 //! estimate is filtered through (I − hγJ)⁻¹ (Hairer & Wanner IV.8) so stiff components do
 //! not cause spurious rejections.
 //!
-//! [`explicit`] holds Dormand–Prince 5(4) for systems that are stiff only now and then
+//! [`explicit`] holds Dormand–Prince 5(4) and Verner's 6(5) for systems that are stiff only
+//! now and then
 //! ([`Sdirk4::integrate_nonstiff_first`] hands over between the two), and both end their
 //! steps at the breakpoints a system reports ([`OdeSystem::breakpoint`]).
 
@@ -125,6 +126,16 @@ const B_HAT: [f64; 5] = [59.0 / 48.0, -17.0 / 96.0, 225.0 / 32.0, -85.0 / 12.0, 
 
 const MAX_NEWTON_ITERATIONS: usize = 8;
 pub(crate) const MIN_STEP: f64 = 1e-14;
+
+/// The explicit pair [`Sdirk4::integrate_nonstiff_first`] starts with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExplicitPair {
+    /// Dormand–Prince 5(4), seven stages: the cheaper step where the error sets the steps.
+    DormandPrince,
+    /// Verner's 6(5), nine stages: its error estimate over-reads fast exponential forcing
+    /// ([`explicit::VERNER_65`]), so it needs no cap where the forcing rings.
+    Verner,
+}
 
 /// The integrator: its only memory between calls is the step size to try next, which is
 /// part of the simulation state (it makes results reproducible after a state restore).
@@ -249,12 +260,13 @@ impl Sdirk4 {
         Ok(y)
     }
 
-    /// Integrate from (t0, y0) to t1 with Dormand–Prince 5(4) while the system is not stiff
+    /// Integrate from (t0, y0) to t1 with the explicit `pair` while the system is not stiff
     /// and with SDIRK4 from where it becomes so (or where the explicit step collapses) to t1.
     /// For systems that are mostly non-stiff, such as the chambers between their pressure
     /// limits: no Newton iterations and no Jacobians there.
     pub fn integrate_nonstiff_first<const N: usize, S: OdeSystem<N>>(
         &mut self,
+        pair: ExplicitPair,
         system: &S,
         t0: f64,
         y0: SVector<f64, N>,
@@ -270,16 +282,21 @@ impl Sdirk4 {
             max_step: self.max_step,
             first_step: None,
         };
-        let outcome = explicit::integrate(
-            &explicit::DORMAND_PRINCE_54,
-            &mut memory,
-            system,
-            t0,
-            y0,
-            t1,
-            tol,
-            stats,
-        );
+        let outcome = match pair {
+            ExplicitPair::DormandPrince => explicit::integrate(
+                &explicit::DORMAND_PRINCE_54,
+                &mut memory,
+                system,
+                t0,
+                y0,
+                t1,
+                tol,
+                stats,
+            ),
+            ExplicitPair::Verner => {
+                explicit::integrate(&explicit::VERNER_65, &mut memory, system, t0, y0, t1, tol, stats)
+            }
+        };
         self.next_step = memory.next_step;
         if let Some(first) = memory.first_step {
             self.first_step = first;
