@@ -285,9 +285,11 @@ pub enum Method {
 /// How the split method integrates the two chamber pressures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ChamberMethod {
-    /// Dormand–Prince 5(4) while the chambers are not stiff, SDIRK4 from where they become
-    /// so to the end of the communication step. The chambers' own time constants are 3 ms
-    /// and slower in the standard scenarios, so this is the default: no Newton iterations.
+    /// Dormand–Prince 5(4) while the chambers are not stiff (Verner's 6(5) for a ringing
+    /// stretch that Dormand–Prince's quarter-period cap would cut in two), SDIRK4 from where
+    /// they become so to the end of the communication step. The chambers' own time constants
+    /// are 3 ms and slower in the standard scenarios, so this is the default: no Newton
+    /// iterations.
     NonStiffFirst,
     /// [`ChamberMethod::NonStiffFirst`] with Dormand–Prince for every explicit step, capped at
     /// a quarter of the ringing period while the jet pipe rings (the default until Verner's

@@ -109,8 +109,8 @@ pub const DORMAND_PRINCE_54: Tableau<7> = Tableau {
 ///
 /// Why a second pair: its error estimate over-reads the quadrature error of an exponential
 /// forcing e^{zt} (the jet pipe's ringing and current transient) for |z| up to a full
-/// ringing period per step and hω_cd up to 40, where Dormand–Prince's under-reads from half
-/// a period and hω_cd = 3 on (`estimates_read_the_error_of_fast_exponential_forcing`). So
+/// ringing period per step and hω_cd up to 40, where Dormand–Prince's under-reads beyond half
+/// a period and from hω_cd = 3 on (`estimates_read_the_error_of_fast_exponential_forcing`). So
 /// it needs no quarter-period cap while the jet pipe rings, and one step of it replaces the
 /// two capped ones Dormand–Prince takes for a 1 ms communication step.
 ///
