@@ -68,10 +68,13 @@ struct ChamberSystem<'a> {
     trajectory: &'a Trajectory<'a>,
     x_s: f64,
     x_s_rate: f64,
-    /// The orifice areas at the last time asked for: Newton iterations and the Jacobian
-    /// evaluate many pressures at one stage time, and the jet pipe position and the areas
-    /// (four lens areas) cost more than the flows.
-    areas_at: std::cell::Cell<Option<(f64, OrificeAreas)>>,
+    /// The jet pipe position at t = 0: the state's, which the trajectory starts from (its
+    /// own value there agrees to rounding).
+    start_position: f64,
+    /// The jet pipe position and orifice areas at the last time asked for: Newton
+    /// iterations and the Jacobian evaluate many pressures at one stage time, and the jet
+    /// pipe position and the areas (four lens areas) cost more than the flows.
+    areas_at: std::cell::Cell<Option<(f64, f64, OrificeAreas)>>,
     /// The areas at the stage times of the current explicit step, worked out together in
     /// [`OdeSystem::prepare_stages`]. An entry from an earlier step is still right: the
     /// areas depend on the time alone.
@@ -79,6 +82,9 @@ struct ChamberSystem<'a> {
     /// The pressures and rates at the step's start (t = 0), asked for twice: by the ringing
     /// test and by the integrator's first stage.
     start_rates: std::cell::Cell<Option<(SVector<f64, 2>, SVector<f64, 2>)>>,
+    /// The jet pipe position, pressures and rates of the last evaluation at t = duration:
+    /// the integrator's last stage, whose rates are the next step's rates at its start.
+    end_rates: std::cell::Cell<Option<(f64, SVector<f64, 2>, SVector<f64, 2>)>>,
     /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
     /// question starts there.
     stretch_at: std::cell::Cell<Option<(f64, i32)>>,
@@ -90,16 +96,27 @@ struct ChamberSystem<'a> {
 }
 
 impl<'a> ChamberSystem<'a> {
-    /// The chambers over [0, duration].
-    fn new(model: &'a Actuator, trajectory: &'a Trajectory<'a>, duration: f64, x_s: f64, x_s_rate: f64) -> Self {
+    /// The chambers over [0, duration], from the jet pipe position `start_position`; the
+    /// pressure rates at the start are `start_rates` when they are already known.
+    fn new(
+        model: &'a Actuator,
+        trajectory: &'a Trajectory<'a>,
+        duration: f64,
+        start_position: f64,
+        start_rates: Option<(SVector<f64, 2>, SVector<f64, 2>)>,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> Self {
         Self {
             model,
             trajectory,
             x_s,
             x_s_rate,
+            start_position,
             areas_at: std::cell::Cell::new(None),
             stage_areas: std::cell::RefCell::new(StageAreas::default()),
-            start_rates: std::cell::Cell::new(None),
+            start_rates: std::cell::Cell::new(start_rates),
+            end_rates: std::cell::Cell::new(None),
             stretch_at: std::cell::Cell::new(None),
             tangency_free: std::cell::Cell::new(None),
             duration,
@@ -120,15 +137,25 @@ impl<'a> ChamberSystem<'a> {
     }
 
     fn areas(&self, t: f64) -> OrificeAreas {
-        if let Some(areas) = self.stage_areas.borrow().at(t) {
-            return areas;
+        self.position_and_areas(t).1
+    }
+
+    /// The jet pipe position at `t` and the orifice areas there.
+    fn position_and_areas(&self, t: f64) -> (f64, OrificeAreas) {
+        if let Some(known) = self.stage_areas.borrow().at(t) {
+            return known;
         }
         match self.areas_at.get() {
-            Some((cached, areas)) if cached == t => areas,
+            Some((cached, position, areas)) if cached == t => (position, areas),
             _ => {
-                let areas = self.model.areas(self.trajectory.position(t));
-                self.areas_at.set(Some((t, areas)));
-                areas
+                let position = if t == 0.0 {
+                    self.start_position
+                } else {
+                    self.trajectory.position(t)
+                };
+                let areas = self.model.areas(position);
+                self.areas_at.set(Some((t, position, areas)));
+                (position, areas)
             }
         }
     }
@@ -188,6 +215,14 @@ impl<'a> ChamberSystem<'a> {
         }
     }
 
+    /// The rates at t = duration, recorded with the position and pressures (see `end_rates`).
+    fn rates_at_end(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+        let (position, areas) = self.position_and_areas(self.duration);
+        let rates = self.rates(&areas, self.duration, p);
+        self.end_rates.set(Some((position, *p, rates)));
+        rates
+    }
+
     fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
         let x_s = self.x_s + self.x_s_rate * t;
         let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
@@ -195,18 +230,19 @@ impl<'a> ChamberSystem<'a> {
     }
 }
 
-/// Orifice areas at the stage times of one step.
+/// Jet pipe positions and orifice areas at the stage times of one step.
 #[derive(Default)]
 struct StageAreas {
     count: usize,
     times: [f64; MAX_NODES],
+    positions: [f64; MAX_NODES],
     areas: [OrificeAreas; MAX_NODES],
 }
 
 impl StageAreas {
-    fn at(&self, t: f64) -> Option<OrificeAreas> {
+    fn at(&self, t: f64) -> Option<(f64, OrificeAreas)> {
         let i = self.times[..self.count].iter().position(|&time| time == t)?;
-        Some(self.areas[i])
+        Some((self.positions[i], self.areas[i]))
     }
 }
 
@@ -215,6 +251,9 @@ impl OdeSystem<2> for ChamberSystem<'_> {
     fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
         if t == 0.0 {
             return self.rates_at_start(p);
+        }
+        if t == self.duration {
+            return self.rates_at_end(p);
         }
         self.rates(&self.areas(t), t, p)
     }
@@ -231,6 +270,7 @@ impl OdeSystem<2> for ChamberSystem<'_> {
         let mut table = self.stage_areas.borrow_mut();
         for i in 0..count {
             table.times[i] = times[i];
+            table.positions[i] = positions[i];
             table.areas[i] = if i > 0 && positions[i] == positions[i - 1] {
                 table.areas[i - 1]
             } else {
@@ -341,6 +381,20 @@ pub struct Simulation {
     pub stopper_velocity: f64,
     pub x_s_at_last_step: f64,
     propagator: Option<ElectromechanicalPropagator>,
+    /// The chambers' pressure rates at the end of the last split step, with what they are a
+    /// function of: when the next step starts from the same jet pipe position, pressures and
+    /// stopper motion, they are its rates at the start and are not evaluated again.
+    chamber_rates_at_end: Option<ChamberRatesAtEnd>,
+}
+
+/// See [`Simulation::chamber_rates_at_end`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ChamberRatesAtEnd {
+    x_jp: f64,
+    pressures: SVector<f64, 2>,
+    x_s: f64,
+    x_s_rate: f64,
+    rates: SVector<f64, 2>,
 }
 
 /// From `time` on, the command was `v_da` + `rate`·(t − `time`).
@@ -399,6 +453,7 @@ impl Simulation {
             stopper_velocity: 0.0,
             x_s_at_last_step: x_s,
             propagator,
+            chamber_rates_at_end: None,
         }
     }
 
@@ -571,13 +626,22 @@ impl Simulation {
         let outcome = match (self.method, &self.propagator) {
             (Method::Split, Some(propagator)) => {
                 let trajectory = propagator.trajectory(&self.electromechanical_state(), v, v_rate, &self.plays);
-                let system = ChamberSystem::new(&self.model, &trajectory, duration, self.x_s, self.x_s_rate);
+                let pressures = SVector::<f64, 2>::new(self.state[index::P1], self.state[index::P2]);
+                let start_position = self.state[index::JET_POSITION];
+                let system = ChamberSystem::new(
+                    &self.model,
+                    &trajectory,
+                    duration,
+                    start_position,
+                    self.known_chamber_rates().map(|end| (end.pressures, end.rates)),
+                    self.x_s,
+                    self.x_s_rate,
+                );
                 let scale = self.model.state_scales();
                 let tolerances = Tolerances {
                     relative: self.local_tolerance(),
                     absolute: SVector::<f64, 2>::new(scale[index::P1], scale[index::P2]) * self.local_tolerance(),
                 };
-                let pressures = SVector::<f64, 2>::new(self.state[index::P1], self.state[index::P2]);
                 let combine = |s: f64, p: SVector<f64, 2>| {
                     let em = trajectory.state(s);
                     State::from([em.current, em.position, em.velocity, em.acceleration, p[0], p[1]])
@@ -661,8 +725,25 @@ impl Simulation {
                 if plays.iter().all(|p| p.is_finite()) {
                     self.plays = plays;
                 }
+                self.chamber_rates_at_end = None;
                 match result {
-                    Ok(p) => Ok(combine(duration, p)),
+                    Ok(p) => {
+                        let mut end = combine(duration, p);
+                        // The position the chambers' last stage saw (the trajectory's own
+                        // value at the end agrees to rounding): with it the state is the
+                        // last stage's, and its rates are the next step's at its start.
+                        if let Some((x_jp, pressures, rates)) = system.end_rates.get().filter(|(_, q, _)| *q == p) {
+                            end[index::JET_POSITION] = x_jp;
+                            self.chamber_rates_at_end = Some(ChamberRatesAtEnd {
+                                x_jp,
+                                pressures,
+                                x_s: self.x_s + self.x_s_rate * duration,
+                                x_s_rate: self.x_s_rate,
+                                rates,
+                            });
+                        }
+                        Ok(end)
+                    }
                     Err(f) => Err(IntegrationFailure {
                         message: f.message,
                         time: t0 + f.time,
@@ -720,6 +801,17 @@ impl Simulation {
                 time: self.time,
             }),
         }
+    }
+
+    /// The chambers' rates at the last step's end when the next step starts where they
+    /// were taken: same jet pipe position, pressures and stopper motion.
+    fn known_chamber_rates(&self) -> Option<ChamberRatesAtEnd> {
+        self.chamber_rates_at_end.filter(|end| {
+            end.x_jp == self.state[index::JET_POSITION]
+                && end.pressures == SVector::<f64, 2>::new(self.state[index::P1], self.state[index::P2])
+                && end.x_s == self.x_s
+                && end.x_s_rate == self.x_s_rate
+        })
     }
 
     /// The current driver's and jet pipe's part of the state.
@@ -1077,7 +1169,15 @@ mod tests {
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
         // The chambers' time starts at the step's start, as the trajectory's does.
-        let system = ChamberSystem::new(&model, &trajectory, 0.002, sim.x_s, 0.0);
+        let system = ChamberSystem::new(
+            &model,
+            &trajectory,
+            0.002,
+            sim.state[index::JET_POSITION],
+            None,
+            sim.x_s,
+            0.0,
+        );
         let stretch_at = |t: f64| model.area_stretch(trajectory.position(t));
         assert_ne!(stretch_at(0.0), stretch_at(0.002), "the swing must cross a tangency");
         // Walk through 2 ms in 0.1 ms pieces, as an integrator would.
@@ -1115,8 +1215,25 @@ mod tests {
         let propagator = sim.propagator.as_ref().unwrap();
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
-        let system = ChamberSystem::new(&model, &trajectory, 0.01, sim.x_s, 0.0);
-        let fresh = |t: f64, p: &SVector<f64, 2>| system.rates(&model.areas(trajectory.position(t)), t, p);
+        let system = ChamberSystem::new(
+            &model,
+            &trajectory,
+            0.01,
+            sim.state[index::JET_POSITION],
+            None,
+            sim.x_s,
+            0.0,
+        );
+        // At t = 0 the chambers see the state's jet pipe position (the trajectory's agrees to
+        // rounding).
+        let position = |t: f64| {
+            if t == 0.0 {
+                sim.state[index::JET_POSITION]
+            } else {
+                trajectory.position(t)
+            }
+        };
+        let fresh = |t: f64, p: &SVector<f64, 2>| system.rates(&model.areas(position(t)), t, p);
         let p = SVector::<f64, 2>::new(sim.state[index::P1], sim.state[index::P2]);
         let q = p * 1.01;
         for pressures in [p, p, q, p, q, q] {
@@ -1126,6 +1243,53 @@ mod tests {
         assert_eq!(system.rhs(1e-3, &p), fresh(1e-3, &p));
         assert_eq!(system.start_rates.get().map(|(kept, _)| kept), Some(q));
         assert_ne!(system.rhs(0.0, &p), system.rhs(0.0, &q));
+    }
+
+    #[test]
+    fn rates_at_a_step_end_are_the_next_steps_rates_at_its_start() {
+        // Held stopper, then a moving one, then a jump: a millisecond chirp-like command.
+        let run = |forget: bool| {
+            let mut sim = Simulation::at_equilibrium(thesis_model(), 2.5, 0.054, 0.0, 1e-6).unwrap();
+            let mut states = vec![];
+            let mut reused = 0;
+            for k in 0..60 {
+                sim.set_command(2.5 + 1.5 * (k as f64 * 0.3).sin()).unwrap();
+                if (20..30).contains(&k) {
+                    sim.set_stopper_rate(0.05).unwrap();
+                }
+                if k == 40 {
+                    sim.set_stopper(0.05).unwrap();
+                }
+                if forget {
+                    sim.chamber_rates_at_end = None;
+                }
+                reused += usize::from(sim.known_chamber_rates().is_some());
+                sim.step(1e-3).unwrap();
+                states.push(sim.state);
+                let end = sim.chamber_rates_at_end.expect("every step ends with its last stage");
+                // What was kept is the rate function at what it is keyed on, and that key is
+                // the state the step ended in.
+                let (a, b) =
+                    sim.model
+                        .pressure_rates(end.x_jp, end.pressures[0], end.pressures[1], end.x_s, end.x_s_rate);
+                assert_eq!(end.rates, SVector::<f64, 2>::new(a, b));
+                assert_eq!(end.x_jp, sim.state[index::JET_POSITION]);
+                assert_eq!(
+                    end.pressures,
+                    SVector::<f64, 2>::new(sim.state[index::P1], sim.state[index::P2])
+                );
+                assert_eq!(end.x_s, sim.x_s);
+            }
+            (states, reused)
+        };
+        let (with, reused) = run(false);
+        let (without, none) = run(true);
+        // A memo: the results are the same to the last bit.
+        assert_eq!(with, without);
+        assert_eq!(none, 0);
+        // Every step but the first reuses them, except where the stopper starts moving
+        // (step 20), stops (30) and jumps (40).
+        assert_eq!(reused, 56);
     }
 
     #[test]

@@ -168,6 +168,7 @@ impl UnchokedFactor {
 /// Mass flow (kg/s) through an orifice of effective area `cd_area` (C_d·A, m²) between
 /// pressures `p_from` and `p_to`, (2.18): positive from `p_from` to `p_to`, negative when
 /// the pressure difference is reversed; choked below the critical ratio.
+#[inline]
 pub fn mass_flow(k: &FlowConstants, cd_area: f64, p_from: f64, p_to: f64) -> f64 {
     let (p_up, p_down, sign) = if p_from >= p_to {
         (p_from, p_to, 1.0)
