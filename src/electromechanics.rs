@@ -73,6 +73,9 @@ struct SeriesWeight {
 
 /// Largest |ε|/ρ (jump over the distance to tanh's nearest pole) for which the series is used.
 const SERIES_RATIO_LIMIT: f64 = 0.5;
+/// A larger jump is integrated by quadrature until it has decayed to this fraction of the
+/// limit (rounding then cannot push the rest over it), and by the series from there.
+const LATE_SERIES_MARGIN: f64 = 0.9;
 const MAX_SERIES_TERMS: usize = 64;
 /// Largest |k_m δ / F_jp_sat| (the current transient's share of tanh's argument) that a
 /// ramp's closed form neglects: its effect on the jet pipe is below 1e-15·x_jp_sat.
@@ -209,6 +212,8 @@ impl ElectromechanicalPropagator {
         } else {
             None
         };
+        // Where a held command's jump is too large for the series: when it has shrunk enough.
+        let mut series_from = None;
         if ramp == 0.0 && (!self.hysteresis.is_active() || linear_hysteresis.is_some()) {
             let centre = self.k_m * base / self.f_sat;
             let epsilon = self.k_m * delta / self.f_sat;
@@ -220,6 +225,9 @@ impl ElectromechanicalPropagator {
                     *a *= self.x_sat * slope;
                 }
                 series[0] += constant;
+            } else {
+                let shrunk = LATE_SERIES_MARGIN * SERIES_RATIO_LIMIT * radius;
+                series_from = Some((epsilon.abs() / shrunk).ln() / self.omega_cd);
             }
         }
         // A ramp whose current transient is below rounding (a ramp continued from the last
@@ -246,9 +254,19 @@ impl ElectromechanicalPropagator {
             settled: None,
             kinks: vec![],
             panel_ends: std::cell::RefCell::new(vec![]),
+            late: None,
         };
         if trajectory.series.is_empty() {
             trajectory.kinks = trajectory.find_kinks();
+        }
+        if let Some(from) = series_from {
+            // Quadrature up to `from` (a few panels), the series from there: the current
+            // transient is then a jump the series converges for.
+            let late = self.trajectory(&trajectory.state(from), v_da, 0.0, &trajectory.plays_at(from));
+            if late.series_form.is_some() {
+                trajectory.late = Some((from, Box::new(late)));
+                return trajectory;
+            }
         }
         if trajectory.series.is_empty() && ramp == 0.0 {
             // |δ| e^{−ω s} below 1e-15 A: the input is constant to rounding.
@@ -585,8 +603,14 @@ fn constant_and_spread(coefficients: &[f64], z_max: f64) -> (f64, f64) {
 fn modal_bounds(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s_end: f64) -> (f64, f64) {
     let real = amplitude[0].re;
     let real_end = real * (p.lambda[0].re * s_end).exp();
-    let ringing = amplitude[1].norm() + amplitude[2].norm();
+    let ringing = modulus(amplitude[1]) + modulus(amplitude[2]);
     (real.min(real_end) - ringing, real.max(real_end) + ringing)
+}
+
+/// |c| for a modal amplitude (metres, far from overflow and underflow): the root of the
+/// square, without the rescaling of `hypot`, which costs three times as much.
+fn modulus(c: C64) -> f64 {
+    c.norm_sqr().sqrt()
 }
 
 /// e^{λk s}·amplitude_k for the three modes (λ3 = conj(λ2), so one complex exponential).
@@ -731,9 +755,20 @@ pub struct Trajectory<'a> {
     kinks: Vec<f64>,
     /// Panel ends and the modal integrals up to them, filled as queries need them.
     panel_ends: std::cell::RefCell<Vec<(f64, [C64; 3])>>,
+    /// For a held command whose jump is too large for the series: from when on the
+    /// trajectory is the series-form one started there (queries from then on go to it).
+    late: Option<(f64, Box<Trajectory<'a>>)>,
 }
 
 impl Trajectory<'_> {
+    /// The late part of the trajectory and the time into it, for `s` from its start on.
+    fn late_at(&self, s: f64) -> Option<(&Self, f64)> {
+        self.late
+            .as_ref()
+            .filter(|(from, _)| s >= *from)
+            .map(|(from, late)| (&**late, s - from))
+    }
+
     /// Coil current at `s` seconds into the step.
     pub fn current(&self, s: f64) -> f64 {
         self.base + self.ramp * s + self.delta * (-self.propagator.omega_cd * s).exp()
@@ -746,6 +781,9 @@ impl Trajectory<'_> {
 
     /// The hysteresis operator's play states at `s` (all at f3's output when it is off).
     pub fn plays_at(&self, s: f64) -> [f64; PLAY_OPERATORS] {
+        if let Some((late, s)) = self.late_at(s) {
+            return late.plays_at(s);
+        }
         let operator = &self.propagator.hysteresis;
         if !operator.is_active() {
             return [self.static_position(s); PLAY_OPERATORS];
@@ -911,6 +949,9 @@ impl Trajectory<'_> {
     /// ramp, that part lags the input; it does not ring). Otherwise it is measured about the
     /// rest position of the static input at `s`: 2|q − q_rest|, q_rest = −β ū/λ.
     pub fn ringing_amplitude(&self, s: f64) -> f64 {
+        if let Some((late, s)) = self.late_at(s) {
+            return late.ringing_amplitude(s);
+        }
         let p = self.propagator;
         let homogeneous = match (&self.series_form, &self.ramp_form) {
             (Some(form), _) => Some(form.amplitude[1]),
@@ -918,11 +959,11 @@ impl Trajectory<'_> {
             _ => None,
         };
         if let Some(c) = homogeneous {
-            return 2.0 * c.norm() * (p.lambda[1].re * s).exp();
+            return 2.0 * modulus(c) * (p.lambda[1].re * s).exp();
         }
         let q = self.modes(s);
         let u_rest = self.jet_input(s);
-        2.0 * (q[1] + p.beta[1] * u_rest / p.lambda[1]).norm()
+        2.0 * modulus(q[1] + p.beta[1] * u_rest / p.lambda[1])
     }
 
     /// Decay rate ζ2ω2 (1/s) and period 2π/ω_d (s) of that oscillation.
@@ -938,6 +979,17 @@ impl Trajectory<'_> {
     /// [`ElectromechanicalPropagator::with_advances`]); otherwise each is [`Self::position`].
     /// The two agree to rounding (`node_positions_match_the_positions`).
     pub fn node_positions(&self, s0: f64, h: f64, nodes: &[f64], offsets: &[f64], out: &mut [f64]) {
+        if let Some((from, late)) = self
+            .late
+            .as_ref()
+            .filter(|(from, _)| s0 >= *from && offsets.len() <= MAX_NODES)
+        {
+            let mut late_offsets = [0.0; MAX_NODES];
+            for (late_s, s) in late_offsets.iter_mut().zip(offsets) {
+                *late_s = s - from;
+            }
+            return late.node_positions(s0 - from, h, nodes, &late_offsets[..offsets.len()], out);
+        }
         let p = self.propagator;
         let form = match (&self.series_form, &self.ramp_form) {
             (Some(form), _) => Some(ClosedForm::Series(form)),
@@ -977,6 +1029,9 @@ impl Trajectory<'_> {
 
     /// Jet pipe position at `s` seconds into the step.
     pub fn position(&self, s: f64) -> f64 {
+        if let Some((late, s)) = self.late_at(s) {
+            return late.position(s);
+        }
         if let Some(form) = &self.series_form {
             return form.position(self.propagator, s);
         }
@@ -1006,6 +1061,9 @@ impl Trajectory<'_> {
 
     /// The full state at `s` seconds into the step.
     pub fn state(&self, s: f64) -> ElectromechanicalState {
+        if let Some((late, s)) = self.late_at(s) {
+            return late.state(s);
+        }
         let closed_form = match (&self.series_form, &self.ramp_form) {
             (Some(form), _) => Some(form.derivatives(self.propagator, s)),
             (None, Some(form)) if form.covers(s) => Some(form.derivatives(self.propagator, s)),
@@ -1222,9 +1280,12 @@ mod tests {
         let ramp_start = |v: f64, rate: f64| ramp_start(&p, v, rate);
         let nodes = [0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
         let mut fast_paths = 0;
-        // The case without a closed form first: it must not even record a step size.
+        // The case without a closed form first (a ramp with its current transient): it must
+        // not even record a step size. A jump too large for the series has none until it
+        // has decayed enough, then the series form.
         for (start, v, rate, form) in [
-            (swinging, -10.0, 0.0, "none"),
+            (swinging, 1.0, 400.0, "none"),
+            (swinging, -10.0, 0.0, "late"),
             (swinging, 3.1, 0.0, "series"),
             (swinging, 1.3, 0.0, "series"),
             (ramp_start(1.0, 2.5), 1.0, 2.5, "ramp"),
@@ -1235,8 +1296,22 @@ mod tests {
                 "ramp" => assert!(trajectory.ramp_form.is_some()),
                 _ => assert!(trajectory.series_form.is_none() && trajectory.ramp_form.is_none()),
             }
+            let late_from = trajectory.late.as_ref().map(|(from, _)| *from);
+            assert_eq!(late_from.is_some(), form == "late");
+            if let Some(from) = late_from {
+                // After the first step below, before the second.
+                assert!(from > 8.5e-5 && from < 3.1e-4, "{from}");
+            }
             // Early steps (transient alive) and late ones (past `transient_over` for the
             // held commands), each asked for twice: the second time takes the advances.
+            // Both sum the modes' exponentials and round like the largest of them.
+            let amplitudes = |t: &Trajectory| {
+                t.series_form
+                    .as_ref()
+                    .map_or(0.0, |f| f.amplitude.iter().map(|a| modulus(*a)).sum::<f64>())
+            };
+            let largest_mode =
+                amplitudes(&trajectory).max(trajectory.late.as_ref().map_or(0.0, |(_, l)| amplitudes(l)));
             for (s0, h) in [(0.0, 8.5e-5), (3.1e-4, 8.5e-5), (4.0e-3, 8.4e-4), (7.7e-3, 2.3e-3)] {
                 let offsets: Vec<f64> = nodes.iter().map(|c| s0 + c * h).collect();
                 for _ in 0..2 {
@@ -1245,7 +1320,7 @@ mod tests {
                     for (x, &s) in out.iter().zip(&offsets) {
                         let exact = trajectory.position(s);
                         assert!(
-                            (x - exact).abs() <= 1e-15 * p.x_jp_sat,
+                            (x - exact).abs() <= 1e-15 * p.x_jp_sat.max(largest_mode),
                             "{form} v {v} s0 {s0} h {h} s {s}: {x} vs {exact}"
                         );
                     }
@@ -1257,11 +1332,15 @@ mod tests {
                     .slots
                     .iter()
                     .any(|slot| slot.0 == h && slot.1.is_some());
-                assert_eq!(cached, form != "none", "{form} h {h}");
+                let closed_form = match late_from {
+                    Some(from) => s0 >= from,
+                    None => form != "none",
+                };
+                assert_eq!(cached, closed_form, "{form} s0 {s0} h {h}");
                 fast_paths += usize::from(cached);
             }
         }
-        assert_eq!(fast_paths, 12);
+        assert_eq!(fast_paths, 15);
         // The first two steps above lie before the transient is over, the last after it and
         // the third across it.
         let over = propagator
@@ -1412,9 +1491,11 @@ mod tests {
             acceleration: -30.0,
         };
         let y0 = SVector::<f64, 4>::new(start.current, start.position, start.velocity, start.acceleration);
-        // small jump (series), large jump (quadrature), and a ramp (quadrature)
+        // small jump (series), large jumps (quadrature until the series converges, then the
+        // series), and a ramp (quadrature)
         for (v, rate) in [(1.3, 0.0), (10.0, 0.0), (-8.0, 0.0), (1.0, 400.0)] {
             let trajectory = propagator.trajectory(&start, v, rate, &[start.position; PLAY_OPERATORS]);
+            assert_eq!(trajectory.late.is_some(), v.abs() > 5.0);
             for s in [1e-5, 3e-4, 2e-3, 1e-2] {
                 let exact = trajectory.state(s);
                 let y = reference(&p, y0, v, rate, s);

@@ -373,7 +373,8 @@ pub struct Simulation {
     /// next step after a change starts, instead of the long steps that suit the end of a
     /// quiet interval.
     pub step_after_change: f64,
-    /// Play operators of the jet_pipe_hysteresis effect (all at f3's output when it is off).
+    /// Play operators of the jet_pipe_hysteresis effect (when it is off, f3's output at the
+    /// start, and not followed).
     pub plays: [f64; PLAY_OPERATORS],
     /// Commands of the recent past, for the transport_delay effect.
     pub command_history: Vec<CommandChange>,
@@ -717,13 +718,15 @@ impl Simulation {
                 if changed {
                     self.step_after_change = self.chamber_integrator.first_step;
                 }
-                let reached = match &result {
-                    Ok(_) => duration,
-                    Err(f) => f.time,
-                };
-                let plays = trajectory.plays_at(reached);
-                if plays.iter().all(|p| p.is_finite()) {
-                    self.plays = plays;
+                if self.model.hysteresis.is_active() {
+                    let reached = match &result {
+                        Ok(_) => duration,
+                        Err(f) => f.time,
+                    };
+                    let plays = trajectory.plays_at(reached);
+                    if plays.iter().all(|p| p.is_finite()) {
+                        self.plays = plays;
+                    }
                 }
                 self.chamber_rates_at_end = None;
                 match result {
