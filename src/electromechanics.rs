@@ -255,6 +255,7 @@ impl ElectromechanicalPropagator {
             kinks: vec![],
             panel_ends: std::cell::RefCell::new(vec![]),
             late: None,
+            last_node: std::cell::Cell::new(None),
         };
         if trajectory.series.is_empty() {
             trajectory.kinks = trajectory.find_kinks();
@@ -445,7 +446,12 @@ impl SeriesForm {
     }
 
     fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
-        let (g, r) = self.growth(p, s);
+        self.derivatives_from(p, &p.exponentials(s, true))
+    }
+
+    /// [`Self::derivatives`] from the exponentials at `s` (with `decay`).
+    fn derivatives_from(&self, p: &ElectromechanicalPropagator, e: &Exponentials) -> [f64; 3] {
+        let (g, r) = (growth_from(&self.amplitude, e), e.decay);
         let l = &p.lambda;
         [
             (g[0] + g[1] + g[2]).re + Self::horner(&self.polynomials[0], r),
@@ -758,6 +764,10 @@ pub struct Trajectory<'a> {
     /// For a held command whose jump is too large for the series: from when on the
     /// trajectory is the series-form one started there (queries from then on go to it).
     late: Option<(f64, Box<Trajectory<'a>>)>,
+    /// The last stage time [`Self::node_positions`] took the series form's exponentials
+    /// at (with the current transient's), and those exponentials: the step's end, where
+    /// [`Self::state`] is asked next.
+    last_node: std::cell::Cell<Option<(f64, Exponentials)>>,
 }
 
 impl Trajectory<'_> {
@@ -1005,12 +1015,17 @@ impl Trajectory<'_> {
             };
             let done = p.with_advances(h, nodes, |advances| {
                 let at_start = p.exponentials(s0, with_decay);
+                let mut last = None;
                 for ((x, &s), advance) in out.iter_mut().zip(offsets).zip(advances) {
                     let e = at_start.then(advance);
                     *x = match form {
                         ClosedForm::Series(series) => series.position_from(s, &e),
                         ClosedForm::Ramp(ramp) => ramp.position_from(s, &e),
                     };
+                    last = Some((s, e));
+                }
+                if with_decay && matches!(form, ClosedForm::Series(_)) {
+                    self.last_node.set(last);
                 }
             });
             if done.is_some() {
@@ -1065,7 +1080,10 @@ impl Trajectory<'_> {
             return late.state(s);
         }
         let closed_form = match (&self.series_form, &self.ramp_form) {
-            (Some(form), _) => Some(form.derivatives(self.propagator, s)),
+            (Some(form), _) => Some(match self.last_node.get() {
+                Some((at, e)) if at == s => form.derivatives_from(self.propagator, &e),
+                _ => form.derivatives(self.propagator, s),
+            }),
             (None, Some(form)) if form.covers(s) => Some(form.derivatives(self.propagator, s)),
             _ => None,
         };
@@ -1324,6 +1342,25 @@ mod tests {
                             "{form} v {v} s0 {s0} h {h} s {s}: {x} vs {exact}"
                         );
                     }
+                    // The state at the last node, from the exponentials kept there, is a
+                    // fresh trajectory's to rounding.
+                    let end = *offsets.last().unwrap();
+                    let kept = trajectory.state(end);
+                    let fresh = propagator
+                        .trajectory(&start, v, rate, &[start.position; PLAY_OPERATORS])
+                        .state(end);
+                    let rate_scale = propagator.lambda.iter().map(|l| modulus(*l)).fold(0.0, f64::max);
+                    let scale = 1e-15 * p.x_jp_sat.max(largest_mode);
+                    assert_eq!(kept.current, fresh.current);
+                    assert!((kept.position - fresh.position).abs() <= scale, "{kept:?} {fresh:?}");
+                    assert!(
+                        (kept.velocity - fresh.velocity).abs() <= scale * rate_scale,
+                        "{kept:?} {fresh:?}"
+                    );
+                    assert!(
+                        (kept.acceleration - fresh.acceleration).abs() <= scale * rate_scale * rate_scale,
+                        "{kept:?} {fresh:?}"
+                    );
                 }
                 let cached = propagator
                     .advances
