@@ -27,7 +27,8 @@ type C64 = Complex<f64>;
 
 /// Series coefficients: on the stack up to 16 terms (a command step of ordinary size needs
 /// fewer), so building a step's trajectory does not allocate.
-type Coefficients = SmallVec<[f64; 16]>;
+type Coefficients = SmallVec<[f64; INLINE_TERMS]>;
+const INLINE_TERMS: usize = 16;
 
 /// Current, jet pipe position and its first two derivatives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -365,16 +366,32 @@ impl SeriesForm {
             return None;
         }
         let mut amplitude = *q0;
-        let zeros = || Coefficients::from_elem(0.0, series.len());
-        let mut polynomials = [zeros(), zeros(), zeros()];
+        // Filled in arrays and handed to the small vectors whole: indexing a SmallVec checks
+        // where it lives at every element.
+        let mut buffers = [[0.0; INLINE_TERMS]; 3];
+        let mut spilled: [Coefficients; 3] = Default::default();
         for (n, (a, weight)) in series.iter().zip(&p.series_weights).enumerate() {
             for k in 0..3 {
                 amplitude[k] += weight.modes[k] * *a;
             }
             for m in 0..3 {
-                polynomials[m][n] = -a * weight.moments[m];
+                let c = -a * weight.moments[m];
+                match buffers[m].get_mut(n) {
+                    Some(slot) => *slot = c,
+                    None => {
+                        if n == INLINE_TERMS {
+                            spilled[m] = Coefficients::from_slice(&buffers[m]);
+                        }
+                        spilled[m].push(c);
+                    }
+                }
             }
         }
+        let polynomials = if series.len() <= INLINE_TERMS {
+            buffers.map(|buffer| Coefficients::from_buf_and_len(buffer, series.len()))
+        } else {
+            spilled
+        };
         // Σ_{n≥1} |cₙ| rⁿ ≤ r Σ|cₙ| for r ≤ 1.
         let (_, transient) = constant_and_spread(&polynomials[0], 1.0);
         let negligible = 1e-16 * p.x_sat;
@@ -1150,9 +1167,11 @@ mod tests {
             velocity: 0.02,
             acceleration: -30.0,
         };
+        let mut lengths = vec![];
         for v in [1.3, 2.0, 3.1] {
             let trajectory = propagator.trajectory(&start, v, 0.0, &[start.position; PLAY_OPERATORS]);
             let form = trajectory.series_form.as_ref().expect("series form");
+            lengths.push(trajectory.series.len());
             // Past `transient_over` the position skips the current transient's terms: they
             // are still there below it, and gone (to rounding) above it.
             let over = form.transient_over;
@@ -1208,6 +1227,8 @@ mod tests {
                 );
             }
         }
+        // The forms' polynomials held inline and spilled to the heap (10, 18, 25 terms).
+        assert!(lengths.iter().any(|&n| n <= INLINE_TERMS) && lengths.iter().any(|&n| n > INLINE_TERMS + 1));
     }
 
     /// A jet pipe in mid-swing.
