@@ -315,32 +315,60 @@ impl ElectromechanicalPropagator {
     }
 }
 
+/// 1/(n + 1) for the series recurrence: a multiplication per term instead of a division.
+const RECIPROCALS: [f64; MAX_SERIES_TERMS] = {
+    let mut table = [0.0; MAX_SERIES_TERMS];
+    let mut n = 0;
+    while n < MAX_SERIES_TERMS {
+        table[n] = 1.0 / (n as f64 + 1.0);
+        n += 1;
+    }
+    table
+};
+
 /// Coefficients aₙ = cₙ εⁿ of tanh(x0 + ε r) = Σ aₙ rⁿ, truncated where they stop mattering.
 fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Coefficients {
     let max_terms = max_terms.min(MAX_SERIES_TERMS);
     let mut c = [0.0; MAX_SERIES_TERMS];
     c[0] = x0.tanh();
-    let mut a = Coefficients::new();
-    a.push(c[0]);
-    if epsilon == 0.0 {
-        return a;
-    }
-    // y' = 1 − y²  ⇒  (n+1) c_{n+1} = [n = 0] − Σ_{k=0}^{n} c_k c_{n−k}, the sum folded in half.
-    let mut power = 1.0;
-    for n in 0..max_terms - 1 {
-        let half: f64 = (0..(n + 1) / 2).map(|k| c[k] * c[n - k]).sum();
-        let middle = if n % 2 == 0 { c[n / 2] * c[n / 2] } else { 0.0 };
-        let convolution = 2.0 * half + middle;
-        let next = ((if n == 0 { 1.0 } else { 0.0 }) - convolution) / (n + 1) as f64;
-        c[n + 1] = next;
-        power *= epsilon;
-        let term = next * power;
-        a.push(term);
-        if n >= 2 && term.abs() < 1e-17 && (c[n] * power / epsilon).abs() < 1e-17 {
-            break;
+    // The terms go to an array first and to the small vector whole (see SeriesForm::new).
+    let mut terms = [0.0; INLINE_TERMS];
+    terms[0] = c[0];
+    let mut count = 1;
+    let mut spilled = Coefficients::new();
+    if epsilon != 0.0 {
+        // y' = 1 − y²  ⇒  (n+1) c_{n+1} = [n = 0] − Σ_{k=0}^{n} c_k c_{n−k}, the sum folded in half.
+        let mut power = 1.0;
+        let mut previous_term = c[0];
+        for n in 0..max_terms - 1 {
+            let half: f64 = (0..(n + 1) / 2).map(|k| c[k] * c[n - k]).sum();
+            let middle = if n % 2 == 0 { c[n / 2] * c[n / 2] } else { 0.0 };
+            let convolution = 2.0 * half + middle;
+            let next = ((if n == 0 { 1.0 } else { 0.0 }) - convolution) * RECIPROCALS[n];
+            c[n + 1] = next;
+            power *= epsilon;
+            let term = next * power;
+            match terms.get_mut(count) {
+                Some(slot) => *slot = term,
+                None => {
+                    if count == INLINE_TERMS {
+                        spilled = Coefficients::from_slice(&terms);
+                    }
+                    spilled.push(term);
+                }
+            }
+            count += 1;
+            if n >= 2 && term.abs() < 1e-17 && previous_term.abs() < 1e-17 {
+                break;
+            }
+            previous_term = term;
         }
     }
-    a
+    if count <= INLINE_TERMS {
+        Coefficients::from_buf_and_len(terms, count)
+    } else {
+        spilled
+    }
 }
 
 /// For a held command with the series form, each mode is
