@@ -700,6 +700,14 @@ impl Exponentials {
 impl ElectromechanicalPropagator {
     /// The exponentials at `s`; `decay` is left at 0 unless `with_decay`.
     fn exponentials(&self, s: f64, with_decay: bool) -> Exponentials {
+        // A step's start, where most are asked for: exactly 1, without the calls.
+        if s == 0.0 {
+            return Exponentials {
+                real: 1.0,
+                oscillation: C64::new(1.0, 0.0),
+                decay: if with_decay { 1.0 } else { 0.0 },
+            };
+        }
         let envelope = (self.lambda[1].re * s).exp();
         let (sin, cos) = (self.lambda[1].im * s).sin_cos();
         Exponentials {
@@ -1014,7 +1022,8 @@ impl Trajectory<'_> {
             _ => None,
         };
         if let Some(c) = homogeneous {
-            return 2.0 * modulus(c) * (p.lambda[1].re * s).exp();
+            let envelope = if s == 0.0 { 1.0 } else { (p.lambda[1].re * s).exp() };
+            return 2.0 * modulus(c) * envelope;
         }
         let q = self.modes(s);
         let u_rest = self.jet_input(s);
