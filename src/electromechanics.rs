@@ -717,12 +717,14 @@ impl ElectromechanicalPropagator {
         }
     }
 
-    /// The exponentials at cᵢh for `nodes` cᵢ, if this step size was asked for before with
-    /// these nodes; a first request only records it and returns `None`. Stage positions
-    /// are then the product of the exponentials at the step's start and these, one set of
-    /// transcendental functions per step instead of one per stage, whenever the step size
-    /// recurs: as it does while the chambers' integrator is capped at a quarter of the
-    /// ringing period, and on its grid of step sizes otherwise.
+    /// The exponentials at cᵢh for `nodes` cᵢ (`None` for more than [`MAX_NODES`]), kept
+    /// per step size: stage positions are the product of the exponentials at the step's
+    /// start and these, one set of transcendental functions per step instead of one per
+    /// stage whenever the step size recurs, as it does while the chambers' integrator is
+    /// capped at a quarter of the ringing period, and on its grid of step sizes otherwise.
+    /// A step size met for the first time costs what positions one by one would, and
+    /// takes the same product: the positions never depend on what the memo held, so a
+    /// restored FMU state continues to the bit.
     fn with_advances<R>(&self, h: f64, nodes: &[f64], use_them: impl FnOnce(&[Exponentials]) -> R) -> Option<R> {
         if nodes.len() > MAX_NODES {
             return None;
@@ -734,24 +736,21 @@ impl ElectromechanicalPropagator {
             cache.count = nodes.len();
         }
         if cache.slots.is_empty() {
-            cache.slots.resize(ADVANCE_SLOTS, (f64::NAN, None));
+            cache
+                .slots
+                .resize(ADVANCE_SLOTS, (f64::NAN, [Exponentials::default(); MAX_NODES]));
         }
         // Direct-mapped on the top mantissa bits and the low exponent bits, which tell the
         // integrator's grid sizes apart.
         let bits = h.to_bits();
         let slot = &mut cache.slots[((bits >> 47) ^ (bits >> 52)) as usize % ADVANCE_SLOTS];
         if slot.0 != h {
-            *slot = (h, None);
-            return None;
-        }
-        if slot.1.is_none() {
-            let mut advances = [Exponentials::default(); MAX_NODES];
-            for (advance, c) in advances.iter_mut().zip(nodes) {
+            slot.0 = h;
+            for (advance, c) in slot.1.iter_mut().zip(nodes) {
                 *advance = self.exponentials(c * h, true);
             }
-            slot.1 = Some(advances);
         }
-        slot.1.as_ref().map(|advances| use_them(&advances[..nodes.len()]))
+        Some(use_them(&slot.1[..nodes.len()]))
     }
 }
 
@@ -773,8 +772,8 @@ const ADVANCE_SLOTS: usize = 32;
 struct AdvanceTable {
     nodes: [f64; MAX_NODES],
     count: usize,
-    /// (h, its advances once asked for a second time).
-    slots: Vec<(f64, Option<[Exponentials; MAX_NODES]>)>,
+    /// (h, its advances); h is NaN in a slot not yet used.
+    slots: Vec<(f64, [Exponentials; MAX_NODES])>,
 }
 
 /// A memo inside the propagator: it changes no result, so two propagators that differ
@@ -1390,9 +1389,13 @@ mod tests {
                 amplitudes(&trajectory).max(trajectory.late.as_ref().map_or(0.0, |(_, l)| amplitudes(l)));
             for (s0, h) in [(0.0, 8.5e-5), (3.1e-4, 8.5e-5), (4.0e-3, 8.4e-4), (7.7e-3, 2.3e-3)] {
                 let offsets: Vec<f64> = nodes.iter().map(|c| s0 + c * h).collect();
+                let mut first_time = None;
                 for _ in 0..2 {
                     let mut out = [0.0; 6];
                     trajectory.node_positions(s0, h, &nodes, &offsets, &mut out);
+                    // The memo changes no bit: a step size met for the first time gives what
+                    // it gives once kept (a restored FMU state continues exactly).
+                    assert_eq!(*first_time.get_or_insert(out), out, "{form} s0 {s0} h {h}");
                     for (x, &s) in out.iter().zip(&offsets) {
                         let exact = trajectory.position(s);
                         assert!(
@@ -1420,13 +1423,7 @@ mod tests {
                         "{kept:?} {fresh:?}"
                     );
                 }
-                let cached = propagator
-                    .advances
-                    .0
-                    .borrow()
-                    .slots
-                    .iter()
-                    .any(|slot| slot.0 == h && slot.1.is_some());
+                let cached = propagator.advances.0.borrow().slots.iter().any(|slot| slot.0 == h);
                 let closed_form = match late_from {
                     Some(from) => s0 >= from,
                     None => form != "none",
