@@ -67,6 +67,67 @@ impl<const PIECES: usize> Piecewise<PIECES> {
     }
 }
 
+/// Two piecewise polynomials on the same `PIECES` equal pieces of [start, end], evaluated
+/// together: one piece index, one local variable, and each power's two coefficients side by
+/// side, so the two Estrin passes run as one on two-wide vector registers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PiecewisePair<const PIECES: usize> {
+    start: f64,
+    end: f64,
+    pieces_per_unit: f64,
+    coefficients: [[[f64; 2]; DEGREE + 1]; PIECES],
+}
+
+impl<const PIECES: usize> PiecewisePair<PIECES> {
+    /// The interpolants of `f` and `g` at the Chebyshev points of each piece (see
+    /// [`Piecewise::interpolating`]).
+    pub fn interpolating(start: f64, end: f64, f: impl Fn(f64) -> f64, g: impl Fn(f64) -> f64) -> Self {
+        let first = Piecewise::<PIECES>::interpolating(start, end, f);
+        let second = Piecewise::<PIECES>::interpolating(start, end, g);
+        let mut coefficients = [[[0.0; 2]; DEGREE + 1]; PIECES];
+        for (piece, (a, b)) in coefficients
+            .iter_mut()
+            .zip(first.coefficients.iter().zip(&second.coefficients))
+        {
+            for (pair, (&ca, &cb)) in piece.iter_mut().zip(a.iter().zip(b)) {
+                *pair = [ca, cb];
+            }
+        }
+        Self {
+            start,
+            end,
+            pieces_per_unit: first.pieces_per_unit,
+            coefficients,
+        }
+    }
+
+    /// Both values at `x`, or `None` outside [start, end] (and for NaN); the same to the bit
+    /// as the two [`Piecewise`] evaluations.
+    #[inline]
+    pub fn value(&self, x: f64) -> Option<[f64; 2]> {
+        if !(x >= self.start && x <= self.end) {
+            return None;
+        }
+        let position = (x - self.start) * self.pieces_per_unit;
+        let k = (position as i32).min(PIECES as i32 - 1) as usize;
+        Some(estrin_pair(&self.coefficients[k], 2.0 * (position - k as f64) - 1.0))
+    }
+}
+
+/// [`estrin`] for two coefficient sets at once.
+#[inline]
+fn estrin_pair(c: &[[f64; 2]; DEGREE + 1], u: f64) -> [f64; 2] {
+    let u2 = u * u;
+    let u4 = u2 * u2;
+    let mut value = [0.0; 2];
+    for (j, v) in value.iter_mut().enumerate() {
+        let low = (c[0][j] + c[1][j] * u) + u2 * (c[2][j] + c[3][j] * u);
+        let high = (c[4][j] + c[5][j] * u) + u2 * (c[6][j] + c[7][j] * u);
+        *v = low + u4 * (high + u4 * c[8][j]);
+    }
+    value
+}
+
 /// Monomial coefficients of the degree-8 interpolant of `f` on [−1, 1] at the Chebyshev
 /// points of the first kind.
 pub fn chebyshev_interpolant(f: impl Fn(f64) -> f64) -> Piece {
@@ -133,5 +194,25 @@ mod tests {
         assert_eq!(fit.value(-1e-9), None);
         assert_eq!(fit.value(1.0 + 1e-9), None);
         assert_eq!(fit.value(f64::NAN), None);
+    }
+
+    #[test]
+    fn a_pair_evaluates_to_the_bit_as_its_two_polynomials() {
+        let (f, g) = (f64::exp, |x: f64| 1.0 / (2.0 + x));
+        let pair = PiecewisePair::<10>::interpolating(-0.5, 2.0, f, g);
+        let (single_f, single_g) = (
+            Piecewise::<10>::interpolating(-0.5, 2.0, f),
+            Piecewise::<10>::interpolating(-0.5, 2.0, g),
+        );
+        for j in 0..=2500 {
+            let x = -0.5 + 2.5 * j as f64 / 2500.0;
+            let [a, b] = pair.value(x).unwrap();
+            assert_eq!(a, single_f.value(x).unwrap(), "x {x}");
+            assert_eq!(b, single_g.value(x).unwrap(), "x {x}");
+            assert!((a - f(x)).abs() < 1e-9 && (b - g(x)).abs() < 1e-9, "x {x}");
+        }
+        assert_eq!(pair.value(-0.5 - 1e-12), None);
+        assert_eq!(pair.value(2.0 + 1e-12), None);
+        assert_eq!(pair.value(f64::NAN), None);
     }
 }

@@ -15,7 +15,7 @@
 
 use std::f64::consts::PI;
 
-use crate::polynomial::Piecewise;
+use crate::polynomial::PiecewisePair;
 
 /// Area of the intersection of two discs of radii `r1`, `r2` whose centres are `d` apart.
 pub fn circle_intersection_area(r1: f64, r2: f64, d: f64) -> f64 {
@@ -107,8 +107,9 @@ pub fn first_tangency_between(d_jp: f64, from: i32, to: i32) -> f64 {
     boundary as f64 * d_jp
 }
 
-/// Pieces of each tabulated part of the areas.
-const AREA_PIECES: usize = 8;
+/// Pieces of the tabulated areas over |ξ| ∈ [0, 1]; the return area changes form at
+/// |ξ| = 1/2, a piece boundary.
+const AREA_PIECES: usize = 16;
 
 /// The areas of a geometry with D = 1 (every length scales with D, so A(D, x) = D² A(1, x/D)),
 /// tabulated once per process: the closed forms cost three to six `atan2` per call and the
@@ -117,50 +118,75 @@ const AREA_PIECES: usize = 8;
 /// part is that power times a piecewise polynomial of degree 8, interpolated at Chebyshev
 /// points: within 2e-15 of the port area of the closed forms (`tabulated_areas_match_the_closed_forms`).
 ///
-/// With ξ = x/D, R = 1/2 and the port area π/4:
-/// * A_s1(ξ) = ξ^{3/2} S(ξ) on (0, 1], A_s1(ξ) = A_s1(2 − ξ) on (1, 2), 0 elsewhere;
-/// * A_r1(ξ) = |ξ|^{3/2} T(ξ) on (−1/2, 0), π/4 − (ξ + 1)^{3/2} U(ξ) on (−1, −1/2],
-///   A_r1(ξ) = A_r1(2 − ξ) for ξ > 1, π/4 for ξ ≤ −1 and 0 on [0, 2].
+/// With ξ = x/D, a = |ξ|, R = 1/2 and the port area π/4, for |ξ| ≤ 1 (the whole operating
+/// range: the jet pipe saturates near ξ = ±0.5) one port's supply and the other's return
+/// are open, and both are functions of a:
+/// * supply(a) = a^{3/2} S(a);
+/// * return(a) = a^{3/2} T(a) on [0, 1/2), π/4 − (1 − a)^{3/2} U(a) on [1/2, 1];
+/// * A_s1 = supply, A_r2 = return for ξ ≥ 0; A_s2 = supply, A_r1 = return for ξ < 0.
+///
+/// S and T or U share their pieces ([`PiecewisePair`]): one lookup gives both open areas.
+/// Beyond |ξ| = 1 the geometry repeats by reflection: A_s1(ξ) = A_s1(2 − ξ) on (1, 2) and 0
+/// beyond, A_r1 = π/4 for ξ ≤ −1 and A_r1(ξ) = A_r1(2 − ξ) for ξ > 1 (0 up to ξ = 2).
 #[derive(Debug)]
 struct UnitAreaTable {
-    supply: Piecewise<AREA_PIECES>,
-    return_near: Piecewise<AREA_PIECES>,
-    return_far: Piecewise<AREA_PIECES>,
+    supply_and_return: PiecewisePair<AREA_PIECES>,
 }
 
 impl UnitAreaTable {
     fn get() -> &'static Self {
         static TABLE: std::sync::OnceLock<UnitAreaTable> = std::sync::OnceLock::new();
         TABLE.get_or_init(|| {
-            let power = |t: f64| t.abs() * t.abs().sqrt();
+            let power = |t: f64| t * t.sqrt();
             Self {
-                supply: Piecewise::interpolating(0.0, 1.0, |xi| supply_area_port1(1.0, xi) / power(xi)),
-                return_near: Piecewise::interpolating(-0.5, 0.0, |xi| return_area_port1(1.0, xi) / power(xi)),
-                return_far: Piecewise::interpolating(-1.0, -0.5, |xi| {
-                    (port_area(1.0) - return_area_port1(1.0, xi)) / power(xi + 1.0)
-                }),
+                supply_and_return: PiecewisePair::interpolating(
+                    0.0,
+                    1.0,
+                    |a| supply_area_port1(1.0, a) / power(a),
+                    |a| {
+                        if a < 0.5 {
+                            return_area_port1(1.0, -a) / power(a)
+                        } else {
+                            (port_area(1.0) - return_area_port1(1.0, -a)) / power(1.0 - a)
+                        }
+                    },
+                ),
             }
         })
     }
 
+    /// The open supply and return areas at a = |ξ| ≤ 1 (see the table's description).
+    #[inline]
+    fn open_areas(&self, a: f64) -> (f64, f64) {
+        let [s, r] = self.supply_and_return.value(a).unwrap_or([0.0; 2]);
+        let power = a * a.sqrt();
+        let supply = power * s;
+        let ret = if a < 0.5 {
+            power * r
+        } else {
+            let t = 1.0 - a;
+            port_area(1.0) - t * t.sqrt() * r
+        };
+        (supply, ret)
+    }
+
+    /// A_s1 at any ξ, through the reflection beyond ξ = 1.
     fn supply_1(&self, xi: f64) -> f64 {
         let xi = if xi > 1.0 { 2.0 - xi } else { xi };
-        match self.supply.value(xi) {
-            Some(s) => xi * xi.sqrt() * s,
-            None => 0.0,
+        if (0.0..=1.0).contains(&xi) {
+            self.open_areas(xi).0
+        } else {
+            0.0
         }
     }
 
+    /// A_r1 at any ξ, through the reflection beyond ξ = 1.
     fn return_1(&self, xi: f64) -> f64 {
         let xi = if xi > 1.0 { 2.0 - xi } else { xi };
         if xi >= 0.0 {
             0.0
-        } else if xi > -0.5 {
-            let t = -xi;
-            t * t.sqrt() * self.return_near.value(xi).unwrap_or(0.0)
         } else if xi > -1.0 {
-            let t = xi + 1.0;
-            port_area(1.0) - t * t.sqrt() * self.return_far.value(xi).unwrap_or(0.0)
+            self.open_areas(-xi).1
         } else {
             port_area(1.0)
         }
@@ -170,11 +196,30 @@ impl UnitAreaTable {
 /// [`orifice_areas`] from the tabulated unit geometry: what the integrators use.
 pub fn tabulated_orifice_areas(d_jp: f64, x_abs: f64) -> OrificeAreas {
     let xi = x_abs / d_jp;
+    let table = UnitAreaTable::get();
+    let scale = d_jp * d_jp;
+    if xi.abs() <= 1.0 {
+        let (supply, ret) = table.open_areas(xi.abs());
+        let (supply, ret) = (scale * supply, scale * ret);
+        return if xi >= 0.0 {
+            OrificeAreas {
+                supply_1: supply,
+                return_1: 0.0,
+                supply_2: 0.0,
+                return_2: ret,
+            }
+        } else {
+            OrificeAreas {
+                supply_1: 0.0,
+                return_1: ret,
+                supply_2: supply,
+                return_2: 0.0,
+            }
+        };
+    }
     if !xi.is_finite() {
         return orifice_areas(d_jp, x_abs);
     }
-    let table = UnitAreaTable::get();
-    let scale = d_jp * d_jp;
     OrificeAreas {
         supply_1: scale * table.supply_1(xi),
         return_1: scale * table.return_1(xi),
