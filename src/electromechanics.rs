@@ -329,46 +329,59 @@ const RECIPROCALS: [f64; MAX_SERIES_TERMS] = {
 /// Coefficients aₙ = cₙ εⁿ of tanh(x0 + ε r) = Σ aₙ rⁿ, truncated where they stop mattering.
 fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Coefficients {
     let max_terms = max_terms.min(MAX_SERIES_TERMS);
-    let mut c = [0.0; MAX_SERIES_TERMS];
-    c[0] = x0.tanh();
-    // The terms go to an array first and to the small vector whole (see SeriesForm::new).
-    let mut terms = [0.0; INLINE_TERMS];
-    terms[0] = c[0];
+    // The terms go to an array first, and to the small vector whole (indexing a SmallVec
+    // checks where it lives at every element); only a series longer than the array spills.
+    let mut inline = [0.0; INLINE_TERMS];
+    inline[0] = x0.tanh();
+    if epsilon == 0.0 {
+        return Coefficients::from_buf_and_len(inline, 1);
+    }
+    let converged = |terms: &[f64]| match terms {
+        [.., before, last] => terms.len() > 3 && last.abs() < 1e-17 && before.abs() < 1e-17,
+        _ => false,
+    };
     let mut count = 1;
-    let mut spilled = Coefficients::new();
-    if epsilon != 0.0 {
-        // y' = 1 − y²  ⇒  (n+1) c_{n+1} = [n = 0] − Σ_{k=0}^{n} c_k c_{n−k}, the sum folded in half.
-        let mut power = 1.0;
-        let mut previous_term = c[0];
-        for n in 0..max_terms - 1 {
-            let half: f64 = (0..(n + 1) / 2).map(|k| c[k] * c[n - k]).sum();
-            let middle = if n % 2 == 0 { c[n / 2] * c[n / 2] } else { 0.0 };
-            let convolution = 2.0 * half + middle;
-            let next = ((if n == 0 { 1.0 } else { 0.0 }) - convolution) * RECIPROCALS[n];
-            c[n + 1] = next;
-            power *= epsilon;
-            let term = next * power;
-            match terms.get_mut(count) {
-                Some(slot) => *slot = term,
-                None => {
-                    if count == INLINE_TERMS {
-                        spilled = Coefficients::from_slice(&terms);
-                    }
-                    spilled.push(term);
-                }
-            }
-            count += 1;
-            if n >= 2 && term.abs() < 1e-17 && previous_term.abs() < 1e-17 {
-                break;
-            }
-            previous_term = term;
+    while count < max_terms.min(INLINE_TERMS) {
+        inline[count] = next_tanh_term(&inline[..count], epsilon);
+        count += 1;
+        if converged(&inline[..count]) {
+            return Coefficients::from_buf_and_len(inline, count);
         }
     }
-    if count <= INLINE_TERMS {
-        Coefficients::from_buf_and_len(terms, count)
-    } else {
-        spilled
+    if count == max_terms {
+        return Coefficients::from_buf_and_len(inline, count);
     }
+    let mut spilled = Coefficients::from_slice(&inline);
+    while spilled.len() < max_terms {
+        let term = next_tanh_term(&spilled, epsilon);
+        spilled.push(term);
+        if converged(&spilled) {
+            break;
+        }
+    }
+    spilled
+}
+
+/// The next coefficient of [`tanh_series`] from `terms` a₀ … aₙ: y' = 1 − y² in the
+/// variable εr gives (n+1) a_{n+1} = ε ([n = 0] − Σ_{k=0}^{n} a_k a_{n−k}), the sum folded
+/// in half and split over two accumulators (each term waits for all before it, so the
+/// sum's latency is the series' critical path).
+#[inline]
+fn next_tanh_term(terms: &[f64], epsilon: f64) -> f64 {
+    let n = terms.len() - 1;
+    let (low, high) = terms.split_at(n.div_ceil(2));
+    // low = a_0 … a_{⌈n/2⌉−1}; the mirrored partners a_n, a_{n−1}, … from the top.
+    let (mut even, mut odd) = (0.0, 0.0);
+    let mut pairs = low.iter().zip(high.iter().rev());
+    while let Some((a, b)) = pairs.next() {
+        even += a * b;
+        if let Some((a, b)) = pairs.next() {
+            odd += a * b;
+        }
+    }
+    let middle = if n % 2 == 0 { terms[n / 2] * terms[n / 2] } else { 0.0 };
+    let convolution = 2.0 * (even + odd) + middle;
+    epsilon * ((if n == 0 { 1.0 } else { 0.0 }) - convolution) * RECIPROCALS[n]
 }
 
 /// For a held command with the series form, each mode is
@@ -379,8 +392,10 @@ fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Coefficients {
 struct SeriesForm {
     /// q_k(0) + β_k Σₙ aₙ/(λk + nω).
     amplitude: [C64; 3],
-    /// Coefficients of rⁿ in the position, velocity and acceleration: −Re Σ_k λk^m β_k aₙ/(λk + nω).
-    polynomials: [Coefficients; 3],
+    /// Coefficients of rⁿ in the position: −Re Σ_k β_k aₙ/(λk + nω). Those of the velocity
+    /// and acceleration (moments 1 and 2 in place of 0) are summed where asked for, once per
+    /// step at its end, from the series itself.
+    position: Coefficients,
     /// From when on the position's terms n ≥ 1 sum to under 1e-16 of the saturated stroke:
     /// past it the position needs neither e^{−ω s} nor the polynomial.
     transient_over: f64,
@@ -394,34 +409,25 @@ impl SeriesForm {
             return None;
         }
         let mut amplitude = *q0;
-        // Filled in arrays and handed to the small vectors whole: indexing a SmallVec checks
+        // Filled in an array and handed to the small vector whole: indexing a SmallVec checks
         // where it lives at every element.
-        let mut buffers = [[0.0; INLINE_TERMS]; 3];
-        let mut spilled: [Coefficients; 3] = Default::default();
-        for (n, (a, weight)) in series.iter().zip(&p.series_weights).enumerate() {
+        let mut inline = [0.0; INLINE_TERMS];
+        let terms = series.len().min(INLINE_TERMS);
+        for ((a, weight), c) in series.iter().zip(&p.series_weights).zip(&mut inline[..terms]) {
             for k in 0..3 {
                 amplitude[k] += weight.modes[k] * *a;
             }
-            for m in 0..3 {
-                let c = -a * weight.moments[m];
-                match buffers[m].get_mut(n) {
-                    Some(slot) => *slot = c,
-                    None => {
-                        if n == INLINE_TERMS {
-                            spilled[m] = Coefficients::from_slice(&buffers[m]);
-                        }
-                        spilled[m].push(c);
-                    }
-                }
-            }
+            *c = -a * weight.moments[0];
         }
-        let polynomials = if series.len() <= INLINE_TERMS {
-            buffers.map(|buffer| Coefficients::from_buf_and_len(buffer, series.len()))
-        } else {
-            spilled
-        };
+        let mut position = Coefficients::from_buf_and_len(inline, terms);
+        for (a, weight) in series.iter().zip(&p.series_weights).skip(INLINE_TERMS) {
+            for k in 0..3 {
+                amplitude[k] += weight.modes[k] * *a;
+            }
+            position.push(-a * weight.moments[0]);
+        }
         // Σ_{n≥1} |cₙ| rⁿ ≤ r Σ|cₙ| for r ≤ 1.
-        let (_, transient) = constant_and_spread(&polynomials[0], 1.0);
+        let (_, transient) = constant_and_spread(&position, 1.0);
         let negligible = 1e-16 * p.x_sat;
         let transient_over = if transient <= negligible {
             0.0
@@ -430,7 +436,7 @@ impl SeriesForm {
         };
         Some(Self {
             amplitude,
-            polynomials,
+            position,
             transient_over,
         })
     }
@@ -476,32 +482,41 @@ impl SeriesForm {
     fn position_from(&self, s: f64, e: &Exponentials) -> f64 {
         let g = growth_from(&self.amplitude, e);
         let polynomial = if s >= self.transient_over {
-            self.polynomials[0][0]
+            self.position[0]
         } else {
-            Self::horner(&self.polynomials[0], e.decay)
+            Self::horner(&self.position, e.decay)
         };
         (g[0] + g[1] + g[2]).re + polynomial
     }
 
     /// Bounds on the position over [0, s_end].
     fn position_bounds(&self, p: &ElectromechanicalPropagator, s_end: f64) -> (f64, f64) {
-        let (constant, transient) = constant_and_spread(&self.polynomials[0], 1.0);
+        let (constant, transient) = constant_and_spread(&self.position, 1.0);
         let (lo, hi) = modal_bounds(p, &self.amplitude, s_end);
         (lo + constant - transient, hi + constant + transient)
     }
 
-    fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
-        self.derivatives_from(p, &p.exponentials(s, true))
+    fn derivatives(&self, p: &ElectromechanicalPropagator, series: &[f64], s: f64) -> [f64; 3] {
+        self.derivatives_from(p, series, &p.exponentials(s, true))
     }
 
-    /// [`Self::derivatives`] from the exponentials at `s` (with `decay`).
-    fn derivatives_from(&self, p: &ElectromechanicalPropagator, e: &Exponentials) -> [f64; 3] {
+    /// [`Self::derivatives`] from the exponentials at `s` (with `decay`), for the `series`
+    /// the form was built from.
+    fn derivatives_from(&self, p: &ElectromechanicalPropagator, series: &[f64], e: &Exponentials) -> [f64; 3] {
         let (g, r) = (growth_from(&self.amplitude, e), e.decay);
         let l = &p.lambda;
+        // Σₙ −aₙ (moment m of term n) rⁿ for m = 1, 2, by Horner.
+        let (velocity, acceleration) = series
+            .iter()
+            .zip(&p.series_weights)
+            .rev()
+            .fold((0.0, 0.0), |(v, a), (term, weight)| {
+                (v * r - term * weight.moments[1], a * r - term * weight.moments[2])
+            });
         [
-            (g[0] + g[1] + g[2]).re + Self::horner(&self.polynomials[0], r),
-            (l[0] * g[0] + l[1] * g[1] + l[2] * g[2]).re + Self::horner(&self.polynomials[1], r),
-            (l[0] * l[0] * g[0] + l[1] * l[1] * g[1] + l[2] * l[2] * g[2]).re + Self::horner(&self.polynomials[2], r),
+            (g[0] + g[1] + g[2]).re + Self::horner(&self.position, r),
+            (l[0] * g[0] + l[1] * g[1] + l[2] * g[2]).re + velocity,
+            (l[0] * l[0] * g[0] + l[1] * l[1] * g[1] + l[2] * l[2] * g[2]).re + acceleration,
         ]
     }
 }
@@ -1134,8 +1149,8 @@ impl Trajectory<'_> {
         }
         let closed_form = match (&self.series_form, &self.ramp_form) {
             (Some(form), _) => Some(match self.last_node.get() {
-                Some((at, e)) if at == s => form.derivatives_from(self.propagator, &e),
-                _ => form.derivatives(self.propagator, s),
+                Some((at, e)) if at == s => form.derivatives_from(self.propagator, &self.series, &e),
+                _ => form.derivatives(self.propagator, &self.series, s),
             }),
             (None, Some(form)) if form.covers(s) => Some(form.derivatives(self.propagator, s)),
             _ => None,
@@ -1216,15 +1231,15 @@ mod tests {
                 "v {v}: transient over at {over:e} s"
             );
             let (_, r) = form.growth(&propagator, over);
-            let rest = SeriesForm::horner(&form.polynomials[0], r) - form.polynomials[0][0];
+            let rest = SeriesForm::horner(&form.position, r) - form.position[0];
             // The difference is taken from the constant term: a few of its ulps come on top.
-            let rounding = 1e-15 * form.polynomials[0][0].abs();
+            let rounding = 1e-15 * form.position[0].abs();
             assert!(
                 rest.abs() <= 1e-16 * propagator.x_sat + rounding,
                 "v {v}: {rest:e} m left at {over:e} s"
             );
             let (_, r) = form.growth(&propagator, 0.5 * over);
-            let before = SeriesForm::horner(&form.polynomials[0], r) - form.polynomials[0][0];
+            let before = SeriesForm::horner(&form.position, r) - form.position[0];
             assert!(
                 before.abs() > 1e-14 * propagator.x_sat,
                 "v {v}: {before:e} m at {:e} s",
