@@ -756,26 +756,38 @@ impl ElectromechanicalPropagator {
         }
         let mut cache = self.advances.0.borrow_mut();
         if cache.nodes[..cache.count] != *nodes {
-            cache.slots.clear();
+            cache.sets.clear();
             cache.nodes[..nodes.len()].copy_from_slice(nodes);
             cache.count = nodes.len();
         }
-        if cache.slots.is_empty() {
-            cache
-                .slots
-                .resize(ADVANCE_SLOTS, (f64::NAN, [Exponentials::default(); MAX_NODES]));
+        if cache.sets.is_empty() {
+            let unused = (f64::NAN, [Exponentials::default(); MAX_NODES]);
+            cache.sets.resize(
+                ADVANCE_SETS,
+                AdvanceSet {
+                    ways: [unused; 2],
+                    older: 0,
+                },
+            );
         }
-        // Direct-mapped on the top mantissa bits and the low exponent bits, which tell the
+        // Two-way sets on the top mantissa bits and the low exponent bits, which tell the
         // integrator's grid sizes apart.
         let bits = h.to_bits();
-        let slot = &mut cache.slots[((bits >> 47) ^ (bits >> 52)) as usize % ADVANCE_SLOTS];
-        if slot.0 != h {
-            slot.0 = h;
-            for (advance, c) in slot.1.iter_mut().zip(nodes) {
-                *advance = self.exponentials(c * h, true);
+        let set = &mut cache.sets[((bits >> 47) ^ (bits >> 52)) as usize % ADVANCE_SETS];
+        let way = match set.ways.iter().position(|(kept, _)| *kept == h) {
+            Some(way) => way,
+            None => {
+                let way = set.older;
+                let (kept, advances) = &mut set.ways[way];
+                *kept = h;
+                for (advance, c) in advances.iter_mut().zip(nodes) {
+                    *advance = self.exponentials(c * h, true);
+                }
+                way
             }
-        }
-        Some(use_them(&slot.1[..nodes.len()]))
+        };
+        set.older = 1 - way;
+        Some(use_them(&set.ways[way].1[..nodes.len()]))
     }
 }
 
@@ -789,16 +801,26 @@ enum ClosedForm<'f> {
 /// Most stages of one step [`Trajectory::node_positions`] takes: Verner's eight after the
 /// first (Dormand–Prince has six).
 pub const MAX_NODES: usize = 8;
-/// Step sizes whose advances are kept (8.7 kB, allocated on first use): the error-controlled
-/// steps and the rest of each communication step come in about twenty.
-const ADVANCE_SLOTS: usize = 32;
+/// Sets of two step sizes whose advances are kept (34 kB, allocated on first use): the
+/// error-controlled steps and the rest of each communication step come in some hundred
+/// sizes (the closed loop's current transients spread them most), and with 32 direct-mapped
+/// slots three in ten steps of the closed loop recomputed theirs, with 128 in two-way sets
+/// one in fifteen.
+const ADVANCE_SETS: usize = 64;
 
 #[derive(Clone, Debug, Default)]
 struct AdvanceTable {
     nodes: [f64; MAX_NODES],
     count: usize,
-    /// (h, its advances); h is NaN in a slot not yet used.
-    slots: Vec<(f64, [Exponentials; MAX_NODES])>,
+    sets: Vec<AdvanceSet>,
+}
+
+/// Two step sizes and their advances (h is NaN in a way not yet used), and which of the two
+/// was used less recently: the one a new size replaces.
+#[derive(Clone, Copy, Debug)]
+struct AdvanceSet {
+    ways: [(f64, [Exponentials; MAX_NODES]); 2],
+    older: usize,
 }
 
 /// A memo inside the propagator: it changes no result, so two propagators that differ
@@ -1470,7 +1492,13 @@ mod tests {
                         "{kept:?} {fresh:?}"
                     );
                 }
-                let cached = propagator.advances.0.borrow().slots.iter().any(|slot| slot.0 == h);
+                let cached = propagator
+                    .advances
+                    .0
+                    .borrow()
+                    .sets
+                    .iter()
+                    .any(|set| set.ways.iter().any(|(kept, _)| *kept == h));
                 let closed_form = match late_from {
                     Some(from) => s0 >= from,
                     None => form != "none",
