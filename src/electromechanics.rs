@@ -61,6 +61,34 @@ pub struct ElectromechanicalPropagator {
     series_weights: Vec<SeriesWeight>,
     /// The advances by cᵢh of the last few step sizes (see [`Trajectory::node_positions`]).
     advances: AdvanceCache,
+    /// e^{Re λ1 s} and e^{Re λ2 s} at the last s asked for: the position bounds over a
+    /// step and the ringing test ask at the same s every step of a regular grid.
+    real_mode_growth: ExpMemo,
+    ringing_envelope: ExpMemo,
+}
+
+/// e^{rate·s} for the last s asked for, with the rate fixed by the caller. A memo: it
+/// changes no result, so two propagators that differ only in it are equal.
+#[derive(Clone, Debug, Default)]
+struct ExpMemo(std::cell::Cell<Option<(f64, f64)>>);
+
+impl ExpMemo {
+    fn at(&self, rate: f64, s: f64) -> f64 {
+        match self.0.get() {
+            Some((kept, value)) if kept == s => value,
+            _ => {
+                let value = (rate * s).exp();
+                self.0.set(Some((s, value)));
+                value
+            }
+        }
+    }
+}
+
+impl PartialEq for ExpMemo {
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 /// For term aₙ e^{−nω s} of the jet pipe input: each mode's weight wₖ = β_k/(λk + nω) and
@@ -179,6 +207,8 @@ impl ElectromechanicalPropagator {
             hysteresis: PrandtlIshlinskii::new(p.hysteresis_width, p.hysteresis_deadband),
             series_weights,
             advances: AdvanceCache::default(),
+            real_mode_growth: ExpMemo::default(),
+            ringing_envelope: ExpMemo::default(),
         })
     }
 
@@ -237,7 +267,7 @@ impl ElectromechanicalPropagator {
             && !self.hysteresis.is_active()
             && (self.k_m * delta / self.f_sat).abs() <= RAMP_TRANSIENT_LIMIT
         {
-            RampForm::new(self, &q0, self.k_m * base / self.f_sat, self.k_m * ramp / self.f_sat)
+            RampForm::new(self, &q0, self.k_m * base / self.f_sat, self.k_m * ramp / self.f_sat).map(Box::new)
         } else {
             None
         };
@@ -678,7 +708,7 @@ fn constant_and_spread(coefficients: &[f64], z_max: f64) -> (f64, f64) {
 /// monotonically between its ends, the decaying complex pair stays within its moduli.
 fn modal_bounds(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s_end: f64) -> (f64, f64) {
     let real = amplitude[0].re;
-    let real_end = real * (p.lambda[0].re * s_end).exp();
+    let real_end = real * p.real_mode_growth.at(p.lambda[0].re, s_end);
     let ringing = modulus(amplitude[1]) + modulus(amplitude[2]);
     (real.min(real_end) - ringing, real.max(real_end) + ringing)
 }
@@ -845,8 +875,9 @@ pub struct Trajectory<'a> {
     series: Coefficients,
     /// The same series summed in closed form, for fast evaluation (see [`SeriesForm`]).
     series_form: Option<SeriesForm>,
-    /// The closed form for a ramp without a current transient (see [`RampForm`]).
-    ramp_form: Option<RampForm>,
+    /// The closed form for a ramp without a current transient (see [`RampForm`]); boxed, as
+    /// its polynomials are anyway, so the held commands' trajectories stay small to move.
+    ramp_form: Option<Box<RampForm>>,
     /// Hysteresis play states at the start of the step.
     plays: [f64; PLAY_OPERATORS],
     /// For a held command integrated by quadrature: the time after which the current
@@ -1068,7 +1099,11 @@ impl Trajectory<'_> {
             _ => None,
         };
         if let Some(c) = homogeneous {
-            let envelope = if s == 0.0 { 1.0 } else { (p.lambda[1].re * s).exp() };
+            let envelope = if s == 0.0 {
+                1.0
+            } else {
+                p.ringing_envelope.at(p.lambda[1].re, s)
+            };
             return 2.0 * modulus(c) * envelope;
         }
         let q = self.modes(s);
