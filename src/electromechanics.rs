@@ -422,6 +422,8 @@ fn next_tanh_term(terms: &[f64], epsilon: f64) -> f64 {
 struct SeriesForm {
     /// q_k(0) + β_k Σₙ aₙ/(λk + nω).
     amplitude: [C64; 3],
+    /// [`position_weights`] of `amplitude`.
+    position_weights: [f64; 3],
     /// Coefficients of rⁿ in the position: −Re Σ_k β_k aₙ/(λk + nω). Those of the velocity
     /// and acceleration (moments 1 and 2 in place of 0) are summed where asked for, once per
     /// step at its end, from the series itself.
@@ -466,6 +468,7 @@ impl SeriesForm {
         };
         Some(Self {
             amplitude,
+            position_weights: position_weights(&amplitude),
             position,
             transient_over,
         })
@@ -510,13 +513,12 @@ impl SeriesForm {
     /// The position at `s` from the exponentials there (`decay` needed only before
     /// `transient_over`).
     fn position_from(&self, s: f64, e: &Exponentials) -> f64 {
-        let g = growth_from(&self.amplitude, e);
         let polynomial = if s >= self.transient_over {
             self.position[0]
         } else {
             Self::horner(&self.position, e.decay)
         };
-        (g[0] + g[1] + g[2]).re + polynomial
+        modal_position(&self.position_weights, e) + polynomial
     }
 
     /// Bounds on the position over [0, s_end].
@@ -544,7 +546,7 @@ impl SeriesForm {
                 (v * r - term * weight.moments[1], a * r - term * weight.moments[2])
             });
         [
-            (g[0] + g[1] + g[2]).re + Self::horner(&self.position, r),
+            modal_position(&self.position_weights, e) + Self::horner(&self.position, r),
             (l[0] * g[0] + l[1] * g[1] + l[2] * g[2]).re + velocity,
             (l[0] * l[0] * g[0] + l[1] * l[1] * g[1] + l[2] * l[2] * g[2]).re + acceleration,
         ]
@@ -564,6 +566,8 @@ struct RampForm {
     horizon: f64,
     /// q_k(0) − q_p,k(0).
     amplitude: [C64; 3],
+    /// [`position_weights`] of `amplitude`.
+    position_weights: [f64; 3],
     /// P and its first two derivatives with respect to s, as polynomials in τ.
     polynomials: [Vec<f64>; 3],
     /// Each mode's particular solution q_p,k as a polynomial in τ.
@@ -626,6 +630,7 @@ impl RampForm {
         Some(Self {
             horizon,
             amplitude,
+            position_weights: position_weights(&amplitude),
             polynomials: [particular, velocity, acceleration],
             particular_modes,
         })
@@ -644,8 +649,7 @@ impl RampForm {
     }
 
     fn position_from(&self, s: f64, e: &Exponentials) -> f64 {
-        let g = growth_from(&self.amplitude, e);
-        (g[0] + g[1] + g[2]).re + SeriesForm::horner(&self.polynomials[0], s / self.horizon)
+        modal_position(&self.position_weights, e) + SeriesForm::horner(&self.polynomials[0], s / self.horizon)
     }
 
     /// Bounds on the position over [0, s_end], s_end within the horizon.
@@ -656,10 +660,11 @@ impl RampForm {
     }
 
     fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
-        let g = self.growth(p, s);
+        let e = p.exponentials(s, false);
+        let g = growth_from(&self.amplitude, &e);
         let (l, tau) = (&p.lambda, s / self.horizon);
         [
-            (g[0] + g[1] + g[2]).re + SeriesForm::horner(&self.polynomials[0], tau),
+            modal_position(&self.position_weights, &e) + SeriesForm::horner(&self.polynomials[0], tau),
             (l[0] * g[0] + l[1] * g[1] + l[2] * g[2]).re + SeriesForm::horner(&self.polynomials[1], tau),
             (l[0] * l[0] * g[0] + l[1] * l[1] * g[1] + l[2] * l[2] * g[2]).re
                 + SeriesForm::horner(&self.polynomials[2], tau),
@@ -722,6 +727,21 @@ fn modulus(c: C64) -> f64 {
 /// e^{λk s}·amplitude_k for the three modes (λ3 = conj(λ2), so one complex exponential).
 fn modal_growth(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s: f64) -> [C64; 3] {
     growth_from(amplitude, &p.exponentials(s, false))
+}
+
+/// Weights (w₀, w₁, w₂) with Re Σ_k amplitude_k e^{λk s} = w₀ e^{λ1 s} + w₁ Re e^{λ2 s} +
+/// w₂ Im e^{λ2 s}: the position's modal part in three products instead of three complex ones
+/// (the pair's conjugate exponential folds into w₁ and w₂).
+fn position_weights(amplitude: &[C64; 3]) -> [f64; 3] {
+    [
+        amplitude[0].re,
+        amplitude[1].re + amplitude[2].re,
+        amplitude[2].im - amplitude[1].im,
+    ]
+}
+
+fn modal_position(weights: &[f64; 3], e: &Exponentials) -> f64 {
+    weights[0] * e.real + weights[1] * e.oscillation.re + weights[2] * e.oscillation.im
 }
 
 fn growth_from(amplitude: &[C64; 3], e: &Exponentials) -> [C64; 3] {
@@ -1149,10 +1169,11 @@ impl Trajectory<'_> {
                 ClosedForm::Ramp(_) => false,
             };
             let done = p.with_advances(h, nodes, |advances| {
-                let at_start = p.exponentials(s0, with_decay);
+                // At a step's start the exponentials are 1, and the products the advances.
+                let at_start = (s0 != 0.0).then(|| p.exponentials(s0, with_decay));
                 let mut last = None;
                 for ((x, &s), advance) in out.iter_mut().zip(offsets).zip(advances) {
-                    let e = at_start.then(advance);
+                    let e = at_start.map_or(*advance, |start| start.then(advance));
                     *x = match form {
                         ClosedForm::Series(series) => series.position_from(s, &e),
                         ClosedForm::Ramp(ramp) => ramp.position_from(s, &e),
