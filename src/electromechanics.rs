@@ -502,8 +502,21 @@ impl SeriesForm {
         (growth_from(&self.amplitude, &e), e.decay)
     }
 
+    /// Σ cₙ rⁿ as E(r²) + r O(r²), its even and odd parts by Horner side by side: half the
+    /// dependent multiply-adds of one Horner chain, which the stage positions wait on.
     fn horner(coefficients: &[f64], r: f64) -> f64 {
-        coefficients.iter().rev().fold(0.0, |acc, c| acc * r + c)
+        let r2 = r * r;
+        let pairs = coefficients.chunks_exact(2);
+        let mut even = match pairs.remainder() {
+            [highest] => *highest,
+            _ => 0.0,
+        };
+        let mut odd = 0.0;
+        for pair in pairs.rev() {
+            even = even * r2 + pair[0];
+            odd = odd * r2 + pair[1];
+        }
+        even + r * odd
     }
 
     fn position(&self, p: &ElectromechanicalPropagator, s: f64) -> f64 {
