@@ -393,14 +393,19 @@ fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Coefficients {
 }
 
 /// The next coefficient of [`tanh_series`] from `terms` a₀ … aₙ: y' = 1 − y² in the
-/// variable εr gives (n+1) a_{n+1} = ε ([n = 0] − Σ_{k=0}^{n} a_k a_{n−k}), the sum folded
-/// in half and split over two accumulators (each term waits for all before it, so the
-/// sum's latency is the series' critical path).
+/// variable εr gives (n+1) a_{n+1} = ε ([n = 0] − Σ_{k=0}^{n} a_k a_{n−k}). The newest term
+/// aₙ enters the sum only as 2a₀aₙ: the rest (pairs folded in half, over two accumulators)
+/// does not wait for it, so each term is three dependent operations after the one before.
 #[inline]
 fn next_tanh_term(terms: &[f64], epsilon: f64) -> f64 {
     let n = terms.len() - 1;
-    let (low, high) = terms.split_at(n.div_ceil(2));
-    // low = a_0 … a_{⌈n/2⌉−1}; the mirrored partners a_n, a_{n−1}, … from the top.
+    let scale = epsilon * RECIPROCALS[n];
+    if n == 0 {
+        return (1.0 - terms[0] * terms[0]) * scale;
+    }
+    // a_1 … a_{n−1}, paired from both ends.
+    let inner = &terms[1..n];
+    let (low, high) = inner.split_at(inner.len() / 2);
     let (mut even, mut odd) = (0.0, 0.0);
     let mut pairs = low.iter().zip(high.iter().rev());
     while let Some((a, b)) = pairs.next() {
@@ -409,9 +414,13 @@ fn next_tanh_term(terms: &[f64], epsilon: f64) -> f64 {
             odd += a * b;
         }
     }
-    let middle = if n % 2 == 0 { terms[n / 2] * terms[n / 2] } else { 0.0 };
-    let convolution = 2.0 * (even + odd) + middle;
-    epsilon * ((if n == 0 { 1.0 } else { 0.0 }) - convolution) * RECIPROCALS[n]
+    let middle = if inner.len() % 2 == 1 {
+        inner[inner.len() / 2] * inner[inner.len() / 2]
+    } else {
+        0.0
+    };
+    let older = 2.0 * (even + odd) + middle;
+    -((2.0 * terms[0]) * terms[n] + older) * scale
 }
 
 /// For a held command with the series form, each mode is
