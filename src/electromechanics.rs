@@ -67,18 +67,28 @@ pub struct ElectromechanicalPropagator {
     ringing_envelope: ExpMemo,
 }
 
-/// e^{rate·s} for the last s asked for, with the rate fixed by the caller. A memo: it
-/// changes no result, so two propagators that differ only in it are equal.
-#[derive(Clone, Debug, Default)]
-struct ExpMemo(std::cell::Cell<Option<(f64, f64)>>);
+/// e^{rate·s} for a fixed rate, kept for the last s asked for. A memo: it changes no result,
+/// so two propagators that differ only in it are equal.
+#[derive(Clone, Debug)]
+struct ExpMemo {
+    rate: f64,
+    last: std::cell::Cell<Option<(f64, f64)>>,
+}
 
 impl ExpMemo {
-    fn at(&self, rate: f64, s: f64) -> f64 {
-        match self.0.get() {
+    fn new(rate: f64) -> Self {
+        Self {
+            rate,
+            last: std::cell::Cell::new(None),
+        }
+    }
+
+    fn at(&self, s: f64) -> f64 {
+        match self.last.get() {
             Some((kept, value)) if kept == s => value,
             _ => {
-                let value = (rate * s).exp();
-                self.0.set(Some((s, value)));
+                let value = (self.rate * s).exp();
+                self.last.set(Some((s, value)));
                 value
             }
         }
@@ -207,8 +217,8 @@ impl ElectromechanicalPropagator {
             hysteresis: PrandtlIshlinskii::new(p.hysteresis_width, p.hysteresis_deadband),
             series_weights,
             advances: AdvanceCache::default(),
-            real_mode_growth: ExpMemo::default(),
-            ringing_envelope: ExpMemo::default(),
+            real_mode_growth: ExpMemo::new(lambda[0].re),
+            ringing_envelope: ExpMemo::new(lambda[1].re),
         })
     }
 
@@ -735,7 +745,7 @@ fn constant_and_spread(coefficients: &[f64], z_max: f64) -> (f64, f64) {
 /// monotonically between its ends, the decaying complex pair stays within its moduli.
 fn modal_bounds(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s_end: f64) -> (f64, f64) {
     let real = amplitude[0].re;
-    let real_end = real * p.real_mode_growth.at(p.lambda[0].re, s_end);
+    let real_end = real * p.real_mode_growth.at(s_end);
     let ringing = modulus(amplitude[1]) + modulus(amplitude[2]);
     (real.min(real_end) - ringing, real.max(real_end) + ringing)
 }
@@ -1141,11 +1151,7 @@ impl Trajectory<'_> {
             _ => None,
         };
         if let Some(c) = homogeneous {
-            let envelope = if s == 0.0 {
-                1.0
-            } else {
-                p.ringing_envelope.at(p.lambda[1].re, s)
-            };
+            let envelope = if s == 0.0 { 1.0 } else { p.ringing_envelope.at(s) };
             return 2.0 * modulus(c) * envelope;
         }
         let q = self.modes(s);
