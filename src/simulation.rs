@@ -509,8 +509,8 @@ impl Simulation {
 
     /// How long into a step of length `step` the jet pipe's ringing still moves the
     /// pressures by more than a hundredth of the tolerance (0 if never; the whole step,
-    /// without asking, if it is no longer than half a ringing period and the default
-    /// method integrates it). The pressure rates at the start come from `system`, which
+    /// without asking, if it is no longer than a ringing period and the default method
+    /// integrates it). The pressure rates at the start come from `system`, which
     /// keeps them for the integrator's first stage.
     fn ringing_until(&self, system: &ChamberSystem, trajectory: &Trajectory, step: f64) -> f64 {
         let after_current_transient = step.min(5.0 / self.model.params.omega_cd);
@@ -521,9 +521,9 @@ impl Simulation {
             return 0.0;
         }
         let (decay, period) = trajectory.ringing_decay_and_period();
-        // A step of at most half a period is one Verner step either way (see `advance`):
-        // taking it is cheaper than working out whether the ringing matters, which costs
-        // the rates at a second jet pipe position.
+        // A step of at most a period goes to Verner's pair, whose estimate holds whether or
+        // not the ringing matters (see `advance`): cheaper than working out whether it does,
+        // which costs the rates at a second jet pipe position.
         if self.chamber_method == ChamberMethod::NonStiffFirst && step <= period {
             return step;
         }
