@@ -56,6 +56,14 @@ PARAMETERS = {
     "command_delay": (0.0, "s"),
     "force_sensor_offset": (0.0, "N"),
     "force_sensor_gain": (1.0, "1"),
+    # generic correction terms of the diagnosis, all off at their start values
+    "supply_area_scale_1": (1.0, "1"),
+    "supply_area_scale_2": (1.0, "1"),
+    "return_area_scale_1": (1.0, "1"),
+    "return_area_scale_2": (1.0, "1"),
+    "return_resistance": (0.0, "Pa.s/kg"),
+    "chamber_vent_1": (0.0, "m2"),
+    "chamber_vent_2": (0.0, "m2"),
 }
 
 

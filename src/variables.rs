@@ -57,6 +57,15 @@ pub mod vr {
     pub const COMMAND_DELAY: u32 = 350;
     pub const FORCE_SENSOR_OFFSET: u32 = 360;
     pub const FORCE_SENSOR_GAIN: u32 = 361;
+
+    // Generic correction terms of the diagnosis (docs/model.md), all off at their start values.
+    pub const SUPPLY_AREA_SCALE_1: u32 = 400;
+    pub const SUPPLY_AREA_SCALE_2: u32 = 401;
+    pub const RETURN_AREA_SCALE_1: u32 = 402;
+    pub const RETURN_AREA_SCALE_2: u32 = 403;
+    pub const RETURN_RESISTANCE: u32 = 410;
+    pub const CHAMBER_VENT_1: u32 = 420;
+    pub const CHAMBER_VENT_2: u32 = 421;
 }
 
 pub const UNITS: &[UnitDefinition] = &[
@@ -383,4 +392,11 @@ pub const VARIABLES: &[Variable] = &[
     parameter("command_delay", vr::COMMAND_DELAY, "s", 0.0, "transport_delay: the current driver sees v_DA delayed by this time (0 = off)"),
     parameter("force_sensor_offset", vr::FORCE_SENSOR_OFFSET, "N", 0.0, "sensor_offset_gain: offset of F_meas (0 = off)"),
     parameter("force_sensor_gain", vr::FORCE_SENSOR_GAIN, "1", 1.0, "sensor_offset_gain: gain of F_meas (1 = off)"),
+    parameter("supply_area_scale_1", vr::SUPPLY_AREA_SCALE_1, "1", 1.0, "valve asymmetry: factor on the supply orifice area of port 1 (1 = the geometry of (2.8)-(2.17))"),
+    parameter("supply_area_scale_2", vr::SUPPLY_AREA_SCALE_2, "1", 1.0, "valve asymmetry: factor on the supply orifice area of port 2 (1 = the geometry)"),
+    parameter("return_area_scale_1", vr::RETURN_AREA_SCALE_1, "1", 1.0, "valve asymmetry: factor on the return orifice area of port 1 (1 = the geometry)"),
+    parameter("return_area_scale_2", vr::RETURN_AREA_SCALE_2, "1", 1.0, "valve asymmetry: factor on the return orifice area of port 2 (1 = the geometry)"),
+    parameter("return_resistance", vr::RETURN_RESISTANCE, "Pa.s/kg", 0.0, "return restriction: the pressure the return orifices vent into rises above P_r by this times the return mass flow (0 = off)"),
+    parameter("chamber_vent_1", vr::CHAMBER_VENT_1, "m2", 0.0, "chamber leak: discharge coefficient times area of a leak from chamber 1 to the return pressure (0 = off)"),
+    parameter("chamber_vent_2", vr::CHAMBER_VENT_2, "m2", 0.0, "chamber leak: discharge coefficient times area of a leak from chamber 2 to the return pressure (0 = off)"),
 ];

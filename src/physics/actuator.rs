@@ -46,16 +46,20 @@ pub struct MassFlows {
     pub return_2: f64,
     /// From chamber 1 to chamber 2.
     pub leakage: f64,
+    /// From each chamber to the return pressure through a leak (the `chamber_vent_*` terms;
+    /// zero in the thesis model).
+    pub vent_1: f64,
+    pub vent_2: f64,
 }
 
 impl MassFlows {
     /// Net inflow of chamber 1, (2.24).
     pub fn net_1(&self) -> f64 {
-        self.supply_1 - self.return_1 - self.leakage
+        self.supply_1 - self.return_1 - self.leakage - self.vent_1
     }
     /// Net inflow of chamber 2, (2.25).
     pub fn net_2(&self) -> f64 {
-        self.supply_2 - self.return_2 + self.leakage
+        self.supply_2 - self.return_2 + self.leakage - self.vent_2
     }
 }
 
@@ -81,6 +85,9 @@ pub struct Actuator {
     pub hysteresis: PrandtlIshlinskii,
     /// Polytropic exponent of the chambers: γ unless the heat_transfer effect is on.
     pub polytropic_exponent: f64,
+    /// C_d times the area factor of each orifice, [supply 1, return 1, supply 2, return 2]:
+    /// C_d for all four in the thesis model, other factors under the valve asymmetry terms.
+    pub discharge: [f64; 4],
 }
 
 impl Actuator {
@@ -91,6 +98,12 @@ impl Actuator {
         let piston_area = cylinder.piston_area();
         let hysteresis = PrandtlIshlinskii::new(params.hysteresis_width, params.hysteresis_deadband);
         let polytropic_exponent = effects::polytropic_exponent(params.gamma, params.heat_transfer_fraction);
+        let discharge = [
+            params.c_d * params.supply_area_scale_1,
+            params.c_d * params.return_area_scale_1,
+            params.c_d * params.supply_area_scale_2,
+            params.c_d * params.return_area_scale_2,
+        ];
         Ok(Self {
             params,
             flow,
@@ -98,6 +111,7 @@ impl Actuator {
             piston_area,
             hysteresis,
             polytropic_exponent,
+            discharge,
         })
     }
 
@@ -134,10 +148,11 @@ impl Actuator {
     pub fn mass_flows_through(&self, a: &OrificeAreas, p1: f64, p2: f64) -> MassFlows {
         let p = &self.params;
         let k = &self.flow;
+        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
         let supply = |p_supply: f64| {
             (
-                mass_flow(k, p.c_d * a.supply_1, p_supply, p1),
-                mass_flow(k, p.c_d * a.supply_2, p_supply, p2),
+                mass_flow(k, cd_s1 * a.supply_1, p_supply, p1),
+                mass_flow(k, cd_s2 * a.supply_2, p_supply, p2),
             )
         };
         let p_supply = effects::supply_pressure_at_jet(p.p_s, p.supply_resistance, p1.min(p2), |ps| {
@@ -145,12 +160,33 @@ impl Actuator {
             s1 + s2
         });
         let (supply_1, supply_2) = supply(p_supply);
+        let returns = |p_return: f64| {
+            (
+                mass_flow(k, cd_r1 * a.return_1, p1, p_return),
+                mass_flow(k, cd_r2 * a.return_2, p2, p_return),
+            )
+        };
+        let p_return = effects::return_pressure_at_vent(p.p_r, p.return_resistance, p1.max(p2), |pr| {
+            let (r1, r2) = returns(pr);
+            r1 + r2
+        });
+        let (return_1, return_2) = returns(p_return);
+        let (vent_1, vent_2) = if p.chamber_vent_1 == 0.0 && p.chamber_vent_2 == 0.0 {
+            (0.0, 0.0)
+        } else {
+            (
+                mass_flow(k, p.chamber_vent_1, p1, p.p_r),
+                mass_flow(k, p.chamber_vent_2, p2, p.p_r),
+            )
+        };
         MassFlows {
             supply_1,
-            return_1: mass_flow(k, p.c_d * a.return_1, p1, p.p_r),
+            return_1,
             supply_2,
-            return_2: mass_flow(k, p.c_d * a.return_2, p2, p.p_r),
+            return_2,
             leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+            vent_1,
+            vent_2,
         }
     }
 

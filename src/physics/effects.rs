@@ -128,11 +128,35 @@ pub fn supply_pressure_at_jet(p_s: f64, resistance: f64, lowest: f64, supply_flo
 
 #[inline(never)]
 fn supply_pressure_through_line(p_s: f64, resistance: f64, lowest: f64, supply_flow: impl Fn(f64) -> f64) -> f64 {
-    let residual = |p: f64| p - p_s + resistance * supply_flow(p);
-    let (mut a, mut fa) = (lowest.min(p_s), residual(lowest.min(p_s)));
-    let (mut b, mut fb) = (p_s, residual(p_s));
+    increasing_root(lowest.min(p_s), p_s, |p| p - p_s + resistance * supply_flow(p))
+}
+
+/// Pressure that the return orifices vent into when the return line has a resistance
+/// `resistance` (Pa·s/kg) to the return pressure `p_r`: the root of p = P_r + R ṁ(p),
+/// with ṁ(p) the return mass flow, which falls as p rises. At `highest` (the higher
+/// chamber pressure) no air enters the line, so the root lies in [P_r, highest].
+#[inline]
+pub fn return_pressure_at_vent(p_r: f64, resistance: f64, highest: f64, return_flow: impl Fn(f64) -> f64) -> f64 {
+    if resistance == 0.0 {
+        return p_r;
+    }
+    return_pressure_through_line(p_r, resistance, highest, return_flow)
+}
+
+#[inline(never)]
+fn return_pressure_through_line(p_r: f64, resistance: f64, highest: f64, return_flow: impl Fn(f64) -> f64) -> f64 {
+    increasing_root(p_r, highest.max(p_r), |p| p - p_r - resistance * return_flow(p))
+}
+
+/// The root in [a, b] of an increasing `residual` (the end nearest the sign change when
+/// the bracket holds none): the Illinois variant of regula falsi, which never leaves the
+/// bracket however steep the residual is.
+fn increasing_root(a: f64, b: f64, residual: impl Fn(f64) -> f64) -> f64 {
+    let scale = a.abs().max(b.abs());
+    let (mut a, mut fa) = (a, residual(a));
+    let (mut b, mut fb) = (b, residual(b));
     if fb <= 0.0 {
-        return p_s;
+        return b;
     }
     if fa >= 0.0 {
         return a;
@@ -146,7 +170,7 @@ fn supply_pressure_through_line(p_s: f64, resistance: f64, lowest: f64, supply_f
             (a * fb - b * fa) / (fb - fa)
         };
         let fc = residual(c);
-        if fc.abs() < 1e-10 * p_s || (b - a).abs() < 1e-12 * p_s {
+        if fc.abs() < 1e-10 * scale || (b - a).abs() < 1e-12 * scale {
             return c;
         }
         if fc > 0.0 {
@@ -237,6 +261,20 @@ mod tests {
         let chamber = 3e5;
         let p = supply_pressure_at_jet(p_s, 1e300, chamber, |p| k * (p - chamber));
         assert!(p >= chamber && p < chamber + 1.0, "{p}");
+    }
+
+    #[test]
+    fn return_restriction_solves_its_equation() {
+        // Return flow falling linearly in the vent pressure: ṁ = k (P_h − p), so
+        // p = P_r + R k (P_h − p) ⇒ p = (P_r + R k P_h) / (1 + R k).
+        let (p_r, p_h, r, k) = (101_325.0, 4e5, 3e8, 1e-9);
+        let p = return_pressure_at_vent(p_r, r, p_h, |p| k * (p_h - p));
+        let exact = (p_r + r * k * p_h) / (1.0 + r * k);
+        assert!((p - exact).abs() < 1e-6 * p_h, "{p} vs {exact}");
+        assert_eq!(return_pressure_at_vent(p_r, 0.0, p_h, |p| k * (p_h - p)), p_r);
+        // An enormous resistance: the vent rises to (almost) the higher chamber pressure.
+        let p = return_pressure_at_vent(p_r, 1e300, p_h, |p| k * (p_h - p));
+        assert!(p <= p_h && p > p_h - 1.0, "{p}");
     }
 
     #[test]

@@ -45,6 +45,14 @@ pub struct Parameters {
     pub command_delay: f64,
     pub force_sensor_offset: f64,
     pub force_sensor_gain: f64,
+    /// Generic correction terms of the diagnosis; each is off at its default.
+    pub supply_area_scale_1: f64,
+    pub supply_area_scale_2: f64,
+    pub return_area_scale_1: f64,
+    pub return_area_scale_2: f64,
+    pub return_resistance: f64,
+    pub chamber_vent_1: f64,
+    pub chamber_vent_2: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -96,6 +104,13 @@ impl Default for Parameters {
             command_delay: 0.0,
             force_sensor_offset: 0.0,
             force_sensor_gain: 0.0,
+            supply_area_scale_1: 0.0,
+            supply_area_scale_2: 0.0,
+            return_area_scale_1: 0.0,
+            return_area_scale_2: 0.0,
+            return_resistance: 0.0,
+            chamber_vent_1: 0.0,
+            chamber_vent_2: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -153,6 +168,13 @@ impl Parameters {
         vr::COMMAND_DELAY,
         vr::FORCE_SENSOR_OFFSET,
         vr::FORCE_SENSOR_GAIN,
+        vr::SUPPLY_AREA_SCALE_1,
+        vr::SUPPLY_AREA_SCALE_2,
+        vr::RETURN_AREA_SCALE_1,
+        vr::RETURN_AREA_SCALE_2,
+        vr::RETURN_RESISTANCE,
+        vr::CHAMBER_VENT_1,
+        vr::CHAMBER_VENT_2,
     ];
 
     fn field_and_bound(&mut self, value_reference: u32) -> Option<(&mut f64, Bound)> {
@@ -194,6 +216,13 @@ impl Parameters {
             vr::COMMAND_DELAY => (&mut self.command_delay, NonNegative),
             vr::FORCE_SENSOR_OFFSET => (&mut self.force_sensor_offset, Finite),
             vr::FORCE_SENSOR_GAIN => (&mut self.force_sensor_gain, Positive),
+            vr::SUPPLY_AREA_SCALE_1 => (&mut self.supply_area_scale_1, NonNegative),
+            vr::SUPPLY_AREA_SCALE_2 => (&mut self.supply_area_scale_2, NonNegative),
+            vr::RETURN_AREA_SCALE_1 => (&mut self.return_area_scale_1, NonNegative),
+            vr::RETURN_AREA_SCALE_2 => (&mut self.return_area_scale_2, NonNegative),
+            vr::RETURN_RESISTANCE => (&mut self.return_resistance, NonNegative),
+            vr::CHAMBER_VENT_1 => (&mut self.chamber_vent_1, NonNegative),
+            vr::CHAMBER_VENT_2 => (&mut self.chamber_vent_2, NonNegative),
             _ => return None,
         })
     }
