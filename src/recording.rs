@@ -147,7 +147,7 @@ impl Recording {
             for (name, values) in [("p1_Pa", &p1), ("p2_Pa", &p2)] {
                 if let Some(k) = values.iter().position(|&p| p <= 0.0) {
                     return Err(format!(
-                        "row {}, column {name}: absolute pressure {} Pa is not positive",
+                        "row {}, column {name}: absolute pressure {} Pa is not positive (gauge pressure? the column must be absolute)",
                         k + 2,
                         values[k]
                     ));

@@ -13,6 +13,8 @@ pub struct Replay {
     pub p1: Vec<f64>,
     pub p2: Vec<f64>,
     pub current: Vec<f64>,
+    /// Jet pipe tip position relative to its rest position.
+    pub x_jp: Vec<f64>,
     /// Work done, for progress and benchmarks.
     pub steps: u64,
 }
@@ -24,6 +26,7 @@ impl Replay {
             p1: Vec::with_capacity(n),
             p2: Vec::with_capacity(n),
             current: Vec::with_capacity(n),
+            x_jp: Vec::with_capacity(n),
             steps: 0,
         }
     }
@@ -33,6 +36,7 @@ impl Replay {
         self.p1.push(y.p1);
         self.p2.push(y.p2);
         self.current.push(y.current);
+        self.x_jp.push(y.x_jp);
     }
 }
 

@@ -24,7 +24,7 @@ fn run(name: &str, effects: BenchEffects, seed: u64) -> Diagnosis {
     let named: Vec<String> = d
         .effects
         .iter()
-        .map(|(f, _)| {
+        .map(|f| {
             format!(
                 "{} {:?}",
                 f.name,
@@ -56,7 +56,7 @@ fn selected(name: &str) -> bool {
 }
 
 fn names(d: &Diagnosis) -> Vec<&'static str> {
-    d.effects.iter().map(|(f, _)| f.name).collect()
+    d.effects.iter().map(|f| f.name).collect()
 }
 
 #[test]
@@ -234,7 +234,7 @@ fn calibration_re_identifies_the_static_parameters() {
     wrong.x_jp_offset = 0.07e-3;
     let recording = Recording::read(&path, &wrong).unwrap();
     let d = diagnose(&recording, &wrong, true, &mut |line| println!("{line}")).unwrap();
-    let value = |name: &str| d.calibrated.iter().find(|(n, _)| *n == name).map(|(_, v)| *v).unwrap();
+    let value = |name: &str| d.calibrated.iter().find(|c| c.name == name).map(|c| c.value).unwrap();
     println!(
         "calibrated: {:?}; after {:.4} N, noise {:.4} N",
         d.calibrated, d.after.rms, d.noise_floor

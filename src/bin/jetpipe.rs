@@ -63,6 +63,9 @@ enum Command {
         /// Directory for SVG plots of the residuals and force/current loops.
         #[arg(long)]
         plots: Option<PathBuf>,
+        /// Worker threads for the candidate fits (default: every core this process may use).
+        #[arg(long)]
+        jobs: Option<usize>,
     },
     /// Run the standard scenario in-process and print a summary.
     Simulate {
@@ -169,7 +172,15 @@ fn run(cli: Cli) -> Result<(), String> {
             params,
             calibrate,
             plots,
-        } => diagnose(&recording, &report, params.as_deref(), calibrate, plots.as_deref()),
+            jobs,
+        } => diagnose(
+            &recording,
+            &report,
+            params.as_deref(),
+            calibrate,
+            plots.as_deref(),
+            jobs,
+        ),
     }
 }
 
@@ -229,12 +240,23 @@ fn diagnose(
     params: Option<&std::path::Path>,
     calibrate: bool,
     plots: Option<&std::path::Path>,
+    jobs: Option<usize>,
 ) -> Result<(), String> {
+    if jobs == Some(0) {
+        return Err("--jobs 0 is invalid: must be at least 1".to_string());
+    }
     let started = Instant::now();
     let base = read_parameters(params)?;
     let recording = jetpipe::recording::Recording::read(recording_path, &base)?;
     let mut progress = |line: &str| eprintln!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
-    let diagnosis = jetpipe::diagnosis::diagnose(&recording, &base, calibrate, &mut progress)?;
+    let mut options = jetpipe::diagnosis::Options {
+        calibrate,
+        ..Default::default()
+    };
+    if let Some(jobs) = jobs {
+        options.jobs = jobs;
+    }
+    let diagnosis = jetpipe::diagnosis::diagnose_with(&recording, &base, &options, &mut progress)?;
     let name = recording_path.display().to_string();
     let json = diagnosis.to_json(&name);
     if let Some(dir) = plots {
@@ -250,22 +272,10 @@ fn diagnose(
         "{name}: {} samples, noise floor {:.4} N",
         diagnosis.samples, diagnosis.noise_floor
     );
-    println!(
-        "  before: force RMS {:.4} N (held-out {:.4} N)",
-        diagnosis.before.rms, diagnosis.before.heldout_rms
-    );
-    if diagnosis.effects.is_empty() {
-        println!("  no effect added: the thesis model explains the recording to within its noise");
+    println!("  verdict: {}", diagnosis.verdict());
+    for line in diagnosis.summary() {
+        println!("  {line}");
     }
-    for (fit, evidence) in &diagnosis.effects {
-        let values: Vec<String> = fit.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
-        println!("  + {} ({})", fit.name, values.join(", "));
-        println!("    {evidence}");
-    }
-    println!(
-        "  after:  force RMS {:.4} N (held-out {:.4} N)",
-        diagnosis.after.rms, diagnosis.after.heldout_rms
-    );
     println!(
         "  report: {} ({:.1} s)",
         report.display(),

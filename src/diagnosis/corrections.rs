@@ -1,0 +1,1029 @@
+//! Corrections to the model, built from three general mechanisms:
+//!
+//! * **a constant of the model re-identified** ([`Mechanism::Parameter`]): a thesis
+//!   constant with another value, or one of the model's terms that are off in the thesis
+//!   model (per-orifice area factors, a return line resistance, chamber vents, and the named
+//!   effects' own parameters); a constant **varying in time** is the same constant with its
+//!   sensitivity modulated by a ramp or a sinusoid ([`Mechanism::Modulated`]);
+//! * **a transform inserted in the chain**: on the command ([`Mechanism::CommandLag`],
+//!   [`Mechanism::CurrentLimit`]) or on a measured channel ([`Mechanism::Output`] with a
+//!   sensor regressor);
+//! * **an extra term in a balance**: a force on the piston as a function of the stopper's
+//!   motion ([`Mechanism::Output`] with a mechanics regressor), a mass flow through a vent.
+//!
+//! Each [`Candidate`] is a set of such terms at one place of the chain. It is fitted by
+//! Gauss–Newton with bounds on the training blocks of every measured channel at once (each
+//! channel weighted by its noise floor) and scored on the held-out blocks.
+
+use crate::physics::actuator::Actuator;
+use crate::physics::parameters::Parameters;
+use crate::recording::Recording;
+use crate::replay::{replay_fast, Replay};
+use crate::variables::VARIABLES;
+
+use super::signals::{rate, stopper_velocity, CHANNELS, FORCE, P1, P2};
+
+/// A signal that a measured channel may carry in proportion to a coefficient.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Regressor {
+    One,
+    /// The modelled value of the channel itself (a gain), and its powers.
+    Own,
+    OwnSquared,
+    OwnCubed,
+    /// Time derivative of the channel (−τ times it is a first-order lag of τ).
+    OwnRate,
+    /// −sign(dx_s/dt) where the pressures set the force: Coulomb friction.
+    Friction,
+    /// −dx_s/dt where the pressures set the force: viscous friction.
+    Viscous,
+    /// x_s minus its mean where the pressures set the force: a spring on the piston.
+    Position,
+    /// (t − t_mid) / (t_end − t_start): drift.
+    Ramp,
+    Sine(f64),
+    Cosine(f64),
+}
+
+/// How a time-varying constant varies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Modulation {
+    Ramp,
+    Sine(f64),
+    Cosine(f64),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Mechanism {
+    /// An FMU parameter of the model.
+    Parameter(&'static str),
+    /// A first-order lag (time constant, s) on the command the current driver sees.
+    CommandLag,
+    /// The current saturates at ± this (A): the command clipped where k_cd v + i_offset
+    /// reaches it (the current driver is linear, so the two are the same).
+    CurrentLimit,
+    /// A term on a measured channel: coefficient × regressor.
+    Output { channel: usize, regressor: Regressor },
+    /// A parameter varying in time: coefficient × its sensitivity × the modulation (first order).
+    Modulated {
+        parameter: &'static str,
+        modulation: Modulation,
+    },
+}
+
+impl Mechanism {
+    fn is_linear(&self) -> bool {
+        matches!(self, Mechanism::Output { .. } | Mechanism::Modulated { .. })
+    }
+}
+
+/// One coefficient of a candidate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Term {
+    /// The name the report gives it (an FMU parameter name where it is one).
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub mechanism: Mechanism,
+    /// Value with the term off (for parameters: their value in the base model).
+    pub neutral: f64,
+    /// Finite-difference step, and a typical size.
+    pub step: f64,
+    pub lower: f64,
+    pub upper: f64,
+}
+
+/// Terms at one place of the chain, fitted together.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Candidate {
+    pub label: &'static str,
+    pub location: &'static str,
+    pub family: &'static str,
+    /// The named effect this candidate is, if it is one.
+    pub named: Option<&'static str>,
+    pub terms: Vec<Term>,
+}
+
+fn value_reference(name: &str) -> u32 {
+    VARIABLES
+        .iter()
+        .find(|v| v.name == name)
+        .map(|v| v.value_reference)
+        .unwrap_or_else(|| panic!("{name} is not a variable of the model"))
+}
+
+/// The base model's value of an FMU parameter.
+pub fn parameter_value(p: &Parameters, name: &str) -> f64 {
+    p.get(value_reference(name))
+        .unwrap_or_else(|| panic!("{name} is not a parameter"))
+}
+
+/// Set an FMU parameter, with the model's own checks.
+pub fn set_parameter(p: &mut Parameters, name: &str, value: f64) -> Result<(), String> {
+    p.set(value_reference(name), value)
+}
+
+fn parameter(base: &Parameters, name: &'static str, unit: &'static str, relative: f64, lower: f64, upper: f64) -> Term {
+    let neutral = parameter_value(base, name);
+    Term {
+        name,
+        unit,
+        mechanism: Mechanism::Parameter(name),
+        neutral,
+        step: relative * neutral.abs().max(1e-30),
+        lower,
+        upper,
+    }
+}
+
+fn term_off(name: &'static str, unit: &'static str, step: f64, upper: f64) -> Term {
+    Term {
+        name,
+        unit,
+        mechanism: Mechanism::Parameter(name),
+        neutral: 0.0,
+        step,
+        lower: 0.0,
+        upper,
+    }
+}
+
+fn output(name: &'static str, unit: &'static str, channel: usize, regressor: Regressor, step: f64) -> Term {
+    Term {
+        name,
+        unit,
+        mechanism: Mechanism::Output { channel, regressor },
+        neutral: 0.0,
+        step,
+        lower: f64::NEG_INFINITY,
+        upper: f64::INFINITY,
+    }
+}
+
+fn modulated(
+    name: &'static str,
+    unit: &'static str,
+    parameter: &'static str,
+    modulation: Modulation,
+    step: f64,
+) -> Term {
+    Term {
+        name,
+        unit,
+        mechanism: Mechanism::Modulated { parameter, modulation },
+        neutral: 0.0,
+        step,
+        lower: f64::NEG_INFINITY,
+        upper: f64::INFINITY,
+    }
+}
+
+/// Every candidate, for a base model and a recording with or without pressures.
+/// `periodic_hz` is the residual's spectral line, if it has one.
+pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64>) -> Vec<Candidate> {
+    let c = |label, location, family, named, terms| Candidate {
+        label,
+        location,
+        family,
+        named,
+        terms,
+    };
+    let p = |name, unit, relative, lower, upper| parameter(base, name, unit, relative, lower, upper);
+    let inf = f64::INFINITY;
+    let mut list = vec![
+        c(
+            "command delay",
+            "command",
+            "delay",
+            Some("transport_delay"),
+            vec![Term {
+                step: 1e-3,
+                ..term_off("command_delay", "s", 1e-3, 0.05)
+            }],
+        ),
+        c(
+            "command lag",
+            "command",
+            "dynamics",
+            None,
+            vec![Term {
+                name: "command_lag",
+                unit: "s",
+                mechanism: Mechanism::CommandLag,
+                neutral: 0.0,
+                step: 1e-3,
+                lower: 0.0,
+                upper: 0.2,
+            }],
+        ),
+        c(
+            "current driver gain and offset",
+            "current_driver",
+            "parameter_offset",
+            None,
+            vec![
+                p("k_cd", "A/V", 0.01, 0.0, inf),
+                Term {
+                    step: 1e-3,
+                    ..p("i_offset", "A", 0.0, -0.2, 0.2)
+                },
+            ],
+        ),
+        c(
+            "current limit",
+            "current_driver",
+            "limit",
+            None,
+            vec![Term {
+                name: "current_limit",
+                unit: "A",
+                mechanism: Mechanism::CurrentLimit,
+                neutral: f64::INFINITY,
+                step: 0.0,
+                lower: 0.0,
+                upper: inf,
+            }],
+        ),
+        c(
+            "jet pipe null and travel",
+            "jet_pipe",
+            "parameter_offset",
+            None,
+            vec![
+                Term {
+                    step: 2e-6,
+                    ..p("x_jp_offset", "m", 0.0, -1e-3, 1e-3)
+                },
+                p("x_jp_sat", "m", 0.01, 1e-5, 5e-3),
+            ],
+        ),
+        c(
+            "jet pipe lag",
+            "jet_pipe",
+            "dynamics",
+            None,
+            vec![p("omega_1", "rad/s", 0.05, 1.0, 1e5)],
+        ),
+        c(
+            "jet pipe hysteresis",
+            "jet_pipe",
+            "hysteresis",
+            Some("jet_pipe_hysteresis"),
+            vec![
+                term_off("hysteresis_width", "m", 2e-5, 1e-3),
+                term_off("hysteresis_deadband", "m", 5e-6, 1e-3),
+            ],
+        ),
+        c(
+            "jet pipe null drift",
+            "jet_pipe",
+            "drift",
+            None,
+            vec![modulated(
+                "x_jp_offset_drift",
+                "m",
+                "x_jp_offset",
+                Modulation::Ramp,
+                1e-6,
+            )],
+        ),
+        c(
+            "discharge coefficient",
+            "valve",
+            "parameter_offset",
+            None,
+            vec![p("C_d", "1", 0.01, 1e-3, 1.0)],
+        ),
+        c(
+            "orifice areas port by port",
+            "valve",
+            "asymmetry",
+            None,
+            vec![
+                p("supply_area_scale_1", "1", 0.01, 0.0, 3.0),
+                p("supply_area_scale_2", "1", 0.01, 0.0, 3.0),
+                p("return_area_scale_1", "1", 0.01, 0.0, 3.0),
+                p("return_area_scale_2", "1", 0.01, 0.0, 3.0),
+            ],
+        ),
+        c(
+            "supply pressure",
+            "supply",
+            "parameter_offset",
+            None,
+            vec![p("P_s", "Pa", 0.005, 1.2e5, 2e6)],
+        ),
+        c(
+            "supply line resistance",
+            "supply",
+            "restriction",
+            Some("supply_pressure_drop"),
+            vec![term_off("supply_resistance", "Pa.s/kg", 1e8, 1e11)],
+        ),
+        c(
+            "supply pressure drift",
+            "supply",
+            "drift",
+            None,
+            vec![modulated("P_s_drift", "Pa", "P_s", Modulation::Ramp, 1e3)],
+        ),
+        c(
+            "return pressure",
+            "return",
+            "parameter_offset",
+            None,
+            vec![p("P_r", "Pa", 0.01, 1e4, 6e5)],
+        ),
+        c(
+            "return line resistance",
+            "return",
+            "restriction",
+            None,
+            vec![term_off("return_resistance", "Pa.s/kg", 1e8, 1e11)],
+        ),
+        c(
+            "dead volumes",
+            "chambers",
+            "parameter_offset",
+            Some("dead_volume"),
+            vec![
+                term_off("dead_volume_1", "m3", 5e-7, 1e-4),
+                term_off("dead_volume_2", "m3", 5e-7, 1e-4),
+            ],
+        ),
+        c(
+            "heat exchange",
+            "chambers",
+            "parameter_offset",
+            Some("heat_transfer"),
+            vec![term_off("heat_transfer_fraction", "1", 0.05, 1.0)],
+        ),
+        c(
+            "leakage past the piston",
+            "chambers",
+            "parameter_offset",
+            None,
+            vec![
+                Term {
+                    step: 2e-9,
+                    ..p("C_dm_A_lpp", "m2", 0.0, -1e-6, 1e-6)
+                },
+                Term {
+                    step: 2e-9,
+                    ..p("C_db_A_lpp", "m2", 0.0, 0.0, 1e-6)
+                },
+            ],
+        ),
+        c(
+            "chamber leaks to the return",
+            "chambers",
+            "extra_flow",
+            None,
+            vec![
+                term_off("chamber_vent_1", "m2", 5e-9, 1e-6),
+                term_off("chamber_vent_2", "m2", 5e-9, 1e-6),
+            ],
+        ),
+        c(
+            "Coulomb friction",
+            "mechanics",
+            "extra_force",
+            Some("piston_friction"),
+            vec![Term {
+                lower: 0.0,
+                ..output("friction_coulomb", "N", FORCE, Regressor::Friction, 0.1)
+            }],
+        ),
+        c(
+            "viscous friction",
+            "mechanics",
+            "extra_force",
+            None,
+            vec![output("viscous_friction", "N.s/m", FORCE, Regressor::Viscous, 1.0)],
+        ),
+        c(
+            "force on the stopper position",
+            "mechanics",
+            "compliance",
+            None,
+            vec![output("position_stiffness", "N/m", FORCE, Regressor::Position, 10.0)],
+        ),
+        c(
+            "force sensor offset and gain",
+            "force_sensor",
+            "parameter_offset",
+            Some("sensor_offset_gain"),
+            vec![
+                output("force_sensor_offset", "N", FORCE, Regressor::One, 0.1),
+                output("force_sensor_gain_error", "1", FORCE, Regressor::Own, 1e-3),
+            ],
+        ),
+        c(
+            "force sensor curve",
+            "force_sensor",
+            "nonlinearity",
+            None,
+            vec![
+                output("force_sensor_offset", "N", FORCE, Regressor::One, 0.1),
+                output("force_sensor_gain_error", "1", FORCE, Regressor::Own, 1e-3),
+                output("force_sensor_quadratic", "1/N", FORCE, Regressor::OwnSquared, 1e-5),
+                output("force_sensor_cubic", "1/N2", FORCE, Regressor::OwnCubed, 1e-7),
+            ],
+        ),
+        c(
+            "force sensor lag",
+            "force_sensor",
+            "dynamics",
+            None,
+            vec![output("force_sensor_lag", "s", FORCE, Regressor::OwnRate, 1e-4)],
+        ),
+        c(
+            "force sensor drift",
+            "force_sensor",
+            "drift",
+            None,
+            vec![output("force_sensor_drift", "N", FORCE, Regressor::Ramp, 0.1)],
+        ),
+    ];
+    if let Some(f) = periodic_hz {
+        list.push(c(
+            "supply pressure ripple",
+            "supply",
+            "periodic",
+            None,
+            vec![
+                modulated("P_s_ripple_sin", "Pa", "P_s", Modulation::Sine(f), 1e3),
+                modulated("P_s_ripple_cos", "Pa", "P_s", Modulation::Cosine(f), 1e3),
+            ],
+        ));
+        list.push(c(
+            "force sensor pick-up",
+            "force_sensor",
+            "periodic",
+            None,
+            vec![
+                output("force_sensor_ripple_sin", "N", FORCE, Regressor::Sine(f), 0.1),
+                output("force_sensor_ripple_cos", "N", FORCE, Regressor::Cosine(f), 0.1),
+            ],
+        ));
+    }
+    if has_pressures {
+        list.push(c(
+            "pressure sensor offsets and gains",
+            "pressure_sensors",
+            "parameter_offset",
+            None,
+            vec![
+                output("p1_sensor_offset", "Pa", P1, Regressor::One, 100.0),
+                output("p1_sensor_gain_error", "1", P1, Regressor::Own, 1e-3),
+                output("p2_sensor_offset", "Pa", P2, Regressor::One, 100.0),
+                output("p2_sensor_gain_error", "1", P2, Regressor::Own, 1e-3),
+            ],
+        ));
+        list.push(c(
+            "pressure sensor drift",
+            "pressure_sensors",
+            "drift",
+            None,
+            vec![
+                output("p1_sensor_drift", "Pa", P1, Regressor::Ramp, 100.0),
+                output("p2_sensor_drift", "Pa", P2, Regressor::Ramp, 100.0),
+            ],
+        ));
+    }
+    list
+}
+
+/// The fixed part of a fitting problem: the recording, the base model, the blocks and
+/// the channels' weights.
+pub struct Problem<'a> {
+    pub recording: &'a Recording,
+    pub base: &'a Parameters,
+    /// Training samples (the others are held out).
+    pub training: &'a [bool],
+    /// 1/noise floor of each channel (0 for a channel the recording lacks).
+    pub weights: [f64; CHANNELS],
+    pub measured: [&'a [f64]; CHANNELS],
+    velocity: Vec<f64>,
+    mean_position: f64,
+    t_mid: f64,
+    t_span: f64,
+}
+
+impl<'a> Problem<'a> {
+    pub fn new(recording: &'a Recording, base: &'a Parameters, training: &'a [bool], noise: [f64; CHANNELS]) -> Self {
+        let empty: &[f64] = &[];
+        let measured = [
+            recording.force.as_slice(),
+            recording.p1.as_deref().unwrap_or(empty),
+            recording.p2.as_deref().unwrap_or(empty),
+        ];
+        let mut weights = [0.0; CHANNELS];
+        for c in 0..CHANNELS {
+            if !measured[c].is_empty() && noise[c] > 0.0 {
+                weights[c] = 1.0 / noise[c];
+            }
+        }
+        let n = recording.len();
+        let (t0, t1) = (recording.time[0], recording.time[n - 1]);
+        Self {
+            recording,
+            base,
+            training,
+            weights,
+            measured,
+            velocity: stopper_velocity(recording),
+            mean_position: recording.x_s.iter().sum::<f64>() / n as f64,
+            t_mid: 0.5 * (t0 + t1),
+            t_span: (t1 - t0).max(1e-9),
+        }
+    }
+
+    /// Model outputs with the nonlinear terms at `values` (linear terms are added by
+    /// [`Self::predict`]).
+    fn replay(&self, terms: &[Term], values: &[f64]) -> Result<Replay, String> {
+        let mut p = self.base.clone();
+        let mut lag = 0.0;
+        let mut limit = f64::INFINITY;
+        for (term, &value) in terms.iter().zip(values) {
+            match term.mechanism {
+                Mechanism::Parameter(name) => set_parameter(&mut p, name, value)?,
+                Mechanism::CommandLag => lag = value,
+                Mechanism::CurrentLimit => limit = value,
+                _ => {}
+            }
+        }
+        let model = Actuator::new(p)?;
+        if lag == 0.0 && limit == f64::INFINITY {
+            return replay_fast(&model, self.recording, self.recording.len());
+        }
+        let mut shaped = self.recording.clone();
+        if limit.is_finite() {
+            let (k, i0) = (model.params.k_cd, model.params.i_offset);
+            if k != 0.0 {
+                let (a, b) = ((-limit - i0) / k, (limit - i0) / k);
+                let (lo, hi) = (a.min(b), a.max(b));
+                for v in shaped.v_da.iter_mut() {
+                    *v = v.clamp(lo, hi);
+                }
+            }
+        }
+        if lag > 0.0 {
+            // Exact for a command held between samples, sampled at the sample instants.
+            let mut state = shaped.v_da[0];
+            for k in 0..shaped.len() {
+                let v = shaped.v_da[k];
+                shaped.v_da[k] = state;
+                if k + 1 < shaped.len() {
+                    let dt = shaped.time[k + 1] - shaped.time[k];
+                    state += (1.0 - (-dt / lag).exp()) * (v - state);
+                }
+            }
+        }
+        replay_fast(&model, &shaped, shaped.len())
+    }
+
+    fn regressor(&self, regressor: Regressor, own: &[f64], own_rate: &[f64], floor: &[bool], k: usize) -> f64 {
+        let t = self.recording.time[k];
+        let v = self.velocity[k];
+        let set_by_pressures = !floor[k];
+        match regressor {
+            Regressor::One => 1.0,
+            Regressor::Own => own[k],
+            Regressor::OwnSquared => own[k] * own[k],
+            Regressor::OwnCubed => own[k] * own[k] * own[k],
+            Regressor::OwnRate => -own_rate[k],
+            Regressor::Friction if set_by_pressures && v.abs() > 1e-9 => -v.signum(),
+            Regressor::Viscous if set_by_pressures => -v,
+            Regressor::Position if set_by_pressures => -(self.recording.x_s[k] - self.mean_position),
+            Regressor::Friction | Regressor::Viscous | Regressor::Position => 0.0,
+            Regressor::Ramp => (t - self.t_mid) / self.t_span,
+            Regressor::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
+            Regressor::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
+        }
+    }
+}
+
+fn modulation_at(m: Modulation, t: f64, t_mid: f64, t_span: f64) -> f64 {
+    match m {
+        Modulation::Ramp => (t - t_mid) / t_span,
+        Modulation::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
+        Modulation::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
+    }
+}
+
+/// A candidate fitted: its values, what it predicts, and its errors.
+#[derive(Clone, Debug)]
+pub struct Fit {
+    pub candidate: Candidate,
+    pub values: Vec<f64>,
+    pub prediction: [Vec<f64>; CHANNELS],
+    /// Weighted sums of squares per channel on the training and held-out samples.
+    pub train: [f64; CHANNELS],
+    pub heldout: [f64; CHANNELS],
+    pub replays: usize,
+}
+
+impl Fit {
+    pub fn train_total(&self) -> f64 {
+        self.train.iter().sum()
+    }
+    pub fn heldout_total(&self) -> f64 {
+        self.heldout.iter().sum()
+    }
+}
+
+/// Sensitivities of the model's outputs to the nonlinear terms, shared by candidates that
+/// start from the same point.
+pub type Sensitivity = [Vec<f64>; CHANNELS];
+
+/// Everything needed at one point of a candidate's terms.
+struct Point {
+    values: Vec<f64>,
+    replay: Replay,
+}
+
+impl Problem<'_> {
+    /// Predictions of the measured channels for a candidate at `values`, from a replay at
+    /// those values and the sensitivities of modulated parameters.
+    fn predict(&self, terms: &[Term], point: &Point, sensitivities: &[Option<Sensitivity>]) -> [Vec<f64>; CHANNELS] {
+        let r = &point.replay;
+        let mut out = [r.force.clone(), r.p1.clone(), r.p2.clone()];
+        let n = self.recording.len();
+        for (j, (term, &value)) in terms.iter().zip(&point.values).enumerate() {
+            if value == 0.0 {
+                continue;
+            }
+            match term.mechanism {
+                Mechanism::Output { channel, regressor } => {
+                    let own = [&r.force, &r.p1, &r.p2][channel];
+                    let own_rate = if regressor == Regressor::OwnRate {
+                        rate(&self.recording.time, own, 2)
+                    } else {
+                        vec![]
+                    };
+                    let floor = self.floor(r);
+                    for k in 0..n {
+                        out[channel][k] += value * self.regressor(regressor, own, &own_rate, &floor, k);
+                    }
+                }
+                Mechanism::Modulated { modulation, .. } => {
+                    if let Some(s) = &sensitivities[j] {
+                        for c in 0..CHANNELS {
+                            if s[c].is_empty() {
+                                continue;
+                            }
+                            for k in 0..n {
+                                let m = modulation_at(modulation, self.recording.time[k], self.t_mid, self.t_span);
+                                out[c][k] += value * s[c][k] * m;
+                            }
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
+    }
+
+    /// Samples where the spring floor, not the pressures, sets the modelled force.
+    fn floor(&self, r: &Replay) -> Vec<bool> {
+        let p = &self.base;
+        let area = std::f64::consts::PI * p.d_cyl * p.d_cyl / 4.0;
+        (0..self.recording.len())
+            .map(|k| {
+                let spring =
+                    crate::physics::piston::spring_force(p.k_spring, p.l_spring0, p.l_s, p.l_p, self.recording.x_s[k]);
+                area * (r.p1[k] - r.p2[k]) <= spring
+            })
+            .collect()
+    }
+
+    /// Weighted sums of squares per channel, training and held-out.
+    pub fn errors(&self, prediction: &[Vec<f64>; CHANNELS]) -> ([f64; CHANNELS], [f64; CHANNELS]) {
+        let mut train = [0.0; CHANNELS];
+        let mut heldout = [0.0; CHANNELS];
+        for c in 0..CHANNELS {
+            let w = self.weights[c];
+            if w == 0.0 {
+                continue;
+            }
+            for (k, (&m, &y)) in self.measured[c].iter().zip(&prediction[c]).enumerate() {
+                let e = w * (m - y);
+                if self.training[k] {
+                    train[c] += e * e;
+                } else {
+                    heldout[c] += e * e;
+                }
+            }
+        }
+        (train, heldout)
+    }
+
+    /// Sensitivity of the outputs to one parameter at a point of the base model.
+    pub fn sensitivity(&self, name: &'static str, step: f64, at: &Replay) -> Option<Sensitivity> {
+        let mut p = self.base.clone();
+        let value = parameter_value(&p, name);
+        set_parameter(&mut p, name, value + step).ok()?;
+        let model = Actuator::new(p).ok()?;
+        let moved = replay_fast(&model, self.recording, self.recording.len()).ok()?;
+        let d = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| (x - y) / step).collect() };
+        Some([d(&moved.force, &at.force), d(&moved.p1, &at.p1), d(&moved.p2, &at.p2)])
+    }
+
+    /// Fit a candidate: bounded Gauss–Newton from its neutral values, at most `iterations`
+    /// linearisations. `start` may give the base replay and the sensitivities to the
+    /// candidate's nonlinear terms at the neutral point (shared between candidates).
+    pub fn fit(
+        &self,
+        candidate: &Candidate,
+        iterations: usize,
+        base_replay: &Replay,
+        shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
+    ) -> Result<Fit, String> {
+        let terms = &candidate.terms;
+        if terms.iter().any(|t| t.mechanism == Mechanism::CurrentLimit) {
+            return self.fit_limit(candidate, base_replay);
+        }
+        // Sensitivities of the modulated parameters (at the base point: first order).
+        let modulated: Vec<Option<Sensitivity>> = terms
+            .iter()
+            .map(|t| match t.mechanism {
+                Mechanism::Modulated { parameter, .. } => shared(parameter),
+                _ => None,
+            })
+            .collect();
+        let mut point = Point {
+            values: terms.iter().map(|t| t.neutral).collect(),
+            replay: base_replay.clone(),
+        };
+        let mut replays = 0;
+        let mut prediction = self.predict(terms, &point, &modulated);
+        let (mut train, _) = self.errors(&prediction);
+        for iteration in 0..iterations.max(1) {
+            // Columns: nonlinear terms by finite differences (shared ones at the start).
+            let mut columns: Vec<Sensitivity> = Vec::with_capacity(terms.len());
+            for (j, term) in terms.iter().enumerate() {
+                let column = match term.mechanism {
+                    Mechanism::Parameter(name) if iteration == 0 => shared(name),
+                    Mechanism::Parameter(_) | Mechanism::CommandLag => {
+                        let mut moved = point.values.clone();
+                        let step = if moved[j] + term.step <= term.upper {
+                            term.step
+                        } else {
+                            -term.step
+                        };
+                        moved[j] += step;
+                        replays += 1;
+                        self.replay(terms, &moved).ok().map(|r| {
+                            let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                                a.iter().zip(b).map(|(x, y)| (x - y) / step).collect()
+                            };
+                            [
+                                d(&r.force, &point.replay.force),
+                                d(&r.p1, &point.replay.p1),
+                                d(&r.p2, &point.replay.p2),
+                            ]
+                        })
+                    }
+                    Mechanism::Output { .. } | Mechanism::Modulated { .. } => {
+                        let mut unit = point.values.clone();
+                        unit.iter_mut().zip(terms).for_each(|(v, t)| {
+                            if t.mechanism.is_linear() {
+                                *v = 0.0
+                            }
+                        });
+                        unit[j] = 1.0;
+                        let only = Point {
+                            values: unit,
+                            replay: point.replay.clone(),
+                        };
+                        let with = self.predict(terms, &only, &modulated);
+                        Some([
+                            difference(&with[0], &point.replay.force),
+                            difference(&with[1], &point.replay.p1),
+                            difference(&with[2], &point.replay.p2),
+                        ])
+                    }
+                    Mechanism::CurrentLimit => None,
+                };
+                columns.push(column.unwrap_or_else(|| [vec![], vec![], vec![]]));
+            }
+            let step = self.solve(terms, &point.values, &columns, &prediction);
+            // Line search on the true model.
+            let mut accepted = false;
+            let mut alpha = 1.0;
+            for _ in 0..4 {
+                let values: Vec<f64> = point
+                    .values
+                    .iter()
+                    .zip(&step)
+                    .zip(terms)
+                    .map(|((v, s), t)| (v + alpha * s).clamp(t.lower, t.upper))
+                    .collect();
+                let nonlinear_moved = terms
+                    .iter()
+                    .zip(values.iter().zip(&point.values))
+                    .any(|(t, (a, b))| !t.mechanism.is_linear() && a != b);
+                let replay = if nonlinear_moved {
+                    replays += 1;
+                    match self.replay(terms, &values) {
+                        Ok(r) => r,
+                        Err(_) => {
+                            alpha *= 0.5;
+                            continue;
+                        }
+                    }
+                } else {
+                    point.replay.clone()
+                };
+                let trial = Point { values, replay };
+                let trial_prediction = self.predict(terms, &trial, &modulated);
+                let (trial_train, _) = self.errors(&trial_prediction);
+                if trial_train.iter().sum::<f64>() < train.iter().sum::<f64>() {
+                    point = trial;
+                    prediction = trial_prediction;
+                    train = trial_train;
+                    accepted = true;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            if !accepted || terms.iter().all(|t| t.mechanism.is_linear()) {
+                break;
+            }
+        }
+        let (train, heldout) = self.errors(&prediction);
+        Ok(Fit {
+            candidate: candidate.clone(),
+            values: point.values,
+            prediction,
+            train,
+            heldout,
+            replays,
+        })
+    }
+
+    /// Bounded linear least squares for the step of every term, on the training samples.
+    fn solve(
+        &self,
+        terms: &[Term],
+        values: &[f64],
+        columns: &[Sensitivity],
+        prediction: &[Vec<f64>; CHANNELS],
+    ) -> Vec<f64> {
+        let m = terms.len();
+        let usable: Vec<bool> = columns.iter().map(|c| c.iter().any(|ch| !ch.is_empty())).collect();
+        let mut ata = vec![vec![0.0; m]; m];
+        let mut atb = vec![0.0; m];
+        for c in 0..CHANNELS {
+            let w2 = self.weights[c] * self.weights[c];
+            if w2 == 0.0 {
+                continue;
+            }
+            for k in 0..self.recording.len() {
+                if !self.training[k] {
+                    continue;
+                }
+                let r = self.measured[c][k] - prediction[c][k];
+                for a in 0..m {
+                    let ja = if usable[a] && !columns[a][c].is_empty() {
+                        columns[a][c][k]
+                    } else {
+                        0.0
+                    };
+                    if ja == 0.0 {
+                        continue;
+                    }
+                    atb[a] += w2 * ja * r;
+                    for b in a..m {
+                        let jb = if usable[b] && !columns[b][c].is_empty() {
+                            columns[b][c][k]
+                        } else {
+                            0.0
+                        };
+                        ata[a][b] += w2 * ja * jb;
+                    }
+                }
+            }
+        }
+        for a in 0..m {
+            for b in 0..a {
+                ata[a][b] = ata[b][a];
+            }
+        }
+        let lower: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.lower - v).collect();
+        let upper: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.upper - v).collect();
+        bounded_least_squares(&ata, &atb, &usable, &lower, &upper)
+    }
+
+    /// A current limit: golden-section search on the limit (its sensitivity is zero until
+    /// it clips), between a fifth of the largest current the command asks for and that.
+    fn fit_limit(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
+        let p = self.base;
+        let largest = self
+            .recording
+            .v_da
+            .iter()
+            .map(|v| (p.k_cd * v + p.i_offset).abs())
+            .fold(0.0, f64::max);
+        let terms = &candidate.terms;
+        let mut replays = 0;
+        let mut evaluate = |limit: f64| -> (f64, Option<Replay>) {
+            replays += 1;
+            match self.replay(terms, &[limit]) {
+                Ok(r) => {
+                    let (train, _) = self.errors(&Prediction::of_replay(&r));
+                    (train.iter().sum(), Some(r))
+                }
+                Err(_) => (f64::INFINITY, None),
+            }
+        };
+        let phi = (5f64.sqrt() - 1.0) / 2.0;
+        let (mut a, mut b) = (0.2 * largest, largest);
+        let mut c = b - phi * (b - a);
+        let mut d = a + phi * (b - a);
+        let (mut fc, mut fd) = (evaluate(c).0, evaluate(d).0);
+        for _ in 0..14 {
+            if fc < fd {
+                b = d;
+                d = c;
+                fd = fc;
+                c = b - phi * (b - a);
+                fc = evaluate(c).0;
+            } else {
+                a = c;
+                c = d;
+                fc = fd;
+                d = a + phi * (b - a);
+                fd = evaluate(d).0;
+            }
+        }
+        let best = if fc < fd { c } else { d };
+        let (cost, replay) = evaluate(best);
+        let (values, replay) = match replay {
+            Some(r) if cost < self.errors(&Prediction::of_replay(base_replay)).0.iter().sum::<f64>() => (vec![best], r),
+            _ => (vec![f64::INFINITY], base_replay.clone()),
+        };
+        let prediction = Prediction::of_replay(&replay);
+        let (train, heldout) = self.errors(&prediction);
+        Ok(Fit {
+            candidate: candidate.clone(),
+            values,
+            prediction,
+            train,
+            heldout,
+            replays,
+        })
+    }
+}
+
+struct Prediction;
+
+impl Prediction {
+    fn of_replay(r: &Replay) -> [Vec<f64>; CHANNELS] {
+        [r.force.clone(), r.p1.clone(), r.p2.clone()]
+    }
+}
+
+/// min |A x − b|² given the normal equations (ata, atb), with lower ≤ x ≤ upper and the
+/// unusable unknowns at 0: solve the free unknowns, clamp those that leave their bounds,
+/// and solve again for the rest (at most once per unknown).
+fn bounded_least_squares(ata: &[Vec<f64>], atb: &[f64], usable: &[bool], lower: &[f64], upper: &[f64]) -> Vec<f64> {
+    let m = atb.len();
+    let mut x = vec![0.0; m];
+    let mut fixed: Vec<bool> = usable.iter().map(|u| !u).collect();
+    for _ in 0..=m {
+        let free: Vec<usize> = (0..m).filter(|&j| !fixed[j]).collect();
+        if free.is_empty() {
+            return x;
+        }
+        let mut a = nalgebra::DMatrix::<f64>::zeros(free.len(), free.len());
+        let mut b = nalgebra::DVector::<f64>::zeros(free.len());
+        for (i, &fi) in free.iter().enumerate() {
+            b[i] = atb[fi] - (0..m).filter(|&j| fixed[j]).map(|j| ata[fi][j] * x[j]).sum::<f64>();
+            for (j, &fj) in free.iter().enumerate() {
+                a[(i, j)] = ata[fi][fj];
+            }
+            // A whisker of ridge keeps nearly collinear columns solvable.
+            a[(i, i)] += 1e-10 * ata[fi][fi].max(1e-300);
+        }
+        let Some(solution) = a.lu().solve(&b) else { return x };
+        let mut clamped = false;
+        for (i, &fi) in free.iter().enumerate() {
+            x[fi] = solution[i];
+            if !(lower[fi]..=upper[fi]).contains(&x[fi]) {
+                x[fi] = x[fi].clamp(lower[fi], upper[fi]);
+                fixed[fi] = true;
+                clamped = true;
+            }
+        }
+        if !clamped {
+            return x;
+        }
+    }
+    x
+}
+
+fn difference(a: &[f64], b: &[f64]) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x - y).collect()
+}
