@@ -118,3 +118,86 @@ fn fuzzed_csv_text_never_crashes_the_reader() {
         }
     }
 }
+
+/// A clean synthetic recording of `seconds`, rows of (t, v, x_s, F, p1, p2).
+fn clean_rows(seconds: f64) -> Vec<[f64; 6]> {
+    jetpipe::synthetic_bench::generate(&jetpipe::synthetic_bench::BenchEffects::default(), 7, seconds)
+}
+
+fn csv(rows: &[[f64; 6]], map: impl Fn([f64; 6]) -> [f64; 6]) -> String {
+    let mut text = String::from("time_s,v_da_V,x_s_m,force_N,p1_Pa,p2_Pa\n");
+    for r in rows {
+        let r = map(*r);
+        text.push_str(&format!("{},{},{},{},{},{}\n", r[0], r[1], r[2], r[3], r[4], r[5]));
+    }
+    text
+}
+
+#[test]
+fn wrong_units_and_a_too_short_recording_are_refused_naming_the_column_and_the_unit() {
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-units-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rows = clean_rows(20.0);
+    let cases: Vec<(String, [&str; 2])> = vec![
+        (
+            csv(&rows, |r| [r[0], r[1], r[2], r[3] / 1000.0, r[4], r[5]]),
+            ["force_N", "kilonewtons"],
+        ),
+        (
+            csv(&rows, |r| [r[0], r[1], r[2], r[3] * 1000.0, r[4], r[5]]),
+            ["force_N", "millinewtons"],
+        ),
+        (
+            csv(&rows, |r| [r[0] * 1000.0, r[1], r[2], r[3], r[4], r[5]]),
+            ["time_s", "milliseconds"],
+        ),
+        (
+            csv(&rows, |r| [r[0], r[1], r[2], r[3], r[4] / 1000.0, r[5] / 1000.0]),
+            ["p1_Pa", "kPa"],
+        ),
+        (
+            csv(&rows, |r| [r[0], r[1], r[2], r[3], r[4] - 101_325.0, r[5] - 101_325.0]),
+            ["Pa", "gauge"],
+        ),
+        (csv(&rows[..10], |r| r), ["at least 8 s", "10 samples"]),
+    ];
+    for (text, expected) in cases {
+        let (ok, stderr) = diagnose(&dir, &text);
+        assert!(!ok, "{expected:?}: accepted");
+        for word in expected {
+            assert!(stderr.contains(word), "{expected:?}: stderr was {stderr}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn irregular_sampling_goes_on_with_a_sentence_in_the_report() {
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-irregular-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Drop every 7th row of a clean recording: steps of 1 and 2 ms.
+    let rows: Vec<[f64; 6]> = clean_rows(20.0)
+        .into_iter()
+        .enumerate()
+        .filter(|(k, _)| k % 7 != 3)
+        .map(|(_, r)| r)
+        .collect();
+    let (ok, stderr) = diagnose(&dir, &csv(&rows, |r| r));
+    assert!(ok, "{stderr}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let checks = report["input_checks"].as_array().unwrap();
+    assert!(
+        checks.iter().any(|c| c.as_str().unwrap().contains("irregular")),
+        "{checks:?}"
+    );
+    assert!(report["summary"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|l| l.as_str().unwrap().contains("irregular")));
+    // Nothing was wrong with the actuator: the verdict says so and nothing is named.
+    assert_eq!(report["verdict"], "explained", "{}", report["summary"]);
+    assert_eq!(report["effects"].as_array().unwrap().len(), 0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
