@@ -1531,6 +1531,122 @@ mod tests {
         assert!(undeclared_mechanism("no_such").is_none());
     }
 
+    fn und(u: UndeclaredEffects) -> BenchEffects {
+        BenchEffects {
+            undeclared: u,
+            ..Default::default()
+        }
+    }
+
+    /// Lags, the slew limit and the contact compliance leave the statics alone but slow the
+    /// step of `step_cmd` (within 0.5 N of the base 0.3 s later: the plant has a slow tail);
+    /// the leak lowers p1 and the force at rest.
+    #[test]
+    fn undeclared_dynamics_keep_the_statics_and_slow_the_step() {
+        let p = BenchParams::default();
+        let base_e = BenchEffects::default();
+        let cases = [
+            (
+                "jet_pipe_lag",
+                und(UndeclaredEffects {
+                    jet_pipe_lag: 15e-3,
+                    ..Default::default()
+                }),
+            ),
+            (
+                "current_slew_limit",
+                und(UndeclaredEffects {
+                    current_slew_limit: 3.0,
+                    ..Default::default()
+                }),
+            ),
+            (
+                "contact_compliance",
+                und(UndeclaredEffects {
+                    contact_stiffness: 2e4,
+                    ..Default::default()
+                }),
+            ),
+            (
+                "force_sensor_lag",
+                und(UndeclaredEffects {
+                    force_sensor_lag: 10e-3,
+                    ..Default::default()
+                }),
+            ),
+        ];
+        let base = run_custom(&base_e, step_cmd, |_| (STOPPER_HOME, 0.0), 400);
+        let rise = |r: &Vec<[f64; 6]>| r[105][3] - r[99][3];
+        for (name, e) in &cases {
+            for v in [1.0, 4.0, 8.0] {
+                let (f0, f1) = (static_force(&p, &base_e, v), static_force(&p, e, v));
+                assert!((f1 - f0).abs() < 1e-3, "{name} at {v} V: {f1} vs {f0}");
+            }
+            let r = run_custom(e, step_cmd, |_| (STOPPER_HOME, 0.0), 400);
+            println!("{name}: rise in 5 ms {:.3} N (base {:.3} N)", rise(&r), rise(&base));
+            assert!(rise(&r) < 0.8 * rise(&base), "{name}: {} vs {}", rise(&r), rise(&base));
+            println!("  at 0.3 s after the step: {:.4} N vs {:.4} N", r[399][3], base[399][3]);
+            assert!((r[399][3] - base[399][3]).abs() < 0.5, "{name} settles");
+            if *name == "force_sensor_lag" {
+                assert!(r.iter().zip(&base).all(|(a, b)| a[4] == b[4] && a[5] == b[5]));
+            }
+        }
+        let leak = und(UndeclaredEffects {
+            chamber_leak_1: 0.01e-6,
+            ..Default::default()
+        });
+        let (b, l) = (
+            run_custom(&base_e, |_| 3.0, |_| (STOPPER_HOME, 0.0), 2),
+            run_custom(&leak, |_| 3.0, |_| (STOPPER_HOME, 0.0), 2),
+        );
+        assert!(l[1][4] < b[1][4] - 5000.0, "leak p1 {} vs {}", l[1][4], b[1][4]);
+        assert!(l[1][3] < b[1][3] - 0.5, "leak force {} vs {}", l[1][3], b[1][3]);
+    }
+
+    /// Every mechanism, declared and undeclared, at once: finite, bounded rows (RK4 stays
+    /// stable with all extra states and the supply plenum fed by a varying source).
+    #[test]
+    fn all_mechanisms_at_once_stay_finite() {
+        let mut e = BenchEffects {
+            hysteresis_width: 0.12e-3,
+            friction_coulomb: 2.0,
+            dead_volume_1: 3e-6,
+            dead_volume_2: 4e-6,
+            supply_resistance: 5e8,
+            heat_transfer: 0.7,
+            command_delay: 0.004,
+            force_sensor_offset: 0.3,
+            force_sensor_gain: 1.02,
+            undeclared: UndeclaredEffects::default(),
+        };
+        for m in UNDECLARED {
+            // each standard constructor sets only its own fields (the rest are 0): add them up
+            let u = (m.effects)().undeclared;
+            let t = &mut e.undeclared;
+            t.pressure_sensor_offset_1 += u.pressure_sensor_offset_1;
+            t.supply_drift += u.supply_drift;
+            t.supply_ripple_amplitude += u.supply_ripple_amplitude;
+            t.supply_ripple_frequency += u.supply_ripple_frequency;
+            t.command_limit += u.command_limit;
+            t.current_slew_limit += u.current_slew_limit;
+            t.jet_pipe_lag += u.jet_pipe_lag;
+            t.chamber_leak_1 += u.chamber_leak_1;
+            t.viscous_friction += u.viscous_friction;
+            t.contact_stiffness += u.contact_stiffness;
+            t.force_sensor_lag += u.force_sensor_lag;
+        }
+        assert!(e.undeclared.contact_stiffness > 0.0 && e.undeclared.supply_drift > 0.0);
+        // protocol segments B (steps of slope) and E (moving stopper), 1.5 s each
+        for t0 in [20.0, 68.5] {
+            let rows = run_custom(&e, |t| protocol_command(t + t0), |t| protocol_stopper(t + t0), 1500);
+            for r in &rows {
+                assert!(r.iter().all(|x| x.is_finite()), "{r:?}");
+                assert!(r[3] > -5.0 && r[3] < 150.0, "{r:?}");
+                assert!(r[4] > 50_000.0 && r[4] < 700_000.0 && r[5] > 50_000.0 && r[5] < 700_000.0);
+            }
+        }
+    }
+
     /// Noiseless, unquantised protocol run (bench pre-time), first `n` samples.
     fn protocol_clean(e: &BenchEffects, n: usize) -> Vec<[f64; 6]> {
         let opts = RunOptions {
