@@ -82,6 +82,12 @@
 //! * `force_sensor_lag` (`force_sensor`/`dynamics`, `force_sensor_lag` = τ_F, standard 10 ms):
 //!   the logged force is F_L with τ_F Ḟ_L = F_act − F_L, integrated with the plant (then gain
 //!   and offset of `sensor_offset_gain`). Pressures bit-identical. Force 0.91 N rms / 6.3 N max.
+//! * `return_back_pressure` (`return`/`parameter_offset`, `return_back_pressure`, standard
+//!   40 kPa): the ports exhaust into P_r + 40 kPa (a clogged muffler); the chamber 1 leak and
+//!   the initial pressures keep the thesis P_r. Force 1.3 N rms / 3.7 N max (p2 6.9 kPa rms).
+//! * `p2_sensor_delay` (`pressure_sensors`/`delay`, `pressure_sensor_delay_2`, standard 10 ms,
+//!   rounded to whole samples): logged p2 at sample k is P2 at sample k − d (the value at t = 0
+//!   before), then noise and quantisation; force and p1 bit-identical (force effect 0).
 //!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 //! zero and the compressible law's value at 20 Pa (continuous, Lipschitz).
@@ -145,6 +151,11 @@ pub struct UndeclaredEffects {
     pub contact_stiffness: f64,
     /// `force_sensor`/`dynamics`: time constant (s) of a first-order lag of the force sensor.
     pub force_sensor_lag: f64,
+    /// `return`/`parameter_offset`: the return (exhaust) pressure is higher by this (Pa).
+    pub return_back_pressure: f64,
+    /// `pressure_sensors`/`delay`: the chamber 2 pressure is logged this late (s, rounded to
+    /// whole 1 ms samples).
+    pub pressure_sensor_delay_2: f64,
 }
 
 impl Default for BenchEffects {
@@ -244,6 +255,18 @@ fn std_contact_compliance() -> BenchEffects {
         ..Default::default()
     })
 }
+fn std_return_back_pressure() -> BenchEffects {
+    with_undeclared(UndeclaredEffects {
+        return_back_pressure: 40_000.0,
+        ..Default::default()
+    })
+}
+fn std_p2_sensor_delay() -> BenchEffects {
+    with_undeclared(UndeclaredEffects {
+        pressure_sensor_delay_2: 10e-3,
+        ..Default::default()
+    })
+}
 fn std_force_sensor_lag() -> BenchEffects {
     with_undeclared(UndeclaredEffects {
         force_sensor_lag: 10e-3,
@@ -324,6 +347,20 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "dynamics",
         truth: "the force sensor reads through a first-order lag of 10 ms",
         effects: std_force_sensor_lag,
+    },
+    UndeclaredMechanism {
+        name: "return_back_pressure",
+        location: "return",
+        family: "parameter_offset",
+        truth: "the return (exhaust) pressure is 40 kPa above the thesis value (clogged exhaust muffler)",
+        effects: std_return_back_pressure,
+    },
+    UndeclaredMechanism {
+        name: "p2_sensor_delay",
+        location: "pressure_sensors",
+        family: "delay",
+        truth: "the chamber 2 pressure is logged 10 ms late; force and p1 are unaffected",
+        effects: std_p2_sensor_delay,
     },
 ];
 
@@ -509,6 +546,7 @@ struct Model {
     viscous: bool,
     contact: bool,
     f_lag: bool,
+    ret_bp: bool,
 }
 
 impl Model {
@@ -570,6 +608,7 @@ impl Model {
             viscous: e.undeclared.viscous_friction > 0.0,
             contact: e.undeclared.contact_stiffness > 0.0,
             f_lag: e.undeclared.force_sensor_lag > 0.0,
+            ret_bp: e.undeclared.return_back_pressure != 0.0,
         }
     }
 
@@ -697,7 +736,11 @@ impl Model {
         let (p1, p2) = (y[S_P1], y[S_P2]);
         let (t1, t2) = if self.heat { (y[S_T1], y[S_T2]) } else { (t0, t0) };
         let ps = if self.supply { y[S_PPL] } else { p_src };
-        let pr = p.p_return;
+        let pr = if self.ret_bp {
+            p.p_return + self.e.undeclared.return_back_pressure
+        } else {
+            p.p_return
+        };
         let m_s1 = self.orifice(p.c_d * a_s1, ps, t0, p1, t1);
         let m_r1 = self.orifice(p.c_d * a_r1, p1, t1, pr, t0);
         let m_s2 = self.orifice(p.c_d * a_s2, ps, t0, p2, t2);
@@ -1076,6 +1119,9 @@ where
 
     let mut rng = opts.noise_seed.map(Rng::new);
     let mut rows = Vec::with_capacity(n_samples);
+    // undeclared p2 transducer delay, whole samples; before t = 0 the plant is at rest
+    let p2_delay = (und.pressure_sensor_delay_2.max(0.0) / SAMPLE).round() as usize;
+    let mut p2_hist: Vec<f64> = Vec::new();
     for (k, &cmd) in cmds.iter().enumerate().take(n_samples) {
         let t = k as f64 * SAMPLE;
         let (xs, xd) = stopper(t);
@@ -1084,6 +1130,10 @@ where
         let (mut p1, mut p2) = (y[S_P1], y[S_P2]);
         if und.pressure_sensor_offset_1 != 0.0 {
             p1 += und.pressure_sensor_offset_1;
+        }
+        if p2_delay > 0 {
+            p2_hist.push(p2);
+            p2 = p2_hist[k.saturating_sub(p2_delay)];
         }
         if let Some(r) = rng.as_mut() {
             f += 0.05 * r.normal();
@@ -1474,6 +1524,8 @@ mod tests {
             u.viscous_friction,
             u.contact_stiffness,
             u.force_sensor_lag,
+            u.return_back_pressure,
+            u.pressure_sensor_delay_2,
         ];
         assert!(fields.iter().all(|&x| x == 0.0));
         assert_eq!(BenchEffects::default().undeclared, u);
@@ -1634,6 +1686,8 @@ mod tests {
             t.viscous_friction += u.viscous_friction;
             t.contact_stiffness += u.contact_stiffness;
             t.force_sensor_lag += u.force_sensor_lag;
+            t.return_back_pressure += u.return_back_pressure;
+            t.pressure_sensor_delay_2 += u.pressure_sensor_delay_2;
         }
         assert!(e.undeclared.contact_stiffness > 0.0 && e.undeclared.supply_drift > 0.0);
         // protocol segments B (steps of slope) and E (moving stopper), 1.5 s each
@@ -1696,6 +1750,8 @@ mod tests {
                 "viscous_friction" => 1.49,
                 "contact_compliance" => 1.41,
                 "force_sensor_lag" => 0.91,
+                "return_back_pressure" => 1.31,
+                "p2_sensor_delay" => 0.0,
                 other => panic!("no documented size for {other}"),
             };
             assert!(
@@ -1723,6 +1779,11 @@ mod tests {
                     assert!(same_until(3, 60.0) && same_until(4, 81.0) && same_until(5, 81.0));
                 }
                 "force_sensor_lag" => assert!(same_until(4, 81.0) && same_until(5, 81.0)),
+                "p2_sensor_delay" => {
+                    assert!(same_until(3, 81.0) && same_until(4, 81.0));
+                    assert!(rows[10..].iter().zip(&base).all(|(r, b)| r[5] == b[5]));
+                    assert!(rows[..10].iter().all(|r| r[5] == base[0][5]));
+                }
                 "supply_drift" => {
                     let early = diff_stats(&rows[..20_000], &base[..20_000], 3).0;
                     let late = diff_stats(&rows[60_000..], &base[60_000..], 3).0;

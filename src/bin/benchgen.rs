@@ -92,6 +92,12 @@ struct Cli {
     /// force_sensor_lag: first-order lag of the force sensor, s (e.g. 0.01).
     #[arg(long)]
     force_sensor_lag: Option<f64>,
+    /// return_back_pressure: the return (exhaust) pressure is higher by this, Pa (e.g. 20000).
+    #[arg(long)]
+    return_back_pressure: Option<f64>,
+    /// p2_sensor_delay: the chamber 2 pressure is logged this late, s (whole ms; e.g. 0.005).
+    #[arg(long)]
+    pressure_sensor_delay_2: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -129,6 +135,8 @@ fn main() -> ExitCode {
     set(&mut und.viscous_friction, cli.viscous_friction);
     set(&mut und.contact_stiffness, cli.contact_stiffness);
     set(&mut und.force_sensor_lag, cli.force_sensor_lag);
+    set(&mut und.return_back_pressure, cli.return_back_pressure);
+    set(&mut und.pressure_sensor_delay_2, cli.pressure_sensor_delay_2);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -138,6 +146,7 @@ fn main() -> ExitCode {
         und.viscous_friction,
         und.contact_stiffness,
         und.force_sensor_lag,
+        und.pressure_sensor_delay_2,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -145,6 +154,7 @@ fn main() -> ExitCode {
             und.pressure_sensor_offset_1,
             und.supply_drift,
             und.supply_ripple_amplitude,
+            und.return_back_pressure,
         ]
         .iter()
         .all(|x| x.is_finite());
