@@ -88,6 +88,14 @@
 //! * `p2_sensor_delay` (`pressure_sensors`/`delay`, `pressure_sensor_delay_2`, standard 10 ms,
 //!   rounded to whole samples): logged p2 at sample k is P2 at sample k − d (the value at t = 0
 //!   before), then noise and quantisation; force and p1 bit-identical (force effect 0).
+//! * `receiver_offset` (`valve`/`parameter_offset`, `receiver_offset`, standard 10 µm): the
+//!   port areas are evaluated at x_jp + (x_jp_offset + 10 µm), i.e. the receivers sit further
+//!   from the jet pipe null (the static force curve shifts along the command axis). Force
+//!   1.9 N rms / 3.0 N max.
+//! * `force_sensor_backlash` (`force_sensor`/`hysteresis`, `force_sensor_backlash` = w,
+//!   standard 1.5 N): the reading passes a play operator of half width r = w/2 at the samples,
+//!   y_k = clamp(y_{k−1}, F_k − r, F_k + r), y_0 = F_0 (after the force lag, before gain,
+//!   offset, noise and quantisation). Pressures bit-identical. Force 0.71 N rms / 0.75 N max.
 //!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 //! zero and the compressible law's value at 20 Pa (continuous, Lipschitz).
@@ -156,6 +164,12 @@ pub struct UndeclaredEffects {
     /// `pressure_sensors`/`delay`: the chamber 2 pressure is logged this late (s, rounded to
     /// whole 1 ms samples).
     pub pressure_sensor_delay_2: f64,
+    /// `valve`/`parameter_offset`: the receivers sit this much (m) further from the jet pipe
+    /// null than the thesis offset `x_jp_offset`.
+    pub receiver_offset: f64,
+    /// `force_sensor`/`hysteresis`: full width (N) of a play (backlash) operator on the force
+    /// reading.
+    pub force_sensor_backlash: f64,
 }
 
 impl Default for BenchEffects {
@@ -267,6 +281,18 @@ fn std_p2_sensor_delay() -> BenchEffects {
         ..Default::default()
     })
 }
+fn std_receiver_offset() -> BenchEffects {
+    with_undeclared(UndeclaredEffects {
+        receiver_offset: 10e-6,
+        ..Default::default()
+    })
+}
+fn std_force_sensor_backlash() -> BenchEffects {
+    with_undeclared(UndeclaredEffects {
+        force_sensor_backlash: 1.5,
+        ..Default::default()
+    })
+}
 fn std_force_sensor_lag() -> BenchEffects {
     with_undeclared(UndeclaredEffects {
         force_sensor_lag: 10e-3,
@@ -361,6 +387,20 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "delay",
         truth: "the chamber 2 pressure is logged 10 ms late; force and p1 are unaffected",
         effects: std_p2_sensor_delay,
+    },
+    UndeclaredMechanism {
+        name: "receiver_offset",
+        location: "valve",
+        family: "parameter_offset",
+        truth: "the receivers sit 10 µm further from the jet pipe null (x_jp_offset 0.099 → 0.109 mm)",
+        effects: std_receiver_offset,
+    },
+    UndeclaredMechanism {
+        name: "force_sensor_backlash",
+        location: "force_sensor",
+        family: "hysteresis",
+        truth: "the force reading passes a play (backlash) operator of full width 1.5 N",
+        effects: std_force_sensor_backlash,
     },
 ];
 
@@ -547,6 +587,7 @@ struct Model {
     contact: bool,
     f_lag: bool,
     ret_bp: bool,
+    rcv_off: bool,
 }
 
 impl Model {
@@ -609,6 +650,7 @@ impl Model {
             contact: e.undeclared.contact_stiffness > 0.0,
             f_lag: e.undeclared.force_sensor_lag > 0.0,
             ret_bp: e.undeclared.return_back_pressure != 0.0,
+            rcv_off: e.undeclared.receiver_offset != 0.0,
         }
     }
 
@@ -731,7 +773,11 @@ impl Model {
         dy[S_XJP] = y[S_VJP];
         dy[S_VJP] = p.omega_2 * p.omega_2 * (y[S_X1] - y[S_XJP]) - 2.0 * p.zeta_2 * p.omega_2 * y[S_VJP];
         // orifice areas
-        let x_abs = y[S_XJP] + p.x_jp_offset;
+        let x_abs = if self.rcv_off {
+            y[S_XJP] + (p.x_jp_offset + self.e.undeclared.receiver_offset)
+        } else {
+            y[S_XJP] + p.x_jp_offset
+        };
         let (a_s1, a_r1, a_s2, a_r2) = port_areas(x_abs, p.d_jp);
         let (p1, p2) = (y[S_P1], y[S_P2]);
         let (t1, t2) = if self.heat { (y[S_T1], y[S_T2]) } else { (t0, t0) };
@@ -1122,10 +1168,18 @@ where
     // undeclared p2 transducer delay, whole samples; before t = 0 the plant is at rest
     let p2_delay = (und.pressure_sensor_delay_2.max(0.0) / SAMPLE).round() as usize;
     let mut p2_hist: Vec<f64> = Vec::new();
+    // undeclared force sensor play operator, half width r, starting centred
+    let play_r = 0.5 * und.force_sensor_backlash.max(0.0);
+    let mut play_y: Option<f64> = None;
     for (k, &cmd) in cmds.iter().enumerate().take(n_samples) {
         let t = k as f64 * SAMPLE;
         let (xs, xd) = stopper(t);
-        let f_true = if m.f_lag { y[S_FF] } else { m.force(&y, xs, xd) };
+        let mut f_true = if m.f_lag { y[S_FF] } else { m.force(&y, xs, xd) };
+        if play_r > 0.0 {
+            let yp = play_y.map_or(f_true, |yp| yp.clamp(f_true - play_r, f_true + play_r));
+            play_y = Some(yp);
+            f_true = yp;
+        }
         let mut f = effects.force_sensor_gain * f_true + effects.force_sensor_offset;
         let (mut p1, mut p2) = (y[S_P1], y[S_P2]);
         if und.pressure_sensor_offset_1 != 0.0 {
@@ -1526,6 +1580,8 @@ mod tests {
             u.force_sensor_lag,
             u.return_back_pressure,
             u.pressure_sensor_delay_2,
+            u.receiver_offset,
+            u.force_sensor_backlash,
         ];
         assert!(fields.iter().all(|&x| x == 0.0));
         assert_eq!(BenchEffects::default().undeclared, u);
@@ -1688,6 +1744,8 @@ mod tests {
             t.force_sensor_lag += u.force_sensor_lag;
             t.return_back_pressure += u.return_back_pressure;
             t.pressure_sensor_delay_2 += u.pressure_sensor_delay_2;
+            t.receiver_offset += u.receiver_offset;
+            t.force_sensor_backlash += u.force_sensor_backlash;
         }
         assert!(e.undeclared.contact_stiffness > 0.0 && e.undeclared.supply_drift > 0.0);
         // protocol segments B (steps of slope) and E (moving stopper), 1.5 s each
@@ -1752,6 +1810,8 @@ mod tests {
                 "force_sensor_lag" => 0.91,
                 "return_back_pressure" => 1.31,
                 "p2_sensor_delay" => 0.0,
+                "receiver_offset" => 1.9,
+                "force_sensor_backlash" => 0.71,
                 other => panic!("no documented size for {other}"),
             };
             assert!(
@@ -1779,6 +1839,10 @@ mod tests {
                     assert!(same_until(3, 60.0) && same_until(4, 81.0) && same_until(5, 81.0));
                 }
                 "force_sensor_lag" => assert!(same_until(4, 81.0) && same_until(5, 81.0)),
+                "force_sensor_backlash" => {
+                    assert!(same_until(4, 81.0) && same_until(5, 81.0));
+                    assert!(f_max <= 0.75 + 1e-9, "the play is at most half its width");
+                }
                 "p2_sensor_delay" => {
                     assert!(same_until(3, 81.0) && same_until(4, 81.0));
                     assert!(rows[10..].iter().zip(&base).all(|(r, b)| r[5] == b[5]));

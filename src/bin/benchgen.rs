@@ -98,6 +98,12 @@ struct Cli {
     /// p2_sensor_delay: the chamber 2 pressure is logged this late, s (whole ms; e.g. 0.005).
     #[arg(long)]
     pressure_sensor_delay_2: Option<f64>,
+    /// receiver_offset: receivers further from the jet pipe null than x_jp_offset, m (e.g. 1e-5).
+    #[arg(long)]
+    receiver_offset: Option<f64>,
+    /// force_sensor_backlash: full width of a play operator on the force reading, N (e.g. 1.5).
+    #[arg(long)]
+    force_sensor_backlash: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -137,6 +143,8 @@ fn main() -> ExitCode {
     set(&mut und.force_sensor_lag, cli.force_sensor_lag);
     set(&mut und.return_back_pressure, cli.return_back_pressure);
     set(&mut und.pressure_sensor_delay_2, cli.pressure_sensor_delay_2);
+    set(&mut und.receiver_offset, cli.receiver_offset);
+    set(&mut und.force_sensor_backlash, cli.force_sensor_backlash);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -147,6 +155,7 @@ fn main() -> ExitCode {
         und.contact_stiffness,
         und.force_sensor_lag,
         und.pressure_sensor_delay_2,
+        und.force_sensor_backlash,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -155,6 +164,7 @@ fn main() -> ExitCode {
             und.supply_drift,
             und.supply_ripple_amplitude,
             und.return_back_pressure,
+            und.receiver_offset,
         ]
         .iter()
         .all(|x| x.is_finite());
