@@ -96,6 +96,14 @@
 //!   standard 1.5 N): the reading passes a play operator of half width r = w/2 at the samples,
 //!   y_k = clamp(y_{k−1}, F_k − r, F_k + r), y_0 = F_0 (after the force lag, before gain,
 //!   offset, noise and quantisation). Pressures bit-identical. Force 0.71 N rms / 0.75 N max.
+//! * `jet_pipe_curve` (`jet_pipe`/`nonlinearity`, `jet_pipe_curve_blend` = β, standard 1):
+//!   f3 becomes x_sat [(1 − β) tanh u + β u/√(1 + u²)], u = k_m i / f_sat: the same slope at 0
+//!   and the same saturation, a softer knee (the Bouc–Wen drive uses its slope). Force
+//!   1.7 N rms / 2.9 N max.
+//! * `return_area_reduction` (`valve`/`asymmetry`, `return_area_reduction` = r, standard 0.05):
+//!   both return (vent) areas A_r1, A_r2 are multiplied by 1 − r, the supply areas are not
+//!   (supply against return, symmetric between the ports; not the shared port 2 example).
+//!   Force 1.7 N rms / 2.4 N max.
 //!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 //! zero and the compressible law's value at 20 Pa (continuous, Lipschitz).
@@ -170,6 +178,12 @@ pub struct UndeclaredEffects {
     /// `force_sensor`/`hysteresis`: full width (N) of a play (backlash) operator on the force
     /// reading.
     pub force_sensor_backlash: f64,
+    /// `jet_pipe`/`nonlinearity`: blend β (0..1) of the static curve f3 towards the algebraic
+    /// sigmoid: x̄ = x_sat [(1 − β) tanh u + β u/√(1 + u²)].
+    pub jet_pipe_curve_blend: f64,
+    /// `valve`/`asymmetry`: fractional reduction of both return (vent) areas, supply areas
+    /// unchanged.
+    pub return_area_reduction: f64,
 }
 
 impl Default for BenchEffects {
@@ -293,6 +307,18 @@ fn std_force_sensor_backlash() -> BenchEffects {
         ..Default::default()
     })
 }
+fn std_jet_pipe_curve() -> BenchEffects {
+    with_undeclared(UndeclaredEffects {
+        jet_pipe_curve_blend: 1.0,
+        ..Default::default()
+    })
+}
+fn std_return_area_reduction() -> BenchEffects {
+    with_undeclared(UndeclaredEffects {
+        return_area_reduction: 0.05,
+        ..Default::default()
+    })
+}
 fn std_force_sensor_lag() -> BenchEffects {
     with_undeclared(UndeclaredEffects {
         force_sensor_lag: 10e-3,
@@ -401,6 +427,20 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "hysteresis",
         truth: "the force reading passes a play (backlash) operator of full width 1.5 N",
         effects: std_force_sensor_backlash,
+    },
+    UndeclaredMechanism {
+        name: "jet_pipe_curve",
+        location: "jet_pipe",
+        family: "nonlinearity",
+        truth: "the static jet pipe curve is x_sat u/sqrt(1 + u^2) instead of x_sat tanh u (same slope at 0, same saturation)",
+        effects: std_jet_pipe_curve,
+    },
+    UndeclaredMechanism {
+        name: "return_area_reduction",
+        location: "valve",
+        family: "asymmetry",
+        truth: "both return (vent) areas are 5 % smaller, the supply areas unchanged (supply against return)",
+        effects: std_return_area_reduction,
     },
 ];
 
@@ -588,6 +628,8 @@ struct Model {
     f_lag: bool,
     ret_bp: bool,
     rcv_off: bool,
+    blend: bool,
+    ret_area: bool,
 }
 
 impl Model {
@@ -651,6 +693,8 @@ impl Model {
             f_lag: e.undeclared.force_sensor_lag > 0.0,
             ret_bp: e.undeclared.return_back_pressure != 0.0,
             rcv_off: e.undeclared.receiver_offset != 0.0,
+            blend: e.undeclared.jet_pipe_curve_blend != 0.0,
+            ret_area: e.undeclared.return_area_reduction != 0.0,
         }
     }
 
@@ -706,6 +750,11 @@ impl Model {
     }
 
     fn static_position(&self, i: f64) -> f64 {
+        if self.blend {
+            let u = self.p.k_m * i / self.p.f_jp_sat;
+            let b = self.e.undeclared.jet_pipe_curve_blend;
+            return self.p.x_jp_sat * ((1.0 - b) * u.tanh() + b * u / (1.0 + u * u).sqrt());
+        }
         self.p.x_jp_sat * (self.p.k_m * i / self.p.f_jp_sat).tanh()
     }
 
@@ -751,10 +800,19 @@ impl Model {
         // static jet pipe curve f3 and hysteresis
         let u = p.k_m * i / p.f_jp_sat;
         let th = u.tanh();
-        let xbar = p.x_jp_sat * th;
+        let mut xbar = p.x_jp_sat * th;
+        // slope dx̄/du / x_sat
+        let mut slope = 1.0 - th * th;
+        if self.blend {
+            // undeclared: static curve blended towards the algebraic sigmoid
+            let b = self.e.undeclared.jet_pipe_curve_blend;
+            let q = 1.0 / (1.0 + u * u).sqrt();
+            xbar = p.x_jp_sat * ((1.0 - b) * th + b * u * q);
+            slope = (1.0 - b) * slope + b * q * q * q;
+        }
         let mut target = xbar;
         if self.hyst {
-            let xbar_dot = p.x_jp_sat * (1.0 - th * th) * p.k_m * di / p.f_jp_sat;
+            let xbar_dot = p.x_jp_sat * slope * p.k_m * di / p.f_jp_sat;
             let z = y[S_Z];
             dy[S_Z] = self.bw_a * xbar_dot - self.bw_beta * xbar_dot.abs() * z - self.bw_gamma * xbar_dot * z.abs();
             target -= z;
@@ -778,7 +836,12 @@ impl Model {
         } else {
             y[S_XJP] + p.x_jp_offset
         };
-        let (a_s1, a_r1, a_s2, a_r2) = port_areas(x_abs, p.d_jp);
+        let (a_s1, mut a_r1, a_s2, mut a_r2) = port_areas(x_abs, p.d_jp);
+        if self.ret_area {
+            let f = 1.0 - self.e.undeclared.return_area_reduction;
+            a_r1 *= f;
+            a_r2 *= f;
+        }
         let (p1, p2) = (y[S_P1], y[S_P2]);
         let (t1, t2) = if self.heat { (y[S_T1], y[S_T2]) } else { (t0, t0) };
         let ps = if self.supply { y[S_PPL] } else { p_src };
@@ -1582,6 +1645,8 @@ mod tests {
             u.pressure_sensor_delay_2,
             u.receiver_offset,
             u.force_sensor_backlash,
+            u.jet_pipe_curve_blend,
+            u.return_area_reduction,
         ];
         assert!(fields.iter().all(|&x| x == 0.0));
         assert_eq!(BenchEffects::default().undeclared, u);
@@ -1746,6 +1811,8 @@ mod tests {
             t.pressure_sensor_delay_2 += u.pressure_sensor_delay_2;
             t.receiver_offset += u.receiver_offset;
             t.force_sensor_backlash += u.force_sensor_backlash;
+            t.jet_pipe_curve_blend += u.jet_pipe_curve_blend;
+            t.return_area_reduction += u.return_area_reduction;
         }
         assert!(e.undeclared.contact_stiffness > 0.0 && e.undeclared.supply_drift > 0.0);
         // protocol segments B (steps of slope) and E (moving stopper), 1.5 s each
@@ -1787,6 +1854,7 @@ mod tests {
     fn undeclared_force_effects_over_the_protocol() {
         let n = (PROTOCOL_DURATION / SAMPLE).round() as usize;
         let base = protocol_clean(&BenchEffects::default(), n);
+        let mut off_size = Vec::new();
         for m in UNDECLARED {
             let rows = protocol_clean(&(m.effects)(), n);
             let (f_rms, f_max) = diff_stats(&rows, &base, 3);
@@ -1812,13 +1880,13 @@ mod tests {
                 "p2_sensor_delay" => 0.0,
                 "receiver_offset" => 1.9,
                 "force_sensor_backlash" => 0.71,
+                "jet_pipe_curve" => 1.71,
+                "return_area_reduction" => 1.69,
                 other => panic!("no documented size for {other}"),
             };
-            assert!(
-                f_rms >= 0.7 * doc_rms && f_rms <= 1.4 * doc_rms,
-                "{}: force rms {f_rms} vs documented {doc_rms}",
-                m.name
-            );
+            if !(f_rms >= 0.7 * doc_rms && f_rms <= 1.4 * doc_rms) {
+                off_size.push(format!("{}: force rms {f_rms} vs documented {doc_rms}", m.name));
+            }
             let same_until = |col: usize, t_end: f64| {
                 rows.iter()
                     .zip(&base)
@@ -1856,6 +1924,7 @@ mod tests {
                 _ => {}
             }
         }
+        assert!(off_size.is_empty(), "{off_size:?}");
     }
 
     #[test]

@@ -104,6 +104,12 @@ struct Cli {
     /// force_sensor_backlash: full width of a play operator on the force reading, N (e.g. 1.5).
     #[arg(long)]
     force_sensor_backlash: Option<f64>,
+    /// jet_pipe_curve: blend 0..1 of the static jet pipe curve towards u/sqrt(1+u²) (e.g. 1).
+    #[arg(long)]
+    jet_pipe_curve_blend: Option<f64>,
+    /// return_area_reduction: fractional reduction 0..1 of both return areas (e.g. 0.05).
+    #[arg(long)]
+    return_area_reduction: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -145,6 +151,8 @@ fn main() -> ExitCode {
     set(&mut und.pressure_sensor_delay_2, cli.pressure_sensor_delay_2);
     set(&mut und.receiver_offset, cli.receiver_offset);
     set(&mut und.force_sensor_backlash, cli.force_sensor_backlash);
+    set(&mut und.jet_pipe_curve_blend, cli.jet_pipe_curve_blend);
+    set(&mut und.return_area_reduction, cli.return_area_reduction);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -156,6 +164,8 @@ fn main() -> ExitCode {
         und.force_sensor_lag,
         und.pressure_sensor_delay_2,
         und.force_sensor_backlash,
+        und.jet_pipe_curve_blend,
+        und.return_area_reduction,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -168,10 +178,12 @@ fn main() -> ExitCode {
         ]
         .iter()
         .all(|x| x.is_finite());
+    let und_bad = und_bad || und.jet_pipe_curve_blend > 1.0 || und.return_area_reduction > 1.0;
     if und_bad {
         eprintln!(
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
-             friction, stiffness and ripple frequency non-negative"
+             friction, stiffness, delay, backlash and ripple frequency non-negative; curve \
+             blend and return area reduction in 0..1"
         );
         return ExitCode::from(2);
     }
