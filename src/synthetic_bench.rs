@@ -104,6 +104,11 @@
 //!   both return (vent) areas A_r1, A_r2 are multiplied by 1 − r, the supply areas are not
 //!   (supply against return, symmetric between the ports; not the shared port 2 example).
 //!   Force 1.7 N rms / 2.4 N max.
+//! * `port_1_restriction` (`valve`/`restriction`, `port_1_restriction` = C_d·A, standard
+//!   0.2 mm², about 40 % of a fully open port): receiver port 1 fills and vents a line of
+//!   3 cm³ (at T, (2.29); enlarged only if RK4 at 20 µs would need it) that reaches chamber 1
+//!   through an orifice of that C_d·A (same compressible law, inflow to the chamber at T).
+//!   Force 2.2 N rms / 6.9 N max.
 //!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 //! zero and the compressible law's value at 20 Pa (continuous, Lipschitz).
@@ -184,6 +189,9 @@ pub struct UndeclaredEffects {
     /// `valve`/`asymmetry`: fractional reduction of both return (vent) areas, supply areas
     /// unchanged.
     pub return_area_reduction: f64,
+    /// `valve`/`restriction`: C_d·A (m²) of an orifice between receiver port 1 and chamber 1,
+    /// with a line volume on the receiver side; 0 = none.
+    pub port_1_restriction: f64,
 }
 
 impl Default for BenchEffects {
@@ -319,6 +327,12 @@ fn std_return_area_reduction() -> BenchEffects {
         ..Default::default()
     })
 }
+fn std_port_1_restriction() -> BenchEffects {
+    with_undeclared(UndeclaredEffects {
+        port_1_restriction: 0.2e-6,
+        ..Default::default()
+    })
+}
 fn std_force_sensor_lag() -> BenchEffects {
     with_undeclared(UndeclaredEffects {
         force_sensor_lag: 10e-3,
@@ -442,6 +456,13 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         truth: "both return (vent) areas are 5 % smaller, the supply areas unchanged (supply against return)",
         effects: std_return_area_reduction,
     },
+    UndeclaredMechanism {
+        name: "port_1_restriction",
+        location: "valve",
+        family: "restriction",
+        truth: "receiver port 1 reaches chamber 1 through a 3 cm³ line and an orifice of C_d·A = 0.2 mm²",
+        effects: std_port_1_restriction,
+    },
 ];
 
 /// The undeclared mechanism of this name, if any.
@@ -562,7 +583,7 @@ fn port_areas(x: f64, d_jp: f64) -> (f64, f64, f64, f64) {
 // Model
 // ---------------------------------------------------------------------------------------------
 
-const NS: usize = 15;
+const NS: usize = 16;
 type State = [f64; NS];
 const S_I: usize = 0; // coil current
 const S_X1: usize = 1; // output of the first-order jet pipe lag
@@ -579,6 +600,7 @@ const S_PPL: usize = 11; // supply plenum pressure
 const S_XL: usize = 12; // output of the extra jet pipe lag (undeclared)
 const S_FF: usize = 13; // force sensor lag output (undeclared)
 const S_DEL: usize = 14; // piston-stopper contact deflection (undeclared)
+const S_PL1: usize = 15; // port 1 line pressure upstream of the restriction (undeclared)
 
 /// Integration step (s): 50 steps per 1 ms command/log period.
 const H: f64 = 20e-6;
@@ -592,6 +614,9 @@ const LINE_TAU: f64 = 1e-3;
 const TAU_ISO: f64 = 0.5e-3;
 /// Atmosphere into which the undeclared chamber leak vents (Pa).
 const P_ATM: f64 = 101_325.0;
+/// Line volume between receiver port 1 and the undeclared restriction (m³), enlarged only
+/// when RK4 would need it.
+const LINE1_VOLUME: f64 = 3e-6;
 /// Relaxation time of the piston on its contact compliance (s): mass and seal damping.
 const TAU_CONTACT: f64 = 0.5e-3;
 
@@ -630,6 +655,8 @@ struct Model {
     rcv_off: bool,
     blend: bool,
     ret_area: bool,
+    line1: bool,
+    v_line1: f64,
 }
 
 impl Model {
@@ -662,6 +689,8 @@ impl Model {
         let port_max = p.c_d * PI * p.d_jp * p.d_jp / 4.0;
         let v_needed = g * rt * H * (slope(cda_supply) + 2.0 * slope(port_max)) / 1.0;
         let v_plenum = PLENUM_VOLUME.max(v_needed);
+        let cda_line1 = e.undeclared.port_1_restriction.max(0.0);
+        let v_line1 = LINE1_VOLUME.max(g * rt * H * (slope(cda_line1) + 2.0 * slope(port_max)));
         Self {
             p: p.clone(),
             e: e.clone(),
@@ -695,6 +724,8 @@ impl Model {
             rcv_off: e.undeclared.receiver_offset != 0.0,
             blend: e.undeclared.jet_pipe_curve_blend != 0.0,
             ret_area: e.undeclared.return_area_reduction != 0.0,
+            line1: e.undeclared.port_1_restriction > 0.0,
+            v_line1,
         }
     }
 
@@ -850,8 +881,19 @@ impl Model {
         } else {
             p.p_return
         };
-        let m_s1 = self.orifice(p.c_d * a_s1, ps, t0, p1, t1);
-        let m_r1 = self.orifice(p.c_d * a_r1, p1, t1, pr, t0);
+        // with the undeclared port 1 restriction, port 1 feeds a line at temperature T
+        let (p1v, t1v) = if self.line1 { (y[S_PL1], t0) } else { (p1, t1) };
+        let m_s1 = self.orifice(p.c_d * a_s1, ps, t0, p1v, t1v);
+        let m_r1 = self.orifice(p.c_d * a_r1, p1v, t1v, pr, t0);
+        // line → chamber 1 through the restriction
+        let m_ln = if self.line1 {
+            let m = self.orifice(self.e.undeclared.port_1_restriction, p1v, t0, p1, t1);
+            dy[S_PL1] = p.gamma * rt * (m_s1 - m_r1 - m) / self.v_line1;
+            m
+        } else {
+            dy[S_PL1] = 0.0;
+            0.0
+        };
         let m_s2 = self.orifice(p.c_d * a_s2, ps, t0, p2, t2);
         let m_r2 = self.orifice(p.c_d * a_r2, p2, t2, pr, t0);
         // leakage past the piston (2.23), positive 1 → 2
@@ -912,7 +954,11 @@ impl Model {
         // chambers
         let (v1, v2) = self.volumes(x_pist);
         let (dv1, dv2) = (self.a_p * x_pist_dot, -self.a_p * x_pist_dot);
-        let mut m1 = m_s1 - m_r1 - m_l - m_d1;
+        let mut m1 = if self.line1 {
+            m_ln - m_l - m_d1
+        } else {
+            m_s1 - m_r1 - m_l - m_d1
+        };
         if self.leak1 {
             m1 -= m_a1;
         }
@@ -925,7 +971,11 @@ impl Model {
         } else {
             // enthalpy flux Σ ṁ_k T_k,up (inflows at their source temperature, outflows at T_i)
             let up = |m: f64, t_src: f64, t_own: f64| if m > 0.0 { m * t_src } else { m * t_own };
-            let mut h1 = up(m_s1, t0, t1) + up(-m_r1, t0, t1) + up(-m_l, t2, t1) + up(-m_d1, t0, t1);
+            let mut h1 = if self.line1 {
+                up(m_ln, t0, t1) + up(-m_l, t2, t1) + up(-m_d1, t0, t1)
+            } else {
+                up(m_s1, t0, t1) + up(-m_r1, t0, t1) + up(-m_l, t2, t1) + up(-m_d1, t0, t1)
+            };
             if self.leak1 {
                 h1 += up(-m_a1, t0, t1);
             }
@@ -1179,6 +1229,7 @@ where
     y[S_PD2] = pm;
     y[S_PPL] = params.p_supply;
     y[S_DEL] = 0.0;
+    y[S_PL1] = pm;
     if m.contact {
         // δ = F/k at the start (the force does not depend on δ)
         y[S_DEL] = m.force(&y, stop_at(0.0), 0.0) / und.contact_stiffness;
@@ -1647,6 +1698,7 @@ mod tests {
             u.force_sensor_backlash,
             u.jet_pipe_curve_blend,
             u.return_area_reduction,
+            u.port_1_restriction,
         ];
         assert!(fields.iter().all(|&x| x == 0.0));
         assert_eq!(BenchEffects::default().undeclared, u);
@@ -1813,6 +1865,7 @@ mod tests {
             t.force_sensor_backlash += u.force_sensor_backlash;
             t.jet_pipe_curve_blend += u.jet_pipe_curve_blend;
             t.return_area_reduction += u.return_area_reduction;
+            t.port_1_restriction += u.port_1_restriction;
         }
         assert!(e.undeclared.contact_stiffness > 0.0 && e.undeclared.supply_drift > 0.0);
         // protocol segments B (steps of slope) and E (moving stopper), 1.5 s each
@@ -1882,6 +1935,7 @@ mod tests {
                 "force_sensor_backlash" => 0.71,
                 "jet_pipe_curve" => 1.71,
                 "return_area_reduction" => 1.69,
+                "port_1_restriction" => 2.21,
                 other => panic!("no documented size for {other}"),
             };
             if !(f_rms >= 0.7 * doc_rms && f_rms <= 1.4 * doc_rms) {

@@ -110,6 +110,9 @@ struct Cli {
     /// return_area_reduction: fractional reduction 0..1 of both return areas (e.g. 0.05).
     #[arg(long)]
     return_area_reduction: Option<f64>,
+    /// port_1_restriction: C_d·A of an orifice between receiver port 1 and chamber 1, m² (e.g. 2e-7).
+    #[arg(long)]
+    port_1_restriction: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -153,6 +156,7 @@ fn main() -> ExitCode {
     set(&mut und.force_sensor_backlash, cli.force_sensor_backlash);
     set(&mut und.jet_pipe_curve_blend, cli.jet_pipe_curve_blend);
     set(&mut und.return_area_reduction, cli.return_area_reduction);
+    set(&mut und.port_1_restriction, cli.port_1_restriction);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -166,6 +170,7 @@ fn main() -> ExitCode {
         und.force_sensor_backlash,
         und.jet_pipe_curve_blend,
         und.return_area_reduction,
+        und.port_1_restriction,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -182,7 +187,7 @@ fn main() -> ExitCode {
     if und_bad {
         eprintln!(
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
-             friction, stiffness, delay, backlash and ripple frequency non-negative; curve \
+             friction, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
              blend and return area reduction in 0..1"
         );
         return ExitCode::from(2);
