@@ -64,6 +64,9 @@ PARAMETERS = {
     "return_resistance": (0.0, "Pa.s/kg"),
     "chamber_vent_1": (0.0, "m2"),
     "chamber_vent_2": (0.0, "m2"),
+    "port_resistance_1": (0.0, "Pa.s/kg"),
+    "port_resistance_2": (0.0, "Pa.s/kg"),
+    "stopper_compliance": (0.0, "m/N"),
 }
 
 

@@ -88,10 +88,11 @@
 //! * `p2_sensor_delay` (`pressure_sensors`/`delay`, `pressure_sensor_delay_2`, standard 10 ms,
 //!   rounded to whole samples): logged p2 at sample k is P2 at sample k − d (the value at t = 0
 //!   before), then noise and quantisation; force and p1 bit-identical (force effect 0).
-//! * `receiver_offset` (`valve`/`parameter_offset`, `receiver_offset`, standard 10 µm): the
+//! * `receiver_offset` (`jet_pipe`/`parameter_offset`, `receiver_offset`, standard 10 µm): the
 //!   port areas are evaluated at x_jp + (x_jp_offset + 10 µm), i.e. the receivers sit further
-//!   from the jet pipe null (the static force curve shifts along the command axis). Force
-//!   1.9 N rms / 3.0 N max.
+//!   from the jet pipe null (the static force curve shifts along the command axis). The
+//!   offset is the jet pipe's constant x_jp_offset of x_abs = x_jp + x_jp_offset (2.4)–(2.7),
+//!   so the chain places it at the jet pipe. Force 1.9 N rms / 3.0 N max.
 //! * `force_sensor_backlash` (`force_sensor`/`hysteresis`, `force_sensor_backlash` = w,
 //!   standard 1.5 N): the reading passes a play operator of half width r = w/2 at the samples,
 //!   y_k = clamp(y_{k−1}, F_k − r, F_k + r), y_0 = F_0 (after the force lag, before gain,
@@ -441,7 +442,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
     },
     UndeclaredMechanism {
         name: "receiver_offset",
-        location: "valve",
+        location: "jet_pipe",
         family: "parameter_offset",
         truth: "the receivers sit 10 µm further from the jet pipe null (x_jp_offset 0.099 → 0.109 mm)",
         effects: std_receiver_offset,

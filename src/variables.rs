@@ -66,6 +66,9 @@ pub mod vr {
     pub const RETURN_RESISTANCE: u32 = 410;
     pub const CHAMBER_VENT_1: u32 = 420;
     pub const CHAMBER_VENT_2: u32 = 421;
+    pub const PORT_RESISTANCE_1: u32 = 430;
+    pub const PORT_RESISTANCE_2: u32 = 431;
+    pub const STOPPER_COMPLIANCE: u32 = 440;
 }
 
 pub const UNITS: &[UnitDefinition] = &[
@@ -194,6 +197,14 @@ pub const UNITS: &[UnitDefinition] = &[
         kg: 0,
         m: -1,
         s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m/N",
+        kg: -1,
+        m: 0,
+        s: 2,
         a: 0,
         k: 0,
     },
@@ -399,4 +410,7 @@ pub const VARIABLES: &[Variable] = &[
     parameter("return_resistance", vr::RETURN_RESISTANCE, "Pa.s/kg", 0.0, "return restriction: the pressure the return orifices vent into rises above P_r by this times the return mass flow (0 = off)"),
     parameter("chamber_vent_1", vr::CHAMBER_VENT_1, "m2", 0.0, "chamber leak: discharge coefficient times area of a leak from chamber 1 to the return pressure (0 = off)"),
     parameter("chamber_vent_2", vr::CHAMBER_VENT_2, "m2", 0.0, "chamber leak: discharge coefficient times area of a leak from chamber 2 to the return pressure (0 = off)"),
+    parameter("port_resistance_1", vr::PORT_RESISTANCE_1, "Pa.s/kg", 0.0, "port restriction: the orifices of port 1 see a pressure that differs from chamber 1's by this times the net flow through the port (0 = off)"),
+    parameter("port_resistance_2", vr::PORT_RESISTANCE_2, "Pa.s/kg", 0.0, "port restriction: the orifices of port 2 see a pressure that differs from chamber 2's by this times the net flow through the port (0 = off)"),
+    parameter("stopper_compliance", vr::STOPPER_COMPLIANCE, "m/N", 0.0, "compliance between stopper and piston: the piston sits this times A_p (P1 - P2) beyond the stopper, which moves the chamber volumes (0 = rigid)"),
 ];

@@ -120,3 +120,46 @@ fn rec_03_is_explained_with_nothing_added() {
     assert!(d.effects.is_empty(), "named {:?}", names(&d));
     assert_eq!(d.verdict(), "explained");
 }
+
+fn calibrated(name: &str) -> Option<Diagnosis> {
+    let path = shared(name)?;
+    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    Some(diagnose(&recording, &Parameters::default(), true, &mut |_| {}).unwrap())
+}
+
+#[test]
+fn calibration_flags_the_constants_an_asymmetric_valve_would_hide_in() {
+    let Some(d) = calibrated("undeclared/u_port2_block.csv") else {
+        return;
+    };
+    let c_d = d.calibrated.iter().find(|c| c.name == "C_d").unwrap();
+    println!("C_d {:.4} (thesis {:.4}): {:?}", c_d.value, c_d.thesis, c_d.flags);
+    assert!(
+        c_d.flags.iter().any(|f| f.contains("both command ranges")),
+        "{:?}",
+        c_d.flags
+    );
+    assert!(d
+        .summary()
+        .iter()
+        .any(|l| l.contains("Calibrated C_d") && l.contains("command ranges")));
+    // However well calibration fits, the port's asymmetry is not named away.
+    assert!(d.effects.is_empty(), "named {:?}", names(&d));
+}
+
+#[test]
+fn calibration_of_a_clean_recording_finds_the_thesis_values_and_flags_nothing() {
+    let Some(d) = calibrated("undeclared/u_null4.csv") else {
+        return;
+    };
+    for c in &d.calibrated {
+        assert!(c.flags.is_empty(), "{}: {:?}", c.name, c.flags);
+        assert!(
+            (c.value - c.thesis).abs() <= 0.02 * c.thesis.abs(),
+            "{} = {} vs thesis {}",
+            c.name,
+            c.value,
+            c.thesis
+        );
+    }
+}

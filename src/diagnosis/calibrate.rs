@@ -141,14 +141,14 @@ pub fn calibrate(recording: &Recording, base: &Parameters, training: &[bool]) ->
         let (t0, t1) = (values[1][j], values[2][j]);
         if ((t1 - t0) / SCALES[j]).abs() > DIFFERENT_HALVES[j] {
             flags.push(format!(
-                "drifting: {} is {t0:.4e} on the first half of the recording and {t1:.4e} on the second",
+                "not constant in time: {} is {t0:.4e} on the first half of the recording and {t1:.4e} on the second (a drift, or an effect the model lacks that the halves' commands expose differently)",
                 NAMES[j]
             ));
         }
         let (c0, c1) = (values[3][j], values[4][j]);
         if ((c1 - c0) / SCALES[j]).abs() > DIFFERENT_HALVES[j] {
             flags.push(format!(
-                "asymmetric: {} is {c0:.4e} for commands below the median ({median_command:.2} V) and {c1:.4e} above it",
+                "not the same for both command ranges: {} is {c0:.4e} for commands below the median ({median_command:.2} V) and {c1:.4e} above it (an asymmetry, or a nonlinearity the constant is absorbing)",
                 NAMES[j]
             ));
         }

@@ -45,6 +45,62 @@ pub enum Regressor {
     Cosine(f64),
 }
 
+/// How a sensor may read its quantity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Filter {
+    Delay,
+    Lag,
+    Play,
+}
+
+impl Filter {
+    /// The reading of `x` through the filter with coefficient `value`.
+    pub fn apply(self, time: &[f64], x: &[f64], value: f64) -> Vec<f64> {
+        let n = x.len();
+        let mut out = Vec::with_capacity(n);
+        match self {
+            Filter::Delay => {
+                let mut j = 0;
+                for k in 0..n {
+                    let at = time[k] - value;
+                    while j + 1 < n && time[j + 1] <= at {
+                        j += 1;
+                    }
+                    let y = if at <= time[0] {
+                        x[0]
+                    } else if j + 1 < n {
+                        let w = (at - time[j]) / (time[j + 1] - time[j]);
+                        x[j] + w * (x[j + 1] - x[j])
+                    } else {
+                        x[n - 1]
+                    };
+                    out.push(y);
+                }
+            }
+            Filter::Lag => {
+                let mut y = x[0];
+                for k in 0..n {
+                    if value <= 0.0 {
+                        y = x[k];
+                    } else if k > 0 {
+                        let dt = time[k] - time[k - 1];
+                        y += (1.0 - (-dt / value).exp()) * (x[k - 1] - y);
+                    }
+                    out.push(y);
+                }
+            }
+            Filter::Play => {
+                let mut y = x[0];
+                for &v in x {
+                    y = y.clamp(v - 0.5 * value, v + 0.5 * value);
+                    out.push(y);
+                }
+            }
+        }
+        out
+    }
+}
+
 /// How a time-varying constant varies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Modulation {
@@ -59,9 +115,17 @@ pub enum Mechanism {
     Parameter(&'static str),
     /// A first-order lag (time constant, s) on the command the current driver sees.
     CommandLag,
+    /// The command the current driver sees saturates at ± this (V).
+    CommandLimit,
     /// The current saturates at ± this (A): the command clipped where k_cd v + i_offset
     /// reaches it (the current driver is linear, so the two are the same).
     CurrentLimit,
+    /// The current slews at most this fast (A/s): the command rate-limited where k_cd
+    /// times it reaches that (the current driver is fast beside it).
+    CurrentSlewLimit,
+    /// A measured channel read through a delay, a lag or a play (the coefficient: its
+    /// time, s, or its width in the channel's unit).
+    OutputFilter { channel: usize, filter: Filter },
     /// A term on a measured channel: coefficient × regressor.
     Output { channel: usize, regressor: Regressor },
     /// A parameter varying in time: coefficient × its sensitivity × the modulation (first order).
@@ -72,6 +136,16 @@ pub enum Mechanism {
 }
 
 impl Mechanism {
+    fn is_searched(&self) -> bool {
+        matches!(
+            self,
+            Mechanism::CurrentLimit
+                | Mechanism::CommandLimit
+                | Mechanism::CurrentSlewLimit
+                | Mechanism::OutputFilter { .. }
+        )
+    }
+
     fn is_linear(&self) -> bool {
         matches!(self, Mechanism::Output { .. } | Mechanism::Modulated { .. })
     }
@@ -159,6 +233,18 @@ fn output(name: &'static str, unit: &'static str, channel: usize, regressor: Reg
     }
 }
 
+fn filter(name: &'static str, unit: &'static str, channel: usize, filter: Filter, lower: f64, upper: f64) -> Term {
+    Term {
+        name,
+        unit,
+        mechanism: Mechanism::OutputFilter { channel, filter },
+        neutral: 0.0,
+        step: 0.0,
+        lower,
+        upper,
+    }
+}
+
 fn modulated(
     name: &'static str,
     unit: &'static str,
@@ -178,7 +264,9 @@ fn modulated(
 }
 
 /// Every candidate, for a base model and a recording with or without pressures.
-/// `periodic_hz` is the residual's spectral line, if it has one.
+/// `periodic_hz` is the residual's spectral line, if it has one. Where two places fit
+/// alike (a command limit and a current limit), the earlier in the chain comes first and
+/// wins the tie.
 pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64>) -> Vec<Candidate> {
     let c = |label, location, family, named, terms| Candidate {
         label,
@@ -188,6 +276,19 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
         terms,
     };
     let p = |name, unit, relative, lower, upper| parameter(base, name, unit, relative, lower, upper);
+    let offset = |name, unit, step, lower, upper| Term {
+        step,
+        ..parameter(base, name, unit, 0.0, lower, upper)
+    };
+    let searched = |name, unit, mechanism, lower, upper| Term {
+        name,
+        unit,
+        mechanism,
+        neutral: f64::INFINITY,
+        step: 0.0,
+        lower,
+        upper,
+    };
     let inf = f64::INFINITY;
     let mut list = vec![
         c(
@@ -195,10 +296,7 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "command",
             "delay",
             Some("transport_delay"),
-            vec![Term {
-                step: 1e-3,
-                ..term_off("command_delay", "s", 1e-3, 0.05)
-            }],
+            vec![term_off("command_delay", "s", 1e-3, 0.05)],
         ),
         c(
             "command lag",
@@ -216,16 +314,20 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             }],
         ),
         c(
+            "command limit",
+            "command",
+            "limit",
+            None,
+            vec![searched("command_limit", "V", Mechanism::CommandLimit, 0.0, inf)],
+        ),
+        c(
             "current driver gain and offset",
             "current_driver",
             "parameter_offset",
             None,
             vec![
                 p("k_cd", "A/V", 0.01, 0.0, inf),
-                Term {
-                    step: 1e-3,
-                    ..p("i_offset", "A", 0.0, -0.2, 0.2)
-                },
+                offset("i_offset", "A", 1e-3, -0.2, 0.2),
             ],
         ),
         c(
@@ -233,15 +335,27 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "current_driver",
             "limit",
             None,
-            vec![Term {
-                name: "current_limit",
-                unit: "A",
-                mechanism: Mechanism::CurrentLimit,
-                neutral: f64::INFINITY,
-                step: 0.0,
-                lower: 0.0,
-                upper: inf,
-            }],
+            vec![searched("current_limit", "A", Mechanism::CurrentLimit, 0.0, inf)],
+        ),
+        c(
+            "current slew limit",
+            "current_driver",
+            "limit",
+            None,
+            vec![searched(
+                "current_slew_limit",
+                "A/s",
+                Mechanism::CurrentSlewLimit,
+                0.05,
+                200.0,
+            )],
+        ),
+        c(
+            "jet pipe null",
+            "jet_pipe",
+            "parameter_offset",
+            None,
+            vec![offset("x_jp_offset", "m", 2e-6, -1e-3, 1e-3)],
         ),
         c(
             "jet pipe null and travel",
@@ -249,10 +363,7 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "parameter_offset",
             None,
             vec![
-                Term {
-                    step: 2e-6,
-                    ..p("x_jp_offset", "m", 0.0, -1e-3, 1e-3)
-                },
+                offset("x_jp_offset", "m", 2e-6, -1e-3, 1e-3),
                 p("x_jp_sat", "m", 0.01, 1e-5, 5e-3),
             ],
         ),
@@ -278,13 +389,10 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "jet_pipe",
             "drift",
             None,
-            vec![modulated(
-                "x_jp_offset_drift",
-                "m",
-                "x_jp_offset",
-                Modulation::Ramp,
-                1e-6,
-            )],
+            vec![
+                offset("x_jp_offset", "m", 2e-6, -1e-3, 1e-3),
+                modulated("x_jp_offset_drift", "m", "x_jp_offset", Modulation::Ramp, 1e-6),
+            ],
         ),
         c(
             "discharge coefficient",
@@ -306,6 +414,16 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             ],
         ),
         c(
+            "port restrictions",
+            "valve",
+            "restriction",
+            None,
+            vec![
+                term_off("port_resistance_1", "Pa.s/kg", 1e8, 1e11),
+                term_off("port_resistance_2", "Pa.s/kg", 1e8, 1e11),
+            ],
+        ),
+        c(
             "supply pressure",
             "supply",
             "parameter_offset",
@@ -324,7 +442,10 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "supply",
             "drift",
             None,
-            vec![modulated("P_s_drift", "Pa", "P_s", Modulation::Ramp, 1e3)],
+            vec![
+                p("P_s", "Pa", 0.005, 1.2e5, 2e6),
+                modulated("P_s_drift", "Pa", "P_s", Modulation::Ramp, 1e3),
+            ],
         ),
         c(
             "return pressure",
@@ -363,14 +484,8 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "parameter_offset",
             None,
             vec![
-                Term {
-                    step: 2e-9,
-                    ..p("C_dm_A_lpp", "m2", 0.0, -1e-6, 1e-6)
-                },
-                Term {
-                    step: 2e-9,
-                    ..p("C_db_A_lpp", "m2", 0.0, 0.0, 1e-6)
-                },
+                offset("C_dm_A_lpp", "m2", 2e-9, -1e-6, 1e-6),
+                offset("C_db_A_lpp", "m2", 2e-9, 0.0, 1e-6),
             ],
         ),
         c(
@@ -401,9 +516,16 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             vec![output("viscous_friction", "N.s/m", FORCE, Regressor::Viscous, 1.0)],
         ),
         c(
-            "force on the stopper position",
+            "stopper compliance",
             "mechanics",
             "compliance",
+            None,
+            vec![term_off("stopper_compliance", "m/N", 1e-6, 1e-3)],
+        ),
+        c(
+            "force on the stopper position",
+            "mechanics",
+            "extra_force",
             None,
             vec![output("position_stiffness", "N/m", FORCE, Regressor::Position, 10.0)],
         ),
@@ -434,14 +556,31 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "force_sensor",
             "dynamics",
             None,
-            vec![output("force_sensor_lag", "s", FORCE, Regressor::OwnRate, 1e-4)],
+            vec![filter("force_sensor_lag", "s", FORCE, Filter::Lag, 1e-4, 0.2)],
+        ),
+        c(
+            "force sensor delay",
+            "force_sensor",
+            "delay",
+            None,
+            vec![filter("force_sensor_delay", "s", FORCE, Filter::Delay, 1e-4, 0.2)],
+        ),
+        c(
+            "force sensor play",
+            "force_sensor",
+            "hysteresis",
+            None,
+            vec![filter("force_sensor_play", "N", FORCE, Filter::Play, 1e-3, 20.0)],
         ),
         c(
             "force sensor drift",
             "force_sensor",
             "drift",
             None,
-            vec![output("force_sensor_drift", "N", FORCE, Regressor::Ramp, 0.1)],
+            vec![
+                output("force_sensor_offset", "N", FORCE, Regressor::One, 0.1),
+                output("force_sensor_drift", "N", FORCE, Regressor::Ramp, 0.1),
+            ],
         ),
     ];
     if let Some(f) = periodic_hz {
@@ -468,6 +607,20 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
     }
     if has_pressures {
         list.push(c(
+            "chamber 1 pressure sensor offset",
+            "pressure_sensors",
+            "parameter_offset",
+            None,
+            vec![output("p1_sensor_offset", "Pa", P1, Regressor::One, 100.0)],
+        ));
+        list.push(c(
+            "chamber 2 pressure sensor offset",
+            "pressure_sensors",
+            "parameter_offset",
+            None,
+            vec![output("p2_sensor_offset", "Pa", P2, Regressor::One, 100.0)],
+        ));
+        list.push(c(
             "pressure sensor offsets and gains",
             "pressure_sensors",
             "parameter_offset",
@@ -479,13 +632,34 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
                 output("p2_sensor_gain_error", "1", P2, Regressor::Own, 1e-3),
             ],
         ));
+        for (channel, lag, delay) in [
+            (P1, "p1_sensor_lag", "p1_sensor_delay"),
+            (P2, "p2_sensor_lag", "p2_sensor_delay"),
+        ] {
+            list.push(c(
+                "pressure sensor lag",
+                "pressure_sensors",
+                "dynamics",
+                None,
+                vec![filter(lag, "s", channel, Filter::Lag, 1e-4, 0.2)],
+            ));
+            list.push(c(
+                "pressure sensor delay",
+                "pressure_sensors",
+                "delay",
+                None,
+                vec![filter(delay, "s", channel, Filter::Delay, 1e-4, 0.2)],
+            ));
+        }
         list.push(c(
             "pressure sensor drift",
             "pressure_sensors",
             "drift",
             None,
             vec![
+                output("p1_sensor_offset", "Pa", P1, Regressor::One, 100.0),
                 output("p1_sensor_drift", "Pa", P1, Regressor::Ramp, 100.0),
+                output("p2_sensor_offset", "Pa", P2, Regressor::One, 100.0),
                 output("p2_sensor_drift", "Pa", P2, Regressor::Ramp, 100.0),
             ],
         ));
@@ -544,19 +718,28 @@ impl<'a> Problem<'a> {
         let mut p = self.base.clone();
         let mut lag = 0.0;
         let mut limit = f64::INFINITY;
+        let mut command_limit = f64::INFINITY;
+        let mut slew = f64::INFINITY;
         for (term, &value) in terms.iter().zip(values) {
             match term.mechanism {
                 Mechanism::Parameter(name) => set_parameter(&mut p, name, value)?,
                 Mechanism::CommandLag => lag = value,
                 Mechanism::CurrentLimit => limit = value,
+                Mechanism::CommandLimit => command_limit = value,
+                Mechanism::CurrentSlewLimit => slew = value,
                 _ => {}
             }
         }
         let model = Actuator::new(p)?;
-        if lag == 0.0 && limit == f64::INFINITY {
+        if lag == 0.0 && limit == f64::INFINITY && command_limit == f64::INFINITY && slew == f64::INFINITY {
             return replay_fast(&model, self.recording, self.recording.len());
         }
         let mut shaped = self.recording.clone();
+        if command_limit.is_finite() {
+            for v in shaped.v_da.iter_mut() {
+                *v = v.clamp(-command_limit, command_limit);
+            }
+        }
         if limit.is_finite() {
             let (k, i0) = (model.params.k_cd, model.params.i_offset);
             if k != 0.0 {
@@ -565,6 +748,15 @@ impl<'a> Problem<'a> {
                 for v in shaped.v_da.iter_mut() {
                     *v = v.clamp(lo, hi);
                 }
+            }
+        }
+        if slew.is_finite() && model.params.k_cd != 0.0 {
+            let rate = slew / model.params.k_cd.abs();
+            let mut held = shaped.v_da[0];
+            for k in 1..shaped.len() {
+                let most = rate * (shaped.time[k] - shaped.time[k - 1]);
+                held += (shaped.v_da[k] - held).clamp(-most, most);
+                shaped.v_da[k] = held;
             }
         }
         if lag > 0.0 {
@@ -741,8 +933,8 @@ impl Problem<'_> {
         shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
     ) -> Result<Fit, String> {
         let terms = &candidate.terms;
-        if terms.iter().any(|t| t.mechanism == Mechanism::CurrentLimit) {
-            return self.fit_limit(candidate, base_replay);
+        if terms.iter().any(|t| t.mechanism.is_searched()) {
+            return self.fit_search(candidate, base_replay);
         }
         // Sensitivities of the modulated parameters (at the base point: first order).
         let modulated: Vec<Option<Sensitivity>> = terms
@@ -804,7 +996,7 @@ impl Problem<'_> {
                             difference(&with[2], &point.replay.p2),
                         ])
                     }
-                    Mechanism::CurrentLimit => None,
+                    _ => None,
                 };
                 columns.push(column.unwrap_or_else(|| [vec![], vec![], vec![]]));
             }
@@ -916,55 +1108,79 @@ impl Problem<'_> {
         bounded_least_squares(&ata, &atb, &usable, &lower, &upper)
     }
 
-    /// A current limit: golden-section search on the limit (its sensitivity is zero until
-    /// it clips), between a fifth of the largest current the command asks for and that.
-    fn fit_limit(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
+    /// A transform with one coefficient whose sensitivity vanishes where it is off (a
+    /// limit does nothing until it clips, a slew limit until the command jumps) or that
+    /// acts on a measured channel exactly (a delay, a lag, a play): golden-section search
+    /// on the coefficient, on a logarithmic scale where it spans decades.
+    fn fit_search(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
         let p = self.base;
-        let largest = self
-            .recording
-            .v_da
-            .iter()
-            .map(|v| (p.k_cd * v + p.i_offset).abs())
-            .fold(0.0, f64::max);
-        let terms = &candidate.terms;
+        let term = &candidate.terms[0];
+        let commands = self.recording.v_da.iter();
+        let (lower, upper, logarithmic) = match term.mechanism {
+            Mechanism::CurrentLimit => {
+                let largest = commands.map(|v| (p.k_cd * v + p.i_offset).abs()).fold(0.0, f64::max);
+                (0.2 * largest, largest, false)
+            }
+            Mechanism::CommandLimit => {
+                let largest = commands.map(|v| v.abs()).fold(0.0, f64::max);
+                (0.2 * largest, largest, false)
+            }
+            _ => (term.lower, term.upper, true),
+        };
+        let base = Prediction::of_replay(base_replay);
         let mut replays = 0;
-        let mut evaluate = |limit: f64| -> (f64, Option<Replay>) {
-            replays += 1;
-            match self.replay(terms, &[limit]) {
-                Ok(r) => {
-                    let (train, _) = self.errors(&Prediction::of_replay(&r));
-                    (train.iter().sum(), Some(r))
+        let mut evaluate = |value: f64| -> (f64, Option<[Vec<f64>; CHANNELS]>) {
+            let prediction = match term.mechanism {
+                Mechanism::OutputFilter { channel, filter } => {
+                    let mut out = base.clone();
+                    out[channel] = filter.apply(&self.recording.time, &base[channel], value);
+                    Some(out)
                 }
-                Err(_) => (f64::INFINITY, None),
+                _ => {
+                    replays += 1;
+                    self.replay(&candidate.terms, &[value])
+                        .ok()
+                        .map(|r| Prediction::of_replay(&r))
+                }
+            };
+            match prediction {
+                Some(y) => (self.errors(&y).0.iter().sum(), Some(y)),
+                None => (f64::INFINITY, None),
+            }
+        };
+        let to_value = |u: f64| {
+            if logarithmic {
+                lower * (upper / lower).powf(u)
+            } else {
+                lower + (upper - lower) * u
             }
         };
         let phi = (5f64.sqrt() - 1.0) / 2.0;
-        let (mut a, mut b) = (0.2 * largest, largest);
+        let (mut a, mut b) = (0.0, 1.0);
         let mut c = b - phi * (b - a);
         let mut d = a + phi * (b - a);
-        let (mut fc, mut fd) = (evaluate(c).0, evaluate(d).0);
-        for _ in 0..14 {
+        let (mut fc, mut fd) = (evaluate(to_value(c)).0, evaluate(to_value(d)).0);
+        for _ in 0..16 {
             if fc < fd {
                 b = d;
                 d = c;
                 fd = fc;
                 c = b - phi * (b - a);
-                fc = evaluate(c).0;
+                fc = evaluate(to_value(c)).0;
             } else {
                 a = c;
                 c = d;
                 fc = fd;
                 d = a + phi * (b - a);
-                fd = evaluate(d).0;
+                fd = evaluate(to_value(d)).0;
             }
         }
-        let best = if fc < fd { c } else { d };
-        let (cost, replay) = evaluate(best);
-        let (values, replay) = match replay {
-            Some(r) if cost < self.errors(&Prediction::of_replay(base_replay)).0.iter().sum::<f64>() => (vec![best], r),
-            _ => (vec![f64::INFINITY], base_replay.clone()),
+        let best = to_value(if fc < fd { c } else { d });
+        let (cost, prediction) = evaluate(best);
+        let (values, prediction) = match prediction {
+            Some(y) if cost < self.errors(&base).0.iter().sum::<f64>() => (vec![best], y),
+            _ => (vec![term.neutral], base),
         };
-        let prediction = Prediction::of_replay(&replay);
         let (train, heldout) = self.errors(&prediction);
         Ok(Fit {
             candidate: candidate.clone(),

@@ -49,6 +49,11 @@ pub const LOCATED_SHARE: f64 = 0.3;
 /// A named effect must explain at least this fraction of what the best candidate at its
 /// place explains: otherwise the departure there is of another kind.
 pub const NAMED_SHARE_OF_PLACE: f64 = 0.75;
+/// …and at least this share of the held-out misfit (of the force against the pressures,
+/// for the mechanics and the force sensor): a named effect that leaves more is standing in
+/// for something else (measured: 0.88–1.00 for the named effects of the synthetic bench,
+/// Bouc–Wen hysteresis lowest; 0.63–0.76 for a supply drift and a port restriction).
+pub const NAMED_MIN_SHARE: f64 = 0.8;
 const MAX_EFFECTS: usize = 3;
 /// Candidates refitted with more Gauss–Newton iterations after the first pass.
 const REFINED: usize = 3;
@@ -223,8 +228,6 @@ pub struct Diagnosis {
     pub localization: Option<Localization>,
     pub pressure_split: Option<PressureSplit>,
     pub unexplained: Option<Unexplained>,
-    /// Pressure channels that depart from the model though the force is explained.
-    pub pressures_unexplained: Option<String>,
     pub residual_tests: Value,
     pub parameters: Parameters,
     pub before_force: Vec<f64>,
@@ -683,7 +686,7 @@ pub fn diagnose_with(
                 let gain = force_before - s.force_heldout_rms;
                 let worse_pressures = (1..CHANNELS)
                     .any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * heldout[c] + count * 0.01);
-                let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share && s.explained >= LOCATED_SHARE;
+                let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share && s.explained >= NAMED_MIN_SHARE;
                 let gain_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
                 let test = named_signature(name, recording, &model, &current, &training, noise, mechanical_noise);
                 progress(&format!(
@@ -737,7 +740,8 @@ pub fn diagnose_with(
                         replays += 1;
                         let after = rms_where(&difference(&recording.force, &with.force), &training, false);
                         let gain = force_before - after;
-                        let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * side_share && s.explained >= LOCATED_SHARE;
+                        let share_ok =
+                            s.explained >= NAMED_SHARE_OF_PLACE * side_share && s.explained >= NAMED_MIN_SHARE;
                         let gain_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
                         let test =
                             named_signature(name, recording, &model, &current, &training, noise, mechanical_noise);
@@ -818,7 +822,12 @@ pub fn diagnose_with(
     let chain = ChainSignals::new(&final_model, recording, &after);
     let remainder = Signature::of(&recording.time, &after_residual, &chain, "N");
     let explained = after_errors.heldout_rms <= EXPLAINED_WITHIN_NOISE * noise;
-    let unexplained = (!explained).then(|| {
+    // The force is the verdict's channel; pressures that depart while the force does not
+    // (a pressure transducer, say) still get their place and signature.
+    let pressures_off = split
+        .as_ref()
+        .map_or(false, |s| s.pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE));
+    let unexplained = (!explained || pressures_off && localization.is_some()).then(|| {
         let (location, family, alternatives) = match &localization {
             Some(l) => (l.location, l.family, l.alternatives()),
             None => ("unknown", "unknown", vec![]),
@@ -841,6 +850,32 @@ pub fn diagnose_with(
                 }
             )
         };
+        if explained {
+            let s = split.as_ref().expect("pressures_off needs the split");
+            let worse = if s.pressure_ratio[0] >= s.pressure_ratio[1] { 0 } else { 1 };
+            let measured = if worse == 0 { &recording.p1 } else { &recording.p2 };
+            let modelled = if worse == 0 { &after.p1 } else { &after.p2 };
+            let residual = difference(measured.as_ref().expect("pressures"), modelled);
+            let signature = Signature::of(&recording.time, &residual, &chain, "Pa");
+            return Unexplained {
+                rms: after_errors.heldout_rms,
+                ratio_to_noise: ratio,
+                location,
+                family,
+                alternatives,
+                sentence: format!(
+                    "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's by {:.0} and {:.0} Pa RMS ({:.1}× and {:.1}× their noise); {place}. Chamber {}: {}",
+                    after_errors.heldout_rms,
+                    s.pressure_rms[0],
+                    s.pressure_rms[1],
+                    s.pressure_ratio[0],
+                    s.pressure_ratio[1],
+                    worse + 1,
+                    signature.sentence
+                ),
+                signature,
+            };
+        }
         Unexplained {
             rms: after_errors.heldout_rms,
             ratio_to_noise: ratio,
@@ -854,13 +889,6 @@ pub fn diagnose_with(
             signature: remainder.clone(),
         }
     });
-    let pressures_unexplained = match (&split, &localization) {
-        (Some(s), Some(l)) if explained && s.pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE) => Some(format!(
-            "The force is explained, but the pressures depart from the model's by {:.0} and {:.0} Pa RMS ({:.1}× and {:.1}× their noise); a correction at the {} ({}) explains most of it.",
-            s.pressure_rms[0], s.pressure_rms[1], s.pressure_ratio[0], s.pressure_ratio[1], l.location, l.family
-        )),
-        _ => None,
-    };
     let heldout_residual: Vec<f64> = after_residual
         .iter()
         .zip(&training)
@@ -885,7 +913,6 @@ pub fn diagnose_with(
         localization,
         pressure_split: split,
         unexplained,
-        pressures_unexplained,
         residual_tests,
         parameters: params,
         before_force: before.force,
@@ -931,6 +958,7 @@ impl Diagnosis {
         let ratio = self.after.heldout_rms / self.noise_floor.max(1e-12);
         let names: Vec<&str> = self.effects.iter().map(|e| e.name).collect();
         lines.push(match (&self.unexplained, names.is_empty()) {
+            (Some(u), _) if self.explained() => format!("Explained in the force, not in the pressures: {}", u.sentence),
             (None, true) => format!(
                 "Explained: the thesis model reproduces the force to within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N); nothing was added.",
                 self.after.heldout_rms, self.noise_floor
@@ -952,9 +980,6 @@ impl Diagnosis {
                 u.sentence
             ),
         });
-        if let Some(p) = &self.pressures_unexplained {
-            lines.push(p.clone());
-        }
         if let Some(s) = &self.pressure_split {
             lines.push(s.sentence.clone());
         }
@@ -1056,11 +1081,9 @@ impl Diagnosis {
                     "alternatives": u.alternatives,
                     "signature": u.signature.to_json("N"),
                     "sentence": u.sentence,
+                    "channel": if self.explained() { "pressures" } else { "force" },
                 }),
             );
-        }
-        if let Some(p) = &self.pressures_unexplained {
-            object.insert("pressures_unexplained".into(), json!(p));
         }
         object.insert(
             "pressure_split".into(),

@@ -149,6 +149,17 @@ impl Actuator {
         let p = &self.params;
         let k = &self.flow;
         let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
+        // The orifices of each port see the chamber's pressure, or, through a port
+        // restriction, a pressure between it and the flow's source.
+        let port =
+            |chamber: f64, resistance: f64, cd_supply: f64, supply_area: f64, cd_return: f64, return_area: f64| {
+                effects::port_pressure(chamber, resistance, p.p_s, p.p_r, |q| {
+                    mass_flow(k, cd_supply * supply_area, p.p_s, q) - mass_flow(k, cd_return * return_area, q, p.p_r)
+                })
+            };
+        let q1 = port(p1, p.port_resistance_1, cd_s1, a.supply_1, cd_r1, a.return_1);
+        let q2 = port(p2, p.port_resistance_2, cd_s2, a.supply_2, cd_r2, a.return_2);
+        let (p1, p2, chamber_1, chamber_2) = (q1, q2, p1, p2);
         let supply = |p_supply: f64| {
             (
                 mass_flow(k, cd_s1 * a.supply_1, p_supply, p1),
@@ -175,8 +186,8 @@ impl Actuator {
             (0.0, 0.0)
         } else {
             (
-                mass_flow(k, p.chamber_vent_1, p1, p.p_r),
-                mass_flow(k, p.chamber_vent_2, p2, p.p_r),
+                mass_flow(k, p.chamber_vent_1, chamber_1, p.p_r),
+                mass_flow(k, p.chamber_vent_2, chamber_2, p.p_r),
             )
         };
         MassFlows {
@@ -184,7 +195,7 @@ impl Actuator {
             return_1,
             supply_2,
             return_2,
-            leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+            leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, chamber_1, chamber_2),
             vent_1,
             vent_2,
         }
@@ -206,6 +217,9 @@ impl Actuator {
     ) -> (f64, f64) {
         let p = &self.params;
         let flows = self.mass_flows_through(areas, p1, p2);
+        if p.stopper_compliance != 0.0 {
+            return self.pressure_rates_on_a_compliant_stopper(&flows, p1, p2, x_s, x_s_rate);
+        }
         let (v1, v2) = self.cylinder.volumes(x_s);
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
         (
@@ -228,6 +242,30 @@ impl Actuator {
                 p2,
             ),
         )
+    }
+
+    /// (2.29) when the piston sits c A_p (P1 − P2) beyond the stopper (`stopper_compliance`
+    /// c): the volumes move with the pressures, and so the rates appear on both sides,
+    /// Ṗ1 = a1 − b1 (ẋ_s + c A_p D), Ṗ2 = a2 + b2 (ẋ_s + c A_p D) with D = Ṗ1 − Ṗ2,
+    /// b_i = n P_i A_p / V_i; solved for D in closed form.
+    fn pressure_rates_on_a_compliant_stopper(
+        &self,
+        flows: &MassFlows,
+        p1: f64,
+        p2: f64,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> (f64, f64) {
+        let p = &self.params;
+        let n = self.polytropic_exponent;
+        let stretch = p.stopper_compliance * self.piston_area;
+        let (v1, v2) = self.cylinder.volumes(x_s + stretch * (p1 - p2));
+        let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
+        let d1 = pressure_rate(n, p.r_gas, p.temperature, v1, dv1, flows.net_1(), p1);
+        let d2 = pressure_rate(n, p.r_gas, p.temperature, v2, dv2, flows.net_2(), p2);
+        let (b1, b2) = (n * p1 * self.piston_area / v1, n * p2 * self.piston_area / v2);
+        let difference = (d1 - d2) / (1.0 + (b1 + b2) * stretch);
+        (d1 - b1 * stretch * difference, d2 + b2 * stretch * difference)
     }
 
     /// Static jet pipe position x̄ for a current, (2.4)–(2.5).

@@ -148,6 +148,30 @@ fn return_pressure_through_line(p_r: f64, resistance: f64, highest: f64, return_
     increasing_root(p_r, highest.max(p_r), |p| p - p_r - resistance * return_flow(p))
 }
 
+/// Pressure that the orifices of a port see when a restriction of `resistance` (Pa·s/kg)
+/// lies between them and the chamber: the root of q = P_chamber + R ṁ(q), with ṁ(q) the
+/// net flow into the port (supply in, return out), which falls as q rises. The root lies
+/// between the lowest and the highest of the chamber, supply and return pressures.
+#[inline]
+pub fn port_pressure(chamber: f64, resistance: f64, p_s: f64, p_r: f64, net_inflow: impl Fn(f64) -> f64) -> f64 {
+    if resistance == 0.0 {
+        return chamber;
+    }
+    port_pressure_through_restriction(chamber, resistance, p_s, p_r, net_inflow)
+}
+
+#[inline(never)]
+fn port_pressure_through_restriction(
+    chamber: f64,
+    resistance: f64,
+    p_s: f64,
+    p_r: f64,
+    net_inflow: impl Fn(f64) -> f64,
+) -> f64 {
+    let (lo, hi) = (chamber.min(p_r).min(p_s), chamber.max(p_s).max(p_r));
+    increasing_root(lo, hi, |q| q - chamber - resistance * net_inflow(q))
+}
+
 /// The root in [a, b] of an increasing `residual` (the end nearest the sign change when
 /// the bracket holds none): the Illinois variant of regula falsi, which never leaves the
 /// bracket however steep the residual is.

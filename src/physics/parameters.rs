@@ -53,6 +53,9 @@ pub struct Parameters {
     pub return_resistance: f64,
     pub chamber_vent_1: f64,
     pub chamber_vent_2: f64,
+    pub port_resistance_1: f64,
+    pub port_resistance_2: f64,
+    pub stopper_compliance: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -111,6 +114,9 @@ impl Default for Parameters {
             return_resistance: 0.0,
             chamber_vent_1: 0.0,
             chamber_vent_2: 0.0,
+            port_resistance_1: 0.0,
+            port_resistance_2: 0.0,
+            stopper_compliance: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -175,6 +181,9 @@ impl Parameters {
         vr::RETURN_RESISTANCE,
         vr::CHAMBER_VENT_1,
         vr::CHAMBER_VENT_2,
+        vr::PORT_RESISTANCE_1,
+        vr::PORT_RESISTANCE_2,
+        vr::STOPPER_COMPLIANCE,
     ];
 
     fn field_and_bound(&mut self, value_reference: u32) -> Option<(&mut f64, Bound)> {
@@ -223,6 +232,9 @@ impl Parameters {
             vr::RETURN_RESISTANCE => (&mut self.return_resistance, NonNegative),
             vr::CHAMBER_VENT_1 => (&mut self.chamber_vent_1, NonNegative),
             vr::CHAMBER_VENT_2 => (&mut self.chamber_vent_2, NonNegative),
+            vr::PORT_RESISTANCE_1 => (&mut self.port_resistance_1, NonNegative),
+            vr::PORT_RESISTANCE_2 => (&mut self.port_resistance_2, NonNegative),
+            vr::STOPPER_COMPLIANCE => (&mut self.stopper_compliance, NonNegative),
             _ => return None,
         })
     }
