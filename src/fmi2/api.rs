@@ -233,7 +233,7 @@ pub fn get_version() -> *const c_char {
 
 /// `fmi2Instantiate`. Returns NULL (after logging, when a logger is available) for a
 /// NULL `functions`, a NULL instance name, a type other than fmi2CoSimulation, or a
-/// GUID other than `M::info().guid`.
+/// GUID other than `M::info().guid()`.
 ///
 /// # Safety
 /// Pointers as in the FMI 2.0 standard (NUL-terminated strings or NULL).
@@ -282,7 +282,7 @@ pub unsafe fn instantiate<M: CoSimModel>(
             ));
             return std::ptr::null_mut();
         }
-        let expected = M::info().guid;
+        let expected = M::info().guid();
         if guid.is_null() {
             log(&format!(
                 "fmi2Instantiate: GUID mismatch: expected {expected}, got NULL"
@@ -713,10 +713,10 @@ unsafe fn snapshot_ref<'a, M: CoSimModel>(fname: &str, s: fmi2FMUstate) -> Resul
         return Err(format!("{fname}: FMUstate is not a live FMU state (freed or foreign)"));
     }
     let snap = &*(s as *const Snapshot);
-    if snap.guid != M::info().guid {
+    if snap.guid != M::info().guid() {
         return Err(format!(
             "{fname}: FMUstate belongs to another FMU: GUID mismatch: expected {}, got {}",
-            M::info().guid,
+            M::info().guid(),
             snap.guid
         ));
     }

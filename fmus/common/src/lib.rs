@@ -27,15 +27,14 @@ use jetpipe::fmi2::model::StepError;
 macro_rules! model_info {
     (
         name: $name:expr,
-        guid: $guid:expr,
         description: $description:expr,
         units: $units:expr,
-        variables: $variables:expr $(,)?
+        variables: $variables:expr,
+        dependencies: $dependencies:expr $(,)?
     ) => {
         $crate::__jetpipe::fmi2::model::ModelInfo {
             model_name: $name,
             model_identifier: $name,
-            guid: $guid,
             description: $description,
             author: "jetpipe project",
             version: env!("CARGO_PKG_VERSION"),
@@ -48,6 +47,9 @@ macro_rules! model_info {
             units: $units,
             variables: $variables,
             can_interpolate_inputs: false,
+            extent: $crate::__jetpipe::fmi2::model::no_extent,
+            dependencies: $dependencies,
+            guid_cache: $crate::__jetpipe::fmi2::model::GuidCache::new(),
         }
     };
 }

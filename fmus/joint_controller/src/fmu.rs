@@ -2,21 +2,48 @@
 
 use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
-use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
+use jetpipe::fmi2::model::{CoSimModel, ModelInfo, OutputDependencies, StepError};
 
 use crate::control::{Commands, Controller, Gains, Measurements};
 use crate::variables::{vr, UNITS, VARIABLES};
 
-/// Changes whenever the interface (variable table) changes.
-pub const GUID: &str = "{c41b7e02-9a6d-4f35-8c1e-jointcontroller-0001}";
-
 pub static MODEL_INFO: ModelInfo = fmu_common::model_info! {
     name: "JointController",
-    guid: GUID,
     description: "Antagonistic joint position controller with co-contraction (Jacobsen et al.) for two jet-pipe actuators: PID on the angle, tension distribution keeping both tendons above T_min, force loops with inverse static feedforward; sampled at the communication step",
     units: UNITS,
     variables: VARIABLES,
+    dependencies: DEPENDENCIES,
 };
+
+/// `<ModelStructure>`: the controller samples its inputs once per step, so no output follows a new input
+/// before the next step; after initialisation the outputs depend on all inputs and parameters.
+pub const DEPENDENCIES: &[OutputDependencies] = &[
+    OutputDependencies {
+        output: vr::V_DA_FLEXOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::V_DA_EXTENSOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::T_FLEXOR_REF,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::T_EXTENSOR_REF,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::TAU_REF,
+        step: &[],
+        initial: None,
+    },
+];
 
 #[derive(Clone, Debug)]
 pub struct JointControllerFmu {
@@ -170,6 +197,7 @@ mod tests {
     use crate::control::{static_command, STATIC_FORCE_MAP};
 
     fmu_common::interface_tests! {
+        model: JointControllerFmu,
         info: MODEL_INFO,
         dir: "fmus/joint_controller",
         checked_in: include_str!("../modelDescription.xml"),
