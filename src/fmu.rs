@@ -169,6 +169,9 @@ pub struct ActuatorFmu {
     tolerance: f64,
     start_time: f64,
     simulation: Option<Simulation>,
+    /// The last x_s set before initialisation ended that was inside the cylinder (the table's
+    /// start at first): where the stopper starts if the last x_s set was not.
+    x_s_valid: f64,
 }
 
 fn start(value_reference: u32) -> f64 {
@@ -216,6 +219,7 @@ impl CoSimModel for ActuatorFmu {
             tolerance: DEFAULT_RELATIVE_TOLERANCE,
             start_time: 0.0,
             simulation: None,
+            x_s_valid: start(vr::X_S),
         }
     }
 
@@ -264,12 +268,19 @@ impl CoSimModel for ActuatorFmu {
                 }
             }
             vr::X_S => match &mut self.simulation {
-                Some(s) => s.set_stopper(value),
+                Some(s) => {
+                    s.set_stopper(value)?;
+                    self.x_s = value;
+                    Ok(())
+                }
                 // Before initialisation ends, a master may start its connectors at 0 and
-                // propagate outputs afterwards: any finite value is taken, and
-                // fmi2ExitInitializationMode checks the one it ends with.
+                // propagate the other FMUs' outputs only afterwards: any finite value is taken,
+                // and checked when initialisation ends and at each step.
                 None if value.is_finite() => {
                     self.x_s = value;
+                    if self.params.check_stopper(value).is_ok() {
+                        self.x_s_valid = value;
+                    }
                     Ok(())
                 }
                 None => Err(format!("x_s = {value} m is invalid: must be finite")),
@@ -329,8 +340,20 @@ impl CoSimModel for ActuatorFmu {
         Ok(())
     }
 
+    /// With an x_s outside the cylinder (a master that set its connectors to 0 and propagates
+    /// outputs only with the first step), the stopper starts at the last valid x_s set (or the
+    /// start value), and the first step is refused unless a valid x_s has been set by then.
     fn exit_initialization(&mut self) -> Result<(), String> {
-        self.simulation = Some(self.initial_simulation()?);
+        let simulation = match self.params.check_stopper(self.x_s) {
+            Ok(()) => self.initial_simulation()?,
+            Err(e) => {
+                let mut fallback = self.clone();
+                fallback.x_s = self.x_s_valid;
+                fallback.params.check_stopper(fallback.x_s).map_err(|_| e)?;
+                fallback.initial_simulation()?
+            }
+        };
+        self.simulation = Some(simulation);
         Ok(())
     }
 
@@ -361,6 +384,14 @@ impl CoSimModel for ActuatorFmu {
     }
 
     fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
+        // An x_s set before initialisation ended and never corrected (see exit_initialization).
+        if self.simulation.is_some() {
+            if let Err(e) = self.params.check_stopper(self.x_s) {
+                return Err(StepError::Error(format!(
+                    "{e} (the x_s set during initialisation; set a valid x_s before the first step)"
+                )));
+            }
+        }
         let simulation = self
             .simulation
             .as_mut()
@@ -727,9 +758,15 @@ mod tests {
                 let inside = b - outward * step;
                 let mut fmu = ActuatorFmu::instantiate();
                 fmu.setup_experiment(None, 0.0, None).unwrap();
+                // Refused when set, when initialisation ends, or (x_s) at the first step.
                 let refused = fmu
                     .set_real(v.value_reference, outside)
-                    .and_then(|_| fmu.exit_initialization());
+                    .and_then(|_| fmu.exit_initialization())
+                    .and_then(|_| {
+                        fmu.do_step(0.0, 1e-3).map_err(|e| match e {
+                            StepError::Error(m) | StepError::Discard { message: m, .. } => m,
+                        })
+                    });
                 let message = refused.expect_err(&format!("{} = {outside} was taken", v.name));
                 assert!(
                     message.contains(v.name) && message.contains(&format!("{outside}")),
@@ -757,11 +794,12 @@ mod tests {
         );
     }
 
-    /// A master may start its connectors at 0 before initialisation and propagate the
-    /// other FMUs' outputs afterwards: x_s = 0 is taken then, and refused only if it is
-    /// still there when initialisation ends, with the same message as a step-time x_s.
+    /// A master may start its connectors at 0 before initialisation and propagate the other
+    /// FMUs' outputs only afterwards: x_s = 0 is taken then; the stopper starts at the last
+    /// valid x_s, and a step is refused, with the message of a step-time x_s, until a valid
+    /// x_s has been set.
     #[test]
-    fn stopper_checked_when_initialisation_ends() {
+    fn stopper_checked_when_initialisation_ends_and_at_each_step() {
         let mut fmu = ActuatorFmu::instantiate();
         fmu.setup_experiment(None, 0.0, None).unwrap();
         fmu.enter_initialization().unwrap();
@@ -770,13 +808,38 @@ mod tests {
         fmu.exit_initialization().unwrap();
         assert_eq!(fmu.get_real(vr::X_S).unwrap(), 0.05);
         let during_steps = fmu.set_real(vr::X_S, 0.0).unwrap_err();
+        assert!(
+            during_steps.contains("x_s = 0 m") && during_steps.contains("0.026"),
+            "{during_steps}"
+        );
 
+        // Connectors started at 0: initialised at the last valid x_s (here the start, 0.054).
+        let mut reference = ActuatorFmu::instantiate();
+        reference.set_real(vr::V_DA, 2.0).unwrap();
+        reference.exit_initialization().unwrap();
         let mut fmu = ActuatorFmu::instantiate();
         fmu.enter_initialization().unwrap();
+        fmu.set_real(vr::V_DA, 2.0).unwrap();
         fmu.set_real(vr::X_S, 0.0).unwrap();
-        let at_exit = fmu.exit_initialization().unwrap_err();
-        assert_eq!(at_exit, during_steps);
-        assert!(at_exit.contains("x_s = 0 m") && at_exit.contains("0.026"), "{at_exit}");
+        fmu.exit_initialization().unwrap();
+        assert_eq!(
+            fmu.get_real(vr::F_ACT).unwrap().to_bits(),
+            reference.get_real(vr::F_ACT).unwrap().to_bits()
+        );
+        let StepError::Error(refused) = fmu.do_step(0.0, 1e-3).unwrap_err() else {
+            panic!("not an error")
+        };
+        assert!(refused.starts_with(&during_steps), "{refused}");
+        assert_eq!(fmu.time(), 0.0, "nothing was stepped");
+        // Propagated before the first step: the step runs, as from that x_s at once.
+        fmu.set_real(vr::X_S, 0.055).unwrap();
+        reference.set_real(vr::X_S, 0.055).unwrap();
+        fmu.do_step(0.0, 1e-3).unwrap();
+        reference.do_step(0.0, 1e-3).unwrap();
+        assert_eq!(
+            fmu.get_real(vr::F_ACT).unwrap().to_bits(),
+            reference.get_real(vr::F_ACT).unwrap().to_bits()
+        );
         assert!(fmu.set_real(vr::X_S, f64::NAN).unwrap_err().contains("x_s = NaN"));
     }
 

@@ -108,13 +108,38 @@ pub struct OutputDependencies {
     pub initial: Option<&'static [(u32, DependencyKind)]>,
 }
 
-/// The GUID, computed once from the model description (see [`ModelInfo::guid`]).
-#[derive(Debug, Default)]
-pub struct GuidCache(std::sync::Mutex<Option<&'static str>>);
+/// The GUID, computed once from the model description (see [`ModelInfo::guid`]). Kept in
+/// the `ModelInfo` itself, not on the heap: a shared library that is unloaded leaves no
+/// allocation behind.
+pub struct GuidCache {
+    once: std::sync::Once,
+    bytes: std::cell::UnsafeCell<[u8; GUID_LEN]>,
+}
+
+/// `{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}`.
+const GUID_LEN: usize = 38;
+
+// The bytes are written once, inside `once`, before any reader can see them.
+unsafe impl Sync for GuidCache {}
 
 impl GuidCache {
     pub const fn new() -> Self {
-        GuidCache(std::sync::Mutex::new(None))
+        GuidCache {
+            once: std::sync::Once::new(),
+            bytes: std::cell::UnsafeCell::new([0; GUID_LEN]),
+        }
+    }
+}
+
+impl Default for GuidCache {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl std::fmt::Debug for GuidCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("GuidCache")
     }
 }
 
@@ -148,17 +173,18 @@ pub struct ModelInfo {
 impl ModelInfo {
     /// The GUID: a name-based UUID (version 5, SHA-1) of the model description with an
     /// empty `guid` attribute, so that it changes whenever anything in the description does.
-    pub fn guid(&self) -> &'static str {
-        let mut cached = match self.guid_cache.0.lock() {
-            Ok(g) => g,
-            Err(poisoned) => poisoned.into_inner(),
-        };
-        if let Some(g) = *cached {
-            return g;
-        }
-        let g: &'static str = Box::leak(super::model_description::content_guid(self).into_boxed_str());
-        *cached = Some(g);
-        g
+    pub fn guid(&self) -> &str {
+        let cache = &self.guid_cache;
+        cache.once.call_once(|| {
+            let guid = super::model_description::content_guid(self);
+            let mut bytes = [0u8; GUID_LEN];
+            bytes.copy_from_slice(&guid.as_bytes()[..GUID_LEN]);
+            // SAFETY: written only here, once, before `call_once` returns to any caller.
+            unsafe { *cache.bytes.get() = bytes };
+        });
+        // SAFETY: never written again after `call_once`.
+        let bytes = unsafe { &*cache.bytes.get() };
+        std::str::from_utf8(bytes).unwrap_or("")
     }
 
     /// The effective extent of a variable: its row's `min`/`max`, else [`ModelInfo::extent`]'s.
