@@ -21,7 +21,7 @@
 #![allow(non_upper_case_globals)] // the FMI constants are spelled as in the headers
 
 use std::any::Any;
-use std::ffi::CStr;
+use std::ffi::{CStr, CString};
 use std::os::raw::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -267,9 +267,12 @@ pub unsafe fn instantiate<M: CoSimModel>(
                 msg,
             );
         };
-        let Some(name) = name.as_deref() else {
-            log("fmi2Instantiate: instanceName is NULL");
-            return std::ptr::null_mut();
+        let name = match name.as_deref() {
+            Some(name) => name,
+            None => {
+                log("fmi2Instantiate: instanceName is NULL");
+                return std::ptr::null_mut();
+            }
         };
         if fmu_type != fmi2CoSimulation {
             let what = if fmu_type == fmi2ModelExchange {
@@ -307,7 +310,14 @@ pub unsafe fn instantiate<M: CoSimModel>(
             if !functions.is_null() {
                 let _ = catch_unwind(AssertUnwindSafe(|| {
                     let cb = *functions;
-                    call_logger(cb.logger, cb.componentEnvironment, c"", fmi2Fatal, CAT_FATAL, &message);
+                    call_logger(
+                        cb.logger,
+                        cb.componentEnvironment,
+                        &CString::default(),
+                        fmi2Fatal,
+                        CAT_FATAL,
+                        &message,
+                    );
                 }));
             }
             std::ptr::null_mut()
@@ -1039,8 +1049,9 @@ unsafe fn get_status_of<M: CoSimModel, T>(
 ) -> fmi2Status {
     guarded::<M>(c, f, |inst| {
         let fname = f.name();
-        let Some(kind_name) = status_kind_name(kind) else {
-            return inst.error(format!("{fname}: invalid fmi2StatusKind {kind}"));
+        let kind_name = match status_kind_name(kind) {
+            Some(kind_name) => kind_name,
+            None => return inst.error(format!("{fname}: invalid fmi2StatusKind {kind}")),
         };
         if value.is_null() {
             return inst.error(format!("{fname}: value is NULL"));

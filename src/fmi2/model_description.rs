@@ -66,7 +66,7 @@ pub fn validate_model_info(info: &ModelInfo) -> Result<(), Vec<String>> {
             if !v.start.is_finite() {
                 problems.push(format!("variable {:?}: start {} is not finite", v.name, v.start));
             }
-            if extent.min.is_some_and(|m| v.start < m) || extent.max.is_some_and(|m| v.start > m) {
+            if extent.min.map_or(false, |m| v.start < m) || extent.max.map_or(false, |m| v.start > m) {
                 problems.push(format!("variable {:?}: start {} outside [min, max]", v.name, v.start));
             }
             if v.var_type != VarType::Real && v.start.fract() != 0.0 {

@@ -34,7 +34,7 @@ fn nearby(info: &ModelInfo, v: &Variable) -> f64 {
         }
         VarType::Integer => {
             let e = info.extent_of(v);
-            if e.max.is_some_and(|m| v.start + 1.0 > m) {
+            if e.max.map_or(false, |m| v.start + 1.0 > m) {
                 v.start - 1.0
             } else {
                 v.start + 1.0
@@ -49,7 +49,7 @@ fn nearby(info: &ModelInfo, v: &Variable) -> f64 {
             } else {
                 e.nominal.map_or(1e-3, |n| 0.01 * n)
             };
-            if e.max.is_some_and(|m| candidate > m) {
+            if e.max.map_or(false, |m| candidate > m) {
                 v.start * 0.99
             } else {
                 candidate
@@ -153,7 +153,7 @@ pub fn check_dependencies<M: CoSimModel>(step_size: f64) -> DependencyReport {
         for (k, out) in outs.iter().enumerate() {
             let changed = moved(info, out, base[k], y[k]);
             let listed =
-                declared(out.value_reference).is_some_and(|d| d.step.iter().any(|&(r, _)| r == u.value_reference));
+                declared(out.value_reference).map_or(false, |d| d.step.iter().any(|&(r, _)| r == u.value_reference));
             if changed {
                 report.step_pairs.push((out.name, u.name));
             }
