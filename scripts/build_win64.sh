@@ -3,7 +3,7 @@
 # rustc and its Windows standard library (rustc 1.63; this machine's rustup toolchain has no
 # Windows target and none can be downloaded) and MinGW-w64 as the linker. The crate root is
 # tools/win64/lib.rs (the FMU's modules of src/ only); its two dependencies, nalgebra (0.32,
-# the last that builds on 1.63, with its own dependencies) and smallvec, are fetched from
+# with its own dependencies, at versions that build on 1.63) and smallvec, are fetched from
 # crates.io by cargo at the versions of tools/win64/Cargo.lock and compiled here with rustc
 # 1.63 one by one. Installs the Debian packages it needs when they are missing (as root),
 # and wine64, on which fmu_tests/test_win64.py runs the DLL.
