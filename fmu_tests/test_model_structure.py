@@ -125,3 +125,15 @@ def test_actuator_structure_and_bounds():
             assert float(v.start) <= float(v.max), v.name
         if v.nominal is not None:
             assert float(v.nominal) > 0, v.name
+
+
+def test_parameters_have_their_default_as_nominal(description):
+    name, _ = description
+    md = fmpy.read_model_description(str(fmu_file(name)))
+    missing = [
+        v.name
+        for v in md.modelVariables
+        if v.causality == "parameter" and v.type == "Real" and float(v.start) != 0.0
+        and (v.nominal is None or float(v.nominal) != abs(float(v.start)))
+    ]
+    assert not missing, f"{name}: no nominal = |start| for {missing}"
