@@ -10,7 +10,7 @@ run() {
     "$@"
 }
 
-run cargo run --release --bin jetpipe -- package
+run bash scripts/package.sh
 run bash scripts/venv.sh
 run .venv/bin/python fmu_tests/run_standard_scenario.py dist/JetPipeActuator.fmu
 run cargo run --release --target-dir target/fmus -p antagonistic -- package

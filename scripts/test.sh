@@ -11,7 +11,8 @@ run() {
 }
 
 run cargo test --release
-run cargo run --release --bin jetpipe -- package
+run bash scripts/build_win64.sh
+JETPIPE_WIN64=1 run bash scripts/package.sh
 if [ ! -f dist/JetPipeActuator.fmu ]; then
     echo "test.sh: dist/JetPipeActuator.fmu was not written" >&2
     exit 1

@@ -727,8 +727,9 @@ fn ln_upper_bound(x: f64) -> f64 {
 /// A polynomial Σ cₙ zⁿ on 0 ≤ z ≤ z_max, as its constant c₀ and a bound Σ_{n≥1} |cₙ| z_maxⁿ
 /// on how far it moves from it.
 fn constant_and_spread(coefficients: &[f64], z_max: f64) -> (f64, f64) {
-    let Some((constant, rest)) = coefficients.split_first() else {
-        return (0.0, 0.0);
+    let (constant, rest) = match coefficients.split_first() {
+        Some(split) => split,
+        None => return (0.0, 0.0),
     };
     let mut power = 1.0;
     let spread = rest

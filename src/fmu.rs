@@ -1,15 +1,12 @@
 //! The actuator behind the generic FMI layer: maps the variable table onto the physics
 //! and the simulation driver. No FFI types here.
 
-use crate::fmi2::model::{CoSimModel, ModelInfo, StepError};
+use crate::fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
 use crate::physics::actuator::{index, Actuator, State, N_STATES};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::parameters::{variable_name, Parameters};
 use crate::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 use crate::variables::{vr, UNITS, VARIABLES};
-
-/// Changes whenever the interface (variable table) changes.
-pub const GUID: &str = "{5b0c7f0e-3d2a-4c1e-9a57-jetpipe-0001}";
 
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logEvents", "initialisation, resets and state restores"),
@@ -20,10 +17,116 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logAll", "every message"),
 ];
 
+/// The D/A converter's range: a command outside it is refused.
+pub const V_DA_RANGE: (f64, f64) = (-10.0, 10.0);
+
+/// `min`, `max` and `nominal` of the model description. Parameters: the bounds that
+/// `Parameters::set` enforces (FMI has no open bounds, so "> 0" is `min="0"`) and the
+/// default's magnitude as nominal. `x_s`: the stopper range of the default geometry (the
+/// run-time check uses the geometry actually set). `v_DA`: the D/A range.
+pub fn extent(value_reference: u32) -> Extent {
+    let defaults = Parameters::default();
+    let scale = |x: f64| if x != 0.0 && x.is_finite() { Some(x.abs()) } else { None };
+    match value_reference {
+        vr::V_DA => Extent {
+            min: Some(V_DA_RANGE.0),
+            max: Some(V_DA_RANGE.1),
+            nominal: Some(V_DA_RANGE.1),
+        },
+        vr::X_S => {
+            let (lo, hi) = defaults.cylinder().stopper_range();
+            Extent {
+                min: Some(lo),
+                max: Some(hi),
+                nominal: scale(start(vr::X_S)),
+            }
+        }
+        vr::P1 | vr::P2 => Extent {
+            min: Some(0.0),
+            max: None,
+            nominal: scale(defaults.p_s),
+        },
+        vr::I => Extent {
+            min: None,
+            max: None,
+            nominal: scale(defaults.k_cd * V_DA_RANGE.1),
+        },
+        vr::X_JP => Extent {
+            min: None,
+            max: None,
+            nominal: scale(defaults.x_jp_sat),
+        },
+        vr::F_ACT | vr::F_MEAS => Extent {
+            min: None,
+            max: None,
+            nominal: Some(100.0),
+        },
+        vr::P1_START | vr::P2_START => Extent {
+            min: Some(0.0),
+            max: None,
+            nominal: scale(start(value_reference)),
+        },
+        _ => match Parameters::declared_range(value_reference) {
+            Some((min, max)) => Extent {
+                min,
+                max,
+                nominal: scale(start(value_reference)),
+            },
+            None => Extent::default(),
+        },
+    }
+}
+
+const DEPENDS: DependencyKind = DependencyKind::Dependent;
+
+/// `<ModelStructure>`: a new x_s moves the stopper at once (the chamber pressures jump,
+/// conserving the air), so the pressures and forces depend on it directly; a new v_DA acts
+/// only through the current's dynamics, during the next step. After initialisation the
+/// current and the jet pipe are at the static values of v_DA; the pressures and forces
+/// depend on everything.
+pub const DEPENDENCIES: &[OutputDependencies] = &[
+    OutputDependencies {
+        output: vr::F_ACT,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::F_MEAS,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::P1,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::P2,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::I,
+        step: &[],
+        initial: Some(&[(vr::V_DA, DEPENDS), (vr::K_CD, DEPENDS), (vr::I_OFFSET, DEPENDS)]),
+    },
+    OutputDependencies {
+        output: vr::X_JP,
+        step: &[],
+        initial: Some(&[
+            (vr::V_DA, DEPENDS),
+            (vr::K_CD, DEPENDS),
+            (vr::I_OFFSET, DEPENDS),
+            (vr::K_M, DEPENDS),
+            (vr::X_JP_SAT, DEPENDS),
+            (vr::F_JP_SAT, DEPENDS),
+        ]),
+    },
+];
+
 pub static MODEL_INFO: ModelInfo = ModelInfo {
     model_name: "JetPipeActuator",
     model_identifier: "JetPipeActuator",
-    guid: GUID,
     description: "Jet-pipe electropneumatic actuator of the Utah/MIT Dextrous Hand (P.D. Henri, 1994): current driver, third-order jet pipe, orifice flows, leaky piston, two chambers with a moving stopper",
     author: "jetpipe project",
     version: env!("CARGO_PKG_VERSION"),
@@ -36,7 +139,21 @@ pub static MODEL_INFO: ModelInfo = ModelInfo {
     units: UNITS,
     variables: VARIABLES,
     can_interpolate_inputs: true,
+    extent,
+    dependencies: DEPENDENCIES,
+    guid_cache: GuidCache::new(),
 };
+
+/// v_DA within the D/A range; the message names the variable, the value and the range.
+fn check_command(v_da: f64) -> Result<(), String> {
+    let (lo, hi) = V_DA_RANGE;
+    if !(lo..=hi).contains(&v_da) {
+        return Err(format!(
+            "v_DA = {v_da} V is invalid: must be finite and within the D/A range [{lo}, {hi}] V"
+        ));
+    }
+    Ok(())
+}
 
 /// One FMU instance: parameters and inputs until initialisation, then a simulation.
 #[derive(Clone, Debug)]
@@ -52,6 +169,9 @@ pub struct ActuatorFmu {
     tolerance: f64,
     start_time: f64,
     simulation: Option<Simulation>,
+    /// The last x_s set before initialisation ended that was inside the cylinder (the table's
+    /// start at first): where the stopper starts if the last x_s set was not.
+    x_s_valid: f64,
 }
 
 fn start(value_reference: u32) -> f64 {
@@ -99,6 +219,7 @@ impl CoSimModel for ActuatorFmu {
             tolerance: DEFAULT_RELATIVE_TOLERANCE,
             start_time: 0.0,
             simulation: None,
+            x_s_valid: start(vr::X_S),
         }
     }
 
@@ -136,21 +257,33 @@ impl CoSimModel for ActuatorFmu {
 
     fn set_real(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
         match value_reference {
-            vr::V_DA => match &mut self.simulation {
-                Some(s) => s.set_command(value),
-                None if value.is_finite() => {
-                    self.v_da = value;
-                    Ok(())
+            vr::V_DA => {
+                check_command(value)?;
+                match &mut self.simulation {
+                    Some(s) => s.set_command(value),
+                    None => {
+                        self.v_da = value;
+                        Ok(())
+                    }
                 }
-                None => Err(format!("v_DA = {value} V is invalid: must be finite")),
-            },
+            }
             vr::X_S => match &mut self.simulation {
-                Some(s) => s.set_stopper(value),
-                None => {
-                    self.params.check_stopper(value)?;
+                Some(s) => {
+                    s.set_stopper(value)?;
                     self.x_s = value;
                     Ok(())
                 }
+                // Before initialisation ends, a master may start its connectors at 0 and
+                // propagate the other FMUs' outputs only afterwards: any finite value is taken,
+                // and checked when initialisation ends and at each step.
+                None if value.is_finite() => {
+                    self.x_s = value;
+                    if self.params.check_stopper(value).is_ok() {
+                        self.x_s_valid = value;
+                    }
+                    Ok(())
+                }
+                None => Err(format!("x_s = {value} m is invalid: must be finite")),
             },
             vr::P1_START | vr::P2_START => {
                 if !(value.is_finite() && value > 0.0) {
@@ -207,8 +340,20 @@ impl CoSimModel for ActuatorFmu {
         Ok(())
     }
 
+    /// With an x_s outside the cylinder (a master that set its connectors to 0 and propagates
+    /// outputs only with the first step), the stopper starts at the last valid x_s set (or the
+    /// start value), and the first step is refused unless a valid x_s has been set by then.
     fn exit_initialization(&mut self) -> Result<(), String> {
-        self.simulation = Some(self.initial_simulation()?);
+        let simulation = match self.params.check_stopper(self.x_s) {
+            Ok(()) => self.initial_simulation()?,
+            Err(e) => {
+                let mut fallback = self.clone();
+                fallback.x_s = self.x_s_valid;
+                fallback.params.check_stopper(fallback.x_s).map_err(|_| e)?;
+                fallback.initial_simulation()?
+            }
+        };
+        self.simulation = Some(simulation);
         Ok(())
     }
 
@@ -239,6 +384,14 @@ impl CoSimModel for ActuatorFmu {
     }
 
     fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
+        // An x_s set before initialisation ended and never corrected (see exit_initialization).
+        if self.simulation.is_some() {
+            if let Err(e) = self.params.check_stopper(self.x_s) {
+                return Err(StepError::Error(format!(
+                    "{e} (the x_s set during initialisation; set a valid x_s before the first step)"
+                )));
+            }
+        }
         let simulation = self
             .simulation
             .as_mut()
@@ -569,5 +722,132 @@ mod tests {
         fmu.exit_initialization().unwrap();
         assert_eq!(early, fmu.get_real(vr::F_ACT).unwrap());
         assert!(early > 10.0 && early < 112.0, "{early}");
+    }
+
+    #[test]
+    fn declared_dependencies_are_what_perturbations_show() {
+        let report = crate::fmi2::structure_check::check_dependencies::<ActuatorFmu>(1e-3);
+        assert!(report.problems.is_empty(), "{:#?}", report.problems);
+        // Only the stopper acts within a step, on the pressures and the forces.
+        let mut pairs = report.step_pairs.clone();
+        pairs.sort();
+        assert_eq!(
+            pairs,
+            vec![("F_act", "x_s"), ("F_meas", "x_s"), ("P1", "x_s"), ("P2", "x_s")]
+        );
+        // Nothing but the pair (deadband > width) that validate() refuses is skipped.
+        assert!(report.skipped.len() <= 1, "{:#?}", report.skipped);
+    }
+
+    /// Every declared min/max is what the FMU enforces: a value just outside is refused
+    /// with a message that names the variable and the value, and a value just inside (or
+    /// on a closed bound) is taken.
+    #[test]
+    fn declared_bounds_are_the_enforced_ones() {
+        let info = ActuatorFmu::info();
+        let mut checked = 0;
+        for v in info.variables {
+            if v.var_type != crate::fmi2::model::VarType::Real || v.causality == crate::fmi2::model::Causality::Output {
+                continue;
+            }
+            let e = info.extent_of(v);
+            for (bound, outward) in [(e.min, -1.0), (e.max, 1.0)] {
+                let Some(b) = bound else { continue };
+                let step = 1e-9 * b.abs().max(1e-3);
+                let outside = b + outward * step;
+                let inside = b - outward * step;
+                let mut fmu = ActuatorFmu::instantiate();
+                fmu.setup_experiment(None, 0.0, None).unwrap();
+                // Refused when set, when initialisation ends, or (x_s) at the first step.
+                let refused = fmu
+                    .set_real(v.value_reference, outside)
+                    .and_then(|_| fmu.exit_initialization())
+                    .and_then(|_| {
+                        fmu.do_step(0.0, 1e-3).map_err(|e| match e {
+                            StepError::Error(m) | StepError::Discard { message: m, .. } => m,
+                        })
+                    });
+                let message = refused.expect_err(&format!("{} = {outside} was taken", v.name));
+                assert!(
+                    message.contains(v.name) && message.contains(&format!("{outside}")),
+                    "{message}"
+                );
+                let mut fmu = ActuatorFmu::instantiate();
+                fmu.set_real(v.value_reference, inside)
+                    .unwrap_or_else(|e| panic!("{} = {inside} refused: {e}", v.name));
+                checked += 1;
+            }
+        }
+        assert!(checked >= 30, "{checked}");
+    }
+
+    #[test]
+    fn nominals_are_positive_and_ranges_hold_the_defaults() {
+        let info = ActuatorFmu::info();
+        crate::fmi2::model_description::validate_model_info(info).unwrap();
+        let x_s = info.variables.iter().find(|v| v.value_reference == vr::X_S).unwrap();
+        let e = info.extent_of(x_s);
+        // The default geometry: the stopper between the support and the piston's travel.
+        assert!(
+            (e.min.unwrap() - 0.026).abs() < 1e-12 && (e.max.unwrap() - 0.096).abs() < 1e-12,
+            "{e:?}"
+        );
+    }
+
+    /// A master may start its connectors at 0 before initialisation and propagate the other
+    /// FMUs' outputs only afterwards: x_s = 0 is taken then; the stopper starts at the last
+    /// valid x_s, and a step is refused, with the message of a step-time x_s, until a valid
+    /// x_s has been set.
+    #[test]
+    fn stopper_checked_when_initialisation_ends_and_at_each_step() {
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.setup_experiment(None, 0.0, None).unwrap();
+        fmu.enter_initialization().unwrap();
+        fmu.set_real(vr::X_S, 0.0).unwrap();
+        fmu.set_real(vr::X_S, 0.05).unwrap();
+        fmu.exit_initialization().unwrap();
+        assert_eq!(fmu.get_real(vr::X_S).unwrap(), 0.05);
+        let during_steps = fmu.set_real(vr::X_S, 0.0).unwrap_err();
+        assert!(
+            during_steps.contains("x_s = 0 m") && during_steps.contains("0.026"),
+            "{during_steps}"
+        );
+
+        // Connectors started at 0: initialised at the last valid x_s (here the start, 0.054).
+        let mut reference = ActuatorFmu::instantiate();
+        reference.set_real(vr::V_DA, 2.0).unwrap();
+        reference.exit_initialization().unwrap();
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.enter_initialization().unwrap();
+        fmu.set_real(vr::V_DA, 2.0).unwrap();
+        fmu.set_real(vr::X_S, 0.0).unwrap();
+        fmu.exit_initialization().unwrap();
+        assert_eq!(
+            fmu.get_real(vr::F_ACT).unwrap().to_bits(),
+            reference.get_real(vr::F_ACT).unwrap().to_bits()
+        );
+        let StepError::Error(refused) = fmu.do_step(0.0, 1e-3).unwrap_err() else {
+            panic!("not an error")
+        };
+        assert!(refused.starts_with(&during_steps), "{refused}");
+        assert_eq!(fmu.time(), 0.0, "nothing was stepped");
+        // Propagated before the first step: the step runs, as from that x_s at once.
+        fmu.set_real(vr::X_S, 0.055).unwrap();
+        reference.set_real(vr::X_S, 0.055).unwrap();
+        fmu.do_step(0.0, 1e-3).unwrap();
+        reference.do_step(0.0, 1e-3).unwrap();
+        assert_eq!(
+            fmu.get_real(vr::F_ACT).unwrap().to_bits(),
+            reference.get_real(vr::F_ACT).unwrap().to_bits()
+        );
+        assert!(fmu.set_real(vr::X_S, f64::NAN).unwrap_err().contains("x_s = NaN"));
+    }
+
+    #[test]
+    fn v_da_outside_the_d_a_range_is_refused() {
+        let mut fmu = initialised();
+        let e = fmu.set_real(vr::V_DA, 10.5).unwrap_err();
+        assert!(e.contains("v_DA = 10.5 V") && e.contains("[-10, 10]"), "{e}");
+        fmu.set_real(vr::V_DA, -10.0).unwrap();
     }
 }

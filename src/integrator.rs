@@ -19,6 +19,7 @@
 
 use nalgebra::{Const, DimMin, SMatrix, SVector};
 
+#[path = "integrator/explicit.rs"]
 pub mod explicit;
 
 /// A system y' = f(t, y) of `N` equations.
@@ -334,8 +335,9 @@ impl Sdirk4 {
         let iteration_matrix = SMatrix::<f64, N, N>::identity() - jac * (h * GAMMA);
         // The explicit inverse, once per step: the Newton corrections are then products,
         // with no division on the iteration's critical path (N is 2 or 6).
-        let Some(inverse) = iteration_matrix.try_inverse() else {
-            return Attempt::NewtonFailed;
+        let inverse = match iteration_matrix.try_inverse() {
+            Some(inverse) => inverse,
+            None => return Attempt::NewtonFailed,
         };
         let mut k = [SVector::<f64, N>::zeros(); 5];
         let mut stage = *y;

@@ -12,6 +12,7 @@
 //! * [`variables`]: the table of FMU variables from which the model description comes;
 //! * [`sweep`]: parameter sweeps of the standard scenario over all cores (`jetpipe sweep`).
 
+pub mod compat;
 pub mod diagnosis;
 pub mod electromechanics;
 pub mod fmi2;

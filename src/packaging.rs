@@ -36,7 +36,8 @@ pub fn documentation_page(info: &ModelInfo, notes: &str) -> String {
             (_, VarType::Boolean) => (v.start != 0.0).to_string(),
             _ => format!("{}", v.start),
         };
-        let range = match (v.min, v.max) {
+        let extent = info.extent_of(v);
+        let range = match (extent.min, extent.max) {
             (None, None) => String::new(),
             (lo, hi) => format!(
                 "[{}, {}]",
@@ -83,7 +84,12 @@ relative tolerance of the integrator (default {tolerance:e}).</p>",
 
 /// Write the FMU archive to `out`, taking the compiled shared library from `library`.
 pub fn write_fmu(out: &Path, library: &Path) -> Result<(), String> {
-    write_model_fmu(out, library, &MODEL_INFO, &documentation_html(&MODEL_INFO))
+    write_fmu_platforms(out, &[("linux64", library)])
+}
+
+/// Write the FMU archive to `out` with one binary per FMI platform (`linux64`, `win64`).
+pub fn write_fmu_platforms(out: &Path, binaries: &[(&str, &Path)]) -> Result<(), String> {
+    write_model_fmu_platforms(out, binaries, &MODEL_INFO, &documentation_html(&MODEL_INFO))
 }
 
 /// Write the FMU archive of any model on the FMI layer to `out`: `modelDescription.xml`
@@ -91,14 +97,39 @@ pub fn write_fmu(out: &Path, library: &Path) -> Result<(), String> {
 /// `binaries/linux64/<modelIdentifier>.so`, and `documentation` as
 /// `documentation/index.html`. The other FMUs of the workspace (`fmus/`) are written with it.
 pub fn write_model_fmu(out: &Path, library: &Path, info: &ModelInfo, documentation: &str) -> Result<(), String> {
+    write_model_fmu_platforms(out, &[("linux64", library)], info, documentation)
+}
+
+/// The file name suffix of a shared library on an FMI 2.0 platform.
+fn library_suffix(platform: &str) -> Result<&'static str, String> {
+    match platform {
+        "linux64" | "linux32" => Ok("so"),
+        "win64" | "win32" => Ok("dll"),
+        "darwin64" => Ok("dylib"),
+        _ => Err(format!("unknown FMI platform {platform:?}")),
+    }
+}
+
+/// [`write_model_fmu`] with one shared library per platform: `binaries/<platform>/<modelIdentifier>.<so|dll>`.
+pub fn write_model_fmu_platforms(
+    out: &Path,
+    libraries: &[(&str, &Path)],
+    info: &ModelInfo,
+    documentation: &str,
+) -> Result<(), String> {
     let model_description = crate::fmi2::model_description::try_model_description_xml(info)
         .map_err(|problems| format!("invalid variable table of {}: {}", info.model_name, problems.join("; ")))?;
-    let binary = std::fs::read(library).map_err(|e| {
-        format!(
-            "cannot read the shared library {}: {e} (build it with `cargo build --release`)",
-            library.display()
-        )
-    })?;
+    let mut binaries = Vec::new();
+    for &(platform, library) in libraries {
+        let suffix = library_suffix(platform)?;
+        let bytes = std::fs::read(library).map_err(|e| {
+            format!(
+                "cannot read the shared library {}: {e} (build it with `cargo build --release`)",
+                library.display()
+            )
+        })?;
+        binaries.push((platform, suffix, bytes));
+    }
     if let Some(parent) = out.parent() {
         std::fs::create_dir_all(parent).map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
     }
@@ -111,9 +142,14 @@ pub fn write_model_fmu(out: &Path, library: &Path, info: &ModelInfo, documentati
         zip.start_file("modelDescription.xml", options)?;
         zip.write_all(model_description.as_bytes())?;
         zip.add_directory("binaries/", options)?;
-        zip.add_directory("binaries/linux64/", options)?;
-        zip.start_file(format!("binaries/linux64/{}.so", info.model_identifier), options)?;
-        zip.write_all(&binary)?;
+        for (platform, suffix, bytes) in &binaries {
+            zip.add_directory(format!("binaries/{platform}/"), options)?;
+            zip.start_file(
+                format!("binaries/{platform}/{}.{suffix}", info.model_identifier),
+                options,
+            )?;
+            zip.write_all(bytes)?;
+        }
         zip.add_directory("documentation/", options)?;
         zip.start_file("documentation/index.html", options)?;
         zip.write_all(documentation.as_bytes())?;

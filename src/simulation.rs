@@ -131,7 +131,9 @@ impl<'a> ChamberSystem<'a> {
         let free = self
             .trajectory
             .position_bounds(self.duration)
-            .is_some_and(|(lo, hi)| self.model.area_stretch(lo) == self.model.area_stretch(hi));
+            .map_or(false, |(lo, hi)| {
+                self.model.area_stretch(lo) == self.model.area_stretch(hi)
+            });
         self.tangency_free.set(Some(free));
         free
     }
@@ -921,8 +923,9 @@ pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, Strin
             break;
         }
         let jac = crate::integrator::finite_difference_jacobian(|q| rates(q[0], q[1]), &pressures, &r);
-        let Some(delta) = jac.lu().solve(&(-r)) else {
-            break;
+        let delta = match jac.lu().solve(&(-r)) {
+            Some(delta) => delta,
+            None => break,
         };
         // Never jump further than a tenth of the supply pressure in one iteration.
         let limit = 0.1 * pressure_scale;

@@ -747,7 +747,7 @@ mod tests {
         let e = parse_axis("C_d=abc").unwrap_err();
         assert!(e.contains("C_d") && e.contains("abc"), "{e}");
         let e = parse_axis("C_d=-0.1").unwrap_err();
-        assert!(e.contains("C_d") && e.contains("-0.1") && e.contains(">= 0"), "{e}");
+        assert!(e.contains("C_d") && e.contains("-0.1") && e.contains("[0, 1]"), "{e}");
         let e = parse_axis("C_d=0.6:0.7:0").unwrap_err();
         assert!(e.contains("N") && e.contains("\"0\""), "{e}");
         let e = parse_axis("C_d=0.6:0.7").unwrap_err();

@@ -22,7 +22,7 @@ fn exported_symbols_drive_a_simulation() {
             stepFinished: None,
             componentEnvironment: null_mut(),
         };
-        let guid = CString::new(ExportedModel::info().guid).unwrap();
+        let guid = CString::new(ExportedModel::info().guid()).unwrap();
         assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, c"{nope}".as_ptr(), null(), &cb, 0, 0).is_null());
         let c = fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, guid.as_ptr(), null(), &cb, 0, 0);
         assert!(!c.is_null());

@@ -862,6 +862,14 @@ impl Fuzz {
             (9999, 1.0),
             (u32::MAX, 1.0),
         ]);
+        // Before initialisation ends, a finite x_s outside the cylinder is taken (a master may
+        // start its connectors at 0) and checked by fmi2ExitInitializationMode: only NaN is
+        // refused at once there.
+        let (r, x) = if early && r == vr::X_S && x.is_finite() {
+            (r, f64::NAN)
+        } else {
+            (r, x)
+        };
         let known = VARIABLES
             .iter()
             .any(|v| v.value_reference == r && v.var_type == jetpipe::fmi2::model::VarType::Real);

@@ -161,7 +161,7 @@ fn bad_names_and_values_are_refused_before_any_run() {
             &["P1_start cannot be swept", "equilibrium"],
         ),
         (&["--param", "C_d=0.6:x:4"], &["C_d", "\"x\"", "not a number"]),
-        (&["--param", "C_d=-0.5"], &["C_d = -0.5", ">= 0"]),
+        (&["--param", "C_d=-0.5"], &["C_d = -0.5", "[0, 1]"]),
         (&["--param", "P_s=0,652925"], &["P_s = 0", "> 0"]),
         (&["--param", "C_d=0.6:0.7:-2"], &["C_d", "\"-2\""]),
         (&["--param", "gamma=1.4,0.9"], &["gamma = 0.9", "> 1"]),

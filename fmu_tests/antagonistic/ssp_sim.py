@@ -2,13 +2,19 @@
 
 The master is FMPy's own `fmpy.ssp.simulation.simulate_ssp` (a fixed-step Jacobi master: every
 FMU steps from the outputs of the others at the start of the step), with the parameter set that
-the .ssp binds at system level. One thing is changed, and only for the duration of a call:
+the .ssp binds on its components. One thing is changed, and only for the duration of a call:
 FMPy 0.3.32 starts every connector at 0.0 and hands those zeros to the inputs in the first step,
-which would put the actuators' stoppers at x_s = 0 m, outside their cylinders (the actuator
-rejects it with fmi2Error). `connectors_start_at_fmu_values` wraps FMPy's `instantiate_fmu` so
-that after each FMU's initialisation its connectors hold the FMU's own values (inputs: the start
-values the parameter set gave them; outputs: the initial outputs). Everything else, including
-the stepping and the connection order, is FMPy's.
+after initialisation (it reads no start value of a connector), which would put the actuators'
+stoppers at x_s = 0 m, outside their cylinders (the actuator rejects it with fmi2Error).
+`connectors_start_at_fmu_values` wraps FMPy's `instantiate_fmu` so that after each FMU's
+initialisation its connectors hold the FMU's own values (inputs: the start values the parameter
+set gave them; outputs: the initial outputs). Everything else, including the stepping and the
+connection order, is FMPy's.
+
+The .ssp steps its reference by itself (the controller's theta_step at t_step). For other
+references, `simulate(theta_ref, ...)` sets theta_step to 0 and sets the controller's theta_ref
+(no connector of the .ssp) to theta_ref(t) of the previous step's start (0 in the first step)
+before each controller step, which is what FMPy did when the reference was a system input.
 """
 
 from __future__ import annotations
@@ -20,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import fmpy.ssp.simulation as ssp_simulation
-from fmpy.ssp.ssd import Parameter, read_ssd
+from fmpy.ssp.ssd import Parameter, ParameterSet, read_ssd
 
 REPO = Path(__file__).resolve().parents[2]
 STEP_SIZE = 1e-3
@@ -48,11 +54,15 @@ def connectors_start_at_fmu_values():
 
 
 def parameter_set(ssp, overrides=None):
-    """The .ssp's own system-level parameter set, with `overrides` ({"component.name": value})."""
+    """The start values the .ssp binds on its components, as the one parameter set FMPy's
+    `simulate_ssp` takes ("component.name" = value), with `overrides` ({"component.name": value})."""
     ssd = read_ssd(str(ssp))
-    bindings = ssd.system.parameterBindings
-    assert len(bindings) == 1 and len(bindings[0].parameterValues) == 1, "expected one system-level parameter set"
-    pset = bindings[0].parameterValues[0]
+    pset = ParameterSet(name="start", parameters=[])
+    for component in ssd.system.elements:
+        for binding in component.parameterBindings:
+            for values in binding.parameterValues:
+                for p in values.parameters:
+                    pset.parameters.append(Parameter(name=f"{component.name}.{p.name}", type=p.type, value=p.value))
     for name, value in (overrides or {}).items():
         for p in pset.parameters:
             if p.name == name:
@@ -63,19 +73,41 @@ def parameter_set(ssp, overrides=None):
     return pset
 
 
+@contextlib.contextmanager
+def controller_reference(theta_ref, step_size):
+    """Drive controller.theta_ref with theta_ref(t - step_size) before each controller step."""
+    if theta_ref is None:
+        yield
+        return
+    original = ssp_simulation.do_step
+
+    def do_step(component, time, h):
+        if component.name == "controller":
+            value = theta_ref(time - step_size) if time >= step_size * 0.5 else 0.0
+            ssp_simulation.set_value(component, "theta_ref", value)
+        return original(component, time, h)
+
+    ssp_simulation.do_step = do_step
+    try:
+        yield
+    finally:
+        ssp_simulation.do_step = original
+
+
 def simulate(theta_ref, stop_time, ssp=None, step_size=STEP_SIZE, overrides=None):
-    """Simulate the system with the joint reference `theta_ref(t)`.
+    """Simulate the system with the joint reference `theta_ref(t)`, or with the .ssp's own step
+    if `theta_ref` is None.
 
     Returns (result, seconds): FMPy's structured array (one row per step; the outputs in a row
     are those at the END of the step, t + step_size) and the wall time of the call.
     """
     ssp = ssp or default_ssp_path()
+    if theta_ref is not None:
+        overrides = {"controller.theta_step": 0.0, **(overrides or {})}
     pset = parameter_set(ssp, overrides)
     started = _time.perf_counter()
-    with connectors_start_at_fmu_values():
-        result = ssp_simulation.simulate_ssp(
-            str(ssp), stop_time=stop_time, step_size=step_size, parameter_set=pset, input={"theta_ref": theta_ref}
-        )
+    with connectors_start_at_fmu_values(), controller_reference(theta_ref, step_size):
+        result = ssp_simulation.simulate_ssp(str(ssp), stop_time=stop_time, step_size=step_size, parameter_set=pset)
     return result, _time.perf_counter() - started
 
 

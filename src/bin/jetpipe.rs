@@ -25,13 +25,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Write dist/JetPipeActuator.fmu (model description, linux64 binary, documentation).
+    /// Write dist/JetPipeActuator.fmu (model description, linux64 and optionally win64 binaries, documentation).
     Package {
         #[arg(long, default_value = "dist/JetPipeActuator.fmu")]
         out: PathBuf,
-        /// The compiled shared library; by default libjetpipe.so next to this executable.
+        /// The compiled linux64 shared library; by default libjetpipe.so next to this executable.
         #[arg(long)]
         library: Option<PathBuf>,
+        /// A win64 DLL of the same library, packaged as binaries/win64/JetPipeActuator.dll.
+        #[arg(long)]
+        win64: Option<PathBuf>,
     },
     /// Print the model description generated from the variable table.
     ModelDescription,
@@ -125,12 +128,16 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
-        Command::Package { out, library } => {
+        Command::Package { out, library, win64 } => {
             let library = match library {
                 Some(path) => path,
                 None => build_shared_library()?,
             };
-            jetpipe::packaging::write_fmu(&out, &library)?;
+            let mut binaries = vec![("linux64", library.as_path())];
+            if let Some(dll) = &win64 {
+                binaries.push(("win64", dll.as_path()));
+            }
+            jetpipe::packaging::write_fmu_platforms(&out, &binaries)?;
             println!("wrote {}", out.display());
             Ok(())
         }

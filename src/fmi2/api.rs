@@ -21,7 +21,7 @@
 #![allow(non_upper_case_globals)] // the FMI constants are spelled as in the headers
 
 use std::any::Any;
-use std::ffi::CStr;
+use std::ffi::{CStr, CString};
 use std::os::raw::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -233,7 +233,7 @@ pub fn get_version() -> *const c_char {
 
 /// `fmi2Instantiate`. Returns NULL (after logging, when a logger is available) for a
 /// NULL `functions`, a NULL instance name, a type other than fmi2CoSimulation, or a
-/// GUID other than `M::info().guid`.
+/// GUID other than `M::info().guid()`.
 ///
 /// # Safety
 /// Pointers as in the FMI 2.0 standard (NUL-terminated strings or NULL).
@@ -267,9 +267,12 @@ pub unsafe fn instantiate<M: CoSimModel>(
                 msg,
             );
         };
-        let Some(name) = name.as_deref() else {
-            log("fmi2Instantiate: instanceName is NULL");
-            return std::ptr::null_mut();
+        let name = match name.as_deref() {
+            Some(name) => name,
+            None => {
+                log("fmi2Instantiate: instanceName is NULL");
+                return std::ptr::null_mut();
+            }
         };
         if fmu_type != fmi2CoSimulation {
             let what = if fmu_type == fmi2ModelExchange {
@@ -282,7 +285,7 @@ pub unsafe fn instantiate<M: CoSimModel>(
             ));
             return std::ptr::null_mut();
         }
-        let expected = M::info().guid;
+        let expected = M::info().guid();
         if guid.is_null() {
             log(&format!(
                 "fmi2Instantiate: GUID mismatch: expected {expected}, got NULL"
@@ -307,7 +310,14 @@ pub unsafe fn instantiate<M: CoSimModel>(
             if !functions.is_null() {
                 let _ = catch_unwind(AssertUnwindSafe(|| {
                     let cb = *functions;
-                    call_logger(cb.logger, cb.componentEnvironment, c"", fmi2Fatal, CAT_FATAL, &message);
+                    call_logger(
+                        cb.logger,
+                        cb.componentEnvironment,
+                        &CString::default(),
+                        fmi2Fatal,
+                        CAT_FATAL,
+                        &message,
+                    );
                 }));
             }
             std::ptr::null_mut()
@@ -713,10 +723,10 @@ unsafe fn snapshot_ref<'a, M: CoSimModel>(fname: &str, s: fmi2FMUstate) -> Resul
         return Err(format!("{fname}: FMUstate is not a live FMU state (freed or foreign)"));
     }
     let snap = &*(s as *const Snapshot);
-    if snap.guid != M::info().guid {
+    if snap.guid != M::info().guid() {
         return Err(format!(
             "{fname}: FMUstate belongs to another FMU: GUID mismatch: expected {}, got {}",
-            M::info().guid,
+            M::info().guid(),
             snap.guid
         ));
     }
@@ -1039,8 +1049,9 @@ unsafe fn get_status_of<M: CoSimModel, T>(
 ) -> fmi2Status {
     guarded::<M>(c, f, |inst| {
         let fname = f.name();
-        let Some(kind_name) = status_kind_name(kind) else {
-            return inst.error(format!("{fname}: invalid fmi2StatusKind {kind}"));
+        let kind_name = match status_kind_name(kind) {
+            Some(kind_name) => kind_name,
+            None => return inst.error(format!("{fname}: invalid fmi2StatusKind {kind}")),
         };
         if value.is_null() {
             return inst.error(format!("{fname}: value is NULL"));

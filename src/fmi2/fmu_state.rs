@@ -36,7 +36,7 @@ impl Snapshot {
     pub fn new<M: CoSimModel>(state: State, model_bytes: Vec<u8>) -> Self {
         Snapshot {
             magic: SNAPSHOT_MAGIC,
-            guid: M::info().guid,
+            guid: M::info().guid(),
             state,
             model_bytes,
         }
@@ -125,7 +125,7 @@ impl Snapshot {
                 "corrupted serialized FMU state: checksum mismatch (stored {stored_crc:08x}, computed {crc:08x})"
             ));
         }
-        let expected = M::info().guid;
+        let expected = M::info().guid();
         if guid != expected.as_bytes() {
             return Err(format!(
                 "serialized FMU state of another FMU: GUID mismatch: expected {expected}, got {}",

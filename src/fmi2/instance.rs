@@ -23,33 +23,39 @@ pub enum HandleKind {
 /// here before it is dereferenced, so a NULL, freed (double `fmi2FreeInstance`,
 /// `fmi2FreeFMUstate` twice through a copy of the pointer) or foreign pointer is rejected
 /// without reading the memory it points to. The lock is held only for the set operation.
-static LIVE_HANDLES: Mutex<BTreeSet<(usize, HandleKind)>> = Mutex::new(BTreeSet::new());
+/// `None` while no handle is live (and a set cannot be made in a const on Rust 1.63).
+static LIVE_HANDLES: Mutex<Option<BTreeSet<(usize, HandleKind)>>> = Mutex::new(None);
 
-fn live_handles() -> std::sync::MutexGuard<'static, BTreeSet<(usize, HandleKind)>> {
+fn live_handles() -> std::sync::MutexGuard<'static, Option<BTreeSet<(usize, HandleKind)>>> {
     // a set of integers cannot be left inconsistent by a panic: ignore poisoning
     LIVE_HANDLES.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Record `p` as a live handle of this kind.
 pub fn register_handle(p: *const c_void, kind: HandleKind) {
-    live_handles().insert((p as usize, kind));
+    live_handles()
+        .get_or_insert_with(BTreeSet::new)
+        .insert((p as usize, kind));
 }
 
 /// Forget `p`; whether it was registered.
 pub fn unregister_handle(p: *const c_void, kind: HandleKind) -> bool {
     let mut set = live_handles();
-    let removed = set.remove(&(p as usize, kind));
-    if set.is_empty() {
+    let removed = set.as_mut().map_or(false, |s| s.remove(&(p as usize, kind)));
+    if set.as_ref().map_or(false, |s| s.is_empty()) {
         // an emptied BTreeSet keeps its root node: release it, so that no allocation
         // outlives the last handle (and a dlclose'd library leaves no block behind)
-        *set = BTreeSet::new();
+        *set = None;
     }
     removed
 }
 
 /// Whether `p` is a live handle of this kind (no memory behind `p` is read).
 pub fn is_registered_handle(p: *const c_void, kind: HandleKind) -> bool {
-    !p.is_null() && live_handles().contains(&(p as usize, kind))
+    !p.is_null()
+        && live_handles()
+            .as_ref()
+            .map_or(false, |s| s.contains(&(p as usize, kind)))
 }
 
 /// Log categories the layer itself uses.
@@ -205,7 +211,7 @@ pub unsafe fn call_logger(
             instance_name.as_ptr(),
             status,
             category.as_ptr(),
-            c"%s".as_ptr(),
+            b"%s\0".as_ptr() as *const std::os::raw::c_char,
             message.as_ptr(),
         );
     }

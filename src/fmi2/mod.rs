@@ -41,6 +41,7 @@ pub mod instance;
 pub mod model;
 pub mod model_description;
 pub mod state;
+pub mod structure_check;
 pub mod testing;
 pub mod types;
 

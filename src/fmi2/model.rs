@@ -61,12 +61,93 @@ pub struct UnitDefinition {
     pub k: i32,
 }
 
+/// Bounds and scale of a variable that its table row does not give: `min`, `max` and
+/// `nominal` in the model description. A row's own `min`/`max` take precedence.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Extent {
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub nominal: Option<f64>,
+}
+
+/// No extent beyond the table row's (the default of [`ModelInfo::extent`]).
+pub fn no_extent(_value_reference: u32) -> Extent {
+    Extent::default()
+}
+
+/// How an output depends on the variables it lists (FMI 2.0 `dependenciesKind`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DependencyKind {
+    /// No particular structure (what a nonlinear dependence is).
+    Dependent,
+    /// Linear with a constant factor.
+    Constant,
+    /// Linear with a factor that depends on fixed parameters only.
+    Fixed,
+}
+
+impl DependencyKind {
+    pub fn attr(self) -> &'static str {
+        match self {
+            DependencyKind::Dependent => "dependent",
+            DependencyKind::Constant => "constant",
+            DependencyKind::Fixed => "fixed",
+        }
+    }
+}
+
+/// The knowns one output depends on (`<ModelStructure>`), by value reference.
+#[derive(Clone, Copy, Debug)]
+pub struct OutputDependencies {
+    pub output: u32,
+    /// `<Outputs>`: the inputs whose new value changes the output before the next step
+    /// (direct feedthrough), with the kind of each.
+    pub step: &'static [(u32, DependencyKind)],
+    /// `<InitialUnknowns>`: the inputs and parameters the output's value after
+    /// initialisation depends on; `None` means every input and parameter (all `dependent`).
+    pub initial: Option<&'static [(u32, DependencyKind)]>,
+}
+
+/// The GUID, computed once from the model description (see [`ModelInfo::guid`]). Kept in
+/// the `ModelInfo` itself, not on the heap: a shared library that is unloaded leaves no
+/// allocation behind.
+pub struct GuidCache {
+    once: std::sync::Once,
+    bytes: std::cell::UnsafeCell<[u8; GUID_LEN]>,
+}
+
+/// `{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}`.
+const GUID_LEN: usize = 38;
+
+// The bytes are written once, inside `once`, before any reader can see them.
+unsafe impl Sync for GuidCache {}
+
+impl GuidCache {
+    pub const fn new() -> Self {
+        GuidCache {
+            once: std::sync::Once::new(),
+            bytes: std::cell::UnsafeCell::new([0; GUID_LEN]),
+        }
+    }
+}
+
+impl Default for GuidCache {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl std::fmt::Debug for GuidCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("GuidCache")
+    }
+}
+
 /// Static description of a model: everything the model description needs.
 #[derive(Debug)]
 pub struct ModelInfo {
     pub model_name: &'static str,
     pub model_identifier: &'static str,
-    pub guid: &'static str,
     pub description: &'static str,
     pub author: &'static str,
     pub version: &'static str,
@@ -80,6 +161,41 @@ pub struct ModelInfo {
     pub variables: &'static [Variable],
     /// `canInterpolateInputs`: the model accepts first-order input derivatives.
     pub can_interpolate_inputs: bool,
+    /// `min`, `max` and `nominal` beyond the table rows', by value reference.
+    pub extent: fn(u32) -> Extent,
+    /// Every output's dependencies; an empty list leaves `dependencies` out of the model
+    /// description (an importer then assumes that each output depends on every known).
+    pub dependencies: &'static [OutputDependencies],
+    /// Holds the GUID once computed.
+    pub guid_cache: GuidCache,
+}
+
+impl ModelInfo {
+    /// The GUID: a name-based UUID (version 5, SHA-1) of the model description with an
+    /// empty `guid` attribute, so that it changes whenever anything in the description does.
+    pub fn guid(&self) -> &str {
+        let cache = &self.guid_cache;
+        cache.once.call_once(|| {
+            let guid = super::model_description::content_guid(self);
+            let mut bytes = [0u8; GUID_LEN];
+            bytes.copy_from_slice(&guid.as_bytes()[..GUID_LEN]);
+            // SAFETY: written only here, once, before `call_once` returns to any caller.
+            unsafe { *cache.bytes.get() = bytes };
+        });
+        // SAFETY: never written again after `call_once`.
+        let bytes = unsafe { &*cache.bytes.get() };
+        std::str::from_utf8(bytes).unwrap_or("")
+    }
+
+    /// The effective extent of a variable: its row's `min`/`max`, else [`ModelInfo::extent`]'s.
+    pub fn extent_of(&self, v: &Variable) -> Extent {
+        let e = (self.extent)(v.value_reference);
+        Extent {
+            min: v.min.or(e.min),
+            max: v.max.or(e.max),
+            nominal: e.nominal,
+        }
+    }
 }
 
 /// Why a step did not complete.
@@ -98,7 +214,7 @@ pub enum StepError {
 /// the legality of the call in the current state; the model checks physical validity
 /// (finite, in range) and returns a message that names the variable and the value.
 pub trait CoSimModel: Send + Sized + 'static {
-    /// The static description (identifier, GUID, variable table).
+    /// The static description (identifier, variable table; the GUID is derived from it).
     fn info() -> &'static ModelInfo;
 
     /// A fresh instance with every variable at its start value.

@@ -3,7 +3,7 @@
 use std::collections::HashSet;
 use std::fmt::Write;
 
-use super::model::{Causality, ModelInfo, VarType, Variability, Variable};
+use super::model::{Causality, DependencyKind, ModelInfo, VarType, Variability, Variable};
 
 /// Check the model info for what the XML (and the layer) rely on: unique, non-empty
 /// variable names; unique value references; declared units; legal
@@ -48,11 +48,25 @@ pub fn validate_model_info(info: &ModelInfo) -> Result<(), Vec<String>> {
             }
             _ => {}
         }
+        let extent = info.extent_of(v);
+        if let (Some(lo), Some(hi)) = (extent.min, extent.max) {
+            if !(lo <= hi) {
+                problems.push(format!("variable {:?}: min {lo} > max {hi}", v.name));
+            }
+        }
+        if let Some(n) = extent.nominal {
+            if !(n.is_finite() && n > 0.0) || v.var_type != VarType::Real {
+                problems.push(format!(
+                    "variable {:?}: nominal {n} must be finite, > 0 and on a Real",
+                    v.name
+                ));
+            }
+        }
         if has_start(v) {
             if !v.start.is_finite() {
                 problems.push(format!("variable {:?}: start {} is not finite", v.name, v.start));
             }
-            if v.min.is_some_and(|m| v.start < m) || v.max.is_some_and(|m| v.start > m) {
+            if extent.min.map_or(false, |m| v.start < m) || extent.max.map_or(false, |m| v.start > m) {
                 problems.push(format!("variable {:?}: start {} outside [min, max]", v.name, v.start));
             }
             if v.var_type != VarType::Real && v.start.fract() != 0.0 {
@@ -60,6 +74,7 @@ pub fn validate_model_info(info: &ModelInfo) -> Result<(), Vec<String>> {
             }
         }
     }
+    problems.extend(dependency_problems(info));
     let mut cats = HashSet::new();
     for (name, _) in info.log_categories {
         if !cats.insert(*name) {
@@ -77,6 +92,56 @@ pub fn validate_model_info(info: &ModelInfo) -> Result<(), Vec<String>> {
     } else {
         Err(problems)
     }
+}
+
+/// What is wrong with `info.dependencies`: an output listed twice or not at all (when the
+/// list is not empty), a listed variable that is not an output, `<Outputs>` dependencies on
+/// anything but inputs, `<InitialUnknowns>` dependencies on anything but inputs and
+/// parameters, or a known listed twice.
+fn dependency_problems(info: &ModelInfo) -> Vec<String> {
+    let mut problems = Vec::new();
+    if info.dependencies.is_empty() {
+        return problems;
+    }
+    let by_vr = |vr: u32| info.variables.iter().find(|v| v.value_reference == vr);
+    let mut seen = HashSet::new();
+    for d in info.dependencies {
+        match by_vr(d.output) {
+            Some(v) if v.causality == Causality::Output => {}
+            _ => problems.push(format!("dependencies: value reference {} is not an output", d.output)),
+        }
+        if !seen.insert(d.output) {
+            problems.push(format!("dependencies: output {} is listed twice", d.output));
+        }
+        let mut check = |list: &[(u32, DependencyKind)], section: &str, allowed: &[Causality]| {
+            let mut knowns = HashSet::new();
+            for &(vr, _) in list {
+                match by_vr(vr) {
+                    Some(v) if allowed.contains(&v.causality) => {}
+                    _ => problems.push(format!(
+                        "{section} dependencies of output {}: value reference {vr} is not one of {allowed:?}",
+                        d.output
+                    )),
+                }
+                if !knowns.insert(vr) {
+                    problems.push(format!(
+                        "{section} dependencies of output {}: {vr} is listed twice",
+                        d.output
+                    ));
+                }
+            }
+        };
+        check(d.step, "Outputs", &[Causality::Input]);
+        if let Some(initial) = d.initial {
+            check(initial, "InitialUnknowns", &[Causality::Input, Causality::Parameter]);
+        }
+    }
+    for v in info.variables {
+        if v.causality == Causality::Output && !seen.contains(&v.value_reference) {
+            problems.push(format!("dependencies: output {:?} is not listed", v.name));
+        }
+    }
+    problems
 }
 
 /// Parameters and inputs carry a start value; outputs and locals are calculated.
@@ -137,6 +202,91 @@ fn variability_attr(v: Variability) -> &'static str {
 /// The complete `modelDescription.xml`, or the problems found by [`validate_model_info`].
 pub fn try_model_description_xml(info: &ModelInfo) -> Result<String, Vec<String>> {
     validate_model_info(info)?;
+    Ok(write_xml(info, info.guid()))
+}
+
+/// The GUID of [`ModelInfo::guid`]: a version-5 UUID (RFC 4122, SHA-1 in the URL namespace)
+/// of the model description written with `guid=""`, in braces.
+pub fn content_guid(info: &ModelInfo) -> String {
+    format!("{{{}}}", uuid_v5(&URL_NAMESPACE, write_xml(info, "").as_bytes()))
+}
+
+/// RFC 4122's namespace for URLs (6ba7b811-9dad-11d1-80b4-00c04fd430c8).
+const URL_NAMESPACE: [u8; 16] = [
+    0x6b, 0xa7, 0xb8, 0x11, 0x9d, 0xad, 0x11, 0xd1, 0x80, 0xb4, 0x00, 0xc0, 0x4f, 0xd4, 0x30, 0xc8,
+];
+
+/// A name-based UUID, version 5 (RFC 4122 section 4.3), in its lowercase hyphenated form.
+pub fn uuid_v5(namespace: &[u8; 16], name: &[u8]) -> String {
+    let mut data = Vec::with_capacity(16 + name.len());
+    data.extend_from_slice(namespace);
+    data.extend_from_slice(name);
+    let hash = sha1(&data);
+    let mut b = [0u8; 16];
+    b.copy_from_slice(&hash[..16]);
+    b[6] = (b[6] & 0x0f) | 0x50;
+    b[8] = (b[8] & 0x3f) | 0x80;
+    let hex: String = b.iter().map(|x| format!("{x:02x}")).collect();
+    format!(
+        "{}-{}-{}-{}-{}",
+        &hex[0..8],
+        &hex[8..12],
+        &hex[12..16],
+        &hex[16..20],
+        &hex[20..32]
+    )
+}
+
+/// SHA-1 (FIPS 180-4); here only to name a UUID, not for security.
+pub fn sha1(message: &[u8]) -> [u8; 20] {
+    let mut h: [u32; 5] = [0x6745_2301, 0xEFCD_AB89, 0x98BA_DCFE, 0x1032_5476, 0xC3D2_E1F0];
+    let mut padded = message.to_vec();
+    padded.push(0x80);
+    while padded.len() % 64 != 56 {
+        padded.push(0);
+    }
+    padded.extend_from_slice(&((message.len() as u64).wrapping_mul(8)).to_be_bytes());
+    for chunk in padded.chunks(64) {
+        let mut w = [0u32; 80];
+        for (i, word) in chunk.chunks(4).enumerate() {
+            w[i] = u32::from_be_bytes([word[0], word[1], word[2], word[3]]);
+        }
+        for i in 16..80 {
+            w[i] = (w[i - 3] ^ w[i - 8] ^ w[i - 14] ^ w[i - 16]).rotate_left(1);
+        }
+        let [mut a, mut b, mut c, mut d, mut e] = h;
+        for (i, &wi) in w.iter().enumerate() {
+            let (f, k) = match i {
+                0..=19 => ((b & c) | (!b & d), 0x5A82_7999),
+                20..=39 => (b ^ c ^ d, 0x6ED9_EBA1),
+                40..=59 => ((b & c) | (b & d) | (c & d), 0x8F1B_BCDC),
+                _ => (b ^ c ^ d, 0xCA62_C1D6),
+            };
+            let t = a
+                .rotate_left(5)
+                .wrapping_add(f)
+                .wrapping_add(e)
+                .wrapping_add(k)
+                .wrapping_add(wi);
+            e = d;
+            d = c;
+            c = b.rotate_left(30);
+            b = a;
+            a = t;
+        }
+        for (x, y) in h.iter_mut().zip([a, b, c, d, e]) {
+            *x = x.wrapping_add(y);
+        }
+    }
+    let mut out = [0u8; 20];
+    for (i, x) in h.iter().enumerate() {
+        out[4 * i..4 * i + 4].copy_from_slice(&x.to_be_bytes());
+    }
+    out
+}
+
+/// The XML with the given GUID, unchecked.
+fn write_xml(info: &ModelInfo, guid: &str) -> String {
     let e = xml_escape;
     let mut x = String::new();
     let w = &mut x;
@@ -146,7 +296,7 @@ pub fn try_model_description_xml(info: &ModelInfo) -> Result<String, Vec<String>
         w,
         r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{}" description="{}" author="{}" version="{}" generationTool="{}" variableNamingConvention="flat" numberOfEventIndicators="0">"#,
         e(info.model_name),
-        e(info.guid),
+        e(guid),
         e(info.description),
         e(info.author),
         e(info.version),
@@ -197,6 +347,7 @@ pub fn try_model_description_xml(info: &ModelInfo) -> Result<String, Vec<String>
     let mut outputs = Vec::new();
     for (i, v) in info.variables.iter().enumerate() {
         let index = i + 1;
+        let extent = info.extent_of(v);
         let _ = writeln!(w, "    <!-- index {index} -->");
         let _ = writeln!(
             w,
@@ -216,21 +367,24 @@ pub fn try_model_description_xml(info: &ModelInfo) -> Result<String, Vec<String>
                 if has_start(v) {
                     let _ = write!(attrs, r#" start="{}""#, format_double(v.start));
                 }
-                if let Some(m) = v.min {
+                if let Some(m) = extent.min {
                     let _ = write!(attrs, r#" min="{}""#, format_double(m));
                 }
-                if let Some(m) = v.max {
+                if let Some(m) = extent.max {
                     let _ = write!(attrs, r#" max="{}""#, format_double(m));
+                }
+                if let Some(n) = extent.nominal {
+                    let _ = write!(attrs, r#" nominal="{}""#, format_double(n));
                 }
             }
             VarType::Integer => {
                 if has_start(v) {
                     let _ = write!(attrs, r#" start="{}""#, v.start as i64);
                 }
-                if let Some(m) = v.min {
+                if let Some(m) = extent.min {
                     let _ = write!(attrs, r#" min="{}""#, m as i64);
                 }
-                if let Some(m) = v.max {
+                if let Some(m) = extent.max {
                     let _ = write!(attrs, r#" max="{}""#, m as i64);
                 }
             }
@@ -248,23 +402,62 @@ pub fn try_model_description_xml(info: &ModelInfo) -> Result<String, Vec<String>
         let _ = writeln!(w, "      <{element}{attrs}/>");
         let _ = writeln!(w, "    </ScalarVariable>");
         if v.causality == Causality::Output {
-            outputs.push(index);
+            outputs.push((index, v.value_reference));
         }
     }
     let _ = writeln!(w, "  </ModelVariables>");
     let _ = writeln!(w, "  <ModelStructure>");
-    for section in ["Outputs", "InitialUnknowns"] {
-        if !outputs.is_empty() {
-            let _ = writeln!(w, "    <{section}>");
-            for i in &outputs {
-                let _ = writeln!(w, r#"      <Unknown index="{i}"/>"#);
-            }
-            let _ = writeln!(w, "    </{section}>");
+    let index_of = |vr: u32| {
+        info.variables
+            .iter()
+            .position(|v| v.value_reference == vr)
+            .map(|i| i + 1)
+    };
+    let all_knowns: Vec<(u32, DependencyKind)> = info
+        .variables
+        .iter()
+        .filter(|v| matches!(v.causality, Causality::Input | Causality::Parameter))
+        .map(|v| (v.value_reference, DependencyKind::Dependent))
+        .collect();
+    for (section, initial) in [("Outputs", false), ("InitialUnknowns", true)] {
+        if outputs.is_empty() {
+            continue;
         }
+        let _ = writeln!(w, "    <{section}>");
+        for &(i, vr) in &outputs {
+            let listed = info.dependencies.iter().find(|d| d.output == vr);
+            match listed {
+                None => {
+                    let _ = writeln!(w, r#"      <Unknown index="{i}"/>"#);
+                }
+                Some(d) => {
+                    let list: &[(u32, DependencyKind)] = match (initial, d.initial) {
+                        (false, _) => d.step,
+                        (true, Some(l)) => l,
+                        (true, None) => &all_knowns,
+                    };
+                    // Ascending indices, as the standard's examples list them.
+                    let mut known: Vec<(usize, DependencyKind)> = list
+                        .iter()
+                        .filter_map(|&(vr, kind)| index_of(vr).map(|j| (j, kind)))
+                        .collect();
+                    known.sort_by_key(|&(j, _)| j);
+                    let indices: Vec<String> = known.iter().map(|(j, _)| j.to_string()).collect();
+                    let kinds: Vec<&str> = known.iter().map(|(_, k)| k.attr()).collect();
+                    let _ = writeln!(
+                        w,
+                        r#"      <Unknown index="{i}" dependencies="{}" dependenciesKind="{}"/>"#,
+                        indices.join(" "),
+                        kinds.join(" ")
+                    );
+                }
+            }
+        }
+        let _ = writeln!(w, "    </{section}>");
     }
     let _ = writeln!(w, "  </ModelStructure>");
     let _ = writeln!(w, "</fmiModelDescription>");
-    Ok(x)
+    x
 }
 
 /// The complete `modelDescription.xml` for `info`.

@@ -116,7 +116,6 @@ pub static DUMMY_VARIABLES: [Variable; 6] = [
 pub static DUMMY_INFO: ModelInfo = ModelInfo {
     model_name: "DummyLag",
     model_identifier: "jetpipe",
-    guid: "{2f1a7c9e-0d6b-4f53-9a41-dummy0000001}",
     description: "First-order lag used to test the generic FMI 2.0 layer",
     author: "jetpipe FMI layer",
     version: "0.1.0",
@@ -153,6 +152,9 @@ pub static DUMMY_INFO: ModelInfo = ModelInfo {
     ],
     variables: &DUMMY_VARIABLES,
     can_interpolate_inputs: true,
+    extent: super::model::no_extent,
+    dependencies: &[],
+    guid_cache: super::model::GuidCache::new(),
 };
 
 #[derive(Clone, Debug, PartialEq)]

@@ -65,7 +65,7 @@ fn callbacks(sink: &RefCell<Vec<LogRecord>>) -> fmi2CallbackFunctions {
 }
 
 fn guid() -> CString {
-    CString::new(M::info().guid).unwrap()
+    CString::new(M::info().guid()).unwrap()
 }
 
 unsafe fn new_instance(sink: &RefCell<Vec<LogRecord>>, logging_on: bool) -> fmi2Component {
@@ -261,7 +261,7 @@ fn instantiate_rejects_bad_arguments() {
             log[0].3,
             format!(
                 "fmi2Instantiate: GUID mismatch: expected {}, got {{wrong}}",
-                M::info().guid
+                M::info().guid()
             )
         );
         assert!(log[1].3.contains("fmi2ModelExchange"), "{}", log[1].3);
@@ -595,7 +595,7 @@ fn forge(magic: &[u8], version: u32, guid: &str, state: u8, model: &[u8]) -> Vec
 fn serialized_state_rejects_corrupted_foreign_and_truncated_bytes() {
     let good = good_bytes();
     let model = M::instantiate().serialize();
-    let g = M::info().guid;
+    let g = M::info().guid();
     assert!(Snapshot::from_bytes::<M>(&good).is_ok());
     assert_eq!(
         forge(STATE_MAGIC, FORMAT_VERSION, g, 3, &{
@@ -654,7 +654,7 @@ fn serialized_state_rejects_corrupted_foreign_and_truncated_bytes() {
 fn model_description_lists_every_variable() {
     let xml = try_model_description_xml(M::info()).unwrap();
     assert!(xml.contains(r#"fmiVersion="2.0""#));
-    assert!(xml.contains(&format!(r#"guid="{}""#, M::info().guid)));
+    assert!(xml.contains(&format!(r#"guid="{}""#, M::info().guid())));
     assert!(xml.contains(r#"canInterpolateInputs="true""#));
     assert!(xml.contains(r#"<ScalarVariable name="u" valueReference="1" description="input &lt;u&gt; &amp; &quot;target&quot;" causality="input" variability="continuous">"#));
     assert!(xml.contains(r#"<Real unit="1" start="0.0"/>"#));
@@ -675,10 +675,99 @@ fn model_description_lists_every_variable() {
 }
 
 #[test]
+fn sha1_and_uuid_v5_match_the_standards_vectors() {
+    use super::model_description::{sha1, uuid_v5};
+    let hex = |b: &[u8]| b.iter().map(|x| format!("{x:02x}")).collect::<String>();
+    // FIPS 180 examples.
+    assert_eq!(hex(&sha1(b"abc")), "a9993e364706816aba3e25717850c26c9cd0d89d");
+    assert_eq!(hex(&sha1(b"")), "da39a3ee5e6b4b0d3255bfef95601890afd80709");
+    assert_eq!(
+        hex(&sha1(b"abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq")),
+        "84983e441c3bd26ebaae4aa1f95129e5e54670f1"
+    );
+    // Python: uuid.uuid5(uuid.NAMESPACE_DNS, "python.org")
+    let dns = [
+        0x6b, 0xa7, 0xb8, 0x10, 0x9d, 0xad, 0x11, 0xd1, 0x80, 0xb4, 0x00, 0xc0, 0x4f, 0xd4, 0x30, 0xc8,
+    ];
+    assert_eq!(uuid_v5(&dns, b"python.org"), "886313e1-3b8a-5372-9b90-0c9aee199e5d");
+}
+
+#[test]
+fn guid_is_a_uuid_of_the_description_and_follows_its_content() {
+    let a = M::info().guid();
+    assert_eq!(a.len(), 38, "{a}");
+    assert!(
+        a.starts_with('{') && a.ends_with('}') && a.as_bytes()[15] == b'5',
+        "{a}"
+    );
+    assert_eq!(a, M::info().guid(), "computed once and kept");
+    let other = ModelInfo {
+        description: "another description",
+        ..clone_info(M::info())
+    };
+    assert_ne!(other.guid(), a);
+    assert_eq!(clone_info(M::info()).guid(), a, "the same content gives the same GUID");
+}
+
+#[test]
+fn model_structure_lists_declared_dependencies() {
+    use super::model::{DependencyKind, OutputDependencies};
+    static DEPS: [OutputDependencies; 1] = [OutputDependencies {
+        output: 2,
+        step: &[(1, DependencyKind::Constant)],
+        initial: Some(&[(11, DependencyKind::Dependent), (1, DependencyKind::Dependent)]),
+    }];
+    let info = ModelInfo {
+        dependencies: &DEPS,
+        ..clone_info(M::info())
+    };
+    let xml = try_model_description_xml(&info).unwrap();
+    let index = |vr: u32| {
+        M::info()
+            .variables
+            .iter()
+            .position(|v| v.value_reference == vr)
+            .unwrap()
+            + 1
+    };
+    let (u, y0) = (index(1), index(11));
+    assert!(
+        xml.contains(&format!(
+            r#"<Outputs>
+      <Unknown index="{}" dependencies="{u}" dependenciesKind="constant"/>"#,
+            index(2)
+        )),
+        "{xml}"
+    );
+    let (first, second) = if u < y0 { (u, y0) } else { (y0, u) };
+    assert!(xml.contains(&format!(
+        r#"<InitialUnknowns>
+      <Unknown index="{}" dependencies="{first} {second}" dependenciesKind="dependent dependent"/>"#,
+        index(2)
+    )));
+    // A dependency of an output on an output is refused.
+    static BAD: [OutputDependencies; 1] = [OutputDependencies {
+        output: 2,
+        step: &[(2, DependencyKind::Dependent)],
+        initial: None,
+    }];
+    let info = ModelInfo {
+        dependencies: &BAD,
+        ..clone_info(M::info())
+    };
+    assert!(validate_model_info(&info)
+        .unwrap_err()
+        .iter()
+        .any(|p| p.contains("is not one of [Input]")));
+}
+
+#[test]
 fn model_description_of_the_actuator_table() {
     let info = ModelInfo {
         variables: crate::variables::VARIABLES,
         units: crate::variables::UNITS,
+        extent: crate::fmu::extent,
+        dependencies: crate::fmu::DEPENDENCIES,
         ..clone_info(M::info())
     };
     let xml = try_model_description_xml(&info).unwrap();
@@ -694,16 +783,48 @@ fn model_description_of_the_actuator_table() {
         .collect();
     assert_eq!(outputs, vec![3, 4, 5, 6, 7, 8], "F_act, P1, P2, i, F_meas, x_jp");
     for i in outputs {
-        assert_eq!(xml.matches(&format!(r#"<Unknown index="{i}"/>"#)).count(), 2);
+        assert_eq!(
+            xml.matches(&format!(r#"<Unknown index="{i}" dependencies="#)).count(),
+            2
+        );
     }
+    // Within a step only x_s (index 2) acts, on F_act, P1, P2 and F_meas; i and x_jp on nothing.
+    for i in [3, 4, 5, 7] {
+        assert!(xml.contains(&format!(
+            r#"<Unknown index="{i}" dependencies="2" dependenciesKind="dependent"/>"#
+        )));
+    }
+    for i in [6, 8] {
+        assert!(xml.contains(&format!(
+            r#"<Unknown index="{i}" dependencies="" dependenciesKind=""/>"#
+        )));
+    }
+    assert!(
+        xml.contains(r#"<Real unit="m" start="0.054" min="0.026" max="0.096" nominal="0.054"/>"#),
+        "{xml}"
+    );
+    assert!(xml.contains(r#"<Real unit="1" start="0.696" min="0.0" max="1.0" nominal="0.696"/>"#));
 }
 
 fn clone_info(i: &ModelInfo) -> ModelInfo {
     ModelInfo {
+        model_name: i.model_name,
+        model_identifier: i.model_identifier,
+        description: i.description,
+        author: i.author,
+        version: i.version,
+        generation_tool: i.generation_tool,
+        default_start_time: i.default_start_time,
+        default_stop_time: i.default_stop_time,
+        default_tolerance: i.default_tolerance,
+        default_step_size: i.default_step_size,
         log_categories: i.log_categories,
         units: i.units,
         variables: i.variables,
-        ..*i
+        can_interpolate_inputs: i.can_interpolate_inputs,
+        extent: i.extent,
+        dependencies: i.dependencies,
+        guid_cache: super::model::GuidCache::new(),
     }
 }
 

@@ -71,9 +71,12 @@ pub struct fmi2CallbackFunctions {
 }
 
 /// `fmi2TypesPlatform`.
-pub const TYPES_PLATFORM: &std::ffi::CStr = c"default";
+// Byte strings, not c"" literals: the win64 build compiles with rustc 1.63.
+// SAFETY: one NUL, at the end.
+pub const TYPES_PLATFORM: &std::ffi::CStr = unsafe { std::ffi::CStr::from_bytes_with_nul_unchecked(b"default\0") };
 /// `fmi2Version`.
-pub const VERSION: &std::ffi::CStr = c"2.0";
+// SAFETY: one NUL, at the end.
+pub const VERSION: &std::ffi::CStr = unsafe { std::ffi::CStr::from_bytes_with_nul_unchecked(b"2.0\0") };
 
 /// A readable name of a status, for log messages.
 pub fn status_name(s: fmi2Status) -> &'static str {

@@ -85,7 +85,7 @@ const AIR_GAMMA: f64 = 1.4;
 impl FactorTable {
     pub fn for_gas(gamma: f64, critical_ratio: f64) -> Self {
         if gamma == AIR_GAMMA {
-            static AIR: std::sync::OnceLock<UnchokedFactor> = std::sync::OnceLock::new();
+            static AIR: crate::compat::OnceLock<UnchokedFactor> = crate::compat::OnceLock::new();
             Self::Air(AIR.get_or_init(|| UnchokedFactor::new(gamma, critical_ratio)))
         } else {
             Self::Owned(std::sync::Arc::new(UnchokedFactor::new(gamma, critical_ratio)))

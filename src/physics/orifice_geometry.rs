@@ -135,7 +135,7 @@ struct UnitAreaTable {
 
 impl UnitAreaTable {
     fn get() -> &'static Self {
-        static TABLE: std::sync::OnceLock<UnitAreaTable> = std::sync::OnceLock::new();
+        static TABLE: crate::compat::OnceLock<UnitAreaTable> = crate::compat::OnceLock::new();
         TABLE.get_or_init(|| {
             let power = |t: f64| t * t.sqrt();
             Self {

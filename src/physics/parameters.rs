@@ -205,7 +205,7 @@ impl Parameters {
             vr::F_JP_SAT => (&mut self.f_jp_sat, Positive),
             vr::X_JP_OFFSET => (&mut self.x_jp_offset, Finite),
             vr::D_JP => (&mut self.d_jp, Positive),
-            vr::C_D => (&mut self.c_d, NonNegative),
+            vr::C_D => (&mut self.c_d, UnitInterval),
             vr::C_DM_A_LPP => (&mut self.c_dm_a_lpp, Finite),
             vr::C_DB_A_LPP => (&mut self.c_db_a_lpp, NonNegative),
             vr::L_CYL => (&mut self.l_cyl, Positive),
@@ -236,6 +236,18 @@ impl Parameters {
             vr::PORT_RESISTANCE_2 => (&mut self.port_resistance_2, NonNegative),
             vr::STOPPER_COMPLIANCE => (&mut self.stopper_compliance, NonNegative),
             _ => return None,
+        })
+    }
+
+    /// The (min, max) that [`Parameters::set`] enforces on a parameter, as the model
+    /// description declares them (FMI's bounds are closed: "> 0" is declared as min 0).
+    pub fn declared_range(value_reference: u32) -> Option<(Option<f64>, Option<f64>)> {
+        let (_, bound) = Parameters::default().field_and_bound(value_reference)?;
+        Some(match bound {
+            Bound::Positive | Bound::NonNegative => (Some(0.0), None),
+            Bound::GreaterThanOne => (Some(1.0), None),
+            Bound::UnitInterval => (Some(0.0), Some(1.0)),
+            Bound::Finite => (None, None),
         })
     }
 

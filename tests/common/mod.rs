@@ -109,7 +109,7 @@ pub fn callbacks(sink: &Sink) -> fmi2CallbackFunctions {
 }
 
 pub fn guid() -> CString {
-    CString::new(ExportedModel::info().guid).unwrap()
+    CString::new(ExportedModel::info().guid()).unwrap()
 }
 
 /// A new instance logging into `sink` (which must outlive it).

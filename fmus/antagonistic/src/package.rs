@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use jetpipe::fmi2::model::ModelInfo;
 
-use crate::system::{check, components, ssd_xml, ssv_xml, SSV_PATH};
+use crate::system::{check, components, ssd_xml};
 
 /// One FMU of this workspace: its model info, the cdylib's file name, and its notes.
 pub struct Fmu {
@@ -110,8 +110,6 @@ pub fn write_ssp(out: &Path, dist: &Path, stop_time: f64) -> Result<(), String> 
         zip.start_file("SystemStructure.ssd", deflated)?;
         zip.write_all(ssd_xml(stop_time).as_bytes())?;
         zip.add_directory("resources/", deflated)?;
-        zip.start_file(SSV_PATH, deflated)?;
-        zip.write_all(ssv_xml().as_bytes())?;
         for (source, file) in &sources {
             zip.start_file(source.as_str(), stored)?;
             zip.write_all(&std::fs::read(file)?)?;

@@ -1,13 +1,13 @@
 //! The structure of the AntagonisticJoint system: components, connectors, connections and the
-//! parameter set, and their SSD/SSV XML.
+//! parameter set, and their SSD XML (each component's start values inline).
 
 use jetpipe::fmi2::model::{Causality, ModelInfo, VarType};
 use jetpipe::fmi2::model_description::{format_double, xml_escape};
 
-/// Name of the system, of the `.ssp` and of its parameter set.
+/// Name of the system and of the `.ssp`.
 pub const SYSTEM_NAME: &str = "AntagonisticJoint";
-/// Where the parameter set lives inside the `.ssp`.
-pub const SSV_PATH: &str = "resources/AntagonisticJoint.ssv";
+/// Name of each component's parameter set (inline in the SSD).
+pub const PARAMETER_SET_NAME: &str = "start";
 
 pub struct Component {
     pub name: &'static str,
@@ -34,7 +34,6 @@ pub fn components() -> Vec<Component> {
             name: "controller",
             info: &joint_controller::fmu::MODEL_INFO,
             connectors: &[
-                "theta_ref",
                 "theta",
                 "omega",
                 "F_flexor",
@@ -84,11 +83,18 @@ pub fn components() -> Vec<Component> {
     ]
 }
 
-/// The system's own input: the joint angle reference.
-pub const SYSTEM_INPUTS: &[(&str, &str)] = &[("theta_ref", "rad")];
+/// The system has no connectors of its own (libcosim's SSP parser takes none): the parameter
+/// set asks for a reference step through the controller's `theta_step` at `t_step`.
+pub const SYSTEM_INPUTS: &[(&str, &str)] = &[];
+
+/// Component connectors that are inputs no connection feeds (none: FMPy's SSP reader fails on
+/// one). The controller's theta_ref is no connector; it holds its start value.
+pub const OPEN_INPUTS: &[(&str, &str)] = &[];
+
+/// The reference step of the parameter set: `theta_step` rad at `t_step` s.
+pub const REFERENCE_STEP: (f64, f64) = (0.5, 1.0);
 
 pub const CONNECTIONS: &[Connection] = &[
-    (None, "theta_ref", "controller", "theta_ref"),
     (Some("joint"), "theta", "controller", "theta"),
     (Some("joint"), "omega", "controller", "omega"),
     (Some("actuator_flexor"), "F_meas", "controller", "F_flexor"),
@@ -135,6 +141,18 @@ pub fn parameter_set() -> Vec<(String, f64)> {
     for name in ["r", "T_co", "T_min", "T_max", "Kp", "Ki", "Kd", "tau_i_max", "K_F"] {
         add("controller", name, start_of(&joint_controller::fmu::MODEL_INFO, name));
     }
+    add("controller", "theta_step", REFERENCE_STEP.0);
+    add("controller", "t_step", REFERENCE_STEP.1);
+    // Every connected input has its start value here (masters that read connector start values
+    // from parameter bindings start their connections there): the joint at rest at its start.
+    let joint = &finger_joint::fmu::MODEL_INFO;
+    let (theta0, omega0, r) = (
+        start_of(joint, "theta_start"),
+        start_of(joint, "omega_start"),
+        start_of(joint, "r"),
+    );
+    add("controller", "theta", theta0);
+    add("controller", "omega", omega0);
     add("controller", "F_flexor", t_co);
     add("controller", "F_extensor", t_co);
     for side in ["flexor", "extensor"] {
@@ -145,6 +163,9 @@ pub fn parameter_set() -> Vec<(String, f64)> {
             add(&name, p, start_of(tendon, p));
         }
         add(&name, "F_act", t_co);
+        let sign = if side == "flexor" { 1.0 } else { -1.0 };
+        add(&name, "x_joint", sign * r * theta0);
+        add(&name, "v_joint", sign * r * omega0);
     }
     for p in ["J", "b", "r", "theta_min", "theta_max"] {
         add("joint", p, start_of(&finger_joint::fmu::MODEL_INFO, p));
@@ -196,7 +217,8 @@ pub fn check() -> Result<(), Vec<String>> {
                         .iter()
                         .filter(|(_, _, e, ec)| *e == c.name && *ec == connector)
                         .count();
-                    if feeds != 1 {
+                    let open = OPEN_INPUTS.contains(&(c.name, connector));
+                    if feeds != usize::from(!open) {
                         problems.push(format!("{}.{connector} is fed by {feeds} connections, not 1", c.name));
                     }
                 }
@@ -301,7 +323,8 @@ pub fn ssd_xml(stop_time: f64) -> String {
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     x.push_str(&format!(
         "<ssd:SystemStructureDescription xmlns:ssc=\"http://ssp-standard.org/SSP1/SystemStructureCommon\" \
-xmlns:ssd=\"http://ssp-standard.org/SSP1/SystemStructureDescription\" version=\"1.0\" name=\"{SYSTEM_NAME}\" \
+xmlns:ssd=\"http://ssp-standard.org/SSP1/SystemStructureDescription\" \
+xmlns:ssv=\"http://ssp-standard.org/SSP1/SystemStructureParameterValues\" version=\"1.0\" name=\"{SYSTEM_NAME}\" \
 generationTool=\"jetpipe antagonistic {}\">\n",
         env!("CARGO_PKG_VERSION")
     ));
@@ -310,16 +333,15 @@ generationTool=\"jetpipe antagonistic {}\">\n",
 driven antagonistically (2N) by two jet-pipe actuators through two tendons, under joint position control with \
 co-contraction\">\n"
     ));
-    x.push_str("    <ssd:Connectors>\n");
-    for (name, unit) in SYSTEM_INPUTS {
-        x.push_str(&format!(
-            "      <ssd:Connector name=\"{name}\" kind=\"input\"><ssc:Real unit=\"{unit}\"/></ssd:Connector>\n"
-        ));
+    if !SYSTEM_INPUTS.is_empty() {
+        x.push_str("    <ssd:Connectors>\n");
+        for (name, unit) in SYSTEM_INPUTS {
+            x.push_str(&format!(
+                "      <ssd:Connector name=\"{name}\" kind=\"input\"><ssc:Real unit=\"{unit}\"/></ssd:Connector>\n"
+            ));
+        }
+        x.push_str("    </ssd:Connectors>\n");
     }
-    x.push_str("    </ssd:Connectors>\n");
-    x.push_str(&format!(
-        "    <ssd:ParameterBindings>\n      <ssd:ParameterBinding source=\"{SSV_PATH}\"/>\n    </ssd:ParameterBindings>\n"
-    ));
     x.push_str("    <ssd:Elements>\n");
     for c in components() {
         x.push_str(&format!(
@@ -341,7 +363,32 @@ co-contraction\">\n"
                 causality_kind(v.causality)
             ));
         }
-        x.push_str("        </ssd:Connectors>\n      </ssd:Component>\n");
+        x.push_str("        </ssd:Connectors>\n");
+        // The component's start values, inline and under its own names: libcosim reads parameter
+        // bindings only on components, FMPy and others read them there too.
+        let prefix = format!("{}.", c.name);
+        let own: Vec<(String, f64)> = parameter_set()
+            .into_iter()
+            .filter_map(|(name, value)| name.strip_prefix(&prefix).map(|n| (n.to_string(), value)))
+            .collect();
+        if !own.is_empty() {
+            x.push_str(&format!(
+                "        <ssd:ParameterBindings>\n          <ssd:ParameterBinding>\n            <ssd:ParameterValues>\n              \
+<ssv:ParameterSet version=\"1.0\" name=\"{PARAMETER_SET_NAME}\">\n                <ssv:Parameters>\n"
+            ));
+            for (name, value) in own {
+                x.push_str(&format!(
+                    "                  <ssv:Parameter name=\"{}\"><ssv:Real value=\"{}\"/></ssv:Parameter>\n",
+                    e(&name),
+                    format_double(value)
+                ));
+            }
+            x.push_str(
+                "                </ssv:Parameters>\n              </ssv:ParameterSet>\n            </ssd:ParameterValues>\n          \
+</ssd:ParameterBinding>\n        </ssd:ParameterBindings>\n",
+            );
+        }
+        x.push_str("      </ssd:Component>\n");
     }
     x.push_str("    </ssd:Elements>\n    <ssd:Connections>\n");
     for &(start, sc, end, ec) in CONNECTIONS {
@@ -367,25 +414,6 @@ co-contraction\">\n"
         "  </ssd:Units>\n  <ssd:DefaultExperiment startTime=\"0\" stopTime=\"{}\"/>\n</ssd:SystemStructureDescription>\n",
         format_double(stop_time)
     ));
-    x
-}
-
-/// `resources/AntagonisticJoint.ssv`: the parameter set bound at system level.
-pub fn ssv_xml() -> String {
-    let mut x = String::new();
-    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    x.push_str(&format!(
-        "<ssv:ParameterSet xmlns:ssc=\"http://ssp-standard.org/SSP1/SystemStructureCommon\" \
-xmlns:ssv=\"http://ssp-standard.org/SSP1/SystemStructureParameterValues\" version=\"1.0\" name=\"{SYSTEM_NAME}\">\n  <ssv:Parameters>\n"
-    ));
-    for (name, value) in parameter_set() {
-        x.push_str(&format!(
-            "    <ssv:Parameter name=\"{}\"><ssv:Real value=\"{}\"/></ssv:Parameter>\n",
-            xml_escape(&name),
-            format_double(value)
-        ));
-    }
-    x.push_str("  </ssv:Parameters>\n</ssv:ParameterSet>\n");
     x
 }
 

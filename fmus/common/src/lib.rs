@@ -27,15 +27,14 @@ use jetpipe::fmi2::model::StepError;
 macro_rules! model_info {
     (
         name: $name:expr,
-        guid: $guid:expr,
         description: $description:expr,
         units: $units:expr,
-        variables: $variables:expr $(,)?
+        variables: $variables:expr,
+        dependencies: $dependencies:expr $(,)?
     ) => {
         $crate::__jetpipe::fmi2::model::ModelInfo {
             model_name: $name,
             model_identifier: $name,
-            guid: $guid,
             description: $description,
             author: "jetpipe project",
             version: env!("CARGO_PKG_VERSION"),
@@ -48,8 +47,35 @@ macro_rules! model_info {
             units: $units,
             variables: $variables,
             can_interpolate_inputs: false,
+            extent: {
+                fn extent(value_reference: u32) -> $crate::__jetpipe::fmi2::model::Extent {
+                    $crate::nominal_from_start($variables, value_reference)
+                }
+                extent
+            },
+            dependencies: $dependencies,
+            guid_cache: $crate::__jetpipe::fmi2::model::GuidCache::new(),
         }
     };
+}
+
+/// The extent these models declare beyond their table rows' min/max: a nominal, the magnitude
+/// of the start value, for every Real parameter and input whose start is not 0.
+pub fn nominal_from_start(
+    variables: &[jetpipe::fmi2::model::Variable],
+    value_reference: u32,
+) -> jetpipe::fmi2::model::Extent {
+    use jetpipe::fmi2::model::{Causality, Extent, VarType};
+    let nominal = variables
+        .iter()
+        .find(|v| v.value_reference == value_reference)
+        .filter(|v| v.var_type == VarType::Real && matches!(v.causality, Causality::Parameter | Causality::Input))
+        .map(|v| v.start.abs())
+        .filter(|n| n.is_finite() && *n > 0.0);
+    Extent {
+        nominal,
+        ..Extent::default()
+    }
 }
 
 /// `fmi2SetupExperiment`'s start time, for the models' `setup_experiment`.

@@ -8,7 +8,13 @@ use jetpipe::fmi2::model_description::model_description_xml;
 /// `include_str!("../modelDescription.xml")`, `vrs` every constant of its `vr` module.
 #[macro_export]
 macro_rules! interface_tests {
-    (info: $info:expr, dir: $dir:expr, checked_in: $checked_in:expr, vrs: [$($vr:expr),* $(,)?] $(,)?) => {
+    (model: $model:ty, info: $info:expr, dir: $dir:expr, checked_in: $checked_in:expr, vrs: [$($vr:expr),* $(,)?] $(,)?) => {
+        #[test]
+        fn declared_dependencies_are_what_perturbations_show() {
+            let report = $crate::__jetpipe::fmi2::structure_check::check_dependencies::<$model>(1e-3);
+            assert!(report.problems.is_empty(), "{:#?}", report.problems);
+        }
+
         #[test]
         fn checked_in_model_description_is_the_generated_one() {
             $crate::testing::assert_model_description_is_current($checked_in, &$info, $dir);

@@ -2,21 +2,71 @@
 
 use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
-use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
+use jetpipe::fmi2::model::{CoSimModel, DependencyKind, ModelInfo, OutputDependencies, StepError};
 
 use crate::physics::{Inputs, Parameters, State};
 use crate::variables::{vr, UNITS, VARIABLES};
 
-/// Changes whenever the interface (variable table) changes.
-pub const GUID: &str = "{3e9a0c71-5f24-4d8b-b7c6-fingerjoint-0001}";
-
 pub static MODEL_INFO: ModelInfo = fmu_common::model_info! {
     name: "FingerJoint",
-    guid: GUID,
     description: "One-degree finger joint pulled by two antagonistic tendons over a pulley (2N drive, Utah/MIT Dextrous Hand): inertia, damping, joint stops; outputs the tendon excursions",
     units: UNITS,
     variables: VARIABLES,
+    dependencies: DEPENDENCIES,
 };
+
+/// `<ModelStructure>`: the state's outputs change only in a step; `tau_tendons` is
+/// r·(T_flexor − T_extensor) of the inputs at once (linear, its factor the fixed parameter r).
+pub const DEPENDENCIES: &[OutputDependencies] = &[
+    OutputDependencies {
+        output: vr::THETA,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::OMEGA,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::X_FLEXOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::V_FLEXOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::X_EXTENSOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::V_EXTENSOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::TAU_LIMIT,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::TAU_TENDONS,
+        step: &[
+            (vr::T_FLEXOR, DependencyKind::Fixed),
+            (vr::T_EXTENSOR, DependencyKind::Fixed),
+        ],
+        // FMI 2.0 allows only "dependent" and "constant" among InitialUnknowns.
+        initial: Some(&[
+            (vr::T_FLEXOR, DependencyKind::Dependent),
+            (vr::T_EXTENSOR, DependencyKind::Dependent),
+            (vr::R, DependencyKind::Dependent),
+        ]),
+    },
+];
 
 #[derive(Clone, Debug)]
 pub struct FingerJointFmu {
@@ -150,6 +200,7 @@ mod tests {
     use super::*;
 
     fmu_common::interface_tests! {
+        model: FingerJointFmu,
         info: MODEL_INFO,
         dir: "fmus/finger_joint",
         checked_in: include_str!("../modelDescription.xml"),

@@ -2,21 +2,48 @@
 
 use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
-use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
+use jetpipe::fmi2::model::{CoSimModel, ModelInfo, OutputDependencies, StepError};
 
 use crate::control::{Commands, Controller, Gains, Measurements};
 use crate::variables::{vr, UNITS, VARIABLES};
 
-/// Changes whenever the interface (variable table) changes.
-pub const GUID: &str = "{c41b7e02-9a6d-4f35-8c1e-jointcontroller-0001}";
-
 pub static MODEL_INFO: ModelInfo = fmu_common::model_info! {
     name: "JointController",
-    guid: GUID,
     description: "Antagonistic joint position controller with co-contraction (Jacobsen et al.) for two jet-pipe actuators: PID on the angle, tension distribution keeping both tendons above T_min, force loops with inverse static feedforward; sampled at the communication step",
     units: UNITS,
     variables: VARIABLES,
+    dependencies: DEPENDENCIES,
 };
+
+/// `<ModelStructure>`: the controller samples its inputs once per step, so no output follows a new input
+/// before the next step; after initialisation the outputs depend on all inputs and parameters.
+pub const DEPENDENCIES: &[OutputDependencies] = &[
+    OutputDependencies {
+        output: vr::V_DA_FLEXOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::V_DA_EXTENSOR,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::T_FLEXOR_REF,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::T_EXTENSOR_REF,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::TAU_REF,
+        step: &[],
+        initial: None,
+    },
+];
 
 #[derive(Clone, Debug)]
 pub struct JointControllerFmu {
@@ -48,9 +75,17 @@ impl JointControllerFmu {
         Ok(g)
     }
 
+    /// The reference at the controller's own time: theta_ref plus theta_step from t_step on
+    /// (with half a nanosecond of slack for a time summed from steps).
+    fn reference(&self) -> f64 {
+        let t = self.start_time + self.elapsed;
+        let stepped = t >= self.values.get(vr::T_STEP) - 0.5e-9;
+        self.values.get(vr::THETA_REF) + if stepped { self.values.get(vr::THETA_STEP) } else { 0.0 }
+    }
+
     fn measurements(&self) -> Measurements {
         Measurements {
-            theta_ref: self.values.get(vr::THETA_REF),
+            theta_ref: self.reference(),
             theta: self.values.get(vr::THETA),
             omega: self.values.get(vr::OMEGA),
             f_flexor: self.values.get(vr::F_FLEXOR),
@@ -170,6 +205,7 @@ mod tests {
     use crate::control::{static_command, STATIC_FORCE_MAP};
 
     fmu_common::interface_tests! {
+        model: JointControllerFmu,
         info: MODEL_INFO,
         dir: "fmus/joint_controller",
         checked_in: include_str!("../modelDescription.xml"),
@@ -177,7 +213,7 @@ mod tests {
             vr::THETA_REF, vr::THETA, vr::OMEGA, vr::F_FLEXOR, vr::F_EXTENSOR,
             vr::V_DA_FLEXOR, vr::V_DA_EXTENSOR, vr::T_FLEXOR_REF, vr::T_EXTENSOR_REF, vr::TAU_REF,
             vr::R, vr::T_CO, vr::T_MIN, vr::T_MAX, vr::KP, vr::KI, vr::KD, vr::TAU_I_MAX, vr::K_F, vr::K_FF,
-            vr::V_MIN, vr::V_MAX,
+            vr::V_MIN, vr::V_MAX, vr::THETA_STEP, vr::T_STEP,
         ],
     }
 
@@ -250,5 +286,32 @@ mod tests {
             b.get_real(vr::V_DA_FLEXOR).unwrap().to_bits()
         );
         assert!(b.deserialize(&bytes[..bytes.len() - 2]).is_err());
+    }
+
+    /// theta_step acts exactly like a theta_ref that steps at t_step: from the first step that
+    /// starts at t_step on (t summed from 1 ms steps), and not before.
+    #[test]
+    fn the_reference_step_is_theta_ref_stepping_at_t_step() {
+        let mut stepped = JointControllerFmu::instantiate();
+        stepped.set_real(vr::THETA_STEP, 0.5).unwrap();
+        stepped.set_real(vr::T_STEP, 0.01).unwrap();
+        stepped.exit_initialization().unwrap();
+        let mut driven = JointControllerFmu::instantiate();
+        driven.exit_initialization().unwrap();
+        let mut t = 0.0;
+        for k in 0..20 {
+            if k == 10 {
+                driven.set_real(vr::THETA_REF, 0.5).unwrap();
+            }
+            stepped.do_step(t, 1e-3).unwrap();
+            driven.do_step(t, 1e-3).unwrap();
+            t += 1e-3;
+            let (a, b) = (
+                stepped.get_real(vr::TAU_REF).unwrap(),
+                driven.get_real(vr::TAU_REF).unwrap(),
+            );
+            assert_eq!(a, b, "step {k}");
+            assert_eq!(a > 0.0, k >= 10, "step {k}: tau_ref {a}");
+        }
     }
 }

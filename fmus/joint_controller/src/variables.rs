@@ -30,6 +30,8 @@ pub mod vr {
     pub const K_FF: u32 = 109;
     pub const V_MIN: u32 = 110;
     pub const V_MAX: u32 = 111;
+    pub const THETA_STEP: u32 = 120;
+    pub const T_STEP: u32 = 121;
 }
 
 pub const UNITS: &[UnitDefinition] = &[
@@ -44,6 +46,7 @@ pub const UNITS: &[UnitDefinition] = &[
     units::N_M_S_PER_RAD,
     units::V_PER_N,
     units::ONE,
+    units::S,
 ];
 
 pub const VARIABLES: &[Variable] = &[
@@ -187,4 +190,20 @@ pub const VARIABLES: &[Variable] = &[
     ),
     parameter("v_min", vr::V_MIN, "V", -10.0, ANY, "lower limit of the D/A command"),
     parameter("v_max", vr::V_MAX, "V", 10.0, ANY, "upper limit of the D/A command"),
+    parameter(
+        "theta_step",
+        vr::THETA_STEP,
+        "rad",
+        0.0,
+        ANY,
+        "a step added to theta_ref from t_step on (0: none), for masters that cannot drive an input",
+    ),
+    parameter(
+        "t_step",
+        vr::T_STEP,
+        "s",
+        0.0,
+        ANY,
+        "time of the theta_step (the first step that starts at or after it sees it)",
+    ),
 ];

@@ -2,21 +2,58 @@
 
 use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
-use jetpipe::fmi2::model::{CoSimModel, ModelInfo, StepError};
+use jetpipe::fmi2::model::{CoSimModel, ModelInfo, OutputDependencies, StepError};
 
 use crate::physics::{JointEnd, Parameters, State};
 use crate::variables::{vr, UNITS, VARIABLES};
 
-/// Changes whenever the interface (variable table) changes.
-pub const GUID: &str = "{8d3f52a4-1c7e-4b0a-9e21-tendon-0001}";
-
 pub static MODEL_INFO: ModelInfo = fmu_common::model_info! {
     name: "Tendon",
-    guid: GUID,
     description: "Tendon of a 2N tendon drive (Utah/MIT Dextrous Hand): rod mass at the actuator end, elastic tendon that goes slack instead of pushing, capstan friction of the pulleys; outputs the actuator's stopper position",
     units: UNITS,
     variables: VARIABLES,
+    dependencies: DEPENDENCIES,
 };
+
+/// `<ModelStructure>`: every output comes from the state at the end of the last step (no direct feedthrough);
+/// after initialisation it is the static rest state of the inputs, which depends on all of them.
+pub const DEPENDENCIES: &[OutputDependencies] = &[
+    OutputDependencies {
+        output: vr::T,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::T_ROD,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::X_S,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::V_ROD,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::STRETCH,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::SLACK_TIME,
+        step: &[],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::SLACK,
+        step: &[],
+        initial: None,
+    },
+];
 
 #[derive(Clone, Debug)]
 pub struct TendonFmu {
@@ -173,6 +210,7 @@ mod tests {
     use super::*;
 
     fmu_common::interface_tests! {
+        model: TendonFmu,
         info: MODEL_INFO,
         dir: "fmus/tendon",
         checked_in: include_str!("../modelDescription.xml"),
