@@ -117,6 +117,9 @@ pub enum Mechanism {
     CommandLag,
     /// The command the current driver sees saturates at ± this (V).
     CommandLimit,
+    /// A cubic term on the static curve's input: the tip force k_m i, and so (the current
+    /// driver being linear and fast) the command, bent by this times (v / 10 V)³.
+    InputCubic,
     /// The current saturates at ± this (A): the command clipped where k_cd v + i_offset
     /// reaches it (the current driver is linear, so the two are the same).
     CurrentLimit,
@@ -364,6 +367,24 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             None,
             vec![
                 offset("x_jp_offset", "m", 2e-6, -1e-3, 1e-3),
+                p("x_jp_sat", "m", 0.01, 1e-5, 5e-3),
+            ],
+        ),
+        c(
+            "jet pipe static curve",
+            "jet_pipe",
+            "nonlinearity",
+            None,
+            vec![
+                Term {
+                    name: "f3_input_cubic",
+                    unit: "V",
+                    mechanism: Mechanism::InputCubic,
+                    neutral: 0.0,
+                    step: 0.05,
+                    lower: -5.0,
+                    upper: 5.0,
+                },
                 p("x_jp_sat", "m", 0.01, 1e-5, 5e-3),
             ],
         ),
@@ -720,21 +741,33 @@ impl<'a> Problem<'a> {
         let mut limit = f64::INFINITY;
         let mut command_limit = f64::INFINITY;
         let mut slew = f64::INFINITY;
+        let mut cubic = 0.0;
         for (term, &value) in terms.iter().zip(values) {
             match term.mechanism {
                 Mechanism::Parameter(name) => set_parameter(&mut p, name, value)?,
                 Mechanism::CommandLag => lag = value,
                 Mechanism::CurrentLimit => limit = value,
                 Mechanism::CommandLimit => command_limit = value,
+                Mechanism::InputCubic => cubic = value,
                 Mechanism::CurrentSlewLimit => slew = value,
                 _ => {}
             }
         }
         let model = Actuator::new(p)?;
-        if lag == 0.0 && limit == f64::INFINITY && command_limit == f64::INFINITY && slew == f64::INFINITY {
+        if lag == 0.0
+            && limit == f64::INFINITY
+            && command_limit == f64::INFINITY
+            && slew == f64::INFINITY
+            && cubic == 0.0
+        {
             return replay_fast(&model, self.recording, self.recording.len());
         }
         let mut shaped = self.recording.clone();
+        if cubic != 0.0 {
+            for v in shaped.v_da.iter_mut() {
+                *v += cubic * (*v / 10.0).powi(3);
+            }
+        }
         if command_limit.is_finite() {
             for v in shaped.v_da.iter_mut() {
                 *v = v.clamp(-command_limit, command_limit);
@@ -957,7 +990,7 @@ impl Problem<'_> {
             for (j, term) in terms.iter().enumerate() {
                 let column = match term.mechanism {
                     Mechanism::Parameter(name) if iteration == 0 => shared(name),
-                    Mechanism::Parameter(_) | Mechanism::CommandLag => {
+                    Mechanism::Parameter(_) | Mechanism::CommandLag | Mechanism::InputCubic => {
                         let mut moved = point.values.clone();
                         let step = if moved[j] + term.step <= term.upper {
                             term.step
