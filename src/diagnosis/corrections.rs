@@ -21,7 +21,7 @@ use crate::recording::Recording;
 use crate::replay::{replay_fast, Replay};
 use crate::variables::VARIABLES;
 
-use super::signals::{rate, stopper_velocity, CHANNELS, FORCE, P1, P2};
+use super::signals::{difference, stopper_velocity, CHANNELS, FORCE, P1, P2};
 
 /// A signal that a measured channel may carry in proportion to a coefficient.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,8 +31,6 @@ pub enum Regressor {
     Own,
     OwnSquared,
     OwnCubed,
-    /// Time derivative of the channel (−τ times it is a first-order lag of τ).
-    OwnRate,
     /// −sign(dx_s/dt) where the pressures set the force: Coulomb friction.
     Friction,
     /// −dx_s/dt where the pressures set the force: viscous friction.
@@ -807,7 +805,7 @@ impl<'a> Problem<'a> {
         replay_fast(&model, &shaped, shaped.len())
     }
 
-    fn regressor(&self, regressor: Regressor, own: &[f64], own_rate: &[f64], floor: &[bool], k: usize) -> f64 {
+    fn regressor(&self, regressor: Regressor, own: &[f64], floor: &[bool], k: usize) -> f64 {
         let t = self.recording.time[k];
         let v = self.velocity[k];
         let set_by_pressures = !floor[k];
@@ -816,7 +814,6 @@ impl<'a> Problem<'a> {
             Regressor::Own => own[k],
             Regressor::OwnSquared => own[k] * own[k],
             Regressor::OwnCubed => own[k] * own[k] * own[k],
-            Regressor::OwnRate => -own_rate[k],
             Regressor::Friction if set_by_pressures && v.abs() > 1e-9 => -v.signum(),
             Regressor::Viscous if set_by_pressures => -v,
             Regressor::Position if set_by_pressures => -(self.recording.x_s[k] - self.mean_position),
@@ -874,6 +871,7 @@ impl Problem<'_> {
         let r = &point.replay;
         let mut out = [r.force.clone(), r.p1.clone(), r.p2.clone()];
         let n = self.recording.len();
+        let mut floor: Option<Vec<bool>> = None;
         for (j, (term, &value)) in terms.iter().zip(&point.values).enumerate() {
             if value == 0.0 {
                 continue;
@@ -881,14 +879,9 @@ impl Problem<'_> {
             match term.mechanism {
                 Mechanism::Output { channel, regressor } => {
                     let own = [&r.force, &r.p1, &r.p2][channel];
-                    let own_rate = if regressor == Regressor::OwnRate {
-                        rate(&self.recording.time, own, 2)
-                    } else {
-                        vec![]
-                    };
-                    let floor = self.floor(r);
+                    let floor = floor.get_or_insert_with(|| self.floor(r));
                     for k in 0..n {
-                        out[channel][k] += value * self.regressor(regressor, own, &own_rate, &floor, k);
+                        out[channel][k] += value * self.regressor(regressor, own, floor, k);
                     }
                 }
                 Mechanism::Modulated { modulation, .. } => {
@@ -1271,8 +1264,4 @@ fn bounded_least_squares(ata: &[Vec<f64>], atb: &[f64], usable: &[bool], lower: 
         }
     }
     x
-}
-
-fn difference(a: &[f64], b: &[f64]) -> Vec<f64> {
-    a.iter().zip(b).map(|(x, y)| x - y).collect()
 }

@@ -13,20 +13,6 @@ pub const P2: usize = 2;
 pub const CHANNELS: usize = 3;
 pub const CHANNEL_NAMES: [&str; CHANNELS] = ["force", "p1", "p2"];
 
-/// A model's prediction of the measured channels.
-#[derive(Clone, Debug)]
-pub struct Prediction {
-    pub channels: [Vec<f64>; CHANNELS],
-}
-
-impl Prediction {
-    pub fn of(replay: &Replay) -> Self {
-        Self {
-            channels: [replay.force.clone(), replay.p1.clone(), replay.p2.clone()],
-        }
-    }
-}
-
 /// Stopper velocity as the replays see it at sample k: the slope of the interval that
 /// ends there (zero at the first sample).
 pub fn stopper_velocity(recording: &Recording) -> Vec<f64> {
