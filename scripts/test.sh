@@ -13,6 +13,8 @@ run() {
 run cargo test --release
 run bash scripts/build_win64.sh
 JETPIPE_WIN64=1 run bash scripts/package.sh
+# The host build, linked against this machine's glibc: the platform test's counter-example.
+run cargo build --release --lib
 if [ ! -f dist/JetPipeActuator.fmu ]; then
     echo "test.sh: dist/JetPipeActuator.fmu was not written" >&2
     exit 1
