@@ -850,20 +850,15 @@ pub fn diagnose_with(
                 }
             )
         };
-        if explained {
+        let (sentence, signature) = if explained {
             let s = split.as_ref().expect("pressures_off needs the split");
             let worse = if s.pressure_ratio[0] >= s.pressure_ratio[1] { 0 } else { 1 };
             let measured = if worse == 0 { &recording.p1 } else { &recording.p2 };
             let modelled = if worse == 0 { &after.p1 } else { &after.p2 };
             let residual = difference(measured.as_ref().expect("pressures"), modelled);
             let signature = Signature::of(&recording.time, &residual, &chain, "Pa");
-            return Unexplained {
-                rms: after_errors.heldout_rms,
-                ratio_to_noise: ratio,
-                location,
-                family,
-                alternatives,
-                sentence: format!(
+            (
+                format!(
                     "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's by {:.0} and {:.0} Pa RMS ({:.1}× and {:.1}× their noise); {place}. Chamber {}: {}",
                     after_errors.heldout_rms,
                     s.pressure_rms[0],
@@ -874,19 +869,24 @@ pub fn diagnose_with(
                     signature.sentence
                 ),
                 signature,
-            };
-        }
+            )
+        } else {
+            (
+                format!(
+                    "A held-out force error of {:.4} N ({ratio:.1}× the noise floor) stays; {place}. {}",
+                    after_errors.heldout_rms, remainder.sentence
+                ),
+                remainder.clone(),
+            )
+        };
         Unexplained {
             rms: after_errors.heldout_rms,
             ratio_to_noise: ratio,
             location,
             family,
             alternatives,
-            sentence: format!(
-                "A held-out force error of {:.4} N ({ratio:.1}× the noise floor) stays; {place}. {}",
-                after_errors.heldout_rms, remainder.sentence
-            ),
-            signature: remainder.clone(),
+            sentence,
+            signature,
         }
     });
     let heldout_residual: Vec<f64> = after_residual
