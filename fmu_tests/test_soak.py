@@ -26,7 +26,7 @@ X_LO, X_HI = 0.035, 0.085  # stopper range used (valid 0.026 < x_s < 0.096)
 
 def volumes(x_s, p):
     A_p = math.pi * p["D_cyl"] ** 2 / 4
-    # from the README: V1 = A_p (x_s - 0.026), V2 = A_p (0.070 - (x_s - 0.026)) with the defaults
+    # from docs/model.md (Chambers): V1 = A_p (x_s - 0.026), V2 = A_p (0.070 - (x_s - 0.026)) with the defaults
     lo = p["L_s"] + p["L_p"] + p["L_sup"]  # 0.026 m: the stopper's lower limit
     stroke = p["L_cyl"] - p["L_p"]  # 0.070 m
     return A_p * (x_s - lo), A_p * (stroke - (x_s - lo))
