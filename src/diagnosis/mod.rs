@@ -70,11 +70,6 @@ pub struct Errors {
     pub heldout_rms: f64,
 }
 
-/// The sensor noise of a recorded channel (see [`noise`]).
-pub fn noise_floor(x: &[f64]) -> f64 {
-    noise::noise_floor(x)
-}
-
 /// Training samples: those in even-numbered blocks.
 pub fn training_mask(time: &[f64]) -> Vec<bool> {
     let t0 = time.first().copied().unwrap_or(0.0);

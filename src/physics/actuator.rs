@@ -150,7 +150,9 @@ impl Actuator {
         let k = &self.flow;
         let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
         // The orifices of each port see the chamber's pressure, or, through a port
-        // restriction, a pressure between it and the flow's source.
+        // restriction, a pressure between it and the flow's source. That pressure is found
+        // with the nominal supply and return pressures: a port restriction together with a
+        // supply or return line resistance is approximated, not solved jointly.
         let port =
             |chamber: f64, resistance: f64, cd_supply: f64, supply_area: f64, cd_return: f64, return_area: f64| {
                 effects::port_pressure(chamber, resistance, p.p_s, p.p_r, |q| {
