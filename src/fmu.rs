@@ -3,7 +3,9 @@
 
 use crate::fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
 use crate::physics::actuator::{index, Actuator, State, N_STATES};
+use crate::physics::command_stage::CommandStage;
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::force_sensor::SensorMemory;
 use crate::physics::parameters::{variable_name, Parameters};
 use crate::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 use crate::variables::{vr, UNITS, VARIABLES};
@@ -108,7 +110,14 @@ pub const DEPENDENCIES: &[OutputDependencies] = &[
     OutputDependencies {
         output: vr::I,
         step: &[],
-        initial: Some(&[(vr::V_DA, DEPENDS), (vr::K_CD, DEPENDS), (vr::I_OFFSET, DEPENDS)]),
+        initial: Some(&[
+            (vr::V_DA, DEPENDS),
+            (vr::K_CD, DEPENDS),
+            (vr::I_OFFSET, DEPENDS),
+            (vr::COMMAND_LIMIT, DEPENDS),
+            (vr::CURRENT_LIMIT, DEPENDS),
+            (vr::F3_INPUT_CUBIC, DEPENDS),
+        ]),
     },
     OutputDependencies {
         output: vr::X_JP,
@@ -117,6 +126,9 @@ pub const DEPENDENCIES: &[OutputDependencies] = &[
             (vr::V_DA, DEPENDS),
             (vr::K_CD, DEPENDS),
             (vr::I_OFFSET, DEPENDS),
+            (vr::COMMAND_LIMIT, DEPENDS),
+            (vr::CURRENT_LIMIT, DEPENDS),
+            (vr::F3_INPUT_CUBIC, DEPENDS),
             (vr::K_M, DEPENDS),
             (vr::X_JP_SAT, DEPENDS),
             (vr::F_JP_SAT, DEPENDS),
@@ -467,6 +479,14 @@ impl CoSimModel for ActuatorFmu {
                     w.f64(change.v_da);
                     w.f64(change.rate);
                 }
+                for v in s.command_stage.to_values() {
+                    w.f64(v);
+                }
+                let sensor = s.force_sensor.as_ref().map(|m| m.to_values()).unwrap_or_default();
+                w.u32(sensor.len() as u32);
+                for v in sensor {
+                    w.f64(v);
+                }
                 let st = &s.statistics;
                 for v in [
                     st.steps,
@@ -546,7 +566,27 @@ impl CoSimModel for ActuatorFmu {
                     rate: r.f64()?,
                 });
             }
+            let mut stage = [0.0; 3];
+            for v in stage.iter_mut() {
+                *v = r.f64()?;
+            }
+            let sensor_values = r.u32()? as usize;
+            if sensor_values > bytes.len() / 8 {
+                return Err(format!(
+                    "the state claims {sensor_values} force sensor values, more than its length holds"
+                ));
+            }
+            let mut sensor = Vec::with_capacity(sensor_values);
+            for _ in 0..sensor_values {
+                sensor.push(r.f64()?);
+            }
             let mut simulation = Simulation::from_state(model, state, v_da, x_s, time, rtol);
+            simulation.command_stage = CommandStage::from_values(stage);
+            simulation.force_sensor = if sensor.is_empty() {
+                None
+            } else {
+                Some(SensorMemory::from_values(&sensor).ok_or("the state's force sensor memory is malformed")?)
+            };
             simulation.v_da_rate = v_da_rate;
             simulation.x_s_rate = x_s_rate;
             simulation.integrator.next_step = next_step;
@@ -602,7 +642,7 @@ impl CoSimModel for ActuatorFmu {
 }
 
 const STATE_MAGIC: &[u8] = b"JetPipeActuatorState";
-const STATE_FORMAT_VERSION: u32 = 1;
+const STATE_FORMAT_VERSION: u32 = 2;
 
 #[derive(Default)]
 struct ByteWriter(Vec<u8>);

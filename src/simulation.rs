@@ -14,7 +14,9 @@ use crate::integrator::{
 };
 use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
+use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::current_driver;
+use crate::physics::force_sensor::{self, SensorMemory};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::orifice_geometry::OrificeAreas;
 
@@ -383,6 +385,10 @@ pub struct Simulation {
     /// Mean stopper velocity over the last step (for piston friction).
     pub stopper_velocity: f64,
     pub x_s_at_last_step: f64,
+    /// The command stage's memory (see [`crate::physics::command_stage`]).
+    pub command_stage: CommandStage,
+    /// The force sensor's memory, when it filters (see [`crate::physics::force_sensor`]).
+    pub force_sensor: Option<SensorMemory>,
     propagator: Option<ElectromechanicalPropagator>,
     /// The chambers' pressure rates at the end of the last split step, with what they are a
     /// function of: when the next step starts from the same jet pipe position, pressures and
@@ -427,6 +433,9 @@ impl Simulation {
     pub fn from_state(model: Actuator, state: State, v_da: f64, x_s: f64, time: f64, relative_tolerance: f64) -> Self {
         let propagator = ElectromechanicalPropagator::new(&model.params);
         let x_bar = model.static_jet_position(state[index::CURRENT]);
+        let command_stage = CommandStage::at_rest(&model.params, time, v_da);
+        let force_sensor = force_sensor::filters(&model.params)
+            .then(|| SensorMemory::at_rest(time, model.outputs_at(&state, x_s, 0.0, time).f_meas));
         Self {
             model,
             time,
@@ -455,13 +464,21 @@ impl Simulation {
             }],
             stopper_velocity: 0.0,
             x_s_at_last_step: x_s,
+            command_stage,
+            force_sensor,
             propagator,
             chamber_rates_at_end: None,
         }
     }
 
     pub fn outputs(&self) -> Outputs {
-        self.model.outputs(&self.state, self.x_s, self.stopper_velocity)
+        let mut y = self
+            .model
+            .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time);
+        if let Some(memory) = &self.force_sensor {
+            y.f_meas = memory.output(&self.model.params, self.time, y.f_meas);
+        }
+        y
     }
 
     pub fn set_command(&mut self, v_da: f64) -> Result<(), String> {
@@ -575,7 +592,30 @@ impl Simulation {
             })?;
         }
         let t_end = self.time + step;
-        for (duration, v, v_rate) in self.command_segments(step) {
+        // The command stage holds what the driver sees over the step (a command ramp
+        // reaches it at the next communication point).
+        let applied = self.v_da;
+        let staged = command_stage::is_active(&self.model.params);
+        if staged {
+            let seen = self.command_stage.next(&self.model.params, self.time, applied);
+            let before = self.command_history.last().map_or(f64::NAN, |c| c.v_da);
+            self.input_changed |= seen != before;
+            self.v_da = seen;
+        }
+        let rate = self.v_da_rate;
+        if staged {
+            self.v_da_rate = 0.0;
+        }
+        let segments = self.command_segments(step);
+        if staged && self.model.params.command_delay == 0.0 {
+            // command_segments keeps the history only for the delay; the stage needs the
+            // last command seen to tell a change.
+            self.command_history.truncate(1);
+            self.command_history[0].v_da = self.v_da;
+        }
+        self.v_da = applied;
+        self.v_da_rate = rate;
+        for (duration, v, v_rate) in segments {
             self.advance(duration, v, v_rate).map_err(|failure| {
                 self.v_da_rate = 0.0;
                 self.x_s_rate = 0.0;
@@ -590,6 +630,15 @@ impl Simulation {
         self.input_changed = false;
         self.stopper_velocity = (self.x_s - self.x_s_at_last_step) / step;
         self.x_s_at_last_step = self.x_s;
+        if self.force_sensor.is_some() {
+            let reading = self
+                .model
+                .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time)
+                .f_meas;
+            if let Some(memory) = &mut self.force_sensor {
+                memory.record(&self.model.params, self.time, reading);
+            }
+        }
         Ok(())
     }
 
@@ -864,7 +913,8 @@ fn check_finite(name: &str, value: f64, unit: &str) -> Result<(), String> {
 /// are set half-way between return and supply.
 pub fn equilibrium_of_electromechanics(model: &Actuator, v_da: f64) -> State {
     let p = &model.params;
-    let current = current_driver::static_current(p.k_cd, p.i_offset, v_da);
+    let seen = command_stage::static_map(p, v_da);
+    let current = current_driver::static_current(p.k_cd, p.i_offset, seen);
     let x_jp = model.static_jet_position(current);
     let mid = 0.5 * (p.p_s + p.p_r);
     State::from([current, x_jp, 0.0, 0.0, mid, mid])
@@ -886,7 +936,7 @@ pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, Strin
     let system = StepSystem {
         model,
         t0: 0.0,
-        v_da,
+        v_da: command_stage::static_map(p, v_da),
         v_da_rate: 0.0,
         x_s,
         x_s_rate: 0.0,

@@ -69,6 +69,24 @@ pub mod vr {
     pub const PORT_RESISTANCE_1: u32 = 430;
     pub const PORT_RESISTANCE_2: u32 = 431;
     pub const STOPPER_COMPLIANCE: u32 = 440;
+    pub const COMMAND_LAG: u32 = 450;
+    pub const COMMAND_LIMIT: u32 = 451;
+    pub const CURRENT_LIMIT: u32 = 452;
+    pub const CURRENT_SLEW_LIMIT: u32 = 453;
+    pub const F3_INPUT_CUBIC: u32 = 454;
+    pub const FORCE_SENSOR_QUADRATIC: u32 = 460;
+    pub const FORCE_SENSOR_CUBIC: u32 = 461;
+    pub const FORCE_SENSOR_DRIFT: u32 = 462;
+    pub const FORCE_SENSOR_LAG: u32 = 463;
+    pub const FORCE_SENSOR_DELAY: u32 = 464;
+    pub const FORCE_SENSOR_PLAY: u32 = 465;
+    pub const FORCE_SENSOR_RIPPLE_AMPLITUDE: u32 = 466;
+    pub const FORCE_SENSOR_RIPPLE_FREQUENCY: u32 = 467;
+    pub const FORCE_SENSOR_RIPPLE_PHASE: u32 = 468;
+    pub const VISCOUS_FRICTION: u32 = 470;
+    pub const POSITION_FORCE_RATE: u32 = 471;
+    pub const POSITION_FORCE_REFERENCE: u32 = 472;
+    pub const RETURN_VENT_AREA: u32 = 480;
 }
 
 pub const UNITS: &[UnitDefinition] = &[
@@ -208,6 +226,62 @@ pub const UNITS: &[UnitDefinition] = &[
         a: 0,
         k: 0,
     },
+    UnitDefinition {
+        name: "1/N",
+        kg: -1,
+        m: -1,
+        s: 2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "1/N2",
+        kg: -2,
+        m: -2,
+        s: 4,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N/s",
+        kg: 1,
+        m: 1,
+        s: -3,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Hz",
+        kg: 0,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "rad",
+        kg: 0,
+        m: 0,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N.s/m",
+        kg: 1,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "A/s",
+        kg: 0,
+        m: 0,
+        s: -1,
+        a: 1,
+        k: 0,
+    },
 ];
 
 const fn input(name: &'static str, vr: u32, unit: &'static str, start: f64, description: &'static str) -> Variable {
@@ -269,7 +343,7 @@ pub const VARIABLES: &[Variable] = &[
     output("P1", vr::P1, "Pa", "absolute pressure of chamber 1 (charging side)"),
     output("P2", vr::P2, "Pa", "absolute pressure of chamber 2 (venting side)"),
         output("i", vr::I, "A", "coil current"),
-    output("F_meas", vr::F_MEAS, "N", "force as read by a sensor with the sensor_offset_gain effect: offset + gain * F_act"),
+    output("F_meas", vr::F_MEAS, "N", "force as the force sensor reads it: F_act unless the force_sensor_* parameters give it an offset, gain, curve, drift, pick-up, delay, lag or play"),
     output(
         "x_jp",
         vr::X_JP,
@@ -413,4 +487,22 @@ pub const VARIABLES: &[Variable] = &[
     parameter("port_resistance_1", vr::PORT_RESISTANCE_1, "Pa.s/kg", 0.0, "port restriction: the orifices of port 1 see a pressure that differs from chamber 1's by this times the net flow through the port (0 = off)"),
     parameter("port_resistance_2", vr::PORT_RESISTANCE_2, "Pa.s/kg", 0.0, "port restriction: the orifices of port 2 see a pressure that differs from chamber 2's by this times the net flow through the port (0 = off)"),
     parameter("stopper_compliance", vr::STOPPER_COMPLIANCE, "m/N", 0.0, "compliance between stopper and piston: the piston sits this times A_p (P1 - P2) beyond the stopper, which moves the chamber volumes (0 = rigid)"),
+    parameter("command_lag", vr::COMMAND_LAG, "s", 0.0, "command dynamics: the current driver sees v_DA through a first-order lag of this time constant, updated at each communication point with the command held over the step (0 = off)"),
+    parameter("command_limit", vr::COMMAND_LIMIT, "V", 0.0, "command limit: the command the current driver sees saturates at plus or minus this (0 = off)"),
+    parameter("current_limit", vr::CURRENT_LIMIT, "A", 0.0, "current limit: the coil current saturates at plus or minus this, applied to the command through k_cd and i_offset (0 = off)"),
+    parameter("current_slew_limit", vr::CURRENT_SLEW_LIMIT, "A/s", 0.0, "current slew limit: the held command changes by at most this over k_cd per second between communication points (0 = off)"),
+    parameter("f3_input_cubic", vr::F3_INPUT_CUBIC, "V", 0.0, "jet pipe static curve: the command reaching f3 is bent by this times (v_DA / 10 V)^3 (0 = off)"),
+    parameter("force_sensor_quadratic", vr::FORCE_SENSOR_QUADRATIC, "1/N", 0.0, "force sensor curve: F_meas gains this times F_act^2 (0 = off)"),
+    parameter("force_sensor_cubic", vr::FORCE_SENSOR_CUBIC, "1/N2", 0.0, "force sensor curve: F_meas gains this times F_act^3 (0 = off)"),
+    parameter("force_sensor_drift", vr::FORCE_SENSOR_DRIFT, "N/s", 0.0, "force sensor drift: F_meas gains this times the time (0 = off)"),
+    parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading held between communication points (0 = off)"),
+    parameter("force_sensor_delay", vr::FORCE_SENSOR_DELAY, "s", 0.0, "force sensor delay: F_meas is the reading this long ago, interpolated between communication points (0 = off)"),
+    parameter("force_sensor_play", vr::FORCE_SENSOR_PLAY, "N", 0.0, "force sensor hysteresis: F_meas stays within half this of the reading, moving only when pushed (a play operator; 0 = off)"),
+    parameter("force_sensor_ripple_amplitude", vr::FORCE_SENSOR_RIPPLE_AMPLITUDE, "N", 0.0, "force sensor pick-up: F_meas gains this times sin(2 pi f t + phase) (0 = off)"),
+    parameter("force_sensor_ripple_frequency", vr::FORCE_SENSOR_RIPPLE_FREQUENCY, "Hz", 0.0, "force sensor pick-up: its frequency f"),
+    parameter("force_sensor_ripple_phase", vr::FORCE_SENSOR_RIPPLE_PHASE, "rad", 0.0, "force sensor pick-up: its phase at t = 0"),
+    parameter("viscous_friction", vr::VISCOUS_FRICTION, "N.s/m", 0.0, "viscous friction: a force of this times the stopper velocity opposes the motion where the pressures set the force (0 = off)"),
+    parameter("position_force_rate", vr::POSITION_FORCE_RATE, "N/m", 0.0, "a force of this times (x_s - position_force_reference) opposes the stopper position where the pressures set the force (0 = off)"),
+    parameter("position_force_reference", vr::POSITION_FORCE_REFERENCE, "m", 0.054, "where the position_force vanishes"),
+    parameter("return_vent_area", vr::RETURN_VENT_AREA, "m2", 0.0, "return restriction: the return orifices vent into a plenum that empties to P_r through an orifice of this discharge coefficient times area, (2.18) (0 = off: the return orifices see P_r)"),
 ];

@@ -10,7 +10,7 @@ use super::effects::{self, PrandtlIshlinskii, PLAY_OPERATORS};
 use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
-use super::{current_driver, jet_pipe, piston};
+use super::{current_driver, force_sensor, jet_pipe, piston};
 
 pub const N_STATES: usize = 6;
 pub type State = SVector<f64, N_STATES>;
@@ -179,10 +179,17 @@ impl Actuator {
                 mass_flow(k, cd_r2 * a.return_2, p2, p_return),
             )
         };
-        let p_return = effects::return_pressure_at_vent(p.p_r, p.return_resistance, p1.max(p2), |pr| {
-            let (r1, r2) = returns(pr);
-            r1 + r2
-        });
+        let p_return = if p.return_vent_area > 0.0 {
+            effects::return_pressure_at_vent_orifice(p.p_r, p1.max(p2), |pr| {
+                let (r1, r2) = returns(pr);
+                (r1 + r2, mass_flow(k, p.return_vent_area, pr, p.p_r))
+            })
+        } else {
+            effects::return_pressure_at_vent(p.p_r, p.return_resistance, p1.max(p2), |pr| {
+                let (r1, r2) = returns(pr);
+                r1 + r2
+            })
+        };
         let (return_1, return_2) = returns(p_return);
         let (vent_1, vent_2) = if p.chamber_vent_1 == 0.0 && p.chamber_vent_2 == 0.0 {
             (0.0, 0.0)
@@ -351,19 +358,40 @@ impl Actuator {
 
     /// Outputs for a state; `stopper_velocity` only matters with the piston_friction effect.
     pub fn outputs(&self, y: &State, x_s: f64, stopper_velocity: f64) -> Outputs {
+        self.outputs_at(y, x_s, stopper_velocity, 0.0)
+    }
+
+    /// The outputs at time `time` (the force sensor's drift and pick-up depend on it; its
+    /// filters are the caller's: see [`super::force_sensor::SensorMemory`]).
+    pub fn outputs_at(&self, y: &State, x_s: f64, stopper_velocity: f64, time: f64) -> Outputs {
         use index::*;
         let p = &self.params;
         let pressure_force = piston::pressure_force(self.piston_area, y[P1], y[P2])
-            - effects::friction_force(p.friction_coulomb, stopper_velocity);
+            - effects::friction_force(p.friction_coulomb, stopper_velocity)
+            - self.extra_piston_force(x_s, stopper_velocity);
         let f_act = piston::actuator_force(pressure_force, self.spring_force(x_s));
         Outputs {
             f_act,
-            f_meas: effects::sensor_reading(p.force_sensor_offset, p.force_sensor_gain, f_act),
+            f_meas: force_sensor::static_reading(p, f_act, time),
             p1: y[P1],
             p2: y[P2],
             current: y[CURRENT],
             x_jp: y[JET_POSITION],
         }
+    }
+
+    /// Forces on the piston beyond the thesis's (2.33)–(2.38) and Coulomb friction: viscous
+    /// friction and a force on the stopper position (off by default).
+    fn extra_piston_force(&self, x_s: f64, stopper_velocity: f64) -> f64 {
+        let p = &self.params;
+        let mut f = 0.0;
+        if p.viscous_friction != 0.0 {
+            f += p.viscous_friction * stopper_velocity;
+        }
+        if p.position_force_rate != 0.0 {
+            f += p.position_force_rate * (x_s - p.position_force_reference);
+        }
+        f
     }
 
     /// Per-state scales used for absolute tolerances: a current of 0.1 A, a tip

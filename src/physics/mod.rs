@@ -10,13 +10,17 @@
 //! | orifice and leakage flow | [`orifice_flow`] | (2.18)–(2.23) |
 //! | chambers | [`chambers`] | (2.24)–(2.32) |
 //! | piston force and spring | [`piston`] | (2.36)–(2.38) |
-//! | effects the thesis model lacks (off by default) | [`effects`] | MODEL.md |
+//! | effects the thesis model lacks (off by default) | [`effects`] | docs/model.md |
+//! | the command as the current driver sees it (off by default) | [`command_stage`] | (2.1) |
+//! | what the force sensor reads | [`force_sensor`] | docs/model.md |
 //! | the assembled six-state model | [`actuator`] | (4.1) |
 
 pub mod actuator;
 pub mod chambers;
+pub mod command_stage;
 pub mod current_driver;
 pub mod effects;
+pub mod force_sensor;
 pub mod jet_pipe;
 pub mod orifice_flow;
 pub mod orifice_geometry;

@@ -56,6 +56,24 @@ pub struct Parameters {
     pub port_resistance_1: f64,
     pub port_resistance_2: f64,
     pub stopper_compliance: f64,
+    pub command_lag: f64,
+    pub command_limit: f64,
+    pub current_limit: f64,
+    pub current_slew_limit: f64,
+    pub f3_input_cubic: f64,
+    pub force_sensor_quadratic: f64,
+    pub force_sensor_cubic: f64,
+    pub force_sensor_drift: f64,
+    pub force_sensor_lag: f64,
+    pub force_sensor_delay: f64,
+    pub force_sensor_play: f64,
+    pub force_sensor_ripple_amplitude: f64,
+    pub force_sensor_ripple_frequency: f64,
+    pub force_sensor_ripple_phase: f64,
+    pub viscous_friction: f64,
+    pub position_force_rate: f64,
+    pub position_force_reference: f64,
+    pub return_vent_area: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -117,6 +135,24 @@ impl Default for Parameters {
             port_resistance_1: 0.0,
             port_resistance_2: 0.0,
             stopper_compliance: 0.0,
+            command_lag: 0.0,
+            command_limit: 0.0,
+            current_limit: 0.0,
+            current_slew_limit: 0.0,
+            f3_input_cubic: 0.0,
+            force_sensor_quadratic: 0.0,
+            force_sensor_cubic: 0.0,
+            force_sensor_drift: 0.0,
+            force_sensor_lag: 0.0,
+            force_sensor_delay: 0.0,
+            force_sensor_play: 0.0,
+            force_sensor_ripple_amplitude: 0.0,
+            force_sensor_ripple_frequency: 0.0,
+            force_sensor_ripple_phase: 0.0,
+            viscous_friction: 0.0,
+            position_force_rate: 0.0,
+            position_force_reference: 0.0,
+            return_vent_area: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -184,6 +220,24 @@ impl Parameters {
         vr::PORT_RESISTANCE_1,
         vr::PORT_RESISTANCE_2,
         vr::STOPPER_COMPLIANCE,
+        vr::COMMAND_LAG,
+        vr::COMMAND_LIMIT,
+        vr::CURRENT_LIMIT,
+        vr::CURRENT_SLEW_LIMIT,
+        vr::F3_INPUT_CUBIC,
+        vr::FORCE_SENSOR_QUADRATIC,
+        vr::FORCE_SENSOR_CUBIC,
+        vr::FORCE_SENSOR_DRIFT,
+        vr::FORCE_SENSOR_LAG,
+        vr::FORCE_SENSOR_DELAY,
+        vr::FORCE_SENSOR_PLAY,
+        vr::FORCE_SENSOR_RIPPLE_AMPLITUDE,
+        vr::FORCE_SENSOR_RIPPLE_FREQUENCY,
+        vr::FORCE_SENSOR_RIPPLE_PHASE,
+        vr::VISCOUS_FRICTION,
+        vr::POSITION_FORCE_RATE,
+        vr::POSITION_FORCE_REFERENCE,
+        vr::RETURN_VENT_AREA,
     ];
 
     fn field_and_bound(&mut self, value_reference: u32) -> Option<(&mut f64, Bound)> {
@@ -235,6 +289,24 @@ impl Parameters {
             vr::PORT_RESISTANCE_1 => (&mut self.port_resistance_1, NonNegative),
             vr::PORT_RESISTANCE_2 => (&mut self.port_resistance_2, NonNegative),
             vr::STOPPER_COMPLIANCE => (&mut self.stopper_compliance, NonNegative),
+            vr::COMMAND_LAG => (&mut self.command_lag, NonNegative),
+            vr::COMMAND_LIMIT => (&mut self.command_limit, NonNegative),
+            vr::CURRENT_LIMIT => (&mut self.current_limit, NonNegative),
+            vr::CURRENT_SLEW_LIMIT => (&mut self.current_slew_limit, NonNegative),
+            vr::F3_INPUT_CUBIC => (&mut self.f3_input_cubic, Finite),
+            vr::FORCE_SENSOR_QUADRATIC => (&mut self.force_sensor_quadratic, Finite),
+            vr::FORCE_SENSOR_CUBIC => (&mut self.force_sensor_cubic, Finite),
+            vr::FORCE_SENSOR_DRIFT => (&mut self.force_sensor_drift, Finite),
+            vr::FORCE_SENSOR_LAG => (&mut self.force_sensor_lag, NonNegative),
+            vr::FORCE_SENSOR_DELAY => (&mut self.force_sensor_delay, NonNegative),
+            vr::FORCE_SENSOR_PLAY => (&mut self.force_sensor_play, NonNegative),
+            vr::FORCE_SENSOR_RIPPLE_AMPLITUDE => (&mut self.force_sensor_ripple_amplitude, Finite),
+            vr::FORCE_SENSOR_RIPPLE_FREQUENCY => (&mut self.force_sensor_ripple_frequency, NonNegative),
+            vr::FORCE_SENSOR_RIPPLE_PHASE => (&mut self.force_sensor_ripple_phase, Finite),
+            vr::VISCOUS_FRICTION => (&mut self.viscous_friction, NonNegative),
+            vr::POSITION_FORCE_RATE => (&mut self.position_force_rate, Finite),
+            vr::POSITION_FORCE_REFERENCE => (&mut self.position_force_reference, Finite),
+            vr::RETURN_VENT_AREA => (&mut self.return_vent_area, NonNegative),
             _ => return None,
         })
     }
@@ -297,6 +369,12 @@ impl Parameters {
             return Err(format!(
                 "hysteresis_deadband = {} m is invalid: must not exceed hysteresis_width = {} m",
                 self.hysteresis_deadband, self.hysteresis_width
+            ));
+        }
+        if self.return_resistance > 0.0 && self.return_vent_area > 0.0 {
+            return Err(format!(
+                "return_resistance = {} Pa.s/kg and return_vent_area = {} m2 are both set: they are two laws of the same return restriction, set one",
+                self.return_resistance, self.return_vent_area
             ));
         }
         if self.l_cyl <= self.l_p {

@@ -1,0 +1,165 @@
+//! What the current driver sees of the D/A command when the command stage departs from
+//! the thesis's ideal D/A (all off by default, and then it sees v_DA itself):
+//!
+//! | parameter | law |
+//! |---|---|
+//! | `f3_input_cubic` (V) | v + c (v / 10 V)³: a static curve before f3 (the current driver is linear and fast, so a curve on the tip force k_m i is the same as one on the command) |
+//! | `command_limit` (V) | clipped at ± the limit |
+//! | `current_limit` (A) | clipped where k_cd v + i_offset reaches ± the limit, (2.1) |
+//! | `current_slew_limit` (A/s) | between communication points the held command moves by at most the limit / k_cd per second |
+//! | `command_lag` (s) | a first-order lag, exact for the command held between communication points |
+//!
+//! The slew limit and the lag act on the command as it is held between communication
+//! points (a sampled D/A stage): the FMU stepped at a recording's sample times and the
+//! replay of that recording see the same command.
+
+use super::parameters::Parameters;
+
+/// Whether any term of the command stage is on.
+pub fn is_active(p: &Parameters) -> bool {
+    p.f3_input_cubic != 0.0
+        || p.command_limit > 0.0
+        || p.current_limit > 0.0
+        || p.current_slew_limit > 0.0
+        || p.command_lag > 0.0
+}
+
+/// The static part of the stage: the cubic, then the command and current limits.
+pub fn static_map(p: &Parameters, v_da: f64) -> f64 {
+    let mut v = v_da;
+    if p.f3_input_cubic != 0.0 {
+        v += p.f3_input_cubic * (v / 10.0).powi(3);
+    }
+    if p.command_limit > 0.0 {
+        v = v.clamp(-p.command_limit, p.command_limit);
+    }
+    if p.current_limit > 0.0 && p.k_cd != 0.0 {
+        let (a, b) = (
+            (-p.current_limit - p.i_offset) / p.k_cd,
+            (p.current_limit - p.i_offset) / p.k_cd,
+        );
+        v = v.clamp(a.min(b), a.max(b));
+    }
+    v
+}
+
+/// The stage's memory between communication points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommandStage {
+    /// Time of the last communication point.
+    time: f64,
+    /// The slew-limited command held since then.
+    held: f64,
+    /// The lag's output at that time.
+    lagged: f64,
+}
+
+impl CommandStage {
+    /// At rest at time `time` with the command `v_da` held since long before.
+    pub fn at_rest(p: &Parameters, time: f64, v_da: f64) -> Self {
+        let v = static_map(p, v_da);
+        Self {
+            time,
+            held: v,
+            lagged: v,
+        }
+    }
+
+    /// The command the current driver sees from `time` on, with `v_da` applied at `time`
+    /// (times never decrease).
+    pub fn next(&mut self, p: &Parameters, time: f64, v_da: f64) -> f64 {
+        let dt = (time - self.time).max(0.0);
+        let v = static_map(p, v_da);
+        if p.command_lag > 0.0 {
+            // The lag integrated over the last interval, with its input held there.
+            self.lagged += (1.0 - (-dt / p.command_lag).exp()) * (self.held - self.lagged);
+        }
+        self.held = if p.current_slew_limit > 0.0 && p.k_cd != 0.0 {
+            let most = p.current_slew_limit / p.k_cd.abs() * dt;
+            self.held + (v - self.held).clamp(-most, most)
+        } else {
+            v
+        };
+        self.time = time;
+        if p.command_lag > 0.0 {
+            self.lagged
+        } else {
+            self.held
+        }
+    }
+
+    /// The stage as bytes (for FMU states): time, held, lagged.
+    pub fn to_values(&self) -> [f64; 3] {
+        [self.time, self.held, self.lagged]
+    }
+
+    pub fn from_values(values: [f64; 3]) -> Self {
+        Self {
+            time: values[0],
+            held: values[1],
+            lagged: values[2],
+        }
+    }
+}
+
+/// The commands the current driver sees at each sample of a recording.
+pub fn seen_commands(p: &Parameters, time: &[f64], v_da: &[f64]) -> Vec<f64> {
+    if !is_active(p) || time.is_empty() {
+        return v_da.to_vec();
+    }
+    let mut stage = CommandStage::at_rest(p, time[0], v_da[0]);
+    time.iter().zip(v_da).map(|(&t, &v)| stage.next(p, t, v)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn with_every_term_off_the_driver_sees_the_command_itself() {
+        let p = Parameters::default();
+        let t = [0.0, 0.001, 0.002, 0.003];
+        let v = [1.0, 5.0, -3.0, 0.25];
+        assert_eq!(seen_commands(&p, &t, &v), v.to_vec());
+    }
+
+    #[test]
+    fn a_lagged_step_reaches_63_percent_after_one_time_constant() {
+        let p = Parameters {
+            command_lag: 0.01,
+            ..Parameters::default()
+        };
+        let t: Vec<f64> = (0..=20).map(|k| k as f64 * 1e-3).collect();
+        let mut v = vec![0.0; t.len()];
+        v[1..].iter_mut().for_each(|x| *x = 1.0);
+        let seen = seen_commands(&p, &t, &v);
+        // The step is applied at t = 1 ms; 10 ms later the lag has 1 − e⁻¹ of it.
+        assert!((seen[11] - (1.0 - (-1.0f64).exp())).abs() < 1e-12, "{}", seen[11]);
+        assert_eq!(seen[1], 0.0, "a lag does not pass a step at once");
+    }
+
+    #[test]
+    fn a_slew_limit_turns_a_step_into_a_ramp_of_the_limit_over_k_cd() {
+        let p = Parameters {
+            current_slew_limit: 0.4,
+            ..Parameters::default()
+        };
+        let rate = 0.4 / p.k_cd; // V/s
+        let t: Vec<f64> = (0..=5).map(|k| k as f64 * 1e-3).collect();
+        let seen = seen_commands(&p, &t, &[0.0, 5.0, 5.0, 5.0, 5.0, 5.0]);
+        for k in 1..=5 {
+            assert!((seen[k] - rate * 1e-3 * k as f64).abs() < 1e-12, "{k}: {}", seen[k]);
+        }
+    }
+
+    #[test]
+    fn a_current_limit_clips_the_command_where_the_current_reaches_it() {
+        let p = Parameters {
+            current_limit: 0.2,
+            ..Parameters::default()
+        };
+        let v = static_map(&p, 10.0);
+        assert!((p.k_cd * v + p.i_offset - 0.2).abs() < 1e-12);
+        assert_eq!(static_map(&p, 1.0), 1.0);
+    }
+}
