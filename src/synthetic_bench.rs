@@ -228,6 +228,10 @@ pub struct UndeclaredMechanism {
     pub truth: &'static str,
     /// The effects with only this mechanism on, at its standard size.
     pub effects: fn() -> BenchEffects,
+    /// The model's (and the FMU's) parameters that are this mechanism at its standard
+    /// size, where the model has them; empty where it has no such parameters (then a
+    /// diagnosis can place the mechanism but not add it).
+    pub model_parameters: &'static [(&'static str, f64)],
 }
 
 fn with_undeclared(u: UndeclaredEffects) -> BenchEffects {
@@ -362,6 +366,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "parameter_offset",
         truth: "the chamber 1 pressure transducer reads 8 kPa high; force and p2 are unaffected",
         effects: std_p1_sensor_offset,
+        model_parameters: &[],
     },
     UndeclaredMechanism {
         name: "supply_drift",
@@ -369,6 +374,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "drift",
         truth: "the supply pressure falls linearly by 30 kPa from t = 0 to t = 80 s",
         effects: std_supply_drift,
+        model_parameters: &[],
     },
     UndeclaredMechanism {
         name: "supply_ripple",
@@ -376,6 +382,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "periodic",
         truth: "the supply pressure carries a 15 kPa, 7 Hz sinusoidal ripple (compressor)",
         effects: std_supply_ripple,
+        model_parameters: &[],
     },
     UndeclaredMechanism {
         name: "command_limit",
@@ -383,6 +390,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "limit",
         truth: "the D/A output seen by the current driver saturates at ±7 V (logged command is the requested one)",
         effects: std_command_limit,
+        model_parameters: &[("command_limit", 7.0)],
     },
     UndeclaredMechanism {
         name: "current_slew_limit",
@@ -390,6 +398,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "limit",
         truth: "the coil current slews at most 3 A/s (driver voltage headroom)",
         effects: std_current_slew_limit,
+        model_parameters: &[("current_slew_limit", 3.0)],
     },
     UndeclaredMechanism {
         name: "jet_pipe_lag",
@@ -397,6 +406,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "dynamics",
         truth: "an extra first-order lag of 15 ms between the static curve f3 and the jet pipe dynamics",
         effects: std_jet_pipe_lag,
+        model_parameters: &[],
     },
     UndeclaredMechanism {
         name: "chamber_1_leak",
@@ -404,6 +414,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "extra_flow",
         truth: "chamber 1 leaks to the atmosphere through C_d·A = 0.01 mm² (compressible orifice law)",
         effects: std_chamber_leak_1,
+        model_parameters: &[("chamber_vent_1", 0.01e-6)],
     },
     UndeclaredMechanism {
         name: "viscous_friction",
@@ -411,6 +422,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "extra_force",
         truth: "viscous friction 60 N·s/m on the stopper velocity: force reads F_act − b v",
         effects: std_viscous_friction,
+        model_parameters: &[("viscous_friction", 60.0)],
     },
     UndeclaredMechanism {
         name: "contact_compliance",
@@ -418,6 +430,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "compliance",
         truth: "a 2e4 N/m spring between piston and stopper: the piston, and the volumes, shift by F/k",
         effects: std_contact_compliance,
+        model_parameters: &[("stopper_compliance", 1.0 / 2e4)],
     },
     UndeclaredMechanism {
         name: "force_sensor_lag",
@@ -425,6 +438,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "dynamics",
         truth: "the force sensor reads through a first-order lag of 10 ms",
         effects: std_force_sensor_lag,
+        model_parameters: &[("force_sensor_lag", 0.01)],
     },
     UndeclaredMechanism {
         name: "return_back_pressure",
@@ -432,6 +446,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "parameter_offset",
         truth: "the return (exhaust) pressure is 40 kPa above the thesis value (clogged exhaust muffler)",
         effects: std_return_back_pressure,
+        model_parameters: &[("P_r", 101_325.0 + 40e3)],
     },
     UndeclaredMechanism {
         name: "p2_sensor_delay",
@@ -439,6 +454,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "delay",
         truth: "the chamber 2 pressure is logged 10 ms late; force and p1 are unaffected",
         effects: std_p2_sensor_delay,
+        model_parameters: &[],
     },
     UndeclaredMechanism {
         name: "receiver_offset",
@@ -446,6 +462,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "parameter_offset",
         truth: "the receivers sit 10 µm further from the jet pipe null (x_jp_offset 0.099 → 0.109 mm)",
         effects: std_receiver_offset,
+        model_parameters: &[("x_jp_offset", 0.109e-3)],
     },
     UndeclaredMechanism {
         name: "force_sensor_backlash",
@@ -453,6 +470,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "hysteresis",
         truth: "the force reading passes a play (backlash) operator of full width 1.5 N",
         effects: std_force_sensor_backlash,
+        model_parameters: &[("force_sensor_play", 1.5)],
     },
     UndeclaredMechanism {
         name: "jet_pipe_curve",
@@ -460,6 +478,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "nonlinearity",
         truth: "the static jet pipe curve is x_sat u/sqrt(1 + u^2) instead of x_sat tanh u (same slope at 0, same saturation)",
         effects: std_jet_pipe_curve,
+        model_parameters: &[],
     },
     UndeclaredMechanism {
         name: "return_area_reduction",
@@ -467,6 +486,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "asymmetry",
         truth: "both return (vent) areas are 5 % smaller, the supply areas unchanged (supply against return)",
         effects: std_return_area_reduction,
+        model_parameters: &[("return_area_scale_1", 0.95), ("return_area_scale_2", 0.95)],
     },
     UndeclaredMechanism {
         name: "port_1_restriction",
@@ -474,6 +494,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "restriction",
         truth: "receiver port 1 reaches chamber 1 through a 3 cm³ line and an orifice of C_d·A = 0.2 mm²",
         effects: std_port_1_restriction,
+        model_parameters: &[],
     },
 ];
 

@@ -16,6 +16,7 @@
 //! channel weighted by its noise floor) and scored on the held-out blocks.
 
 use crate::physics::actuator::Actuator;
+use crate::physics::force_sensor;
 use crate::physics::parameters::Parameters;
 use crate::recording::Recording;
 use crate::replay::{replay_fast, Replay};
@@ -52,50 +53,25 @@ pub enum Filter {
 }
 
 impl Filter {
-    /// The reading of `x` through the filter with coefficient `value`.
+    /// The reading of `x` through the filter with coefficient `value`: the force
+    /// sensor's own filter law (any channel's transducer is read the same way).
     pub fn apply(self, time: &[f64], x: &[f64], value: f64) -> Vec<f64> {
-        let n = x.len();
-        let mut out = Vec::with_capacity(n);
+        let mut p = Parameters::default();
         match self {
-            Filter::Delay => {
-                let mut j = 0;
-                for k in 0..n {
-                    let at = time[k] - value;
-                    while j + 1 < n && time[j + 1] <= at {
-                        j += 1;
-                    }
-                    let y = if at <= time[0] {
-                        x[0]
-                    } else if j + 1 < n {
-                        let w = (at - time[j]) / (time[j + 1] - time[j]);
-                        x[j] + w * (x[j + 1] - x[j])
-                    } else {
-                        x[n - 1]
-                    };
-                    out.push(y);
-                }
-            }
-            Filter::Lag => {
-                let mut y = x[0];
-                for k in 0..n {
-                    if value <= 0.0 {
-                        y = x[k];
-                    } else if k > 0 {
-                        let dt = time[k] - time[k - 1];
-                        y += (1.0 - (-dt / value).exp()) * (x[k - 1] - y);
-                    }
-                    out.push(y);
-                }
-            }
-            Filter::Play => {
-                let mut y = x[0];
-                for &v in x {
-                    y = y.clamp(v - 0.5 * value, v + 0.5 * value);
-                    out.push(y);
-                }
-            }
+            Filter::Delay => p.force_sensor_delay = value,
+            Filter::Lag => p.force_sensor_lag = value,
+            Filter::Play => p.force_sensor_play = value,
         }
-        out
+        force_sensor::filtered(&p, time, x.to_vec())
+    }
+
+    /// The force sensor parameter that carries this filter.
+    pub fn force_sensor_parameter(self) -> &'static str {
+        match self {
+            Filter::Delay => "force_sensor_delay",
+            Filter::Lag => "force_sensor_lag",
+            Filter::Play => "force_sensor_play",
+        }
     }
 }
 
@@ -111,6 +87,10 @@ pub enum Modulation {
 pub enum Mechanism {
     /// An FMU parameter of the model.
     Parameter(&'static str),
+    /// An FMU parameter whose effect is not smooth from its neutral value (an orifice that
+    /// is off at 0 area and at an infinite one): found by a search over its range on a
+    /// logarithmic scale.
+    Searched(&'static str),
     /// A first-order lag (time constant, s) on the command the current driver sees.
     CommandLag,
     /// The command the current driver sees saturates at ± this (V).
@@ -144,7 +124,21 @@ impl Mechanism {
                 | Mechanism::CommandLimit
                 | Mechanism::CurrentSlewLimit
                 | Mechanism::OutputFilter { .. }
+                | Mechanism::Searched(_)
         )
+    }
+
+    /// The model parameter that carries this term in the replay, if one does.
+    pub fn model_parameter(&self) -> Option<&'static str> {
+        match *self {
+            Mechanism::Parameter(name) | Mechanism::Searched(name) => Some(name),
+            Mechanism::CommandLag => Some("command_lag"),
+            Mechanism::CommandLimit => Some("command_limit"),
+            Mechanism::CurrentLimit => Some("current_limit"),
+            Mechanism::CurrentSlewLimit => Some("current_slew_limit"),
+            Mechanism::InputCubic => Some("f3_input_cubic"),
+            _ => None,
+        }
     }
 
     fn is_linear(&self) -> bool {
@@ -481,6 +475,21 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             vec![term_off("return_resistance", "Pa.s/kg", 1e8, 1e11)],
         ),
         c(
+            "return vent orifice",
+            "return",
+            "restriction",
+            None,
+            vec![Term {
+                name: "return_vent_area",
+                unit: "m2",
+                mechanism: Mechanism::Searched("return_vent_area"),
+                neutral: 0.0,
+                step: 0.0,
+                lower: 1e-8,
+                upper: 1e-5,
+            }],
+        ),
+        c(
             "dead volumes",
             "chambers",
             "parameter_offset",
@@ -697,9 +706,11 @@ pub struct Problem<'a> {
     pub weights: [f64; CHANNELS],
     pub measured: [&'a [f64]; CHANNELS],
     velocity: Vec<f64>,
-    mean_position: f64,
-    t_mid: f64,
-    t_span: f64,
+    /// The stopper's mean position, where the position regressor vanishes.
+    pub mean_position: f64,
+    /// The middle and the span of the recording's time, for the ramp regressor.
+    pub t_mid: f64,
+    pub t_span: f64,
 }
 
 impl<'a> Problem<'a> {
@@ -735,74 +746,12 @@ impl<'a> Problem<'a> {
     /// [`Self::predict`]).
     fn replay(&self, terms: &[Term], values: &[f64]) -> Result<Replay, String> {
         let mut p = self.base.clone();
-        let mut lag = 0.0;
-        let mut limit = f64::INFINITY;
-        let mut command_limit = f64::INFINITY;
-        let mut slew = f64::INFINITY;
-        let mut cubic = 0.0;
         for (term, &value) in terms.iter().zip(values) {
-            match term.mechanism {
-                Mechanism::Parameter(name) => set_parameter(&mut p, name, value)?,
-                Mechanism::CommandLag => lag = value,
-                Mechanism::CurrentLimit => limit = value,
-                Mechanism::CommandLimit => command_limit = value,
-                Mechanism::InputCubic => cubic = value,
-                Mechanism::CurrentSlewLimit => slew = value,
-                _ => {}
+            if let Some(name) = term.mechanism.model_parameter() {
+                set_parameter(&mut p, name, value)?;
             }
         }
-        let model = Actuator::new(p)?;
-        if lag == 0.0
-            && limit == f64::INFINITY
-            && command_limit == f64::INFINITY
-            && slew == f64::INFINITY
-            && cubic == 0.0
-        {
-            return replay_fast(&model, self.recording, self.recording.len());
-        }
-        let mut shaped = self.recording.clone();
-        if cubic != 0.0 {
-            for v in shaped.v_da.iter_mut() {
-                *v += cubic * (*v / 10.0).powi(3);
-            }
-        }
-        if command_limit.is_finite() {
-            for v in shaped.v_da.iter_mut() {
-                *v = v.clamp(-command_limit, command_limit);
-            }
-        }
-        if limit.is_finite() {
-            let (k, i0) = (model.params.k_cd, model.params.i_offset);
-            if k != 0.0 {
-                let (a, b) = ((-limit - i0) / k, (limit - i0) / k);
-                let (lo, hi) = (a.min(b), a.max(b));
-                for v in shaped.v_da.iter_mut() {
-                    *v = v.clamp(lo, hi);
-                }
-            }
-        }
-        if slew.is_finite() && model.params.k_cd != 0.0 {
-            let rate = slew / model.params.k_cd.abs();
-            let mut held = shaped.v_da[0];
-            for k in 1..shaped.len() {
-                let most = rate * (shaped.time[k] - shaped.time[k - 1]);
-                held += (shaped.v_da[k] - held).clamp(-most, most);
-                shaped.v_da[k] = held;
-            }
-        }
-        if lag > 0.0 {
-            // Exact for a command held between samples, sampled at the sample instants.
-            let mut state = shaped.v_da[0];
-            for k in 0..shaped.len() {
-                let v = shaped.v_da[k];
-                shaped.v_da[k] = state;
-                if k + 1 < shaped.len() {
-                    let dt = shaped.time[k + 1] - shaped.time[k];
-                    state += (1.0 - (-dt / lag).exp()) * (v - state);
-                }
-            }
-        }
-        replay_fast(&model, &shaped, shaped.len())
+        replay_fast(&Actuator::new(p)?, self.recording, self.recording.len())
     }
 
     fn regressor(&self, regressor: Regressor, own: &[f64], floor: &[bool], k: usize) -> f64 {

@@ -18,6 +18,7 @@
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;
+mod discover;
 mod named;
 pub mod noise;
 pub mod signals;
@@ -55,6 +56,8 @@ pub const NAMED_SHARE_OF_PLACE: f64 = 0.75;
 /// Bouc–Wen hysteresis lowest; 0.63–0.76 for a supply drift and a port restriction).
 pub const NAMED_MIN_SHARE: f64 = 0.8;
 const MAX_EFFECTS: usize = 3;
+/// How many of the located place's candidates are tried in the model, best first.
+const DISCOVERY_TRIALS: usize = 3;
 /// Candidates refitted with more Gauss–Newton iterations after the first pass.
 const REFINED: usize = 3;
 /// Only candidates whose first step explains at least this share are refined.
@@ -194,6 +197,21 @@ pub struct AddedEffect {
     pub remainder_follows: String,
 }
 
+/// A term outside the named effects that was added (see [`discover`]).
+#[derive(Clone, Debug)]
+pub struct DiscoveredTerm {
+    pub location: &'static str,
+    pub family: &'static str,
+    pub candidate: &'static str,
+    /// The FMU parameters that carry it, in SI units.
+    pub parameters: Vec<(&'static str, f64)>,
+    pub reading: String,
+    pub heldout_before: f64,
+    pub heldout_after: f64,
+    /// Share of the held-out force mean square it removes.
+    pub share: f64,
+}
+
 /// What is left when the verdict is not "explained".
 #[derive(Clone, Debug)]
 pub struct Unexplained {
@@ -217,6 +235,7 @@ pub struct Diagnosis {
     pub after: Errors,
     pub calibrated: Vec<Calibrated>,
     pub effects: Vec<AddedEffect>,
+    pub discovered: Vec<DiscoveredTerm>,
     /// Every candidate of the first round.
     pub candidates: Vec<Scored>,
     /// The last round's localization (none when every channel was within its noise).
@@ -608,6 +627,7 @@ pub fn diagnose_with(
         .map(|p| (noise * noise + area * area * (p[0] * p[0] + p[1] * p[1])).sqrt())
         .unwrap_or(noise);
     let mut effects: Vec<AddedEffect> = vec![];
+    let mut discovered: Vec<DiscoveredTerm> = vec![];
     let mut first_candidates: Vec<Scored> = vec![];
     let mut localization: Option<Localization> = None;
     let mut replays = 1;
@@ -754,6 +774,76 @@ pub fn diagnose_with(
                         }
                     }
                 }
+            }
+        }
+        // No named effect fits: the place's own best candidates that the FMU can carry,
+        // each kept only if the model with it (replayed, not predicted) is better on the
+        // held-out blocks by more than a noise floor and by more than its parameters'
+        // BIC penalty, and no pressure channel gets worse.
+        if added.is_none() && round < MAX_EFFECTS && place != "unknown" {
+            let mut at_place: Vec<&Scored> = found
+                .candidates
+                .iter()
+                .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
+                .filter(|s| s.explained >= LOCATED_SHARE)
+                .collect();
+            at_place.sort_by(|a, b| b.explained.total_cmp(&a.explained));
+            let before_total: f64 = heldout.iter().sum();
+            let mut kept = None;
+            for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
+                let label = s.fit.candidate.label;
+                let used = s
+                    .fit
+                    .values
+                    .iter()
+                    .zip(&s.fit.candidate.terms)
+                    .filter(|(v, t)| **v != t.neutral)
+                    .count();
+                let penalty = used as f64 * count.ln();
+                let worse_pressures = (1..CHANNELS)
+                    .any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * heldout[c] + count * 0.01);
+                if worse_pressures || before_total - s.fit.heldout_total() < penalty {
+                    progress(&format!("  {label}: not better than its parameters' penalty, or worse in a pressure"));
+                    continue;
+                }
+                let Some(set) = discover::model_terms(&s.fit.candidate.terms, &s.fit.values, &params, &problem) else {
+                    progress(&format!("  {label}: the FMU has no parameters for it"));
+                    continue;
+                };
+                let mut trial = params.clone();
+                if set.iter().any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
+                    || trial.validate().is_err()
+                {
+                    continue;
+                }
+                let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
+                replays += 1;
+                let residual = difference(&recording.force, &with.force);
+                let after = rms_where(&residual, &training, false);
+                let gain = force_before - after;
+                progress(&format!(
+                    "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
+                ));
+                if gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise {
+                    kept = Some((s.fit.candidate.clone(), set, trial, after));
+                    break;
+                }
+            }
+            if let Some((candidate, set, trial, after)) = kept {
+                progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
+                discovered.push(DiscoveredTerm {
+                    location: candidate.location,
+                    family: candidate.family,
+                    candidate: candidate.label,
+                    reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, &params),
+                    parameters: set,
+                    heldout_before: force_before,
+                    heldout_after: after,
+                    share: 1.0 - (after / force_before).powi(2),
+                });
+                params = trial;
+                reusable = None;
+                continue;
             }
         }
         let Some((s, signature_sentence)) = added else {
@@ -904,6 +994,7 @@ pub fn diagnose_with(
         after: after_errors,
         calibrated,
         effects,
+        discovered,
         candidates: first_candidates,
         localization,
         pressure_split: split,
@@ -951,7 +1042,8 @@ impl Diagnosis {
     pub fn summary(&self) -> Vec<String> {
         let mut lines = vec![];
         let ratio = self.after.heldout_rms / self.noise_floor.max(1e-12);
-        let names: Vec<&str> = self.effects.iter().map(|e| e.name).collect();
+        let mut names: Vec<&str> = self.effects.iter().map(|e| e.name).collect();
+        names.extend(self.discovered.iter().map(|d| d.candidate));
         lines.push(match (&self.unexplained, names.is_empty()) {
             (Some(u), _) if self.explained() => format!("Explained in the force, not in the pressures: {}", u.sentence),
             (None, true) => format!(
@@ -992,6 +1084,15 @@ impl Diagnosis {
                 }
             ));
         }
+        for d in &self.discovered {
+            lines.push(format!(
+                "+ discovered: {} It lowers the held-out force error from {:.4} N to {:.4} N in the model ({:.1} % of its mean square).",
+                d.reading,
+                d.heldout_before,
+                d.heldout_after,
+                100.0 * d.share
+            ));
+        }
         for e in &self.effects {
             let values: Vec<String> = e.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
             lines.push(format!("+ {} ({}): {}", e.name, values.join(", "), e.evidence));
@@ -1008,13 +1109,19 @@ impl Diagnosis {
 
     pub fn to_json(&self, recording_name: &str) -> Value {
         let err = |e: &Errors| json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse});
+        // Every parameter of the final model that is not the thesis's: with these the FMU
+        // is the model whose errors the report gives.
+        let thesis = Parameters::default();
         let mut start_values = serde_json::Map::new();
-        for c in &self.calibrated {
-            start_values.insert(c.name.to_string(), json!(c.value));
-        }
-        for e in &self.effects {
-            for (name, value) in &e.parameters {
-                start_values.insert(name.to_string(), json!(value));
+        for &value_reference in Parameters::VALUE_REFERENCES {
+            let value = self.parameters.get(value_reference);
+            if value != thesis.get(value_reference) {
+                if let Some(v) = value {
+                    start_values.insert(
+                        crate::physics::parameters::variable_name(value_reference).to_string(),
+                        json!(v),
+                    );
+                }
             }
         }
         let mut report = json!({
@@ -1037,7 +1144,17 @@ impl Diagnosis {
                 "remainder_follows": e.remainder_follows,
                 "evidence": e.evidence,
             })).collect::<Vec<_>>(),
-            "discovered": [],
+            "discovered": self.discovered.iter().map(|d| json!({
+                "location": d.location,
+                "family": d.family,
+                "candidate": d.candidate,
+                "parameters": parameters_json(&d.parameters),
+                "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(discover::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
+                "reading": d.reading,
+                "heldout_before_rms_N": d.heldout_before,
+                "heldout_after_rms_N": d.heldout_after,
+                "share_of_heldout_explained": d.share,
+            })).collect::<Vec<_>>(),
             "calibrated": self.calibrated.iter().map(|c| (c.name.to_string(), json!({
                 "value": c.value,
                 "thesis": c.thesis,
