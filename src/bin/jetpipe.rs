@@ -241,6 +241,49 @@ fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String>
     Ok(p)
 }
 
+/// Progress bars on the diagnosis's long phases, on stderr when it is a terminal (indicatif
+/// draws nothing otherwise, and the progress lines go out as they are).
+#[derive(Default)]
+struct TerminalBars {
+    bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
+}
+
+impl TerminalBars {
+    fn println(&self, line: &str) {
+        match self.bar.lock().ok().as_deref().and_then(|b| b.clone()) {
+            Some(bar) if !bar.is_hidden() => bar.suspend(|| eprintln!("{line}")),
+            _ => eprintln!("{line}"),
+        }
+    }
+}
+
+impl jetpipe::diagnosis::ProgressBars for TerminalBars {
+    fn start(&self, phase: &str, total: usize) {
+        let bar = indicatif::ProgressBar::new(total as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{prefix:>13} [{bar:30}] {pos}/{len} {elapsed}") {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.set_prefix(phase.to_string());
+        if let Ok(mut slot) = self.bar.lock() {
+            *slot = Some(bar);
+        }
+    }
+    fn advance(&self) {
+        if let Ok(slot) = self.bar.lock() {
+            if let Some(bar) = slot.as_ref() {
+                bar.inc(1);
+            }
+        }
+    }
+    fn finish(&self) {
+        if let Ok(mut slot) = self.bar.lock() {
+            if let Some(bar) = slot.take() {
+                bar.finish_and_clear();
+            }
+        }
+    }
+}
+
 fn diagnose(
     recording_path: &std::path::Path,
     report: &std::path::Path,
@@ -255,9 +298,14 @@ fn diagnose(
     let started = Instant::now();
     let base = read_parameters(params)?;
     let recording = jetpipe::recording::Recording::read(recording_path, &base)?;
-    let mut progress = |line: &str| eprintln!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
+    let bars = std::sync::Arc::new(TerminalBars::default());
+    let mut progress = |line: &str| {
+        let line = format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
+        bars.println(&line);
+    };
     let mut options = jetpipe::diagnosis::Options {
         calibrate,
+        bars: Some(bars.clone()),
         ..Default::default()
     };
     if let Some(jobs) = jobs {

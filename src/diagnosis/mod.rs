@@ -96,13 +96,23 @@ fn errors(model: &[f64], recording: &Recording, mask: &[bool]) -> Errors {
     }
 }
 
+/// Where a diagnosis shows how far its long phases are (the CLI draws progress bars).
+pub trait ProgressBars: Send + Sync {
+    /// A phase of `total` steps begins.
+    fn start(&self, phase: &str, total: usize);
+    /// One step of the phase is done (called from any worker thread).
+    fn advance(&self);
+    fn finish(&self);
+}
+
 /// Options of a diagnosis.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone)]
 pub struct Options {
     /// Re-identify the jet pipe offset, C_d and the leakage first (§3.3.1).
     pub calibrate: bool,
     /// Worker threads for the candidates.
     pub jobs: usize,
+    pub bars: Option<std::sync::Arc<dyn ProgressBars>>,
 }
 
 impl Default for Options {
@@ -110,6 +120,30 @@ impl Default for Options {
         Self {
             calibrate: false,
             jobs: std::thread::available_parallelism().map_or(2, |n| n.get()),
+            bars: None,
+        }
+    }
+}
+
+/// [`parallel_map`] with a progress bar over the items.
+fn parallel_map_shown<T: Sync, R: Send>(
+    phase: &str,
+    bars: &Option<std::sync::Arc<dyn ProgressBars>>,
+    items: &[T],
+    jobs: usize,
+    f: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    match bars {
+        None => parallel_map(items, jobs, f),
+        Some(bars) => {
+            bars.start(phase, items.len());
+            let out = parallel_map(items, jobs, |item| {
+                let r = f(item);
+                bars.advance();
+                r
+            });
+            bars.finish();
+            out
         }
     }
 }
@@ -303,9 +337,11 @@ fn localize(
     problem: &Problem,
     base_replay: &Replay,
     candidates: &[Candidate],
-    jobs: usize,
+    options: &Options,
     progress: &mut dyn FnMut(&str),
 ) -> (Localization, usize) {
+    let jobs = options.jobs;
+    let bars = &options.bars;
     let base_prediction = [
         base_replay.force.clone(),
         base_replay.p1.clone(),
@@ -338,7 +374,7 @@ fn localize(
         wanted.len(),
         jobs
     ));
-    let sensitivities: Vec<Option<Sensitivity>> = parallel_map(&wanted, jobs, |(name, step)| {
+    let sensitivities: Vec<Option<Sensitivity>> = parallel_map_shown("sensitivities", bars, &wanted, jobs, |(name, step)| {
         problem.sensitivity(name, *step, base_replay)
     });
     let mut replays = wanted.len();
@@ -359,7 +395,9 @@ fn localize(
         }
     };
     progress(&format!("fitting {} candidate corrections", candidates.len()));
-    let first: Vec<Option<Fit>> = parallel_map(candidates, jobs, |c| problem.fit(c, 1, base_replay, &shared).ok());
+    let first: Vec<Option<Fit>> = parallel_map_shown("candidates", bars, candidates, jobs, |c| {
+        problem.fit(c, 1, base_replay, &shared).ok()
+    });
     let mut scored: Vec<Scored> = first.into_iter().flatten().map(score).collect();
     replays += scored.iter().map(|s| s.fit.replays).sum::<usize>();
     scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
@@ -378,7 +416,7 @@ fn localize(
         .map(|s| s.fit.candidate.clone())
         .collect();
     progress(&format!("refining the {} leading candidates", leaders.len()));
-    let refined: Vec<Option<Fit>> = parallel_map(&leaders, jobs, |c| {
+    let refined: Vec<Option<Fit>> = parallel_map_shown("refining", bars, &leaders, jobs, |c| {
         problem.fit(c, REFINE_ITERATIONS, base_replay, &shared).ok()
     });
     for fit in refined.into_iter().flatten() {
@@ -679,7 +717,7 @@ pub fn diagnose_with(
                     .collect();
                 (rank(&mut kept), 0)
             }
-            None => localize(&problem, &current, &candidates, options.jobs, progress),
+            None => localize(&problem, &current, &candidates, options, progress),
         };
         replays += used;
         if round == 0 {
@@ -736,7 +774,7 @@ pub fn diagnose_with(
                     progress(
                         "the force departs from the pressures too: the mechanics and the force sensor on their own",
                     );
-                    let (side, used) = localize(&downstream, &through, &near, options.jobs, progress);
+                    let (side, used) = localize(&downstream, &through, &near, options, progress);
                     replays += used;
                     let side_share = side.best_at(side.location).map_or(0.0, |s| s.explained);
                     let mut named: Vec<&Scored> = side
