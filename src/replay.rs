@@ -2,7 +2,7 @@
 //! the stopper moving linearly between samples (MODEL.md, "Measured data").
 
 use crate::physics::actuator::{Actuator, Outputs};
-use crate::physics::{command_stage, force_sensor};
+use crate::physics::{command_stage, force_sensor, time_varying};
 use crate::recording::Recording;
 use crate::simulation::{Simulation, StepFailure};
 
@@ -93,7 +93,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
     };
     let n = end.min(recording.len());
     let t = &recording.time;
-    let y0 = crate::simulation::equilibrium(model, recording.v_da[0], recording.x_s[0])?;
+    let y0 = crate::simulation::equilibrium_at(model, recording.v_da[0], recording.x_s[0], t[0])?;
     let mut em = ElectromechanicalState {
         current: y0[index::CURRENT],
         position: y0[index::JET_POSITION],
@@ -102,6 +102,8 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
     };
     let mut pressures = Vector2::new(y0[index::P1], y0[index::P2]);
     let commands = command_stage::seen_commands(&model.params, t, &recording.v_da);
+    // A copy whose varying constants are set interval by interval.
+    let mut varying = time_varying::varies(&model.params).then(|| model.clone());
     let mut plays = [model.static_jet_position(em.current); PLAY_OPERATORS];
     let mut velocity = 0.0;
     let delay = model.params.command_delay;
@@ -135,6 +137,13 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
             break;
         }
         let (t0, t1) = (t[k], t[k + 1]);
+        let held: &Actuator = match varying.as_mut() {
+            Some(m) => {
+                time_varying::set_at(&mut m.params, &model.params, 0.5 * (t0 + t1))?;
+                m
+            }
+            None => model,
+        };
         let rate = (recording.x_s[k + 1] - x_s) / (t1 - t0);
         let mut a = t0;
         while a < t1 {
@@ -154,7 +163,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
             let trajectory = propagator.trajectory(&em, v, 0.0, &plays);
             let h = b - a;
             let rates = |x_jp: f64, s: f64, p: &Vector2<f64>| {
-                let (d1, d2) = model.pressure_rates(x_jp, p[0], p[1], x_s + rate * (a + s - t0), rate);
+                let (d1, d2) = held.pressure_rates(x_jp, p[0], p[1], x_s + rate * (a + s - t0), rate);
                 Vector2::new(d1, d2)
             };
             let f = |s: f64, p: &Vector2<f64>| rates(trajectory.position(s), s, p);
@@ -234,6 +243,8 @@ mod tests {
             ("sensor pick-up", Parameters { force_sensor_ripple_amplitude: 0.5, force_sensor_ripple_frequency: 7.0, ..Parameters::default() }),
             ("viscous friction and a position force", Parameters { viscous_friction: 20.0, position_force_rate: 100.0, ..Parameters::default() }),
             ("return vent orifice", Parameters { return_vent_area: 0.35e-6, ..Parameters::default() }),
+            ("supply drift and ripple", Parameters { supply_drift: -400.0, supply_ripple_amplitude: 15e3, supply_ripple_frequency: 7.0, ..Parameters::default() }),
+            ("jet pipe null drift", Parameters { x_jp_offset_drift: 4e-6, ..Parameters::default() }),
         ];
         let thesis_model = Actuator::new(Parameters::default()).unwrap();
         let thesis = replay(&thesis_model, &recording, 1e-6, recording.len()).unwrap();

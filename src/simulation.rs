@@ -17,6 +17,7 @@ use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::current_driver;
 use crate::physics::force_sensor::{self, SensorMemory};
+use crate::physics::time_varying;
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::orifice_geometry::OrificeAreas;
 
@@ -425,7 +426,7 @@ impl Simulation {
     ) -> Result<Self, String> {
         check_finite("v_DA", v_da, "V")?;
         model.params.check_stopper(x_s)?;
-        let state = equilibrium(&model, v_da, x_s)?;
+        let state = equilibrium_at(&model, v_da, x_s, time)?;
         Ok(Self::from_state(model, state, v_da, x_s, time, relative_tolerance))
     }
 
@@ -577,6 +578,24 @@ impl Simulation {
 
     /// Advance by `step` seconds.
     pub fn step(&mut self, step: f64) -> Result<(), StepFailure> {
+        if !time_varying::varies(&self.model.params) {
+            return self.step_with_constants_held(step);
+        }
+        // The varying constants at mid-step, held over the step; the chambers' rates kept
+        // from the last step were for the old values.
+        let nominal = self.model.params.clone();
+        if step.is_finite() && step > 0.0 {
+            time_varying::set_at(&mut self.model.params, &nominal, self.time + 0.5 * step)
+                .map_err(StepFailure::InvalidRequest)?;
+        }
+        self.chamber_rates_at_end = None;
+        let result = self.step_with_constants_held(step);
+        self.model.params = nominal;
+        self.chamber_rates_at_end = None;
+        result
+    }
+
+    fn step_with_constants_held(&mut self, step: f64) -> Result<(), StepFailure> {
         if !(step.is_finite() && step > 0.0) {
             return Err(StepFailure::InvalidRequest(format!(
                 "communicationStepSize = {step} s is invalid: must be finite and > 0"
@@ -918,6 +937,16 @@ pub fn equilibrium_of_electromechanics(model: &Actuator, v_da: f64) -> State {
     let x_jp = model.static_jet_position(current);
     let mid = 0.5 * (p.p_s + p.p_r);
     State::from([current, x_jp, 0.0, 0.0, mid, mid])
+}
+
+/// [`equilibrium`] with the constants that vary in time at their values at `time`.
+pub fn equilibrium_at(model: &Actuator, v_da: f64, x_s: f64, time: f64) -> Result<State, String> {
+    if !time_varying::varies(&model.params) {
+        return equilibrium(model, v_da, x_s);
+    }
+    let mut at = model.clone();
+    time_varying::set_at(&mut at.params, &model.params, time)?;
+    equilibrium(&at, v_da, x_s)
 }
 
 /// The equilibrium state for constant inputs: the current at its static value, the jet

@@ -87,6 +87,11 @@ pub mod vr {
     pub const POSITION_FORCE_RATE: u32 = 471;
     pub const POSITION_FORCE_REFERENCE: u32 = 472;
     pub const RETURN_VENT_AREA: u32 = 480;
+    pub const SUPPLY_DRIFT: u32 = 490;
+    pub const SUPPLY_RIPPLE_AMPLITUDE: u32 = 491;
+    pub const SUPPLY_RIPPLE_FREQUENCY: u32 = 492;
+    pub const SUPPLY_RIPPLE_PHASE: u32 = 493;
+    pub const X_JP_OFFSET_DRIFT: u32 = 494;
 }
 
 pub const UNITS: &[UnitDefinition] = &[
@@ -270,6 +275,22 @@ pub const UNITS: &[UnitDefinition] = &[
         name: "N.s/m",
         kg: 1,
         m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Pa/s",
+        kg: 1,
+        m: -1,
+        s: -3,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m/s",
+        kg: 0,
+        m: 1,
         s: -1,
         a: 0,
         k: 0,
@@ -505,4 +526,9 @@ pub const VARIABLES: &[Variable] = &[
     parameter("position_force_rate", vr::POSITION_FORCE_RATE, "N/m", 0.0, "a force of this times (x_s - position_force_reference) opposes the stopper position where the pressures set the force (0 = off)"),
     parameter("position_force_reference", vr::POSITION_FORCE_REFERENCE, "m", 0.054, "where the position_force vanishes"),
     parameter("return_vent_area", vr::RETURN_VENT_AREA, "m2", 0.0, "return restriction: the return orifices vent into a plenum that empties to P_r through an orifice of this discharge coefficient times area, (2.18) (0 = off: the return orifices see P_r)"),
+    parameter("supply_drift", vr::SUPPLY_DRIFT, "Pa/s", 0.0, "supply drift: the supply pressure is P_s plus this times the time, held over each communication step at its mid-step value (0 = off)"),
+    parameter("supply_ripple_amplitude", vr::SUPPLY_RIPPLE_AMPLITUDE, "Pa", 0.0, "supply ripple: the supply pressure gains this times sin(2 pi f t + phase), held over each communication step at its mid-step value (0 = off)"),
+    parameter("supply_ripple_frequency", vr::SUPPLY_RIPPLE_FREQUENCY, "Hz", 0.0, "supply ripple: its frequency f"),
+    parameter("supply_ripple_phase", vr::SUPPLY_RIPPLE_PHASE, "rad", 0.0, "supply ripple: its phase at t = 0"),
+    parameter("x_jp_offset_drift", vr::X_JP_OFFSET_DRIFT, "m/s", 0.0, "jet pipe null drift: x_jp_offset gains this times the time, held over each communication step at its mid-step value (0 = off)"),
 ];

@@ -7,7 +7,7 @@
 //! cannot carry (a pressure transducer's, a constant modulated in time) and compositions
 //! that would not be exact give `None`, and the candidate stays a located departure.
 
-use super::corrections::{parameter_value, Mechanism, Problem, Regressor, Term};
+use super::corrections::{parameter_value, Mechanism, Modulation, Problem, Regressor, Term};
 use super::signals::FORCE;
 use crate::physics::parameters::Parameters;
 
@@ -25,8 +25,31 @@ pub fn model_terms(terms: &[Term], values: &[f64], base: &Parameters, problem: &
     let mut friction = 0.0;
     let mut viscous = 0.0;
     let mut position = 0.0;
+    // Modulations of a constant: (parameter, ramp coefficient, sine, cosine, frequency).
+    let mut modulated: Vec<(&'static str, f64, f64, f64, f64)> = vec![];
     for (term, &value) in terms.iter().zip(values) {
         match term.mechanism {
+            Mechanism::Modulated { parameter, modulation } => {
+                let k = match modulated.iter().position(|m| m.0 == parameter) {
+                    Some(k) => k,
+                    None => {
+                        modulated.push((parameter, 0.0, 0.0, 0.0, 0.0));
+                        modulated.len() - 1
+                    }
+                };
+                let m = &mut modulated[k];
+                match modulation {
+                    Modulation::Ramp => m.1 += value,
+                    Modulation::Sine(f) => {
+                        m.2 += value;
+                        m.4 = f;
+                    }
+                    Modulation::Cosine(f) => {
+                        m.3 += value;
+                        m.4 = f;
+                    }
+                }
+            }
             m if m.model_parameter().is_some() => set.push((m.model_parameter()?, value)),
             Mechanism::OutputFilter { channel: FORCE, filter } => {
                 let name = filter.force_sensor_parameter();
@@ -57,6 +80,34 @@ pub fn model_terms(terms: &[Term], values: &[f64], base: &Parameters, problem: &
         }
     }
     let p = base;
+    // A constant varying in time: c(t) = c + ramp (t − t_mid)/span + a sin ωt + b cos ωt.
+    for (parameter, ramp, a, b, f) in modulated {
+        let (drift, ripple) = match parameter {
+            "P_s" => ("supply_drift", true),
+            "x_jp_offset" => ("x_jp_offset_drift", false),
+            _ => return None,
+        };
+        if ramp != 0.0 {
+            if parameter_value(base, drift) != 0.0 {
+                return None;
+            }
+            let at_mid = set
+                .iter()
+                .find(|(n, _)| *n == parameter)
+                .map_or_else(|| parameter_value(base, parameter), |(_, v)| *v);
+            set.retain(|(n, _)| *n != parameter);
+            set.push((parameter, at_mid - ramp * problem.t_mid / problem.t_span));
+            set.push((drift, ramp / problem.t_span));
+        }
+        if a != 0.0 || b != 0.0 {
+            if !ripple || base.supply_ripple_amplitude != 0.0 {
+                return None;
+            }
+            set.push(("supply_ripple_amplitude", a.hypot(b)));
+            set.push(("supply_ripple_frequency", f));
+            set.push(("supply_ripple_phase", b.atan2(a)));
+        }
+    }
     let g = p.force_sensor_gain;
     // Forces on the piston read through the sensor's gain.
     if friction != 0.0 {

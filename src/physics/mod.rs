@@ -13,6 +13,7 @@
 //! | effects the thesis model lacks (off by default) | [`effects`] | docs/model.md |
 //! | the command as the current driver sees it (off by default) | [`command_stage`] | (2.1) |
 //! | what the force sensor reads | [`force_sensor`] | docs/model.md |
+//! | constants that vary in time (off by default) | [`time_varying`] | docs/model.md |
 //! | the assembled six-state model | [`actuator`] | (4.1) |
 
 pub mod actuator;
@@ -26,3 +27,4 @@ pub mod orifice_flow;
 pub mod orifice_geometry;
 pub mod parameters;
 pub mod piston;
+pub mod time_varying;

@@ -74,6 +74,11 @@ pub struct Parameters {
     pub position_force_rate: f64,
     pub position_force_reference: f64,
     pub return_vent_area: f64,
+    pub supply_drift: f64,
+    pub supply_ripple_amplitude: f64,
+    pub supply_ripple_frequency: f64,
+    pub supply_ripple_phase: f64,
+    pub x_jp_offset_drift: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -153,6 +158,11 @@ impl Default for Parameters {
             position_force_rate: 0.0,
             position_force_reference: 0.0,
             return_vent_area: 0.0,
+            supply_drift: 0.0,
+            supply_ripple_amplitude: 0.0,
+            supply_ripple_frequency: 0.0,
+            supply_ripple_phase: 0.0,
+            x_jp_offset_drift: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -238,6 +248,11 @@ impl Parameters {
         vr::POSITION_FORCE_RATE,
         vr::POSITION_FORCE_REFERENCE,
         vr::RETURN_VENT_AREA,
+        vr::SUPPLY_DRIFT,
+        vr::SUPPLY_RIPPLE_AMPLITUDE,
+        vr::SUPPLY_RIPPLE_FREQUENCY,
+        vr::SUPPLY_RIPPLE_PHASE,
+        vr::X_JP_OFFSET_DRIFT,
     ];
 
     fn field_and_bound(&mut self, value_reference: u32) -> Option<(&mut f64, Bound)> {
@@ -307,6 +322,11 @@ impl Parameters {
             vr::POSITION_FORCE_RATE => (&mut self.position_force_rate, Finite),
             vr::POSITION_FORCE_REFERENCE => (&mut self.position_force_reference, Finite),
             vr::RETURN_VENT_AREA => (&mut self.return_vent_area, NonNegative),
+            vr::SUPPLY_DRIFT => (&mut self.supply_drift, Finite),
+            vr::SUPPLY_RIPPLE_AMPLITUDE => (&mut self.supply_ripple_amplitude, Finite),
+            vr::SUPPLY_RIPPLE_FREQUENCY => (&mut self.supply_ripple_frequency, NonNegative),
+            vr::SUPPLY_RIPPLE_PHASE => (&mut self.supply_ripple_phase, Finite),
+            vr::X_JP_OFFSET_DRIFT => (&mut self.x_jp_offset_drift, Finite),
             _ => return None,
         })
     }
