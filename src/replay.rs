@@ -240,10 +240,10 @@ mod tests {
             ("sensor curve and drift", Parameters { force_sensor_quadratic: 4e-4, force_sensor_drift: 0.1, ..Parameters::default() }),
             ("sensor delay", Parameters { force_sensor_delay: 4.5e-3, ..Parameters::default() }),
             ("sensor lag and play", Parameters { force_sensor_lag: 0.01, force_sensor_play: 1.0, ..Parameters::default() }),
-            ("sensor pick-up", Parameters { force_sensor_ripple_amplitude: 0.5, force_sensor_ripple_frequency: 7.0, ..Parameters::default() }),
+            ("sensor pick-up", Parameters { force_sensor_ripple_sine: 0.5, force_sensor_ripple_frequency: 7.0, ..Parameters::default() }),
             ("viscous friction and a position force", Parameters { viscous_friction: 20.0, position_force_rate: 100.0, ..Parameters::default() }),
             ("return vent orifice", Parameters { return_vent_area: 0.35e-6, ..Parameters::default() }),
-            ("supply drift and ripple", Parameters { supply_drift: -400.0, supply_ripple_amplitude: 15e3, supply_ripple_frequency: 7.0, ..Parameters::default() }),
+            ("supply drift and ripple", Parameters { supply_drift: -400.0, supply_ripple_sine: 15e3, supply_ripple_frequency: 7.0, ..Parameters::default() }),
             ("jet pipe null drift", Parameters { x_jp_offset_drift: 4e-6, ..Parameters::default() }),
         ];
         let thesis_model = Actuator::new(Parameters::default()).unwrap();

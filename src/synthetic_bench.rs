@@ -374,7 +374,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "drift",
         truth: "the supply pressure falls linearly by 30 kPa from t = 0 to t = 80 s",
         effects: std_supply_drift,
-        model_parameters: &[],
+        model_parameters: &[("supply_drift", -30e3 / 80.0)],
     },
     UndeclaredMechanism {
         name: "supply_ripple",
@@ -382,7 +382,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "periodic",
         truth: "the supply pressure carries a 15 kPa, 7 Hz sinusoidal ripple (compressor)",
         effects: std_supply_ripple,
-        model_parameters: &[],
+        model_parameters: &[("supply_ripple_sine", 15e3), ("supply_ripple_frequency", 7.0)],
     },
     UndeclaredMechanism {
         name: "command_limit",

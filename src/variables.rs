@@ -80,17 +80,17 @@ pub mod vr {
     pub const FORCE_SENSOR_LAG: u32 = 463;
     pub const FORCE_SENSOR_DELAY: u32 = 464;
     pub const FORCE_SENSOR_PLAY: u32 = 465;
-    pub const FORCE_SENSOR_RIPPLE_AMPLITUDE: u32 = 466;
+    pub const FORCE_SENSOR_RIPPLE_SINE: u32 = 466;
     pub const FORCE_SENSOR_RIPPLE_FREQUENCY: u32 = 467;
-    pub const FORCE_SENSOR_RIPPLE_PHASE: u32 = 468;
+    pub const FORCE_SENSOR_RIPPLE_COSINE: u32 = 468;
     pub const VISCOUS_FRICTION: u32 = 470;
     pub const POSITION_FORCE_RATE: u32 = 471;
     pub const POSITION_FORCE_REFERENCE: u32 = 472;
     pub const RETURN_VENT_AREA: u32 = 480;
     pub const SUPPLY_DRIFT: u32 = 490;
-    pub const SUPPLY_RIPPLE_AMPLITUDE: u32 = 491;
+    pub const SUPPLY_RIPPLE_SINE: u32 = 491;
     pub const SUPPLY_RIPPLE_FREQUENCY: u32 = 492;
-    pub const SUPPLY_RIPPLE_PHASE: u32 = 493;
+    pub const SUPPLY_RIPPLE_COSINE: u32 = 493;
     pub const X_JP_OFFSET_DRIFT: u32 = 494;
 }
 
@@ -260,14 +260,6 @@ pub const UNITS: &[UnitDefinition] = &[
         kg: 0,
         m: 0,
         s: -1,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "rad",
-        kg: 0,
-        m: 0,
-        s: 0,
         a: 0,
         k: 0,
     },
@@ -519,16 +511,16 @@ pub const VARIABLES: &[Variable] = &[
     parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading held between communication points (0 = off)"),
     parameter("force_sensor_delay", vr::FORCE_SENSOR_DELAY, "s", 0.0, "force sensor delay: F_meas is the reading this long ago, interpolated between communication points (0 = off)"),
     parameter("force_sensor_play", vr::FORCE_SENSOR_PLAY, "N", 0.0, "force sensor hysteresis: F_meas stays within half this of the reading, moving only when pushed (a play operator; 0 = off)"),
-    parameter("force_sensor_ripple_amplitude", vr::FORCE_SENSOR_RIPPLE_AMPLITUDE, "N", 0.0, "force sensor pick-up: F_meas gains this times sin(2 pi f t + phase) (0 = off)"),
+    parameter("force_sensor_ripple_sine", vr::FORCE_SENSOR_RIPPLE_SINE, "N", 0.0, "force sensor pick-up: F_meas gains this times sin(2 pi f t) (0 = off)"),
     parameter("force_sensor_ripple_frequency", vr::FORCE_SENSOR_RIPPLE_FREQUENCY, "Hz", 0.0, "force sensor pick-up: its frequency f"),
-    parameter("force_sensor_ripple_phase", vr::FORCE_SENSOR_RIPPLE_PHASE, "rad", 0.0, "force sensor pick-up: its phase at t = 0"),
+    parameter("force_sensor_ripple_cosine", vr::FORCE_SENSOR_RIPPLE_COSINE, "N", 0.0, "force sensor pick-up: F_meas gains this times cos(2 pi f t) (0 = off)"),
     parameter("viscous_friction", vr::VISCOUS_FRICTION, "N.s/m", 0.0, "viscous friction: a force of this times the stopper velocity opposes the motion where the pressures set the force (0 = off)"),
     parameter("position_force_rate", vr::POSITION_FORCE_RATE, "N/m", 0.0, "a force of this times (x_s - position_force_reference) opposes the stopper position where the pressures set the force (0 = off)"),
     parameter("position_force_reference", vr::POSITION_FORCE_REFERENCE, "m", 0.054, "where the position_force vanishes"),
     parameter("return_vent_area", vr::RETURN_VENT_AREA, "m2", 0.0, "return restriction: the return orifices vent into a plenum that empties to P_r through an orifice of this discharge coefficient times area, (2.18) (0 = off: the return orifices see P_r)"),
     parameter("supply_drift", vr::SUPPLY_DRIFT, "Pa/s", 0.0, "supply drift: the supply pressure is P_s plus this times the time, held over each communication step at its mid-step value (0 = off)"),
-    parameter("supply_ripple_amplitude", vr::SUPPLY_RIPPLE_AMPLITUDE, "Pa", 0.0, "supply ripple: the supply pressure gains this times sin(2 pi f t + phase), held over each communication step at its mid-step value (0 = off)"),
+    parameter("supply_ripple_sine", vr::SUPPLY_RIPPLE_SINE, "Pa", 0.0, "supply ripple: the supply pressure gains this times sin(2 pi f t), held over each communication step at its mid-step value (0 = off)"),
     parameter("supply_ripple_frequency", vr::SUPPLY_RIPPLE_FREQUENCY, "Hz", 0.0, "supply ripple: its frequency f"),
-    parameter("supply_ripple_phase", vr::SUPPLY_RIPPLE_PHASE, "rad", 0.0, "supply ripple: its phase at t = 0"),
+    parameter("supply_ripple_cosine", vr::SUPPLY_RIPPLE_COSINE, "Pa", 0.0, "supply ripple: the supply pressure gains this times cos(2 pi f t), held likewise (0 = off)"),
     parameter("x_jp_offset_drift", vr::X_JP_OFFSET_DRIFT, "m/s", 0.0, "jet pipe null drift: x_jp_offset gains this times the time, held over each communication step at its mid-step value (0 = off)"),
 ];

@@ -170,6 +170,8 @@ pub struct Candidate {
     /// The named effect this candidate is, if it is one.
     pub named: Option<&'static str>,
     pub terms: Vec<Term>,
+    /// Model parameters set before its terms are fitted (a ripple's frequency).
+    pub settings: Vec<(&'static str, f64)>,
 }
 
 fn value_reference(name: &str) -> u32 {
@@ -269,6 +271,7 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
         family,
         named,
         terms,
+        settings: vec![],
     };
     let p = |name, unit, relative, lower, upper| parameter(base, name, unit, relative, lower, upper);
     let offset = |name, unit, step, lower, upper| Term {
@@ -612,16 +615,38 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
         ),
     ];
     if let Some(f) = periodic_hz {
-        list.push(c(
+        // The chambers filter a fast ripple, so its amplitudes are fitted through the
+        // model at the spectral line's frequency, not as a modulated static sensitivity.
+        let mut ripple = c(
             "supply pressure ripple",
             "supply",
             "periodic",
             None,
             vec![
-                modulated("P_s_ripple_sin", "Pa", "P_s", Modulation::Sine(f), 1e3),
-                modulated("P_s_ripple_cos", "Pa", "P_s", Modulation::Cosine(f), 1e3),
+                Term {
+                    step: 1e3,
+                    lower: -2e5,
+                    upper: 2e5,
+                    ..term_off("supply_ripple_sine", "Pa", 1e3, 2e5)
+                },
+                Term {
+                    step: 1e3,
+                    lower: -2e5,
+                    upper: 2e5,
+                    ..term_off("supply_ripple_cosine", "Pa", 1e3, 2e5)
+                },
+                // The line is placed to a fraction of 1/span; the fit polishes it.
+                Term {
+                    neutral: f,
+                    step: 1e-4,
+                    lower: 0.95 * f,
+                    upper: 1.05 * f,
+                    ..term_off("supply_ripple_frequency", "Hz", 1e-4, 1e3)
+                },
             ],
-        ));
+        );
+        ripple.settings = vec![("supply_ripple_frequency", f)];
+        list.push(ripple);
         list.push(c(
             "force sensor pick-up",
             "force_sensor",
@@ -744,9 +769,12 @@ impl<'a> Problem<'a> {
 
     /// Model outputs with the nonlinear terms at `values` (linear terms are added by
     /// [`Self::predict`]).
-    fn replay(&self, terms: &[Term], values: &[f64]) -> Result<Replay, String> {
+    fn replay(&self, candidate: &Candidate, values: &[f64]) -> Result<Replay, String> {
         let mut p = self.base.clone();
-        for (term, &value) in terms.iter().zip(values) {
+        for &(name, value) in &candidate.settings {
+            set_parameter(&mut p, name, value)?;
+        }
+        for (term, &value) in candidate.terms.iter().zip(values) {
             if let Some(name) = term.mechanism.model_parameter() {
                 set_parameter(&mut p, name, value)?;
             }
@@ -931,7 +959,7 @@ impl Problem<'_> {
             let mut columns: Vec<Sensitivity> = Vec::with_capacity(terms.len());
             for (j, term) in terms.iter().enumerate() {
                 let column = match term.mechanism {
-                    Mechanism::Parameter(name) if iteration == 0 => shared(name),
+                    Mechanism::Parameter(name) if iteration == 0 && candidate.settings.is_empty() => shared(name),
                     Mechanism::Parameter(_) | Mechanism::CommandLag | Mechanism::InputCubic => {
                         let mut moved = point.values.clone();
                         let step = if moved[j] + term.step <= term.upper {
@@ -941,7 +969,7 @@ impl Problem<'_> {
                         };
                         moved[j] += step;
                         replays += 1;
-                        self.replay(terms, &moved).ok().map(|r| {
+                        self.replay(candidate, &moved).ok().map(|r| {
                             let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
                                 a.iter().zip(b).map(|(x, y)| (x - y) / step).collect()
                             };
@@ -993,7 +1021,7 @@ impl Problem<'_> {
                     .any(|(t, (a, b))| !t.mechanism.is_linear() && a != b);
                 let replay = if nonlinear_moved {
                     replays += 1;
-                    match self.replay(terms, &values) {
+                    match self.replay(candidate, &values) {
                         Ok(r) => r,
                         Err(_) => {
                             alpha *= 0.5;
@@ -1113,7 +1141,7 @@ impl Problem<'_> {
                 }
                 _ => {
                     replays += 1;
-                    self.replay(&candidate.terms, &[value])
+                    self.replay(candidate, &[value])
                         .ok()
                         .map(|r| Prediction::of_replay(&r))
                 }

@@ -7,14 +7,15 @@
 //! cannot carry (a pressure transducer's, a constant modulated in time) and compositions
 //! that would not be exact give `None`, and the candidate stays a located departure.
 
-use super::corrections::{parameter_value, Mechanism, Modulation, Problem, Regressor, Term};
+use super::corrections::{parameter_value, Candidate, Mechanism, Modulation, Problem, Regressor};
 use super::signals::FORCE;
 use crate::physics::parameters::Parameters;
 
 /// The FMU parameters (name, value) that put the fitted `values` of `terms` into the
 /// model `base`, or `None` when the FMU cannot carry them exactly.
-pub fn model_terms(terms: &[Term], values: &[f64], base: &Parameters, problem: &Problem) -> Option<Vec<(&'static str, f64)>> {
-    let mut set: Vec<(&'static str, f64)> = vec![];
+pub fn model_terms(candidate: &Candidate, values: &[f64], base: &Parameters, problem: &Problem) -> Option<Vec<(&'static str, f64)>> {
+    let terms = &candidate.terms;
+    let mut set: Vec<(&'static str, f64)> = candidate.settings.clone();
     // Coefficients of the force channel's regressors.
     let mut one = 0.0;
     let mut own = 0.0;
@@ -100,12 +101,12 @@ pub fn model_terms(terms: &[Term], values: &[f64], base: &Parameters, problem: &
             set.push((drift, ramp / problem.t_span));
         }
         if a != 0.0 || b != 0.0 {
-            if !ripple || base.supply_ripple_amplitude != 0.0 {
+            if !ripple || base.supply_ripple_sine != 0.0 || base.supply_ripple_cosine != 0.0 {
                 return None;
             }
-            set.push(("supply_ripple_amplitude", a.hypot(b)));
+            set.push(("supply_ripple_sine", a));
+            set.push(("supply_ripple_cosine", b));
             set.push(("supply_ripple_frequency", f));
-            set.push(("supply_ripple_phase", b.atan2(a)));
         }
     }
     let g = p.force_sensor_gain;
@@ -131,7 +132,8 @@ pub fn model_terms(terms: &[Term], values: &[f64], base: &Parameters, problem: &
     let s_nonlinear = p.force_sensor_quadratic != 0.0
         || p.force_sensor_cubic != 0.0
         || p.force_sensor_drift != 0.0
-        || p.force_sensor_ripple_amplitude != 0.0;
+        || p.force_sensor_ripple_sine != 0.0
+        || p.force_sensor_ripple_cosine != 0.0;
     if curve && s_nonlinear {
         return None;
     }
@@ -156,27 +158,32 @@ pub fn model_terms(terms: &[Term], values: &[f64], base: &Parameters, problem: &
         if ramp != 0.0 || p.force_sensor_drift != 0.0 {
             set.push(("force_sensor_drift", m * p.force_sensor_drift + ramp / t_span));
         }
-        if p.force_sensor_ripple_amplitude != 0.0 && m != 1.0 && sine.is_none() {
-            set.push(("force_sensor_ripple_amplitude", m * p.force_sensor_ripple_amplitude));
+        if (p.force_sensor_ripple_sine != 0.0 || p.force_sensor_ripple_cosine != 0.0) && m != 1.0 && sine.is_none() {
+            set.push(("force_sensor_ripple_sine", m * p.force_sensor_ripple_sine));
+            set.push(("force_sensor_ripple_cosine", m * p.force_sensor_ripple_cosine));
         }
     }
     if let Some((f, a, b)) = sine {
         // a sin ωt + b cos ωt on top of what is there at the same frequency.
-        let r0 = (1.0 + own) * p.force_sensor_ripple_amplitude;
-        let same = p.force_sensor_ripple_frequency == f;
-        if r0 != 0.0 && !same {
+        let m = 1.0 + own;
+        let (s0, c0) = (p.force_sensor_ripple_sine, p.force_sensor_ripple_cosine);
+        if (s0 != 0.0 || c0 != 0.0) && p.force_sensor_ripple_frequency != f {
             return None;
         }
-        let (phase0, r0) = if same { (p.force_sensor_ripple_phase, r0) } else { (0.0, 0.0) };
-        let (sin_part, cos_part) = (a + r0 * phase0.cos(), b + r0 * phase0.sin());
-        set.push(("force_sensor_ripple_amplitude", sin_part.hypot(cos_part)));
+        set.push(("force_sensor_ripple_sine", m * s0 + a));
+        set.push(("force_sensor_ripple_cosine", m * c0 + b));
         set.push(("force_sensor_ripple_frequency", f));
-        set.push(("force_sensor_ripple_phase", cos_part.atan2(sin_part)));
     }
-    if set.is_empty() {
+    // A setting the fit refined appears twice: the last value holds.
+    let mut unique: Vec<(&'static str, f64)> = vec![];
+    for (name, value) in set {
+        unique.retain(|(n, _)| *n != name);
+        unique.push((name, value));
+    }
+    if unique.is_empty() {
         return None;
     }
-    Some(set)
+    Some(unique)
 }
 
 /// The unit of an FMU parameter, from the variable table.

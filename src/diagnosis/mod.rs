@@ -351,7 +351,7 @@ fn localize(
     let before_total: f64 = heldout_before.iter().sum::<f64>().max(1e-300);
     // Sensitivities at the base point, shared by every candidate's first step.
     let mut wanted: Vec<(&'static str, f64)> = vec![];
-    for c in candidates {
+    for c in candidates.iter().filter(|c| c.settings.is_empty()) {
         for t in &c.terms {
             let name = match t.mechanism {
                 Mechanism::Parameter(name) => Some((name, t.step)),
@@ -844,7 +844,7 @@ pub fn diagnose_with(
                     progress(&format!("  {label}: not better than its parameters' penalty, or worse in a pressure"));
                     continue;
                 }
-                let Some(set) = discover::model_terms(&s.fit.candidate.terms, &s.fit.values, &params, &problem) else {
+                let Some(set) = discover::model_terms(&s.fit.candidate, &s.fit.values, &params, &problem) else {
                     progress(&format!("  {label}: the FMU has no parameters for it"));
                     continue;
                 };

@@ -3,7 +3,7 @@
 //!
 //! The static reading at time t is
 //!
-//!   offset + gain F + quadratic F² + cubic F³ + drift t + ripple sin(2π f t + φ),
+//!   offset + gain F + quadratic F² + cubic F³ + drift t + a sin 2πft + b cos 2πft,
 //!
 //! and the sensor may pass it through, in this order, a delay, a first-order lag and a
 //! play (backlash) of a given width. The filters act on the reading as it is sampled at
@@ -23,9 +23,9 @@ pub fn static_reading(p: &Parameters, force: f64, time: f64) -> f64 {
     if p.force_sensor_drift != 0.0 {
         y += p.force_sensor_drift * time;
     }
-    if p.force_sensor_ripple_amplitude != 0.0 {
-        y += p.force_sensor_ripple_amplitude
-            * (2.0 * std::f64::consts::PI * p.force_sensor_ripple_frequency * time + p.force_sensor_ripple_phase).sin();
+    if p.force_sensor_ripple_sine != 0.0 || p.force_sensor_ripple_cosine != 0.0 {
+        let phase = 2.0 * std::f64::consts::PI * p.force_sensor_ripple_frequency * time;
+        y += p.force_sensor_ripple_sine * phase.sin() + p.force_sensor_ripple_cosine * phase.cos();
     }
     y
 }

@@ -8,15 +8,15 @@ use super::parameters::Parameters;
 
 /// Whether any constant varies.
 pub fn varies(p: &Parameters) -> bool {
-    p.supply_drift != 0.0 || p.supply_ripple_amplitude != 0.0 || p.x_jp_offset_drift != 0.0
+    p.supply_drift != 0.0 || p.supply_ripple_sine != 0.0 || p.supply_ripple_cosine != 0.0 || p.x_jp_offset_drift != 0.0
 }
 
 /// The supply pressure at time `t`.
 pub fn supply_pressure(p: &Parameters, t: f64) -> f64 {
     let mut p_s = p.p_s + p.supply_drift * t;
-    if p.supply_ripple_amplitude != 0.0 {
-        p_s += p.supply_ripple_amplitude
-            * (2.0 * std::f64::consts::PI * p.supply_ripple_frequency * t + p.supply_ripple_phase).sin();
+    if p.supply_ripple_sine != 0.0 || p.supply_ripple_cosine != 0.0 {
+        let phase = 2.0 * std::f64::consts::PI * p.supply_ripple_frequency * t;
+        p_s += p.supply_ripple_sine * phase.sin() + p.supply_ripple_cosine * phase.cos();
     }
     p_s
 }
@@ -32,8 +32,8 @@ pub fn set_at(current: &mut Parameters, nominal: &Parameters, t: f64) -> Result<
     let p_s = supply_pressure(nominal, t);
     if p_s <= nominal.p_r {
         return Err(format!(
-            "the supply pressure reaches {p_s} Pa at t = {t} s (P_s = {} Pa, supply_drift = {} Pa/s, supply_ripple_amplitude = {} Pa): it must stay above P_r = {} Pa",
-            nominal.p_s, nominal.supply_drift, nominal.supply_ripple_amplitude, nominal.p_r
+            "the supply pressure reaches {p_s} Pa at t = {t} s (P_s = {} Pa, supply_drift = {} Pa/s, supply_ripple_sine = {} Pa, supply_ripple_cosine = {} Pa): it must stay above P_r = {} Pa",
+            nominal.p_s, nominal.supply_drift, nominal.supply_ripple_sine, nominal.supply_ripple_cosine, nominal.p_r
         ));
     }
     current.p_s = p_s;
