@@ -4,6 +4,13 @@
 reference (the controller's theta_step at t_step), so the three runs are the same scenario; the
 joint angle must agree within 1e-3 rad at every step.
 
+Two masters need something the .ssp cannot give them. FMPy's `simulate_ssp` hands 0.0 to every
+connected input in the first step, which the actuator refuses as x_s; its run goes through
+`ssp_sim`, which starts the connectors at the FMUs' values after initialisation (a test below
+shows the unpatched run stopping there and only there). The container's SSP reader takes
+components and connections only: the start values the .ssp binds are handed over with the
+toolbox's `add_start_value` (`masters.build_container`).
+
 Build what it needs with
     bash scripts/package.sh
     cargo run --release --target-dir target/fmus -p antagonistic -- package
@@ -13,6 +20,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import tempfile
 import zipfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -79,6 +87,32 @@ def test_the_ssd_has_nothing_libcosim_rejects_and_binds_start_values(ssp):
         inputs = {c.get("name") for c in component.iterfind("ssd:Connectors/ssd:Connector", NS) if c.get("kind") == "input"}
         assert inputs <= starts, f"{name}: connected inputs without a start value: {sorted(inputs - starts)}"
         assert all((name, i) in fed for i in inputs)
+
+
+def test_fmpy_unpatched_hands_zero_to_the_stoppers_and_the_actuator_refuses_it(ssp, capfd, tmp_path, monkeypatch):
+    """Why `ssp_sim` changes FMPy's master (`connectors_start_at_fmu_values`), and that this is
+    the only reason. FMPy 0.3.32's `simulate_ssp` sets every connector to 0.0 before it
+    instantiates the FMUs, never reads an output after initialisation, and applies the
+    connections only after every component has stepped: in the first step every connected input
+    gets 0.0, whatever the .ssd says (start values, bindings, order). The actuator must refuse
+    x_s = 0 m (outside its cylinder), so the unpatched run stops there. If this test fails
+    because the run succeeds, FMPy has changed: drop the patch from ssp_sim."""
+    import fmpy.ssp.simulation as ssp_simulation
+    from fmpy.fmi1 import FMICallException
+
+    import ssp_sim  # noqa: E402
+
+    for name in ("instantiate_fmu", "do_step", "simulate_ssp"):
+        assert getattr(ssp_simulation, name).__module__ == "fmpy.ssp.simulation", f"{name} is patched"
+    # FMPy leaves its extracted .ssp and FMUs behind when a run raises: extract them here.
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    with pytest.raises(FMICallException, match="fmi2SetReal failed"):
+        ssp_simulation.simulate_ssp(str(ssp), stop_time=2 * masters.STEP_SIZE, step_size=masters.STEP_SIZE,
+                                    parameter_set=ssp_sim.parameter_set(ssp))
+    log = capfd.readouterr().out
+    errors = [line for line in log.splitlines() if line.startswith("[ERROR]")]
+    assert errors == ["[ERROR] fmi2SetReal: x_s = 0 m is outside the cylinder: both chamber volumes must be "
+                      "positive, 0.026 < x_s < 0.096 m"], log
 
 
 def test_joint_step_response_is_the_same_in_three_masters(runs, scenario):
