@@ -134,6 +134,22 @@ def test_joint_step_response_is_the_same_in_three_masters(runs, scenario):
     assert worst < 1e-3
 
 
+def test_the_container_needs_only_the_reference_step_from_the_bindings(ssp, scenario, runs):
+    """The container's SSP reader drops the bindings. Handed only the reference step (the other
+    bindings are the FMUs' defaults or input start values), it still agrees with the other two
+    masters within 1e-3 rad; handed nothing, it runs the FMUs' defaults, where nothing moves."""
+    _, t_step = scenario
+    n = len(runs["FMPy"][0])
+    stop = n * masters.STEP_SIZE
+    _, theta = masters.run_container(ssp, stop, {"controller.theta_step", "controller.t_step"})
+    for name in ("FMPy", "libcosim"):
+        d = float(np.max(np.abs(theta[:n] - runs[name][1])))
+        print(f"max |theta_{name} - theta_container(reference step only)| = {d:.2e} rad")
+        assert d < 1e-3, name
+    _, theta = masters.run_container(ssp, t_step + 0.1, set())
+    assert np.max(np.abs(theta)) == 0.0
+
+
 def test_fmutool_check_is_clean_for_every_fmu(ssp):
     fmutool = Path(sys.executable).with_name("fmutool")
     dist = ssp.parent
