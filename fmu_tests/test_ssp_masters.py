@@ -4,6 +4,13 @@
 reference (the controller's theta_step at t_step), so the three runs are the same scenario; the
 joint angle must agree within 1e-3 rad at every step.
 
+Two masters need something the .ssp cannot give them. FMPy's `simulate_ssp` hands 0.0 to every
+connected input in the first step, which the actuator refuses as x_s; its run goes through
+`ssp_sim`, which starts the connectors at the FMUs' values after initialisation (a test below
+shows the unpatched run stopping there and only there). The container's SSP reader takes
+components and connections only: the start values the .ssp binds are handed over with the
+toolbox's `add_start_value` (`masters.build_container`).
+
 Build what it needs with
     bash scripts/package.sh
     cargo run --release --target-dir target/fmus -p antagonistic -- package
@@ -13,6 +20,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import tempfile
 import zipfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -81,6 +89,33 @@ def test_the_ssd_has_nothing_libcosim_rejects_and_binds_start_values(ssp):
         assert all((name, i) in fed for i in inputs)
 
 
+def test_fmpy_unpatched_hands_zero_to_the_stoppers_and_the_actuator_refuses_it(ssp, capfd, tmp_path, monkeypatch):
+    """Why `ssp_sim` changes FMPy's master (`connectors_start_at_fmu_values`), and that this is
+    the only reason. FMPy 0.3.32's `simulate_ssp` sets every connector to 0.0 before it
+    instantiates the FMUs, never reads an output after initialisation, and applies the
+    connections only after every component has stepped: in the first step every connected input
+    gets 0.0, whatever the .ssd says (start values, bindings, order). The actuator must refuse
+    x_s = 0 m (outside its cylinder), so the unpatched run stops there. If this test fails
+    because the run succeeds, FMPy has changed: drop the patch from ssp_sim."""
+    import fmpy.ssp.simulation as ssp_simulation
+    from fmpy.fmi1 import FMICallException
+
+    import ssp_sim  # noqa: E402
+
+    for name in ("instantiate_fmu", "do_step", "simulate_ssp"):
+        assert getattr(ssp_simulation, name).__module__ == "fmpy.ssp.simulation", f"{name} is patched"
+    # FMPy leaves its extracted .ssp and FMUs behind when a run raises: extract them here.
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    with pytest.raises(FMICallException, match="fmi2SetReal failed"):
+        ssp_simulation.simulate_ssp(str(ssp), stop_time=2 * masters.STEP_SIZE, step_size=masters.STEP_SIZE,
+                                    parameter_set=ssp_sim.parameter_set(ssp))
+    # FMPy's log lines look different once another test has changed its logger: match the message.
+    log = capfd.readouterr().out
+    errors = [line for line in log.splitlines() if "error" in line.lower()]
+    assert len(errors) == 1, log
+    assert "fmi2SetReal: x_s = 0 m is outside the cylinder: both chamber volumes must be positive" in errors[0], log
+
+
 def test_joint_step_response_is_the_same_in_three_masters(runs, scenario):
     theta_step, t_step = scenario
     for name, (t, theta) in runs.items():
@@ -98,6 +133,22 @@ def test_joint_step_response_is_the_same_in_three_masters(runs, scenario):
             print(f"max |theta_{a} - theta_{b}| = {d:.2e} rad")
             worst = max(worst, d)
     assert worst < 1e-3
+
+
+def test_the_container_needs_only_the_reference_step_from_the_bindings(ssp, scenario, runs):
+    """The container's SSP reader drops the bindings. Handed only the reference step (the other
+    bindings are the FMUs' defaults or input start values), it still agrees with the other two
+    masters within 1e-3 rad; handed nothing, it runs the FMUs' defaults, where nothing moves."""
+    _, t_step = scenario
+    n = len(runs["FMPy"][0])
+    stop = n * masters.STEP_SIZE
+    _, theta = masters.run_container(ssp, stop, {"controller.theta_step", "controller.t_step"})
+    for name in ("FMPy", "libcosim"):
+        d = float(np.max(np.abs(theta[:n] - runs[name][1])))
+        print(f"max |theta_{name} - theta_container(reference step only)| = {d:.2e} rad")
+        assert d < 1e-3, name
+    _, theta = masters.run_container(ssp, t_step + 0.1, set())
+    assert np.max(np.abs(theta)) == 0.0
 
 
 def test_fmutool_check_is_clean_for_every_fmu(ssp):

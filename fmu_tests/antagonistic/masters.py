@@ -74,11 +74,12 @@ def run_libcosim(ssp: Path, stop_time: float):
     return t, theta
 
 
-def build_container(ssp: Path, out_dir: Path) -> Path:
+def build_container(ssp: Path, out_dir: Path, bindings=None) -> Path:
     """The container FMU of the .ssp, built in `out_dir` by FMU Manipulation Toolbox's
     `Assembly` (what `fmucontainer -container <ssp>:<step>` runs). Its SSP reader (marked alpha
-    in 2.0) takes the components and connections only, so each component's start values are
-    handed to the container through the toolbox's `add_start_value`."""
+    in 2.0) takes the systems, components and connections only, so each component's start
+    values are handed to the container through the toolbox's `add_start_value` (only those named
+    in `bindings`, "component.variable", if given)."""
     from fmu_manipulation_toolbox.assembly import Assembly, SSDParser
 
     shutil.copy(ssp, out_dir / ssp.name)
@@ -88,6 +89,8 @@ def build_container(ssp: Path, out_dir: Path) -> Path:
         parser = SSDParser(zin, ssp.with_suffix(".dir").name)
         parser.parse("SystemStructure.ssd")
     for name, value in ssp_parameters(ssp).items():
+        if bindings is not None and name not in bindings:
+            continue
         component, variable = name.split(".", 1)
         assembly.root.add_start_value(parser.fmu_filenames[component], variable, repr(value))
     assembly.make_fmu()
@@ -97,11 +100,11 @@ def build_container(ssp: Path, out_dir: Path) -> Path:
     return fmu
 
 
-def run_container(ssp: Path, stop_time: float):
+def run_container(ssp: Path, stop_time: float, bindings=None):
     import fmpy
 
     with tempfile.TemporaryDirectory() as tmp:
-        fmu = build_container(ssp, Path(tmp))
+        fmu = build_container(ssp, Path(tmp), bindings)
         result = fmpy.simulate_fmu(
             str(fmu), stop_time=stop_time, step_size=STEP_SIZE, output_interval=STEP_SIZE,
             output=["fingerjoint.theta"],

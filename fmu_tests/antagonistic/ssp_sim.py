@@ -2,14 +2,21 @@
 
 The master is FMPy's own `fmpy.ssp.simulation.simulate_ssp` (a fixed-step Jacobi master: every
 FMU steps from the outputs of the others at the start of the step), with the parameter set that
-the .ssp binds on its components. One thing is changed, and only for the duration of a call:
-FMPy 0.3.32 starts every connector at 0.0 and hands those zeros to the inputs in the first step,
-after initialisation (it reads no start value of a connector), which would put the actuators'
-stoppers at x_s = 0 m, outside their cylinders (the actuator rejects it with fmi2Error).
-`connectors_start_at_fmu_values` wraps FMPy's `instantiate_fmu` so that after each FMU's
-initialisation its connectors hold the FMU's own values (inputs: the start values the parameter
-set gave them; outputs: the initial outputs). Everything else, including the stepping and the
-connection order, is FMPy's.
+the .ssp binds on its components (`simulate_ssp` reads no binding itself; it applies the
+`parameter_set` it is given before each FMU's initialisation). One thing is changed, and only
+for the duration of a call. FMPy 0.3.32 sets every connector to 0.0 before it instantiates the
+FMUs, never reads an output after initialisation, and applies the connections only after every
+component has stepped, so in the first step every connected input is set to 0.0, whatever the
+.ssd holds (connector start values, bindings, the order of components or connections). That
+would put the actuators' stoppers at x_s = 0 m, outside their cylinders, and the actuator
+refuses it (fmi2SetReal returns fmi2Error and FMPy raises): no .ssd or FMU change can avoid
+that without accepting an invalid x_s, which the actuator must not
+(`test_ssp_masters.py::test_fmpy_unpatched_hands_zero_to_the_stoppers_and_the_actuator_refuses_it`
+shows the unpatched run stopping there and nowhere else). `connectors_start_at_fmu_values`
+wraps FMPy's `instantiate_fmu` so that after each FMU's initialisation its connectors hold the
+FMU's own values (inputs: the start values the parameter set gave them; outputs: the initial
+outputs), as a master that propagates initial values does. Everything else,
+including the stepping and the connection order, is FMPy's.
 
 The .ssp steps its reference by itself (the controller's theta_step at t_step). For other
 references, `simulate(theta_ref, ...)` sets theta_step to 0 and sets the controller's theta_ref
