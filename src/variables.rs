@@ -50,6 +50,7 @@ pub mod vr {
     pub const HYSTERESIS_WIDTH: u32 = 300;
     pub const HYSTERESIS_DEADBAND: u32 = 301;
     pub const FRICTION_COULOMB: u32 = 310;
+    pub const FRICTION_VELOCITY: u32 = 311;
     pub const DEAD_VOLUME_1: u32 = 320;
     pub const DEAD_VOLUME_2: u32 = 321;
     pub const SUPPLY_RESISTANCE: u32 = 330;
@@ -483,6 +484,7 @@ pub const VARIABLES: &[Variable] = &[
     parameter("hysteresis_width", vr::HYSTERESIS_WIDTH, "m", 0.0, "jet_pipe_hysteresis: separation of the rising and falling branches of the static tip position in large sweeps (Prandtl-Ishlinskii operator after f3; 0 = off)"),
         parameter("hysteresis_deadband", vr::HYSTERESIS_DEADBAND, "m", 0.0, "jet_pipe_hysteresis: travel of the static tip position after a reversal before the hysteretic output moves (smallest play width, at most hysteresis_width)"),
     parameter("friction_coulomb", vr::FRICTION_COULOMB, "N", 0.0, "piston_friction: Coulomb friction opposing stopper motion, (2.35) (0 = off)"),
+    parameter("friction_velocity", vr::FRICTION_VELOCITY, "m/s", 0.0, "piston_friction: the friction reaches the Coulomb level as tanh(v / this) of the stopper velocity v (0 = at once, as (2.35))"),
     parameter("dead_volume_1", vr::DEAD_VOLUME_1, "m3", 0.0, "dead_volume: port and line volume added to chamber 1 (0 = off)"),
     parameter("dead_volume_2", vr::DEAD_VOLUME_2, "m3", 0.0, "dead_volume: port and line volume added to chamber 2 (0 = off)"),
     parameter("supply_resistance", vr::SUPPLY_RESISTANCE, "Pa.s/kg", 0.0, "supply_pressure_drop: the supply pressure at the jet pipe falls by this times the supply mass flow (0 = off)"),

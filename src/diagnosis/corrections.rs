@@ -34,6 +34,9 @@ pub enum Regressor {
     OwnCubed,
     /// −sign(dx_s/dt) where the pressures set the force: Coulomb friction.
     Friction,
+    /// −tanh((dx_s/dt) / v_c) there: Coulomb friction reached over a speed v_c (the
+    /// candidate's [`Mechanism::Shape`] term).
+    SmoothFriction(f64),
     /// −dx_s/dt where the pressures set the force: viscous friction.
     Viscous,
     /// x_s minus its mean where the pressures set the force: a spring on the piston.
@@ -109,6 +112,10 @@ pub enum Mechanism {
     OutputFilter { channel: usize, filter: Filter },
     /// A term on a measured channel: coefficient × regressor.
     Output { channel: usize, regressor: Regressor },
+    /// The shape parameter of the candidate's regressors (a friction's speed scale), found
+    /// by a search over its range on a logarithmic scale with the amplitudes solved at each
+    /// value.
+    Shape,
     /// A parameter varying in time: coefficient × its sensitivity × the modulation (first order).
     Modulated {
         parameter: &'static str,
@@ -125,6 +132,7 @@ impl Mechanism {
                 | Mechanism::CurrentSlewLimit
                 | Mechanism::OutputFilter { .. }
                 | Mechanism::Searched(_)
+                | Mechanism::Shape
         )
     }
 
@@ -540,6 +548,31 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             }],
         ),
         c(
+            "smooth Coulomb and viscous friction",
+            "mechanics",
+            "extra_force",
+            Some("piston_friction"),
+            vec![
+                Term {
+                    lower: 0.0,
+                    ..output("friction_coulomb", "N", FORCE, Regressor::SmoothFriction(0.0), 0.1)
+                },
+                Term {
+                    lower: 0.0,
+                    ..output("viscous_friction", "N.s/m", FORCE, Regressor::Viscous, 1.0)
+                },
+                Term {
+                    name: "friction_velocity",
+                    unit: "m/s",
+                    mechanism: Mechanism::Shape,
+                    neutral: 0.0,
+                    step: 0.0,
+                    lower: 1e-4,
+                    upper: 0.05,
+                },
+            ],
+        ),
+        c(
             "viscous friction",
             "mechanics",
             "extra_force",
@@ -792,9 +825,10 @@ impl<'a> Problem<'a> {
             Regressor::OwnSquared => own[k] * own[k],
             Regressor::OwnCubed => own[k] * own[k] * own[k],
             Regressor::Friction if set_by_pressures && v.abs() > 1e-9 => -v.signum(),
+            Regressor::SmoothFriction(vc) if set_by_pressures => -crate::physics::effects::friction_force(1.0, vc, v),
             Regressor::Viscous if set_by_pressures => -v,
             Regressor::Position if set_by_pressures => -(self.recording.x_s[k] - self.mean_position),
-            Regressor::Friction | Regressor::Viscous | Regressor::Position => 0.0,
+            Regressor::Friction | Regressor::SmoothFriction(_) | Regressor::Viscous | Regressor::Position => 0.0,
             Regressor::Ramp => (t - self.t_mid) / self.t_span,
             Regressor::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
             Regressor::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
@@ -936,6 +970,9 @@ impl Problem<'_> {
         shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
     ) -> Result<Fit, String> {
         let terms = &candidate.terms;
+        if terms.iter().any(|t| t.mechanism == Mechanism::Shape) {
+            return self.fit_shape(candidate, base_replay);
+        }
         if terms.iter().any(|t| t.mechanism.is_searched()) {
             return self.fit_search(candidate, base_replay);
         }
@@ -1115,6 +1152,69 @@ impl Problem<'_> {
     /// limit does nothing until it clips, a slew limit until the command jumps) or that
     /// acts on a measured channel exactly (a delay, a lag, a play): golden-section search
     /// on the coefficient, on a logarithmic scale where it spans decades.
+    /// A candidate whose regressors share one shape parameter: golden-section search of
+    /// its logarithm, the linear amplitudes solved at each trial value.
+    fn fit_shape(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
+        let shape = candidate
+            .terms
+            .iter()
+            .position(|t| t.mechanism == Mechanism::Shape)
+            .ok_or("no shape term")?;
+        let (lower, upper) = (candidate.terms[shape].lower, candidate.terms[shape].upper);
+        let shaped = |value: f64| -> Candidate {
+            let mut c = candidate.clone();
+            c.terms.remove(shape);
+            for t in c.terms.iter_mut() {
+                if let Mechanism::Output {
+                    regressor: Regressor::SmoothFriction(_),
+                    channel,
+                } = t.mechanism
+                {
+                    t.mechanism = Mechanism::Output {
+                        channel,
+                        regressor: Regressor::SmoothFriction(value),
+                    };
+                }
+            }
+            c
+        };
+        let none = |_: &'static str| None;
+        let evaluate = |u: f64| -> Option<Fit> {
+            let value = lower * (upper / lower).powf(u);
+            self.fit(&shaped(value), 1, base_replay, &none).ok()
+        };
+        let cost = |fit: &Option<Fit>| fit.as_ref().map_or(f64::INFINITY, |f| f.train_total());
+        let phi = (5f64.sqrt() - 1.0) / 2.0;
+        let (mut a, mut b) = (0.0, 1.0);
+        let mut c = b - phi * (b - a);
+        let mut d = a + phi * (b - a);
+        let (mut fc, mut fd) = (cost(&evaluate(c)), cost(&evaluate(d)));
+        for _ in 0..14 {
+            if fc < fd {
+                b = d;
+                d = c;
+                fd = fc;
+                c = b - phi * (b - a);
+                fc = cost(&evaluate(c));
+            } else {
+                a = c;
+                c = d;
+                fc = fd;
+                d = a + phi * (b - a);
+                fd = cost(&evaluate(d));
+            }
+        }
+        let u = if fc < fd { c } else { d };
+        let fit = evaluate(u).ok_or("the shaped fit failed")?;
+        let mut values = fit.values.clone();
+        values.insert(shape, lower * (upper / lower).powf(u));
+        Ok(Fit {
+            candidate: candidate.clone(),
+            values,
+            ..fit
+        })
+    }
+
     fn fit_search(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
         let p = self.base;
         let term = &candidate.terms[0];

@@ -537,9 +537,16 @@ fn apply_named(p: &mut Parameters, scored: &Scored) -> Result<Vec<(&'static str,
     let values = scored.parameters();
     match scored.fit.candidate.named {
         Some("piston_friction") => {
-            let value = p.friction_coulomb + values[0].1 / p.force_sensor_gain;
-            set_parameter(p, "friction_coulomb", value)?;
-            set.push(("friction_coulomb", value));
+            // Forces read through the sensor's gain; the speed scale as fitted.
+            for (name, value) in values {
+                let value = match name {
+                    "friction_coulomb" => p.friction_coulomb + value / p.force_sensor_gain,
+                    "viscous_friction" => p.viscous_friction + value / p.force_sensor_gain,
+                    _ => value,
+                };
+                set_parameter(p, name, value)?;
+                set.push((name, value));
+            }
         }
         Some("sensor_offset_gain") => {
             let (offset, gain_error) = (values[0].1, values[1].1);
@@ -693,9 +700,15 @@ pub fn diagnose_with(
         let line = signature::spectrum(&recording.time, &force_residual);
         let periodic =
             (line.peak_over_median > 100.0 && line.low_share < 0.5 && line.peak_hz > 0.2).then_some(line.peak_hz);
+        // Pressures within their noise: nothing upstream of the piston departs by more
+        // than they can show, and only the mechanics and the force sensor are fitted.
+        let pressures_agree = problem.weights[1] > 0.0
+            && problem.weights[2] > 0.0
+            && (1..CHANNELS).all(|c| (heldout[c] / count).sqrt() <= EXPLAINED_WITHIN_NOISE);
         let candidates: Vec<Candidate> = catalogue(&params, pressure_noise.is_some(), periodic)
             .into_iter()
             .filter(|c| !effects.iter().any(|e| Some(e.name) == c.named))
+            .filter(|c| !pressures_agree || matches!(c.location, "mechanics" | "force_sensor"))
             .collect();
         progress(&format!(
             "round {}: held-out misfit {} noise floors",
@@ -825,19 +838,23 @@ pub fn diagnose_with(
                 .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
                 .filter(|s| s.explained >= LOCATED_SHARE)
                 .collect();
-            at_place.sort_by(|a, b| b.explained.total_cmp(&a.explained));
-            let before_total: f64 = heldout.iter().sum();
-            let mut kept = None;
-            for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
-                let label = s.fit.candidate.label;
-                let used = s
-                    .fit
+            // Best first by the held-out misfit plus the BIC-like penalty of the terms
+            // used: a term that adds nothing on the held-out blocks loses to a simpler one.
+            let used = |s: &Scored| {
+                s.fit
                     .values
                     .iter()
                     .zip(&s.fit.candidate.terms)
                     .filter(|(v, t)| **v != t.neutral)
-                    .count();
-                let penalty = used as f64 * count.ln();
+                    .count() as f64
+            };
+            let penalised = |s: &Scored| s.fit.heldout_total() + used(s) * count.ln();
+            at_place.sort_by(|a, b| penalised(a).total_cmp(&penalised(b)));
+            let before_total: f64 = heldout.iter().sum();
+            let mut kept = None;
+            for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
+                let label = s.fit.candidate.label;
+                let penalty = used(s) * count.ln();
                 let worse_pressures = (1..CHANNELS)
                     .any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * heldout[c] + count * 0.01);
                 if worse_pressures || before_total - s.fit.heldout_total() < penalty {

@@ -98,8 +98,13 @@ pub fn polytropic_exponent(gamma: f64, heat_transfer_fraction: f64) -> f64 {
 /// Coulomb friction on the rod force, opposing the stopper velocity (2.35); zero at rest
 /// (stiction holds whatever force the pressures give, and the prescribed stopper does not
 /// stick).
-pub fn friction_force(friction_coulomb: f64, stopper_velocity: f64) -> f64 {
-    if stopper_velocity.abs() < 1e-9 {
+///
+/// With `friction_velocity` > 0 the law is smooth, F_c tanh(v / v_c): seals that deform
+/// before they slide reach the Coulomb level over a speed v_c instead of at once.
+pub fn friction_force(friction_coulomb: f64, friction_velocity: f64, stopper_velocity: f64) -> f64 {
+    if friction_velocity > 0.0 {
+        friction_coulomb * (stopper_velocity / friction_velocity).tanh()
+    } else if stopper_velocity.abs() < 1e-9 {
         0.0
     } else {
         friction_coulomb * stopper_velocity.signum()
@@ -321,8 +326,11 @@ mod tests {
     fn other_effects_are_off_at_their_defaults() {
         assert_eq!(polytropic_exponent(1.4, 0.0), 1.4);
         assert_eq!(polytropic_exponent(1.4, 1.0), 1.0);
-        assert_eq!(friction_force(0.0, 0.3), 0.0);
-        assert_eq!(friction_force(2.0, -0.3), -2.0);
+        assert_eq!(friction_force(0.0, 0.0, 0.3), 0.0);
+        assert_eq!(friction_force(2.0, 0.0, -0.3), -2.0);
+        // The smooth law: tanh(1) of the level at v = v_c, the level far beyond.
+        assert!((friction_force(2.0, 0.005, 0.005) - 2.0 * 1f64.tanh()).abs() < 1e-12);
+        assert!((friction_force(2.0, 0.005, -0.1) + 2.0).abs() < 1e-8);
         assert_eq!(sensor_reading(0.0, 1.0, 45.0), 45.0);
     }
 }
