@@ -740,7 +740,11 @@ pub fn diagnose_with(
         let force_before = rms_where(&force_residual, &training, false);
         let place_share = found.best_at(place).map_or(0.0, |s| s.explained);
         let mut added = None;
-        if round < MAX_EFFECTS && place != "unknown" {
+        // Named effects are the hypotheses tried first: once a term outside them has been
+        // added, a named effect found later would be absorbing what that term's form
+        // misses, and only further terms are tried.
+        let naming = discovered.is_empty();
+        if naming && round < MAX_EFFECTS && place != "unknown" {
             let mut named: Vec<&Scored> = found
                 .candidates
                 .iter()
@@ -774,7 +778,7 @@ pub fn diagnose_with(
         // With pressures, the mechanics and the force sensor are judged on the force
         // against the pressures, where an upstream departure does not reach: a second
         // effect there is found even while a larger one upstream dominates the misfit.
-        if added.is_none() && round < MAX_EFFECTS {
+        if naming && added.is_none() && round < MAX_EFFECTS {
             if let Some(through) = force_through_mechanics(&model, recording) {
                 let downstream = Problem::new(recording, &params, &training, [mechanical_noise, 0.0, 0.0]);
                 let (_, misfit) = downstream.errors(&[through.force.clone(), vec![], vec![]]);
