@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Benchmark of `jetpipe diagnose`: wall time of the diagnosis of 80 s, 1 kHz recordings
 # with pressure channels (target: at most 30 s on a 2-core machine, every candidate fitted).
-# Prints one Markdown table row per recording: the synthetic ones benchgen writes, then the
-# bench recordings beside the repository if they are there.
+# Prints one Markdown table row per recording: the synthetic ones benchgen writes (named
+# effects, then every undeclared mechanism of its table), then the bench recordings beside
+# the repository if they are there. JETPIPE_BENCH_UNDECLARED=0 leaves the undeclared set out.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --bin jetpipe --bin benchgen
@@ -11,7 +12,13 @@ trap 'rm -rf "$work"' EXIT
 ./target/release/benchgen --out "$work/friction.csv" --seed 7 --friction-coulomb 2.0 >/dev/null
 ./target/release/benchgen --out "$work/supply.csv" --seed 107 --supply-resistance 5e8 >/dev/null
 ./target/release/benchgen --out "$work/hysteresis_and_friction.csv" --seed 109 --hysteresis-width 0.12e-3 --friction-coulomb 2 >/dev/null
-echo "| recording | verdict | location | named | held-out before → after (N) | wall (s) on $(nproc) cores |"
+if [ "${JETPIPE_BENCH_UNDECLARED:-1}" != 0 ]; then
+    ./target/release/benchgen --out "$work/list.txt" --list-undeclared > "$work/names.txt"
+    for name in $(awk '{print $1}' "$work/names.txt"); do
+        ./target/release/benchgen --out "$work/u_$name.csv" --seed 7 --undeclared "$name" >/dev/null
+    done
+fi
+echo "| recording | verdict | named | discovered (location, family: parameters) | held-out before → after (N) | wall (s) on $(nproc) cores |"
 echo "|---|---|---|---|---|---|"
 for rec in "$work"/*.csv ../shared/bench/rec_0*.csv ../shared/bench/undeclared/*.csv; do
     [ -f "$rec" ] || continue
@@ -22,10 +29,15 @@ for rec in "$work"/*.csv ../shared/bench/rec_0*.csv ../shared/bench/undeclared/*
     row=$(python3 - "$work/report.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
-u = d.get("unexplained", {})
 names = ", ".join(e["name"] for e in d["effects"]) or "—"
-print(f'{d["verdict"]} | {u.get("location", "—")} | {names} | {d["heldout"]["before_rms_N"]:.3f} → {d["heldout"]["after_rms_N"]:.3f}')
+found = "; ".join(
+    f'{t["location"]}, {t["family"]}: ' + ", ".join(f"{k} = {v:.4g}" for k, v in t["parameters"].items())
+    for t in d["discovered"]) or "—"
+if "unexplained" in d and not d["discovered"]:
+    u = d["unexplained"]
+    found = f'placed at {u["location"]} ({u["family"]})'
+print(f'{d["verdict"]} | {names} | {found} | {d["heldout"]["before_rms_N"]:.3f} → {d["heldout"]["after_rms_N"]:.3f}')
 PY
 )
-    echo "| $(basename "$rec") | $row | $((ms / 1000)).$(( (ms % 1000) / 100 )) |"
+    echo "| $(basename "$rec" .csv) | $row | $((ms / 1000)).$(( (ms % 1000) / 100 )) |"
 done
