@@ -196,6 +196,14 @@ pub fn parameter_value(p: &Parameters, name: &str) -> f64 {
         .unwrap_or_else(|| panic!("{name} is not a parameter"))
 }
 
+/// The bounds the variable table declares for a parameter (infinite where it declares none).
+pub fn declared_bounds(name: &str) -> (f64, f64) {
+    match Parameters::declared_range(value_reference(name)) {
+        Some((lower, upper)) => (lower.unwrap_or(f64::NEG_INFINITY), upper.unwrap_or(f64::INFINITY)),
+        None => (f64::NEG_INFINITY, f64::INFINITY),
+    }
+}
+
 /// Set an FMU parameter, with the model's own checks.
 pub fn set_parameter(p: &mut Parameters, name: &str, value: f64) -> Result<(), String> {
     p.set(value_reference(name), value)
