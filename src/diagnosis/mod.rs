@@ -1011,6 +1011,23 @@ pub fn diagnose_with(
                 ));
                 if after_joint < before_joint {
                     params = trial;
+                    // A named effect the refit turned off (its amplitude at zero: another
+                    // term took over what it explained) is no longer there.
+                    effects.retain(|e| {
+                        let off = match e.name {
+                            "piston_friction" => params.friction_coulomb == 0.0,
+                            _ => e.parameters.iter().all(|(name, _)| {
+                                parameter_value(&params, name) == parameter_value(&Parameters::default(), name)
+                            }),
+                        };
+                        if off {
+                            progress(&format!("  {} is off after the refit: removed", e.name));
+                        }
+                        !off
+                    });
+                    if params.friction_coulomb == 0.0 {
+                        params.friction_velocity = 0.0;
+                    }
                     for (name, value) in effects
                         .iter_mut()
                         .flat_map(|e| e.parameters.iter_mut())
