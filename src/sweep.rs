@@ -801,11 +801,11 @@ mod tests {
     fn a_supply_pressure_below_the_return_pressure_is_refused_naming_both_values() {
         let e = refusal("P_s=652925,90000");
         assert!(
-            e.contains("point 1 (P_s = 90000)") && e.contains("P_s = 90000 Pa is invalid: must exceed P_r = 101325 Pa"),
+            e.contains("point 1 (P_s = 90000)") && e.contains("P_s = 90000 Pa is invalid: must be >= P_r = 101325 Pa"),
             "{e}"
         );
         let e = refusal("P_r=700000");
-        assert!(e.contains("P_s = 652925 Pa is invalid: must exceed P_r = 700000 Pa"), "{e}");
+        assert!(e.contains("P_s = 652925 Pa is invalid: must be >= P_r = 700000 Pa"), "{e}");
     }
 
     #[test]

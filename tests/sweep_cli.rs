@@ -168,7 +168,7 @@ fn bad_names_and_values_are_refused_before_any_run() {
         (&["--param", "C_d=1.5"], &["C_d = 1.5", "must be in (0, 1]"]),
         (
             &["--param", "P_s=90000"],
-            &["P_s = 90000 Pa", "must exceed P_r = 101325 Pa"],
+            &["P_s = 90000 Pa", "must be >= P_r = 101325 Pa"],
         ),
         (&["--param", "k_spring=1e30"], &["k_spring = 1e30 N/m", "must be in [0, 100000] N/m"]),
         (

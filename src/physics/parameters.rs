@@ -256,9 +256,9 @@ impl Parameters {
 
     /// Checks that involve several parameters (run before initialisation).
     pub fn validate(&self) -> Result<(), String> {
-        if self.p_s <= self.p_r {
+        if self.p_s < self.p_r {
             return Err(format!(
-                "P_s = {} Pa is invalid: must exceed P_r = {} Pa (the supply must be above the return pressure, (2.18))",
+                "P_s = {} Pa is invalid: must be >= P_r = {} Pa (a supply below the return pressure would blow the air backwards through the valve; equal is the unpressurised actuator of §3.3.1)",
                 number(self.p_s),
                 number(self.p_r)
             ));
