@@ -1,10 +1,11 @@
 """Issue 5, soak: random commands and stopper motion through FMPy for JETPIPE_SOAK_SECONDS simulated
 seconds (default 60 in CI; 3600 for the full hour), 10 ms communication steps, prints its figures.
 
-1. Sealed chambers (C_d = 0, C_db_A_lpp = C_dm_A_lpp = 0): no air enters or leaves a chamber, so
-   P_i * V_i^gamma must stay at its initial value whatever the stopper does (jumps and ramps through
-   fmi2SetRealInputDerivatives). The drift of that invariant is the mass-balance check: it must stay
-   within 100 x the integrator tolerance (1e-6) over the whole run.
+1. Sealed chambers (the four orifice areas scaled by 0, C_db_A_lpp = C_dm_A_lpp = 0; C_d itself
+   must be > 0): no air enters or leaves a chamber, so P_i * V_i^gamma must stay at its initial
+   value whatever the stopper does (jumps and ramps through fmi2SetRealInputDerivatives). The drift
+   of that invariant is the mass-balance check: it must stay within 100 x the integrator tolerance
+   (1e-6) over the whole run.
 2. Normal parameters: outputs always finite; with the stopper moving the pressures may leave
    [P_r, P_s] (adiabatic compression), so they are checked against the adiabatic bound
    P_r * (V_min/V_max)^gamma <= P <= P_s * (V_max/V_min)^gamma over the stopper range used.
@@ -22,6 +23,15 @@ from jetpipe_fmu import initialize
 SOAK_SECONDS = float(os.environ.get("JETPIPE_SOAK_SECONDS", "60"))
 STEP = 0.01
 X_LO, X_HI = 0.035, 0.085  # stopper range used (valid 0.026 < x_s < 0.096)
+# No flow through the valve (its four orifice areas C_d A times 0) nor past the piston.
+SEALED = {
+    "supply_area_scale_1": 0.0,
+    "supply_area_scale_2": 0.0,
+    "return_area_scale_1": 0.0,
+    "return_area_scale_2": 0.0,
+    "C_db_A_lpp": 0.0,
+    "C_dm_A_lpp": 0.0,
+}
 
 
 def volumes(x_s, p):
@@ -69,7 +79,7 @@ def soak(fmu, vrs, seconds, seed, check):
 def test_soak_sealed_chambers_conserve_air(init_fmu, vrs, defaults):
     p = dict(defaults)
     gamma = p["gamma"]
-    fmu = init_fmu(inputs=(2.5, 0.054), parameters={"C_d": 0.0, "C_db_A_lpp": 0.0, "C_dm_A_lpp": 0.0},
+    fmu = init_fmu(inputs=(2.5, 0.054), parameters=SEALED,
                    tolerance=1e-6)
     P1, P2 = fmu.getReal([vrs["P1"], vrs["P2"]])
     V1, V2 = volumes(0.054, p)

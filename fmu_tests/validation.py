@@ -734,7 +734,9 @@ def scenario_8(ctx: FmuContext, fast=True, inv=None):
 # Scenario 9: stopper motion under constant command
 # --------------------------------------------------------------------------------------------
 
-SEALED = {"C_d": 0.0, "C_db_A_lpp": 0.0, "C_dm_A_lpp": 0.0}
+# No orifice flow (the four areas C_d A times 0: C_d itself must be > 0) and no leakage.
+NO_VALVE = {"supply_area_scale_1": 0.0, "supply_area_scale_2": 0.0, "return_area_scale_1": 0.0, "return_area_scale_2": 0.0}
+SEALED = dict(NO_VALVE, C_db_A_lpp=0.0, C_dm_A_lpp=0.0)
 
 
 def stopper_sine(x0, amp, f):
@@ -768,9 +770,9 @@ def scenario_9(ctx: FmuContext, fast=True):
     r["F_law"] = np.maximum(A_p * (r["P1"] - r["P2"]), spring_force(r["x_s"]))
     res["sealed"] = r
     p.close()
-    # (b) Leakage only (C_d = 0): air moves from chamber 1 to 2 past the piston, the total is kept.
+    # (b) Leakage only (no orifice flow): air moves from chamber 1 to 2 past the piston, the total is kept.
     #     With the model's (2.26)-(2.29), R T dm_i = V_i dP_i / gamma + P_i dV_i.
-    p = ctx.instance(v_DA=2.0, x_s=0.054, parameters={"C_d": 0.0, "P1_start": 6.0e5, "P2_start": 2.0e5},
+    p = ctx.instance(v_DA=2.0, x_s=0.054, parameters=dict(NO_VALVE, P1_start=6.0e5, P2_start=2.0e5),
                      booleans={"start_at_equilibrium": False})
     r = move_stopper(p, x_fun, 2.0, 0.001)
     L1, L2 = chamber_lengths(ctx, r["x_s"])

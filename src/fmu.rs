@@ -298,12 +298,7 @@ impl CoSimModel for ActuatorFmu {
                 None => Err(format!("x_s = {value} m is invalid: must be finite")),
             },
             vr::P1_START | vr::P2_START => {
-                if !(value.is_finite() && value > 0.0) {
-                    return Err(format!(
-                        "{} = {value} Pa is invalid: must be finite and > 0",
-                        variable_name(value_reference)
-                    ));
-                }
+                crate::variables::check(value_reference, value)?;
                 if value_reference == vr::P1_START {
                     self.p1_start = value;
                 } else {
@@ -809,7 +804,9 @@ mod tests {
                     });
                 let message = refused.expect_err(&format!("{} = {outside} was taken", v.name));
                 assert!(
-                    message.contains(v.name) && message.contains(&format!("{outside}")),
+                    message.contains(v.name)
+                        && (message.contains(&format!("{outside}"))
+                            || message.contains(&crate::variables::number(outside))),
                     "{message}"
                 );
                 let mut fmu = ActuatorFmu::instantiate();

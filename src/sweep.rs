@@ -747,7 +747,7 @@ mod tests {
         let e = parse_axis("C_d=abc").unwrap_err();
         assert!(e.contains("C_d") && e.contains("abc"), "{e}");
         let e = parse_axis("C_d=-0.1").unwrap_err();
-        assert!(e.contains("C_d") && e.contains("-0.1") && e.contains("[0, 1]"), "{e}");
+        assert!(e.contains("C_d") && e.contains("-0.1") && e.contains("(0, 1]"), "{e}");
         let e = parse_axis("C_d=0.6:0.7:0").unwrap_err();
         assert!(e.contains("N") && e.contains("\"0\""), "{e}");
         let e = parse_axis("C_d=0.6:0.7").unwrap_err();
@@ -777,6 +777,48 @@ mod tests {
         assert!(Sweep::new(&Parameters::default(), twice, RunSettings::default())
             .unwrap_err()
             .contains("twice"));
+    }
+
+    /// The message of refusing `spec`, whether parsing it or building the grid refuses it.
+    fn refusal(spec: &str) -> String {
+        match parse_axis(spec) {
+            Err(e) => e,
+            Ok(axis) => Sweep::new(&Parameters::default(), vec![axis], RunSettings::default())
+                .err()
+                .unwrap_or_else(|| panic!("--param {spec} was accepted")),
+        }
+    }
+
+    #[test]
+    fn a_discharge_coefficient_above_one_is_refused_naming_the_value_and_the_limit() {
+        let e = refusal("C_d=0.6,1.5");
+        assert!(e.contains("C_d = 1.5 is invalid: must be in (0, 1]"), "{e}");
+        let e = refusal("C_d=0");
+        assert!(e.contains("C_d = 0 is invalid: must be in (0, 1]"), "{e}");
+    }
+
+    #[test]
+    fn a_supply_pressure_below_the_return_pressure_is_refused_naming_both_values() {
+        let e = refusal("P_s=652925,90000");
+        assert!(
+            e.contains("point 1 (P_s = 90000)") && e.contains("P_s = 90000 Pa is invalid: must be >= P_r = 101325 Pa"),
+            "{e}"
+        );
+        let e = refusal("P_r=700000");
+        assert!(e.contains("P_s = 652925 Pa is invalid: must be >= P_r = 700000 Pa"), "{e}");
+    }
+
+    #[test]
+    fn a_spring_rate_of_1e30_is_refused_naming_the_value_and_the_limit() {
+        let e = refusal("k_spring=1e30");
+        assert!(e.contains("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"), "{e}");
+    }
+
+    #[test]
+    fn the_sweep_refuses_with_the_message_of_the_table() {
+        let e = refusal("k_spring=1e30");
+        let table = crate::variables::check(crate::variables::vr::K_SPRING, 1e30).unwrap_err();
+        assert!(e.ends_with(&table), "{e}");
     }
 
     #[test]

@@ -433,8 +433,16 @@ fn supply_below_or_equal_to_return_and_parameters_at_zero() {
         ("P_s barely above P_r", vec![(vr::P_S, 101_325.5)]),
         ("P_r > default P_s", vec![(vr::P_R, 700_000.0)]),
         (
-            "sealed: C_d = leakage = 0",
-            vec![(vr::C_D, 0.0), (vr::C_DB_A_LPP, 0.0), (vr::C_DM_A_LPP, 0.0)],
+            // C_d itself must be > 0: the four orifice areas are scaled by 0 instead.
+            "sealed: orifice areas = leakage = 0",
+            vec![
+                (vr::SUPPLY_AREA_SCALE_1, 0.0),
+                (vr::SUPPLY_AREA_SCALE_2, 0.0),
+                (vr::RETURN_AREA_SCALE_1, 0.0),
+                (vr::RETURN_AREA_SCALE_2, 0.0),
+                (vr::C_DB_A_LPP, 0.0),
+                (vr::C_DM_A_LPP, 0.0),
+            ],
         ),
         ("no leakage", vec![(vr::C_DB_A_LPP, 0.0), (vr::C_DM_A_LPP, 0.0)]),
         ("no spring", vec![(vr::K_SPRING, 0.0), (vr::L_SPRING0, 0.0)]),

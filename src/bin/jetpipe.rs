@@ -38,6 +38,9 @@ enum Command {
     },
     /// Print the model description generated from the variable table.
     ModelDescription,
+    /// Print every variable with its unit, start value, limits, thesis reference and meaning
+    /// (the Markdown table of docs/model.md, from the variable table).
+    Parameters,
     /// Linearise at the equilibrium with the given force (§4.2.2): A, B, C, D, poles, zeros.
     Linearize {
         /// Actuator force of the operating point, N.
@@ -86,7 +89,8 @@ enum Command {
     /// CSV row per run and print the speed-up over one thread.
     Sweep {
         /// NAME=START:STOP:N (N evenly spaced values), NAME=V1,V2,... or NAME=V, with NAME a
-        /// parameter of the FMU (e.g. C_d, P_s). Several --param give their Cartesian product.
+        /// parameter of the FMU (e.g. C_d, P_s; `jetpipe parameters` lists them with their
+        /// limits, which every value must keep). Several --param give their Cartesian product.
         #[arg(long = "param", value_name = "NAME=VALUES", required = true)]
         params: Vec<String>,
         /// Worker threads (default: every core this process may use).
@@ -143,6 +147,10 @@ fn run(cli: Cli) -> Result<(), String> {
         }
         Command::ModelDescription => {
             print!("{}", jetpipe::packaging::actuator_model_description());
+            Ok(())
+        }
+        Command::Parameters => {
+            print!("{}", jetpipe::variables::interface_table());
             Ok(())
         }
         Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),

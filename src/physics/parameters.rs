@@ -3,7 +3,7 @@
 
 use super::chambers::CylinderGeometry;
 use super::orifice_flow::FlowConstants;
-use crate::variables::{vr, VARIABLES};
+use crate::variables::{number, vr, VARIABLES};
 
 /// Every constant of the thesis model, in SI units.
 #[derive(Clone, Debug, PartialEq)]
@@ -173,16 +173,6 @@ impl Default for Parameters {
     }
 }
 
-/// How a parameter value must be bounded.
-#[derive(Clone, Copy)]
-enum Bound {
-    Positive,
-    NonNegative,
-    Finite,
-    GreaterThanOne,
-    UnitInterval,
-}
-
 impl Parameters {
     /// Value references of the fields, in the table's order.
     pub const VALUE_REFERENCES: &'static [u32] = &[
@@ -258,97 +248,88 @@ impl Parameters {
         vr::X_JP_OFFSET_DRIFT,
     ];
 
-    fn field_and_bound(&mut self, value_reference: u32) -> Option<(&mut f64, Bound)> {
-        use Bound::*;
+    fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
         Some(match value_reference {
-            vr::P_S => (&mut self.p_s, Positive),
-            vr::P_R => (&mut self.p_r, Positive),
-            vr::T_GAS => (&mut self.temperature, Positive),
-            vr::GAMMA => (&mut self.gamma, GreaterThanOne),
-            vr::R_GAS => (&mut self.r_gas, Positive),
-            vr::K_CD => (&mut self.k_cd, Finite),
-            vr::I_OFFSET => (&mut self.i_offset, Finite),
-            vr::OMEGA_CD => (&mut self.omega_cd, Positive),
-            vr::K_M => (&mut self.k_m, Finite),
-            vr::OMEGA_1 => (&mut self.omega_1, Positive),
-            vr::OMEGA_2 => (&mut self.omega_2, Positive),
-            vr::ZETA_2 => (&mut self.zeta_2, NonNegative),
-            vr::X_JP_SAT => (&mut self.x_jp_sat, Positive),
-            vr::F_JP_SAT => (&mut self.f_jp_sat, Positive),
-            vr::X_JP_OFFSET => (&mut self.x_jp_offset, Finite),
-            vr::D_JP => (&mut self.d_jp, Positive),
-            vr::C_D => (&mut self.c_d, UnitInterval),
-            vr::C_DM_A_LPP => (&mut self.c_dm_a_lpp, Finite),
-            vr::C_DB_A_LPP => (&mut self.c_db_a_lpp, NonNegative),
-            vr::L_CYL => (&mut self.l_cyl, Positive),
-            vr::L_P => (&mut self.l_p, Positive),
-            vr::L_S => (&mut self.l_s, NonNegative),
-            vr::L_SUP => (&mut self.l_sup, NonNegative),
-            vr::L_SPRING0 => (&mut self.l_spring0, NonNegative),
-            vr::D_CYL => (&mut self.d_cyl, Positive),
-            vr::K_SPRING => (&mut self.k_spring, NonNegative),
-            vr::HYSTERESIS_WIDTH => (&mut self.hysteresis_width, NonNegative),
-            vr::HYSTERESIS_DEADBAND => (&mut self.hysteresis_deadband, NonNegative),
-            vr::FRICTION_COULOMB => (&mut self.friction_coulomb, NonNegative),
-            vr::FRICTION_VELOCITY => (&mut self.friction_velocity, NonNegative),
-            vr::DEAD_VOLUME_1 => (&mut self.dead_volume_1, NonNegative),
-            vr::DEAD_VOLUME_2 => (&mut self.dead_volume_2, NonNegative),
-            vr::SUPPLY_RESISTANCE => (&mut self.supply_resistance, NonNegative),
-            vr::HEAT_TRANSFER_FRACTION => (&mut self.heat_transfer_fraction, UnitInterval),
-            vr::COMMAND_DELAY => (&mut self.command_delay, NonNegative),
-            vr::FORCE_SENSOR_OFFSET => (&mut self.force_sensor_offset, Finite),
-            vr::FORCE_SENSOR_GAIN => (&mut self.force_sensor_gain, Positive),
-            vr::SUPPLY_AREA_SCALE_1 => (&mut self.supply_area_scale_1, NonNegative),
-            vr::SUPPLY_AREA_SCALE_2 => (&mut self.supply_area_scale_2, NonNegative),
-            vr::RETURN_AREA_SCALE_1 => (&mut self.return_area_scale_1, NonNegative),
-            vr::RETURN_AREA_SCALE_2 => (&mut self.return_area_scale_2, NonNegative),
-            vr::RETURN_RESISTANCE => (&mut self.return_resistance, NonNegative),
-            vr::CHAMBER_VENT_1 => (&mut self.chamber_vent_1, NonNegative),
-            vr::CHAMBER_VENT_2 => (&mut self.chamber_vent_2, NonNegative),
-            vr::PORT_RESISTANCE_1 => (&mut self.port_resistance_1, NonNegative),
-            vr::PORT_RESISTANCE_2 => (&mut self.port_resistance_2, NonNegative),
-            vr::STOPPER_COMPLIANCE => (&mut self.stopper_compliance, NonNegative),
-            vr::COMMAND_LAG => (&mut self.command_lag, NonNegative),
-            vr::COMMAND_LIMIT => (&mut self.command_limit, NonNegative),
-            vr::CURRENT_LIMIT => (&mut self.current_limit, NonNegative),
-            vr::CURRENT_SLEW_LIMIT => (&mut self.current_slew_limit, NonNegative),
-            vr::F3_INPUT_CUBIC => (&mut self.f3_input_cubic, Finite),
-            vr::FORCE_SENSOR_QUADRATIC => (&mut self.force_sensor_quadratic, Finite),
-            vr::FORCE_SENSOR_CUBIC => (&mut self.force_sensor_cubic, Finite),
-            vr::FORCE_SENSOR_DRIFT => (&mut self.force_sensor_drift, Finite),
-            vr::FORCE_SENSOR_LAG => (&mut self.force_sensor_lag, NonNegative),
-            vr::FORCE_SENSOR_DELAY => (&mut self.force_sensor_delay, NonNegative),
-            vr::FORCE_SENSOR_PLAY => (&mut self.force_sensor_play, NonNegative),
-            vr::FORCE_SENSOR_RIPPLE_SINE => (&mut self.force_sensor_ripple_sine, Finite),
-            vr::FORCE_SENSOR_RIPPLE_FREQUENCY => (&mut self.force_sensor_ripple_frequency, NonNegative),
-            vr::FORCE_SENSOR_RIPPLE_COSINE => (&mut self.force_sensor_ripple_cosine, Finite),
-            vr::VISCOUS_FRICTION => (&mut self.viscous_friction, NonNegative),
-            vr::POSITION_FORCE_RATE => (&mut self.position_force_rate, Finite),
-            vr::POSITION_FORCE_REFERENCE => (&mut self.position_force_reference, Finite),
-            vr::RETURN_VENT_AREA => (&mut self.return_vent_area, NonNegative),
-            vr::SUPPLY_DRIFT => (&mut self.supply_drift, Finite),
-            vr::SUPPLY_RIPPLE_SINE => (&mut self.supply_ripple_sine, Finite),
-            vr::SUPPLY_RIPPLE_FREQUENCY => (&mut self.supply_ripple_frequency, NonNegative),
-            vr::SUPPLY_RIPPLE_COSINE => (&mut self.supply_ripple_cosine, Finite),
-            vr::X_JP_OFFSET_DRIFT => (&mut self.x_jp_offset_drift, Finite),
+            vr::P_S => &mut self.p_s,
+            vr::P_R => &mut self.p_r,
+            vr::T_GAS => &mut self.temperature,
+            vr::GAMMA => &mut self.gamma,
+            vr::R_GAS => &mut self.r_gas,
+            vr::K_CD => &mut self.k_cd,
+            vr::I_OFFSET => &mut self.i_offset,
+            vr::OMEGA_CD => &mut self.omega_cd,
+            vr::K_M => &mut self.k_m,
+            vr::OMEGA_1 => &mut self.omega_1,
+            vr::OMEGA_2 => &mut self.omega_2,
+            vr::ZETA_2 => &mut self.zeta_2,
+            vr::X_JP_SAT => &mut self.x_jp_sat,
+            vr::F_JP_SAT => &mut self.f_jp_sat,
+            vr::X_JP_OFFSET => &mut self.x_jp_offset,
+            vr::D_JP => &mut self.d_jp,
+            vr::C_D => &mut self.c_d,
+            vr::C_DM_A_LPP => &mut self.c_dm_a_lpp,
+            vr::C_DB_A_LPP => &mut self.c_db_a_lpp,
+            vr::L_CYL => &mut self.l_cyl,
+            vr::L_P => &mut self.l_p,
+            vr::L_S => &mut self.l_s,
+            vr::L_SUP => &mut self.l_sup,
+            vr::L_SPRING0 => &mut self.l_spring0,
+            vr::D_CYL => &mut self.d_cyl,
+            vr::K_SPRING => &mut self.k_spring,
+            vr::HYSTERESIS_WIDTH => &mut self.hysteresis_width,
+            vr::HYSTERESIS_DEADBAND => &mut self.hysteresis_deadband,
+            vr::FRICTION_COULOMB => &mut self.friction_coulomb,
+            vr::FRICTION_VELOCITY => &mut self.friction_velocity,
+            vr::DEAD_VOLUME_1 => &mut self.dead_volume_1,
+            vr::DEAD_VOLUME_2 => &mut self.dead_volume_2,
+            vr::SUPPLY_RESISTANCE => &mut self.supply_resistance,
+            vr::HEAT_TRANSFER_FRACTION => &mut self.heat_transfer_fraction,
+            vr::COMMAND_DELAY => &mut self.command_delay,
+            vr::FORCE_SENSOR_OFFSET => &mut self.force_sensor_offset,
+            vr::FORCE_SENSOR_GAIN => &mut self.force_sensor_gain,
+            vr::SUPPLY_AREA_SCALE_1 => &mut self.supply_area_scale_1,
+            vr::SUPPLY_AREA_SCALE_2 => &mut self.supply_area_scale_2,
+            vr::RETURN_AREA_SCALE_1 => &mut self.return_area_scale_1,
+            vr::RETURN_AREA_SCALE_2 => &mut self.return_area_scale_2,
+            vr::RETURN_RESISTANCE => &mut self.return_resistance,
+            vr::CHAMBER_VENT_1 => &mut self.chamber_vent_1,
+            vr::CHAMBER_VENT_2 => &mut self.chamber_vent_2,
+            vr::PORT_RESISTANCE_1 => &mut self.port_resistance_1,
+            vr::PORT_RESISTANCE_2 => &mut self.port_resistance_2,
+            vr::STOPPER_COMPLIANCE => &mut self.stopper_compliance,
+            vr::COMMAND_LAG => &mut self.command_lag,
+            vr::COMMAND_LIMIT => &mut self.command_limit,
+            vr::CURRENT_LIMIT => &mut self.current_limit,
+            vr::CURRENT_SLEW_LIMIT => &mut self.current_slew_limit,
+            vr::F3_INPUT_CUBIC => &mut self.f3_input_cubic,
+            vr::FORCE_SENSOR_QUADRATIC => &mut self.force_sensor_quadratic,
+            vr::FORCE_SENSOR_CUBIC => &mut self.force_sensor_cubic,
+            vr::FORCE_SENSOR_DRIFT => &mut self.force_sensor_drift,
+            vr::FORCE_SENSOR_LAG => &mut self.force_sensor_lag,
+            vr::FORCE_SENSOR_DELAY => &mut self.force_sensor_delay,
+            vr::FORCE_SENSOR_PLAY => &mut self.force_sensor_play,
+            vr::FORCE_SENSOR_RIPPLE_SINE => &mut self.force_sensor_ripple_sine,
+            vr::FORCE_SENSOR_RIPPLE_FREQUENCY => &mut self.force_sensor_ripple_frequency,
+            vr::FORCE_SENSOR_RIPPLE_COSINE => &mut self.force_sensor_ripple_cosine,
+            vr::VISCOUS_FRICTION => &mut self.viscous_friction,
+            vr::POSITION_FORCE_RATE => &mut self.position_force_rate,
+            vr::POSITION_FORCE_REFERENCE => &mut self.position_force_reference,
+            vr::RETURN_VENT_AREA => &mut self.return_vent_area,
+            vr::SUPPLY_DRIFT => &mut self.supply_drift,
+            vr::SUPPLY_RIPPLE_SINE => &mut self.supply_ripple_sine,
+            vr::SUPPLY_RIPPLE_FREQUENCY => &mut self.supply_ripple_frequency,
+            vr::SUPPLY_RIPPLE_COSINE => &mut self.supply_ripple_cosine,
+            vr::X_JP_OFFSET_DRIFT => &mut self.x_jp_offset_drift,
             _ => return None,
         })
     }
 
-    /// The (min, max) that [`Parameters::set`] enforces on a parameter, as the model
-    /// description declares them (FMI's bounds are closed: "> 0" is declared as min 0).
+    /// The (min, max) that [`Parameters::set`] enforces on a parameter, as the variable table
+    /// declares them (FMI's bounds are closed: "> 0" is declared as min 0).
     pub fn declared_range(value_reference: u32) -> Option<(Option<f64>, Option<f64>)> {
-        let (_, bound) = Parameters::default().field_and_bound(value_reference)?;
-        Some(match bound {
-            Bound::Positive | Bound::NonNegative => (Some(0.0), None),
-            Bound::GreaterThanOne => (Some(1.0), None),
-            Bound::UnitInterval => (Some(0.0), Some(1.0)),
-            Bound::Finite => (None, None),
-        })
-    }
-
-    fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
-        self.field_and_bound(value_reference).map(|(f, _)| f)
+        Parameters::default().field_mut(value_reference)?;
+        let v = &crate::variables::row(value_reference)?.variable;
+        Some((v.min, v.max))
     }
 
     /// Value of the parameter with this value reference, if it is one.
@@ -357,32 +338,27 @@ impl Parameters {
         copy.field_mut(value_reference).map(|f| *f)
     }
 
-    /// Set one parameter, checking its own bound. The message names the variable and value.
+    /// Set one parameter within the limits of its row of the variable table (the FMU's
+    /// setters, `jetpipe sweep` and `--params` files all come here). The message names the
+    /// variable, the value and the limit.
     pub fn set(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
-        let name = variable_name(value_reference);
-        let (field, bound) = self
-            .field_and_bound(value_reference)
+        let field = self
+            .field_mut(value_reference)
             .ok_or_else(|| format!("value reference {value_reference} is not a parameter of the model"))?;
-        let problem = if !value.is_finite() {
-            Some("must be finite")
-        } else {
-            match bound {
-                Bound::Positive if value <= 0.0 => Some("must be > 0"),
-                Bound::NonNegative if value < 0.0 => Some("must be >= 0"),
-                Bound::GreaterThanOne if value <= 1.0 => Some("must be > 1"),
-                Bound::UnitInterval if !(0.0..=1.0).contains(&value) => Some("must be in [0, 1]"),
-                _ => None,
-            }
-        };
-        if let Some(why) = problem {
-            return Err(format!("{name} = {value} is invalid: {why}"));
-        }
+        crate::variables::check(value_reference, value)?;
         *field = value;
         Ok(())
     }
 
     /// Checks that involve several parameters (run before initialisation).
     pub fn validate(&self) -> Result<(), String> {
+        if self.p_s < self.p_r {
+            return Err(format!(
+                "P_s = {} Pa is invalid: must be >= P_r = {} Pa (a supply below the return pressure would blow the air backwards through the valve; equal is the unpressurised actuator of §3.3.1)",
+                number(self.p_s),
+                number(self.p_r)
+            ));
+        }
         if self.c_db_a_lpp + self.c_dm_a_lpp < 0.0 {
             return Err(format!(
                 "C_db_A_lpp + C_dm_A_lpp = {} m2 is invalid: the leakage area (2.23) must stay >= 0 for every pressure ratio",
