@@ -11,6 +11,11 @@ run() {
 }
 
 run cargo test --release
+# Lints: clippy with warnings as errors, on every crate and target (the component is
+# installed when the toolchain lacks it).
+cargo clippy --version >/dev/null 2>&1 || run rustup component add clippy
+run cargo clippy --workspace --all-targets --release -- -D warnings
+RUSTDOCFLAGS="-D warnings" run cargo doc --no-deps --workspace --release
 run bash scripts/build_win64.sh
 JETPIPE_WIN64=1 run bash scripts/package.sh
 # The host build, linked against this machine's glibc: the platform test's counter-example.

@@ -152,7 +152,7 @@ pub fn chebyshev_interpolant(f: impl Fn(f64) -> f64) -> Piece {
         for (m, t) in monomial.iter_mut().zip(t_k) {
             *m += c * t;
         }
-        if k >= 1 && k < DEGREE {
+        if (1..DEGREE).contains(&k) {
             let mut next = [0.0; DEGREE + 1];
             for i in 0..DEGREE {
                 next[i + 1] = 2.0 * current[i];

@@ -62,6 +62,9 @@ impl OdeSystem<N_STATES> for StepSystem<'_> {
     }
 }
 
+/// The jet pipe position, pressures and pressure rates at the end of a step.
+type EndRates = (f64, SVector<f64, 2>, SVector<f64, 2>);
+
 /// The chambers over one step, driven by the exactly known jet pipe trajectory. Its time
 /// is counted from the step's start, as the trajectory's is: a step size the integrator
 /// repeats (the cap, the rest of an equal communication step) is then the same to the last
@@ -87,7 +90,7 @@ struct ChamberSystem<'a> {
     start_rates: std::cell::Cell<Option<(SVector<f64, 2>, SVector<f64, 2>)>>,
     /// The jet pipe position, pressures and rates of the last evaluation at t = duration:
     /// the integrator's last stage, whose rates are the next step's rates at its start.
-    end_rates: std::cell::Cell<Option<(f64, SVector<f64, 2>, SVector<f64, 2>)>>,
+    end_rates: std::cell::Cell<Option<EndRates>>,
     /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
     /// question starts there.
     stretch_at: std::cell::Cell<Option<(f64, i32)>>,
@@ -1093,10 +1096,12 @@ mod tests {
 
     #[test]
     fn sealed_chambers_conserve_air_when_the_stopper_moves() {
-        let mut p = Parameters::default();
-        p.c_d = 0.0;
-        p.c_db_a_lpp = 0.0;
-        p.c_dm_a_lpp = 0.0;
+        let p = Parameters {
+            c_d: 0.0,
+            c_db_a_lpp: 0.0,
+            c_dm_a_lpp: 0.0,
+            ..Parameters::default()
+        };
         let model = Actuator::new(p).unwrap();
         let mut state = equilibrium(&thesis_model(), 2.5, 0.054).unwrap();
         state[index::P1] = 4e5;

@@ -229,9 +229,11 @@ fn calibration_re_identifies_the_static_parameters() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("recording.csv");
     write_csv(&generate(&BenchEffects::default(), 110, 80.0), &path).unwrap();
-    let mut wrong = Parameters::default();
-    wrong.c_d = 0.60;
-    wrong.x_jp_offset = 0.07e-3;
+    let wrong = Parameters {
+        c_d: 0.60,
+        x_jp_offset: 0.07e-3,
+        ..Parameters::default()
+    };
     let recording = Recording::read(&path, &wrong).unwrap();
     let d = diagnose(&recording, &wrong, true, &mut |line| println!("{line}")).unwrap();
     let value = |name: &str| d.calibrated.iter().find(|c| c.name == name).map(|c| c.value).unwrap();

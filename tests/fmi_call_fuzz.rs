@@ -31,6 +31,9 @@ use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
 use std::time::Instant;
 
+/// Status counts per (call, state).
+type Tally = BTreeMap<(&'static str, &'static str), [u32; 5]>;
+
 use common::*;
 use jetpipe::fmi2::fmu_state::crc32;
 use jetpipe::fmi2::state::{Function, State};
@@ -1095,7 +1098,7 @@ impl Fuzz {
     }
 
     /// Free every FMU state and the instance (nothing may leak: see fmu_tests/test_memory.py).
-    fn finish(mut self) -> (BTreeMap<(&'static str, &'static str), [u32; 5]>, u64, u64) {
+    fn finish(mut self) -> (Tally, u64, u64) {
         unsafe {
             for (mut p, _) in std::mem::take(&mut self.states) {
                 let s = fmi2FreeFMUstate(self.c, &mut p);

@@ -254,12 +254,7 @@ fn every_parameter_at_every_extreme() {
         for &x in values {
             cases += 1;
             let label = format!("{} = {x:e}", name(r));
-            // start from given pressures for the P*_start cases
-            let params: Vec<(u32, f64)> = if r == vr::P1_START || r == vr::P2_START {
-                vec![(r, x)]
-            } else {
-                vec![(r, x)]
-            };
+            let params: Vec<(u32, f64)> = vec![(r, x)];
             let booleans_off = r == vr::P1_START || r == vr::P2_START;
             let result = with_watchdog(label.clone(), move || unsafe {
                 if booleans_off {

@@ -11,7 +11,7 @@
 //!    candidate explains most of the held-out misfit is where the model departs.
 //! 5. A named effect is added only when it is a candidate at that place, explains most of
 //!    what that place can explain, lowers the force error by more than the noise, makes no
-//!    channel worse, and the residual carries its own signature ([`named`]). Repeat.
+//!    channel worse, and the residual carries its own signature (`named.rs`). Repeat.
 //! 6. Verdict: explained when the held-out force error after is within 1.5 noise floors;
 //!    otherwise the remainder, where it sits in the chain and its signature.
 
@@ -231,7 +231,7 @@ pub struct AddedEffect {
     pub remainder_follows: String,
 }
 
-/// A term outside the named effects that was added (see [`discover`]).
+/// A term outside the named effects that was added (see `discover.rs`).
 #[derive(Clone, Debug)]
 pub struct DiscoveredTerm {
     pub location: &'static str,
@@ -438,7 +438,7 @@ fn localize(
 }
 
 /// Rank the places of the chain by their best candidate.
-fn rank(scored: &mut Vec<Scored>) -> Localization {
+fn rank(scored: &mut [Scored]) -> Localization {
     scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
     let mut by_location: Vec<(&'static str, f64, &'static str)> = vec![];
     for s in scored.iter() {
@@ -463,7 +463,7 @@ fn rank(scored: &mut Vec<Scored>) -> Localization {
         location,
         family,
         by_location,
-        candidates: scored.clone(),
+        candidates: scored.to_vec(),
     }
 }
 

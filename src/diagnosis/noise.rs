@@ -1,6 +1,6 @@
 //! Sensor noise of a recorded channel, from its second differences.
 //!
-//! For white noise of standard deviation σ, the second difference x[k+1] − 2x[k] + x[k−1]
+//! For white noise of standard deviation σ, the second difference x(k+1) − 2x(k) + x(k−1)
 //! has variance 6σ². The mean square of the second differences is taken over short
 //! windows and the median over the windows kept: a window where the signal itself curves
 //! (a step, a fast chirp) only lifts its own mean square, and a median of mean squares

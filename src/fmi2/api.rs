@@ -7,7 +7,7 @@
 //!   [`Instance::is_live`]); there is no logger to report it to;
 //! * runs its whole body inside `catch_unwind`: a panic is logged with its message, the
 //!   instance goes to the `fatal` state and the call returns fmi2Fatal;
-//! * checks the call against [`state::TABLE`]: an illegal call logs
+//! * checks the call against [`state::TABLE`](super::state::TABLE): an illegal call logs
 //!   "fmi2Xxx: illegal call in state yyy" and returns fmi2Error, state unchanged.
 //!
 //! Other errors (bad arguments, model rejections) return fmi2Error with a logged message

@@ -50,7 +50,8 @@ pub fn validate_model_info(info: &ModelInfo) -> Result<(), Vec<String>> {
         }
         let extent = info.extent_of(v);
         if let (Some(lo), Some(hi)) = (extent.min, extent.max) {
-            if !(lo <= hi) {
+            // NaN bounds are reported too.
+            if lo > hi || lo.is_nan() || hi.is_nan() {
                 problems.push(format!("variable {:?}: min {lo} > max {hi}", v.name));
             }
         }

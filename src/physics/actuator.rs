@@ -433,10 +433,12 @@ mod tests {
 
     #[test]
     fn mass_flows_balance_when_the_chambers_are_sealed() {
-        let mut p = Parameters::default();
-        p.c_d = 0.0;
-        p.c_db_a_lpp = 0.0;
-        p.c_dm_a_lpp = 0.0;
+        let p = Parameters {
+            c_d: 0.0,
+            c_db_a_lpp: 0.0,
+            c_dm_a_lpp: 0.0,
+            ..Parameters::default()
+        };
         let model = Actuator::new(p).unwrap();
         let f = model.mass_flows(3e-4, 4e5, 2e5);
         assert_eq!((f.net_1(), f.net_2()), (0.0, 0.0));
