@@ -51,6 +51,8 @@ pub mod vr {
     pub const HYSTERESIS_DEADBAND: u32 = 301;
     pub const FRICTION_COULOMB: u32 = 310;
     pub const FRICTION_VELOCITY: u32 = 311;
+    pub const FRICTION_STRIBECK: u32 = 312;
+    pub const FRICTION_STRIBECK_VELOCITY: u32 = 313;
     pub const DEAD_VOLUME_1: u32 = 320;
     pub const DEAD_VOLUME_2: u32 = 321;
     pub const SUPPLY_RESISTANCE: u32 = 330;
@@ -715,6 +717,14 @@ pub const TABLE: &[Row] = &[
         .cite("(2.35)")
         .because("1000 N: nine times the piston's largest pneumatic force, A_p (P_s - P_r) = 109 N"),
     parameter("friction_velocity", vr::FRICTION_VELOCITY, "m/s", 0.0, "piston_friction: the friction reaches the Coulomb level as tanh(v / this) of the stopper velocity v (0 = at once, as (2.35))")
+        .at_least(0.0).at_most(1.0)
+        .cite("(2.35)")
+        .because("1 m/s: ten times the stopper's fastest motion on the bench (94 mm/s)"),
+    parameter("friction_stribeck", vr::FRICTION_STRIBECK, "N", 0.0, "piston_friction: the friction level gains this times exp(-(v / friction_stribeck_velocity)^2) at low stopper speed v (stiction; 0 = off)")
+        .at_least(0.0).at_most(1000.0)
+        .cite("(2.35)")
+        .because("1000 N: nine times the piston's largest pneumatic force, A_p (P_s - P_r) = 109 N"),
+    parameter("friction_stribeck_velocity", vr::FRICTION_STRIBECK_VELOCITY, "m/s", 0.0, "piston_friction: the speed over which the Stribeck term fades")
         .at_least(0.0).at_most(1.0)
         .cite("(2.35)")
         .because("1 m/s: ten times the stopper's fastest motion on the bench (94 mm/s)"),

@@ -37,6 +37,9 @@ pub enum Regressor {
     /// −tanh((dx_s/dt) / v_c) there: Coulomb friction reached over a speed v_c (the
     /// candidate's [`Mechanism::Shape`] term).
     SmoothFriction(f64),
+    /// −exp(−(v/v_s)²) tanh(v/v_c) there: the Stribeck part, at the candidate's two shapes
+    /// (v_c, v_s).
+    Stribeck(f64, f64),
     /// −dx_s/dt where the pressures set the force: viscous friction.
     Viscous,
     /// x_s minus its mean where the pressures set the force: a spring on the piston.
@@ -579,6 +582,40 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             ],
         ),
         c(
+            "Stribeck friction",
+            "mechanics",
+            "extra_force",
+            Some("piston_friction"),
+            vec![
+                Term {
+                    lower: 0.0,
+                    ..output("friction_coulomb", "N", FORCE, Regressor::SmoothFriction(0.0), 0.1)
+                },
+                Term {
+                    lower: 0.0,
+                    ..output("friction_stribeck", "N", FORCE, Regressor::Stribeck(0.0, 0.0), 0.1)
+                },
+                Term {
+                    name: "friction_velocity",
+                    unit: "m/s",
+                    mechanism: Mechanism::Shape,
+                    neutral: 0.0,
+                    step: 0.0,
+                    lower: 1e-4,
+                    upper: 0.02,
+                },
+                Term {
+                    name: "friction_stribeck_velocity",
+                    unit: "m/s",
+                    mechanism: Mechanism::Shape,
+                    neutral: 0.0,
+                    step: 0.0,
+                    lower: 1e-3,
+                    upper: 0.05,
+                },
+            ],
+        ),
+        c(
             "viscous friction",
             "mechanics",
             "extra_force",
@@ -831,10 +868,19 @@ impl<'a> Problem<'a> {
             Regressor::OwnSquared => own[k] * own[k],
             Regressor::OwnCubed => own[k] * own[k] * own[k],
             Regressor::Friction if set_by_pressures && v.abs() > 1e-9 => -v.signum(),
-            Regressor::SmoothFriction(vc) if set_by_pressures => -crate::physics::effects::friction_force(1.0, vc, v),
+            Regressor::SmoothFriction(vc) if set_by_pressures => {
+                -crate::physics::effects::friction_force(1.0, vc, 0.0, 0.0, v)
+            }
+            Regressor::Stribeck(vc, vs) if set_by_pressures => {
+                -crate::physics::effects::friction_force(0.0, vc, 1.0, vs, v)
+            }
             Regressor::Viscous if set_by_pressures => -v,
             Regressor::Position if set_by_pressures => -(self.recording.x_s[k] - self.mean_position),
-            Regressor::Friction | Regressor::SmoothFriction(_) | Regressor::Viscous | Regressor::Position => 0.0,
+            Regressor::Friction
+            | Regressor::SmoothFriction(_)
+            | Regressor::Stribeck(..)
+            | Regressor::Viscous
+            | Regressor::Position => 0.0,
             Regressor::Ramp => (t - self.t_mid) / self.t_span,
             Regressor::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
             Regressor::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
@@ -1158,62 +1204,78 @@ impl Problem<'_> {
     /// limit does nothing until it clips, a slew limit until the command jumps) or that
     /// acts on a measured channel exactly (a delay, a lag, a play): golden-section search
     /// on the coefficient, on a logarithmic scale where it spans decades.
-    /// A candidate whose regressors share one shape parameter: golden-section search of
-    /// its logarithm, the linear amplitudes solved at each trial value.
+    /// A candidate whose regressors share one or two shape parameters (a friction's speed
+    /// scales): golden-section search of their logarithms (the second outside the first),
+    /// the linear amplitudes solved at each trial point.
     fn fit_shape(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
-        let shape = candidate
-            .terms
-            .iter()
-            .position(|t| t.mechanism == Mechanism::Shape)
-            .ok_or("no shape term")?;
-        let (lower, upper) = (candidate.terms[shape].lower, candidate.terms[shape].upper);
-        let shaped = |value: f64| -> Candidate {
+        let shapes: Vec<usize> = (0..candidate.terms.len())
+            .filter(|&k| candidate.terms[k].mechanism == Mechanism::Shape)
+            .collect();
+        let range = |k: usize| (candidate.terms[shapes[k]].lower, candidate.terms[shapes[k]].upper);
+        let value_of = |k: usize, u: f64| {
+            let (lower, upper) = range(k);
+            lower * (upper / lower).powf(u)
+        };
+        let shaped = |vc: f64, vs: f64| -> Candidate {
             let mut c = candidate.clone();
-            c.terms.remove(shape);
+            c.terms.retain(|t| t.mechanism != Mechanism::Shape);
             for t in c.terms.iter_mut() {
-                if let Mechanism::Output {
-                    regressor: Regressor::SmoothFriction(_),
-                    channel,
-                } = t.mechanism
-                {
-                    t.mechanism = Mechanism::Output {
-                        channel,
-                        regressor: Regressor::SmoothFriction(value),
+                if let Mechanism::Output { channel, regressor } = t.mechanism {
+                    let regressor = match regressor {
+                        Regressor::SmoothFriction(_) => Regressor::SmoothFriction(vc),
+                        Regressor::Stribeck(..) => Regressor::Stribeck(vc, vs),
+                        other => other,
                     };
+                    t.mechanism = Mechanism::Output { channel, regressor };
                 }
             }
             c
         };
         let none = |_: &'static str| None;
-        let evaluate = |u: f64| -> Option<Fit> {
-            let value = lower * (upper / lower).powf(u);
-            self.fit(&shaped(value), 1, base_replay, &none).ok()
-        };
+        let fit_at = |vc: f64, vs: f64| self.fit(&shaped(vc, vs), 1, base_replay, &none).ok();
         let cost = |fit: &Option<Fit>| fit.as_ref().map_or(f64::INFINITY, |f| f.train_total());
-        let phi = (5f64.sqrt() - 1.0) / 2.0;
-        let (mut a, mut b) = (0.0, 1.0);
-        let mut c = b - phi * (b - a);
-        let mut d = a + phi * (b - a);
-        let (mut fc, mut fd) = (cost(&evaluate(c)), cost(&evaluate(d)));
-        for _ in 0..14 {
-            if fc < fd {
-                b = d;
-                d = c;
-                fd = fc;
-                c = b - phi * (b - a);
-                fc = cost(&evaluate(c));
-            } else {
-                a = c;
-                c = d;
-                fc = fd;
-                d = a + phi * (b - a);
-                fd = cost(&evaluate(d));
+        // The best u in [0, 1] of a unimodal cost, and its cost.
+        let golden = |iterations: usize, f: &dyn Fn(f64) -> f64| -> (f64, f64) {
+            let phi = (5f64.sqrt() - 1.0) / 2.0;
+            let (mut a, mut b) = (0.0, 1.0);
+            let mut c = b - phi * (b - a);
+            let mut d = a + phi * (b - a);
+            let (mut fc, mut fd) = (f(c), f(d));
+            for _ in 0..iterations {
+                if fc < fd {
+                    b = d;
+                    d = c;
+                    fd = fc;
+                    c = b - phi * (b - a);
+                    fc = f(c);
+                } else {
+                    a = c;
+                    c = d;
+                    fc = fd;
+                    d = a + phi * (b - a);
+                    fd = f(d);
+                }
             }
-        }
-        let u = if fc < fd { c } else { d };
-        let fit = evaluate(u).ok_or("the shaped fit failed")?;
+            if fc < fd {
+                (c, fc)
+            } else {
+                (d, fd)
+            }
+        };
+        let inner = |vs: f64| golden(14, &|u| cost(&fit_at(value_of(0, u), vs)));
+        let (vc, vs) = if shapes.len() >= 2 {
+            let (u_s, _) = golden(10, &|u| inner(value_of(1, u)).1);
+            let vs = value_of(1, u_s);
+            (value_of(0, inner(vs).0), vs)
+        } else {
+            (value_of(0, inner(0.0).0), 0.0)
+        };
+        let fit = fit_at(vc, vs).ok_or("the shaped fit failed")?;
         let mut values = fit.values.clone();
-        values.insert(shape, lower * (upper / lower).powf(u));
+        values.insert(shapes[0], vc);
+        if shapes.len() >= 2 {
+            values.insert(shapes[1], vs);
+        }
         Ok(Fit {
             candidate: candidate.clone(),
             values,

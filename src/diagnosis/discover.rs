@@ -74,7 +74,7 @@ pub fn model_terms(candidate: &Candidate, values: &[f64], base: &Parameters, pro
                     s.2 += value;
                 }
                 Regressor::Friction => friction += value,
-                Regressor::SmoothFriction(_) => return None,
+                Regressor::SmoothFriction(_) | Regressor::Stribeck(..) => return None,
                 Regressor::Viscous => viscous += value,
                 Regressor::Position => position += value,
             },

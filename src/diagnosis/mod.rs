@@ -299,6 +299,23 @@ impl Diagnosis {
     }
 }
 
+/// How many of a fitted candidate's terms are away from their neutral values.
+fn used_terms(s: &Scored) -> f64 {
+    s.fit
+        .values
+        .iter()
+        .zip(&s.fit.candidate.terms)
+        .filter(|(v, t)| **v != t.neutral)
+        .count() as f64
+}
+
+/// A candidate's held-out misfit (in noise floors squared) plus a BIC-like penalty of
+/// ln(held-out samples) per term used: best first, a term that adds nothing on the held-out
+/// blocks loses to a simpler candidate.
+fn penalised(s: &Scored, heldout_samples: f64) -> f64 {
+    s.fit.heldout_total() + used_terms(s) * heldout_samples.ln()
+}
+
 /// Runs `f` on every item over `jobs` threads, results in the items' order.
 fn parallel_map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let jobs = jobs.clamp(1, items.len().max(1));
@@ -544,6 +561,7 @@ fn apply_named(p: &mut Parameters, scored: &Scored) -> Result<Vec<(&'static str,
             for (name, value) in values {
                 let value = match name {
                     "friction_coulomb" => p.friction_coulomb + value / p.force_sensor_gain,
+                    "friction_stribeck" => p.friction_stribeck + value / p.force_sensor_gain,
                     "viscous_friction" => p.viscous_friction + value / p.force_sensor_gain,
                     _ => value,
                 };
@@ -753,7 +771,7 @@ pub fn diagnose_with(
                 .iter()
                 .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_some())
                 .collect();
-            named.sort_by(|a, b| b.explained.total_cmp(&a.explained));
+            named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
             for s in named {
                 let name = s.fit.candidate.named.expect("filtered on named");
                 let gain = force_before - s.force_heldout_rms;
@@ -802,7 +820,7 @@ pub fn diagnose_with(
                         .iter()
                         .filter(|s| s.fit.candidate.location == side.location && s.fit.candidate.named.is_some())
                         .collect();
-                    named.sort_by(|a, b| b.explained.total_cmp(&a.explained));
+                    named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
                     for s in named {
                         let name = s.fit.candidate.named.expect("filtered on named");
                         let mut trial = params.clone();
@@ -845,23 +863,12 @@ pub fn diagnose_with(
                 .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
                 .filter(|s| s.explained >= LOCATED_SHARE)
                 .collect();
-            // Best first by the held-out misfit plus the BIC-like penalty of the terms
-            // used: a term that adds nothing on the held-out blocks loses to a simpler one.
-            let used = |s: &Scored| {
-                s.fit
-                    .values
-                    .iter()
-                    .zip(&s.fit.candidate.terms)
-                    .filter(|(v, t)| **v != t.neutral)
-                    .count() as f64
-            };
-            let penalised = |s: &Scored| s.fit.heldout_total() + used(s) * count.ln();
-            at_place.sort_by(|a, b| penalised(a).total_cmp(&penalised(b)));
+            at_place.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
             let before_total: f64 = heldout.iter().sum();
             let mut kept = None;
             for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
                 let label = s.fit.candidate.label;
-                let penalty = used(s) * count.ln();
+                let penalty = used_terms(s) * count.ln();
                 let worse_pressures = (1..CHANNELS)
                     .any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * heldout[c] + count * 0.01);
                 if worse_pressures || before_total - s.fit.heldout_total() < penalty {

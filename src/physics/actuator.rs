@@ -367,7 +367,13 @@ impl Actuator {
         use index::*;
         let p = &self.params;
         let pressure_force = piston::pressure_force(self.piston_area, y[P1], y[P2])
-            - effects::friction_force(p.friction_coulomb, p.friction_velocity, stopper_velocity)
+            - effects::friction_force(
+                p.friction_coulomb,
+                p.friction_velocity,
+                p.friction_stribeck,
+                p.friction_stribeck_velocity,
+                stopper_velocity,
+            )
             - self.extra_piston_force(x_s, stopper_velocity);
         let f_act = piston::actuator_force(pressure_force, self.spring_force(x_s));
         Outputs {

@@ -101,13 +101,26 @@ pub fn polytropic_exponent(gamma: f64, heat_transfer_fraction: f64) -> f64 {
 ///
 /// With `friction_velocity` > 0 the law is smooth, F_c tanh(v / v_c): seals that deform
 /// before they slide reach the Coulomb level over a speed v_c instead of at once.
-pub fn friction_force(friction_coulomb: f64, friction_velocity: f64, stopper_velocity: f64) -> f64 {
+///
+/// A Stribeck term adds `stribeck` · exp(−(v/v_s)²) to the level: the seals stick harder at
+/// low speed than they slide at high speed.
+pub fn friction_force(
+    friction_coulomb: f64,
+    friction_velocity: f64,
+    stribeck: f64,
+    stribeck_velocity: f64,
+    stopper_velocity: f64,
+) -> f64 {
+    let mut level = friction_coulomb;
+    if stribeck != 0.0 && stribeck_velocity > 0.0 {
+        level += stribeck * (-(stopper_velocity / stribeck_velocity).powi(2)).exp();
+    }
     if friction_velocity > 0.0 {
-        friction_coulomb * (stopper_velocity / friction_velocity).tanh()
+        level * (stopper_velocity / friction_velocity).tanh()
     } else if stopper_velocity.abs() < 1e-9 {
         0.0
     } else {
-        friction_coulomb * stopper_velocity.signum()
+        level * stopper_velocity.signum()
     }
 }
 
@@ -326,11 +339,15 @@ mod tests {
     fn other_effects_are_off_at_their_defaults() {
         assert_eq!(polytropic_exponent(1.4, 0.0), 1.4);
         assert_eq!(polytropic_exponent(1.4, 1.0), 1.0);
-        assert_eq!(friction_force(0.0, 0.0, 0.3), 0.0);
-        assert_eq!(friction_force(2.0, 0.0, -0.3), -2.0);
+        assert_eq!(friction_force(0.0, 0.0, 0.0, 0.0, 0.3), 0.0);
+        assert_eq!(friction_force(2.0, 0.0, 0.0, 0.0, -0.3), -2.0);
         // The smooth law: tanh(1) of the level at v = v_c, the level far beyond.
-        assert!((friction_force(2.0, 0.005, 0.005) - 2.0 * 1f64.tanh()).abs() < 1e-12);
-        assert!((friction_force(2.0, 0.005, -0.1) + 2.0).abs() < 1e-8);
+        assert!((friction_force(2.0, 0.005, 0.0, 0.0, 0.005) - 2.0 * 1f64.tanh()).abs() < 1e-12);
+        assert!((friction_force(2.0, 0.005, 0.0, 0.0, -0.1) + 2.0).abs() < 1e-8);
+        // Stribeck: the level is F_c + F_s e^-1 at v = v_s, F_c far beyond.
+        let at_vs = friction_force(2.0, 0.0, 1.0, 0.005, 0.005);
+        assert!((at_vs - (2.0 + (-1f64).exp())).abs() < 1e-12);
+        assert!((friction_force(2.0, 0.0, 1.0, 0.005, 0.1) - 2.0).abs() < 1e-12);
         assert_eq!(sensor_reading(0.0, 1.0, 45.0), 45.0);
     }
 }
