@@ -92,87 +92,87 @@ fn placed(name: &str, seed: u64) {
 }
 
 #[test]
-fn a_pressure_transducer_offset_is_placed_at_the_pressure_sensors() {
+fn a_pressure_transducer_offset_is_found_at_the_pressure_sensors() {
     placed("p1_sensor_offset", 301);
 }
 
 #[test]
-fn a_late_pressure_transducer_is_placed_at_the_pressure_sensors_as_a_delay() {
+fn a_late_pressure_transducer_is_found_at_the_pressure_sensors_as_a_delay() {
     placed("p2_sensor_delay", 302);
 }
 
 #[test]
-fn a_drifting_supply_is_placed_at_the_supply_as_a_drift() {
+fn a_drifting_supply_is_found_at_the_supply_as_a_drift() {
     placed("supply_drift", 303);
 }
 
 #[test]
-fn a_supply_ripple_is_placed_at_the_supply_as_periodic() {
+fn a_supply_ripple_is_found_at_the_supply_as_periodic() {
     placed("supply_ripple", 304);
 }
 
 #[test]
-fn a_saturating_command_is_placed_at_the_command_as_a_limit() {
+fn a_saturating_command_is_found_at_the_command_as_a_limit() {
     placed("command_limit", 305);
 }
 
 #[test]
-fn a_slew_limited_current_is_placed_at_the_current_driver_as_a_limit() {
+fn a_slew_limited_current_is_found_at_the_current_driver_as_a_limit() {
     placed("current_slew_limit", 306);
 }
 
 #[test]
-fn an_extra_jet_pipe_lag_is_placed_at_the_jet_pipe_as_dynamics() {
+fn an_extra_jet_pipe_lag_is_found_at_the_jet_pipe_as_dynamics() {
     placed("jet_pipe_lag", 307);
 }
 
 #[test]
-fn a_reshaped_jet_pipe_curve_is_placed_at_the_jet_pipe_as_a_nonlinearity() {
+fn a_reshaped_jet_pipe_curve_is_found_at_the_jet_pipe_as_a_nonlinearity() {
     placed("jet_pipe_curve", 308);
 }
 
 #[test]
-fn a_shifted_jet_pipe_null_is_placed_at_the_jet_pipe() {
+fn a_shifted_jet_pipe_null_is_found_at_the_jet_pipe() {
     placed("receiver_offset", 309);
 }
 
 #[test]
-fn smaller_return_areas_are_placed_at_the_valve_as_an_asymmetry() {
+fn smaller_return_areas_are_found_at_the_valve_as_an_asymmetry() {
     placed("return_area_reduction", 310);
 }
 
 #[test]
-fn a_restricted_port_line_is_placed_at_the_valve_as_a_restriction() {
+fn a_restricted_port_line_is_found_at_the_valve_as_a_restriction() {
     placed("port_1_restriction", 311);
 }
 
 #[test]
-fn a_back_pressure_on_the_exhaust_is_placed_at_the_return() {
+fn a_back_pressure_on_the_exhaust_is_found_at_the_return() {
     placed("return_back_pressure", 312);
 }
 
 #[test]
-fn a_chamber_leaking_to_atmosphere_is_placed_at_the_chambers_as_an_extra_flow() {
+fn a_chamber_leaking_to_atmosphere_is_found_at_the_chambers_as_an_extra_flow() {
     placed("chamber_1_leak", 313);
 }
 
 #[test]
-fn viscous_friction_is_placed_at_the_mechanics_and_not_named_piston_friction() {
+fn viscous_friction_is_found_at_the_mechanics_and_not_named_piston_friction() {
     placed("viscous_friction", 314);
 }
 
 #[test]
-fn a_compliant_stopper_is_placed_at_the_mechanics_and_not_named_dead_volume() {
+fn a_compliant_stopper_is_found_at_the_mechanics_and_not_named_dead_volume() {
     placed("contact_compliance", 315);
 }
 
 #[test]
-fn a_lagging_force_sensor_is_placed_at_the_force_sensor_as_dynamics() {
+fn a_lagging_force_sensor_is_found_at_the_force_sensor_as_dynamics() {
     placed("force_sensor_lag", 316);
 }
 
 #[test]
-fn a_force_sensor_with_backlash_is_placed_at_the_force_sensor_as_hysteresis_not_jet_pipe_hysteresis() {
+fn a_force_sensor_with_backlash_is_found_at_the_force_sensor_as_hysteresis_not_jet_pipe_hysteresis() {
     placed("force_sensor_backlash", 317);
 }
 
