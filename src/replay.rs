@@ -211,7 +211,13 @@ mod tests {
         let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
         let v_da = time
             .iter()
-            .map(|&t| if t < 1.0 { 2.0 + 4.0 * (t > 0.3) as i32 as f64 } else { 3.0 * (6.0 * t).sin() })
+            .map(|&t| {
+                if t < 1.0 {
+                    2.0 + 4.0 * (t > 0.3) as i32 as f64
+                } else {
+                    3.0 * (6.0 * t).sin()
+                }
+            })
             .collect();
         let x_s = time.iter().map(|&t| 0.054 + 0.01 * (2.0 * t).sin()).collect();
         Recording {
@@ -233,22 +239,103 @@ mod tests {
         let recording = protocol();
         let cases: Vec<(&str, Parameters)> = vec![
             ("thesis", Parameters::default()),
-            ("command lag", Parameters { command_lag: 0.02, ..Parameters::default() }),
-            ("command limit", Parameters { command_limit: 4.0, ..Parameters::default() }),
-            ("current slew limit", Parameters { current_slew_limit: 2.0, ..Parameters::default() }),
-            ("f3 input cubic", Parameters { f3_input_cubic: 2.0, ..Parameters::default() }),
-            ("sensor curve and drift", Parameters { force_sensor_quadratic: 4e-4, force_sensor_drift: 0.1, ..Parameters::default() }),
-            ("sensor delay", Parameters { force_sensor_delay: 4.5e-3, ..Parameters::default() }),
-            ("sensor lag and play", Parameters { force_sensor_lag: 0.01, force_sensor_play: 1.0, ..Parameters::default() }),
-            ("sensor pick-up", Parameters { force_sensor_ripple_sine: 0.5, force_sensor_ripple_frequency: 7.0, ..Parameters::default() }),
-            ("viscous friction and a position force", Parameters { viscous_friction: 20.0, position_force_rate: 100.0, ..Parameters::default() }),
-            ("return vent orifice", Parameters { return_vent_area: 0.35e-6, ..Parameters::default() }),
-            ("supply drift and ripple", Parameters { supply_drift: -400.0, supply_ripple_sine: 15e3, supply_ripple_frequency: 7.0, ..Parameters::default() }),
-            ("jet pipe null drift", Parameters { x_jp_offset_drift: 4e-6, ..Parameters::default() }),
+            (
+                "command lag",
+                Parameters {
+                    command_lag: 0.02,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "command limit",
+                Parameters {
+                    command_limit: 4.0,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "current slew limit",
+                Parameters {
+                    current_slew_limit: 2.0,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "f3 input cubic",
+                Parameters {
+                    f3_input_cubic: 2.0,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "sensor curve and drift",
+                Parameters {
+                    force_sensor_quadratic: 4e-4,
+                    force_sensor_drift: 0.1,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "sensor delay",
+                Parameters {
+                    force_sensor_delay: 4.5e-3,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "sensor lag and play",
+                Parameters {
+                    force_sensor_lag: 0.01,
+                    force_sensor_play: 1.0,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "sensor pick-up",
+                Parameters {
+                    force_sensor_ripple_sine: 0.5,
+                    force_sensor_ripple_frequency: 7.0,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "viscous friction and a position force",
+                Parameters {
+                    viscous_friction: 20.0,
+                    position_force_rate: 100.0,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "return vent orifice",
+                Parameters {
+                    return_vent_area: 0.35e-6,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "supply drift and ripple",
+                Parameters {
+                    supply_drift: -400.0,
+                    supply_ripple_sine: 15e3,
+                    supply_ripple_frequency: 7.0,
+                    ..Parameters::default()
+                },
+            ),
+            (
+                "jet pipe null drift",
+                Parameters {
+                    x_jp_offset_drift: 4e-6,
+                    ..Parameters::default()
+                },
+            ),
         ];
         let thesis_model = Actuator::new(Parameters::default()).unwrap();
         let thesis = replay(&thesis_model, &recording, 1e-6, recording.len()).unwrap();
-        let thesis_gap = rms_difference(&thesis.force, &replay_fast(&thesis_model, &recording, recording.len()).unwrap().force);
+        let thesis_gap = rms_difference(
+            &thesis.force,
+            &replay_fast(&thesis_model, &recording, recording.len()).unwrap().force,
+        );
         for (name, p) in cases {
             let model = Actuator::new(p).unwrap();
             let accurate = replay(&model, &recording, 1e-6, recording.len()).unwrap();
@@ -256,11 +343,20 @@ mod tests {
             let gap = rms_difference(&accurate.force, &fast.force);
             // The fast replay's own error (ROS2 after the 4 V steps) is 0.01 N here: a term
             // must not add to it, which it would if the two paths implemented it apart.
-            assert!(gap < 0.02, "{name}: the fast replay is {gap} N RMS from the accurate one");
-            assert!(gap <= 1.1 * thesis_gap + 1e-3, "{name}: {gap} N against the thesis model's {thesis_gap} N");
+            assert!(
+                gap < 0.02,
+                "{name}: the fast replay is {gap} N RMS from the accurate one"
+            );
+            assert!(
+                gap <= 1.1 * thesis_gap + 1e-3,
+                "{name}: {gap} N against the thesis model's {thesis_gap} N"
+            );
             if name != "thesis" {
                 let effect = rms_difference(&accurate.force, &thesis.force);
-                assert!(effect > 0.1, "{name}: the term changes the force by only {effect} N RMS");
+                assert!(
+                    effect > 0.1,
+                    "{name}: the term changes the force by only {effect} N RMS"
+                );
             }
         }
     }

@@ -805,13 +805,19 @@ mod tests {
             "{e}"
         );
         let e = refusal("P_r=700000");
-        assert!(e.contains("P_s = 652925 Pa is invalid: must be >= P_r = 700000 Pa"), "{e}");
+        assert!(
+            e.contains("P_s = 652925 Pa is invalid: must be >= P_r = 700000 Pa"),
+            "{e}"
+        );
     }
 
     #[test]
     fn a_spring_rate_of_1e30_is_refused_naming_the_value_and_the_limit() {
         let e = refusal("k_spring=1e30");
-        assert!(e.contains("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"), "{e}");
+        assert!(
+            e.contains("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"),
+            "{e}"
+        );
     }
 
     #[test]

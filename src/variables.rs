@@ -472,12 +472,16 @@ const fn parameter(name: &'static str, vr: u32, unit: &'static str, start: f64, 
 }
 
 /// Reasons shared by several rows' limits.
-const LENGTH: &str = "a length of the hand's actuator, whose cylinder is 78 mm long: a metre is beyond any actuator of its kind";
+const LENGTH: &str =
+    "a length of the hand's actuator, whose cylinder is 78 mm long: a metre is beyond any actuator of its kind";
 const PRESSURE: &str = "10 MPa: ten times industrial pneumatic supplies; the orifice law treats air as an ideal gas";
-const RATE: &str = "1e6 rad/s (160 kHz): beyond any current driver or torque motor; Table 3.1's corners are below 7100 rad/s";
+const RATE: &str =
+    "1e6 rad/s (160 kHz): beyond any current driver or torque motor; Table 3.1's corners are below 7100 rad/s";
 const TRAVEL: &str = "10 mm: the receiver's areas stop changing 3 D_jp (3 mm) from its centre (2.8)-(2.17)";
-const LEAK_AREA: &str = "1e-4 m2: half the bore's cross-section (2e-4 m2 with the thesis's D_cyl); a larger opening is no leak";
-const RESISTANCE: &str = "at the jet pipe's flow of about 1e-3 kg/s, 1e12 Pa.s/kg would drop 1e9 Pa, a thousand times the supply pressure";
+const LEAK_AREA: &str =
+    "1e-4 m2: half the bore's cross-section (2e-4 m2 with the thesis's D_cyl); a larger opening is no leak";
+const RESISTANCE: &str =
+    "at the jet pipe's flow of about 1e-3 kg/s, 1e12 Pa.s/kg would drop 1e9 Pa, a thousand times the supply pressure";
 const AREA_SCALE: &str = "ten times the drawn area of (2.8)-(2.17); the diagnosis fits at most 3";
 const DEAD_VOLUME: &str = "1e-3 m3 (a litre): seventy times the two chambers' 1.4e-5 m3";
 
@@ -931,7 +935,9 @@ pub fn interface_table() -> String {
         };
         let limits = match v.value_reference {
             vr::X_S => {
-                let (lo, hi) = crate::physics::parameters::Parameters::default().cylinder().stopper_range();
+                let (lo, hi) = crate::physics::parameters::Parameters::default()
+                    .cylinder()
+                    .stopper_range();
                 format!("in ({}, {}) m with the default geometry", number(lo), number(hi))
             }
             vr::V_DA => {
@@ -993,7 +999,10 @@ mod tests {
     #[test]
     fn a_value_outside_the_limits_is_refused_naming_the_variable_the_value_and_the_limit() {
         let e = check(vr::K_SPRING, 1e30).unwrap_err();
-        assert!(e.starts_with("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"), "{e}");
+        assert!(
+            e.starts_with("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"),
+            "{e}"
+        );
         let e = check(vr::C_D, 1.5).unwrap_err();
         assert!(e.starts_with("C_d = 1.5 is invalid: must be in (0, 1]"), "{e}");
         let e = check(vr::C_D, 0.0).unwrap_err();

@@ -77,14 +77,27 @@ fn undeclared(file: &str, location: &str, family: &str, truth: &[(&str, f64)]) {
         "{file}: named {:?} for an undeclared effect",
         names(&d)
     );
-    let found = d.discovered.first().unwrap_or_else(|| panic!("{file}: nothing discovered"));
-    assert_eq!((found.location, found.family), (location, family), "{file}: {}", found.reading);
+    let found = d
+        .discovered
+        .first()
+        .unwrap_or_else(|| panic!("{file}: nothing discovered"));
+    assert_eq!(
+        (found.location, found.family),
+        (location, family),
+        "{file}: {}",
+        found.reading
+    );
     let departure = |name: &str, value: f64| (value - Parameters::default().get(value_reference(name)).unwrap()).abs();
     // A parameter the truth leaves at its thesis value is held to the others' departure.
     let largest = truth.iter().map(|&(n, v)| departure(n, v)).fold(0.0, f64::max);
     for &(name, value) in truth {
         let fitted = parameter(&d, name);
-        let allowed = 0.2 * if departure(name, value) > 0.0 { departure(name, value) } else { largest };
+        let allowed = 0.2
+            * if departure(name, value) > 0.0 {
+                departure(name, value)
+            } else {
+                largest
+            };
         assert!(
             (fitted - value).abs() <= allowed,
             "{file}: {name} = {fitted}, truth {value}"
@@ -98,7 +111,12 @@ fn undeclared(file: &str, location: &str, family: &str, truth: &[(&str, f64)]) {
 
 #[test]
 fn a_changed_current_driver_gain_is_found_at_the_current_driver_with_its_value() {
-    undeclared("u_kcd_gain.csv", "current_driver", "parameter_offset", &[("k_cd", 0.036)]);
+    undeclared(
+        "u_kcd_gain.csv",
+        "current_driver",
+        "parameter_offset",
+        &[("k_cd", 0.036)],
+    );
 }
 
 #[test]

@@ -58,7 +58,12 @@ fn placed(name: &str, seed: u64) {
             .discovered
             .first()
             .unwrap_or_else(|| panic!("{name}: nothing discovered ({})", d.summary()[0]));
-        assert_eq!((found.location, found.family), (location, family), "{name}: {}", found.reading);
+        assert_eq!(
+            (found.location, found.family),
+            (location, family),
+            "{name}: {}",
+            found.reading
+        );
         let thesis = Parameters::default();
         for &(parameter, truth) in mechanism.model_parameters {
             let reference = jetpipe::variables::VARIABLES
@@ -78,7 +83,12 @@ fn placed(name: &str, seed: u64) {
     }
     match (d.discovered.first(), &d.unexplained) {
         (Some(found), _) => {
-            assert_eq!((found.location, found.family), (location, family), "{name}: {}", found.reading)
+            assert_eq!(
+                (found.location, found.family),
+                (location, family),
+                "{name}: {}",
+                found.reading
+            )
         }
         (None, Some(u)) => {
             assert_eq!((u.location, u.family), (location, family), "{name}: {}", u.sentence);

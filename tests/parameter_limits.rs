@@ -55,9 +55,15 @@ fn the_fmu_refuses_a_discharge_coefficient_above_one_with_the_sweeps_message() {
 fn the_fmu_refuses_a_spring_rate_of_1e30_with_the_sweeps_message() {
     let (set, errors, exit) = unsafe { set_before_initialisation(vr::K_SPRING, 1e30) };
     assert_eq!(set, fmi2Error);
-    assert_eq!(exit, fmi2OK, "the refused value was not applied: the defaults initialise");
+    assert_eq!(
+        exit, fmi2OK,
+        "the refused value was not applied: the defaults initialise"
+    );
     let message = jetpipe::variables::check(vr::K_SPRING, 1e30).unwrap_err();
-    assert!(message.starts_with("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"), "{message}");
+    assert!(
+        message.starts_with("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"),
+        "{message}"
+    );
     if logger_available() {
         assert!(errors.iter().any(|m| m.contains(&message)), "{errors:?}");
     }

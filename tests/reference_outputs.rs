@@ -113,7 +113,13 @@ fn run(scenario: &Scenario) -> Run {
             let (v, x) = (scenario.inputs)(k);
             set_inputs(c, v, x);
             let status = fmi2DoStep(c, t, scenario.step, fmi2True);
-            assert_eq!(status, fmi2OK, "{}: fmi2DoStep at t = {t}: {:?}", scenario.name, sink.since(0));
+            assert_eq!(
+                status,
+                fmi2OK,
+                "{}: fmi2DoStep at t = {t}: {:?}",
+                scenario.name,
+                sink.since(0)
+            );
             record(k + 1, &mut digest);
         }
         fmi2FreeInstance(c);
@@ -218,6 +224,9 @@ fn a_change_in_the_last_bit_of_one_output_is_caught() {
         let b = if *k == 500 { &changed } else { bits };
         b.iter().fold(h, |h, &x| fnv1a(h, x))
     });
-    let original = run.rows.iter().fold(FNV_OFFSET, |h, (_, bits)| bits.iter().fold(h, |h, &x| fnv1a(h, x)));
+    let original = run
+        .rows
+        .iter()
+        .fold(FNV_OFFSET, |h, (_, bits)| bits.iter().fold(h, |h, &x| fnv1a(h, x)));
     assert_ne!(rehashed, original, "one flipped bit changes the digest");
 }

@@ -170,7 +170,10 @@ fn bad_names_and_values_are_refused_before_any_run() {
             &["--param", "P_s=90000"],
             &["P_s = 90000 Pa", "must be >= P_r = 101325 Pa"],
         ),
-        (&["--param", "k_spring=1e30"], &["k_spring = 1e30 N/m", "must be in [0, 100000] N/m"]),
+        (
+            &["--param", "k_spring=1e30"],
+            &["k_spring = 1e30 N/m", "must be in [0, 100000] N/m"],
+        ),
         (
             &["--param", "L_cyl=0.035"],
             &["L_cyl = 0.035", "x_s", "outside the cylinder"],

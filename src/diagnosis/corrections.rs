@@ -1309,9 +1309,7 @@ impl Problem<'_> {
                 }
                 _ => {
                     replays += 1;
-                    self.replay(candidate, &[value])
-                        .ok()
-                        .map(|r| Prediction::of_replay(&r))
+                    self.replay(candidate, &[value]).ok().map(|r| Prediction::of_replay(&r))
                 }
             };
             match prediction {

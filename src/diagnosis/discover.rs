@@ -13,7 +13,12 @@ use crate::physics::parameters::Parameters;
 
 /// The FMU parameters (name, value) that put the fitted `values` of `terms` into the
 /// model `base`, or `None` when the FMU cannot carry them exactly.
-pub fn model_terms(candidate: &Candidate, values: &[f64], base: &Parameters, problem: &Problem) -> Option<Vec<(&'static str, f64)>> {
+pub fn model_terms(
+    candidate: &Candidate,
+    values: &[f64],
+    base: &Parameters,
+    problem: &Problem,
+) -> Option<Vec<(&'static str, f64)>> {
     let terms = &candidate.terms;
     let mut set: Vec<(&'static str, f64)> = candidate.settings.clone();
     // Coefficients of the force channel's regressors.
@@ -59,7 +64,10 @@ pub fn model_terms(candidate: &Candidate, values: &[f64], base: &Parameters, pro
                 }
                 set.push((name, value));
             }
-            Mechanism::Output { channel: FORCE, regressor } => match regressor {
+            Mechanism::Output {
+                channel: FORCE,
+                regressor,
+            } => match regressor {
                 Regressor::One => one += value,
                 Regressor::Own => own += value,
                 Regressor::OwnSquared => squared += value,
@@ -125,7 +133,10 @@ pub fn model_terms(candidate: &Candidate, values: &[f64], base: &Parameters, pro
             return None;
         }
         set.push(("position_force_rate", k0 + k));
-        set.push(("position_force_reference", (k0 * x0 + k * problem.mean_position) / (k0 + k)));
+        set.push((
+            "position_force_reference",
+            (k0 * x0 + k * problem.mean_position) / (k0 + k),
+        ));
     }
     // The sensor: new reading = (1 + own) s + one + squared s² + cubed s³ + ramp r(t) +
     // pick-up, with s the reading so far, o + g F + …; exact when s is affine in F.
@@ -146,7 +157,10 @@ pub fn model_terms(candidate: &Candidate, values: &[f64], base: &Parameters, pro
             "force_sensor_offset",
             m * o + one + squared * o * o + cubed * o * o * o - ramp * t_mid / t_span,
         ));
-        set.push(("force_sensor_gain", m * g + 2.0 * squared * o * g + 3.0 * cubed * o * o * g));
+        set.push((
+            "force_sensor_gain",
+            m * g + 2.0 * squared * o * g + 3.0 * cubed * o * o * g,
+        ));
         if curve || p.force_sensor_quadratic != 0.0 {
             set.push((
                 "force_sensor_quadratic",
@@ -213,8 +227,5 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
             }
         })
         .collect();
-    format!(
-        "At the {location} ({family}), a {label}: {}.",
-        parts.join(", ")
-    )
+    format!("At the {location} ({family}), a {label}: {}.", parts.join(", "))
 }

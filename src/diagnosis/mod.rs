@@ -394,9 +394,10 @@ fn localize(
         wanted.len(),
         jobs
     ));
-    let sensitivities: Vec<Option<Sensitivity>> = parallel_map_shown("sensitivities", bars, &wanted, jobs, |(name, step)| {
-        problem.sensitivity(name, *step, base_replay)
-    });
+    let sensitivities: Vec<Option<Sensitivity>> =
+        parallel_map_shown("sensitivities", bars, &wanted, jobs, |(name, step)| {
+            problem.sensitivity(name, *step, base_replay)
+        });
     let mut replays = wanted.len();
     let shared = |name: &'static str| -> Option<Sensitivity> {
         wanted
@@ -872,7 +873,9 @@ pub fn diagnose_with(
                 let worse_pressures = (1..CHANNELS)
                     .any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * heldout[c] + count * 0.01);
                 if worse_pressures || before_total - s.fit.heldout_total() < penalty {
-                    progress(&format!("  {label}: not better than its parameters' penalty, or worse in a pressure"));
+                    progress(&format!(
+                        "  {label}: not better than its parameters' penalty, or worse in a pressure"
+                    ));
                     continue;
                 }
                 let Some(set) = discover::model_terms(&s.fit.candidate, &s.fit.values, &params, &problem) else {
@@ -880,7 +883,9 @@ pub fn diagnose_with(
                     continue;
                 };
                 let mut trial = params.clone();
-                if set.iter().any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
+                if set
+                    .iter()
+                    .any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
                     || trial.validate().is_err()
                 {
                     continue;

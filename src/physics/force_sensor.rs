@@ -160,7 +160,11 @@ pub fn filtered(p: &Parameters, time: &[f64], statics: Vec<f64>) -> Vec<f64> {
     let mut memory = SensorMemory::at_rest(time[0], statics[0]);
     let mut out = Vec::with_capacity(time.len());
     for (k, (&t, &r)) in time.iter().zip(&statics).enumerate() {
-        out.push(if k == 0 { memory.output(p, t, r) } else { memory.record(p, t, r) });
+        out.push(if k == 0 {
+            memory.output(p, t, r)
+        } else {
+            memory.record(p, t, r)
+        });
     }
     out
 }
