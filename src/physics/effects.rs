@@ -4,12 +4,12 @@
 //! | name | parameter(s) | where it acts |
 //! |---|---|---|
 //! | `jet_pipe_hysteresis` | `hysteresis_width`, `hysteresis_deadband` (m) | Prandtl–Ishlinskii operator on f3's output, before the jet pipe dynamics (§3.2.1–3.2.2) |
-//! | `piston_friction` | `friction_coulomb` (N) | rod force while the stopper moves, (2.33)–(2.35) |
+//! | `piston_friction` | `friction_coulomb` (N), `friction_velocity` (m/s), `friction_stribeck` (N), `friction_stribeck_velocity` (m/s) | rod force while the stopper moves, (2.33)–(2.35) |
 //! | `dead_volume` | `dead_volume_1`, `dead_volume_2` (m³) | added to (2.30)–(2.31) |
 //! | `supply_pressure_drop` | `supply_resistance` (Pa·s/kg) | supply pressure at the jet pipe (§2.6) |
 //! | `heat_transfer` | `heat_transfer_fraction` (1) | polytropic exponent in (2.29) |
 //! | `transport_delay` | `command_delay` (s) | command seen by the current driver |
-//! | `sensor_offset_gain` | `force_sensor_offset` (N), `force_sensor_gain` (1) | the `F_meas` output |
+//! | `sensor_offset_gain` | `force_sensor_offset` (N), `force_sensor_gain` (1) | the `F_meas` output (see [`super::force_sensor`]) |
 
 /// The names of the effects, as reports and parameters use them.
 pub const EFFECT_NAMES: [&str; 7] = [
@@ -122,11 +122,6 @@ pub fn friction_force(
     } else {
         level * stopper_velocity.signum()
     }
-}
-
-/// What a force sensor with an offset and a gain error reads.
-pub fn sensor_reading(offset: f64, gain: f64, force: f64) -> f64 {
-    offset + gain * force
 }
 
 /// Supply pressure at the jet pipe when a supply line of resistance `resistance` (Pa·s/kg)
@@ -348,6 +343,5 @@ mod tests {
         let at_vs = friction_force(2.0, 0.0, 1.0, 0.005, 0.005);
         assert!((at_vs - (2.0 + (-1f64).exp())).abs() < 1e-12);
         assert!((friction_force(2.0, 0.0, 1.0, 0.005, 0.1) - 2.0).abs() < 1e-12);
-        assert_eq!(sensor_reading(0.0, 1.0, 45.0), 45.0);
     }
 }
