@@ -4,7 +4,7 @@
 
 #[path = "../../src/compat.rs"]
 pub mod compat;
-#[path = "../../src/electromechanics.rs"]
+#[path = "../../src/electromechanics/mod.rs"]
 pub mod electromechanics;
 #[path = "../../src/fmi2/mod.rs"]
 pub mod fmi2;
