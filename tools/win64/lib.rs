@@ -20,7 +20,7 @@ pub mod physics;
 pub mod polynomial;
 #[path = "../../src/scenario.rs"]
 pub mod scenario;
-#[path = "../../src/simulation.rs"]
+#[path = "../../src/simulation/mod.rs"]
 pub mod simulation;
 #[path = "../../src/variables.rs"]
 pub mod variables;
