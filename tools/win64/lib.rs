@@ -4,7 +4,7 @@
 
 #[path = "../../src/compat.rs"]
 pub mod compat;
-#[path = "../../src/electromechanics.rs"]
+#[path = "../../src/electromechanics/mod.rs"]
 pub mod electromechanics;
 #[path = "../../src/fmi2/mod.rs"]
 pub mod fmi2;
@@ -20,7 +20,7 @@ pub mod physics;
 pub mod polynomial;
 #[path = "../../src/scenario.rs"]
 pub mod scenario;
-#[path = "../../src/simulation.rs"]
+#[path = "../../src/simulation/mod.rs"]
 pub mod simulation;
 #[path = "../../src/variables.rs"]
 pub mod variables;

@@ -5,21 +5,31 @@
 //! for the step. A stopper position set without a derivative is a jump at the
 //! communication point: the air in each chamber is conserved and the pressures follow
 //! the exact no-flow limit of (2.29), P V^γ = const, so no spike comes from differencing.
+//!
+//! This file holds [`Simulation`] and its stepping: inputs, command segments, the choice
+//! between the split and the monolithic method, and the integrators' hand-overs. What a step
+//! integrates lives apart: `chambers` (the two pressures driven by the jet pipe's exact
+//! trajectory, for the split method), `monolithic` (all six states) and `equilibrium` (the
+//! state a simulation starts from).
+
+mod chambers;
+mod equilibrium;
+mod monolithic;
+
+pub use equilibrium::{equilibrium, equilibrium_at, equilibrium_of_electromechanics};
 
 use nalgebra::SVector;
 
-use crate::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState, Trajectory, MAX_NODES};
-use crate::integrator::{
-    finite_difference_jacobian, ExplicitPair, IntegrationFailure, OdeSystem, Sdirk4, Statistics, Tolerances,
-};
-use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, Outputs, State, N_STATES};
+use self::chambers::ChamberSystem;
+use self::monolithic::StepSystem;
+use crate::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState, Trajectory};
+use crate::integrator::{ExplicitPair, IntegrationFailure, OdeSystem, Sdirk4, Statistics, Tolerances};
+use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
-use crate::physics::current_driver;
+use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::force_sensor::{self, SensorMemory};
 use crate::physics::time_varying;
-use crate::physics::effects::PLAY_OPERATORS;
-use crate::physics::orifice_geometry::OrificeAreas;
 
 /// The default relative tolerance (also the model description's default experiment).
 pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-6;
@@ -29,295 +39,6 @@ pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-6;
 /// √Δp flow law is steep there); a tenth holds the standard scenario's global force error
 /// well below the tolerance times the force (7e-6 N at 1e-6, measured against a 1e-10 run).
 pub const LOCAL_ERROR_FRACTION: f64 = 0.1;
-
-/// The actuator model over one step, with inputs linear in time from `t0`.
-struct StepSystem<'a> {
-    model: &'a Actuator,
-    t0: f64,
-    v_da: f64,
-    v_da_rate: f64,
-    x_s: f64,
-    x_s_rate: f64,
-    plays: Option<[f64; PLAY_OPERATORS]>,
-}
-
-impl StepSystem<'_> {
-    fn inputs(&self, t: f64) -> Inputs {
-        let dt = t - self.t0;
-        Inputs {
-            v_da: self.v_da + self.v_da_rate * dt,
-            x_s: self.x_s + self.x_s_rate * dt,
-            x_s_rate: self.x_s_rate,
-            plays: self.plays,
-        }
-    }
-}
-
-impl OdeSystem<N_STATES> for StepSystem<'_> {
-    fn rhs(&self, t: f64, y: &State) -> State {
-        self.model.derivatives(y, &self.inputs(t))
-    }
-    fn jacobian(&self, t: f64, y: &State, f_y: &State) -> Jacobian {
-        self.model.jacobian(y, &self.inputs(t), f_y)
-    }
-}
-
-/// The jet pipe position, pressures and pressure rates at the end of a step.
-type EndRates = (f64, SVector<f64, 2>, SVector<f64, 2>);
-
-/// The chambers over one step, driven by the exactly known jet pipe trajectory. Its time
-/// is counted from the step's start, as the trajectory's is: a step size the integrator
-/// repeats (the cap, the rest of an equal communication step) is then the same to the last
-/// bit each time, which [`Trajectory::node_positions`] relies on.
-struct ChamberSystem<'a> {
-    model: &'a Actuator,
-    trajectory: &'a Trajectory<'a>,
-    x_s: f64,
-    x_s_rate: f64,
-    /// The jet pipe position at t = 0: the state's, which the trajectory starts from (its
-    /// own value there agrees to rounding).
-    start_position: f64,
-    /// The jet pipe position and orifice areas at the last time asked for: Newton
-    /// iterations and the Jacobian evaluate many pressures at one stage time, and the jet
-    /// pipe position and the areas (four lens areas) cost more than the flows.
-    areas_at: std::cell::Cell<Option<(f64, f64, OrificeAreas)>>,
-    /// The areas at the stage times of the current explicit step, worked out together in
-    /// [`OdeSystem::prepare_stages`]. An entry from an earlier step is still right: the
-    /// areas depend on the time alone.
-    stage_areas: std::cell::RefCell<StageAreas>,
-    /// The pressures and rates at the step's start (t = 0), asked for twice: by the ringing
-    /// test and by the integrator's first stage.
-    start_rates: std::cell::Cell<Option<(SVector<f64, 2>, SVector<f64, 2>)>>,
-    /// The jet pipe position, pressures and rates of the last evaluation at t = duration:
-    /// the integrator's last stage, whose rates are the next step's rates at its start.
-    end_rates: std::cell::Cell<Option<EndRates>>,
-    /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
-    /// question starts there.
-    stretch_at: std::cell::Cell<Option<(f64, i32)>>,
-    /// Whether the trajectory's position bounds over [0, duration] lie within one
-    /// stretch of the orifice geometry (then no step inside has a breakpoint); found on the
-    /// first question.
-    tangency_free: std::cell::Cell<Option<bool>>,
-    duration: f64,
-}
-
-impl<'a> ChamberSystem<'a> {
-    /// The chambers over [0, duration], from the jet pipe position `start_position`; the
-    /// pressure rates at the start are `start_rates` when they are already known.
-    fn new(
-        model: &'a Actuator,
-        trajectory: &'a Trajectory<'a>,
-        duration: f64,
-        start_position: f64,
-        start_rates: Option<(SVector<f64, 2>, SVector<f64, 2>)>,
-        x_s: f64,
-        x_s_rate: f64,
-    ) -> Self {
-        Self {
-            model,
-            trajectory,
-            x_s,
-            x_s_rate,
-            start_position,
-            areas_at: std::cell::Cell::new(None),
-            stage_areas: std::cell::RefCell::new(StageAreas::default()),
-            start_rates: std::cell::Cell::new(start_rates),
-            end_rates: std::cell::Cell::new(None),
-            stretch_at: std::cell::Cell::new(None),
-            tangency_free: std::cell::Cell::new(None),
-            duration,
-        }
-    }
-
-    /// Whether the jet pipe provably stays within one stretch over the whole system's time.
-    fn tangency_free(&self) -> bool {
-        if let Some(free) = self.tangency_free.get() {
-            return free;
-        }
-        let free = self
-            .trajectory
-            .position_bounds(self.duration)
-            .map_or(false, |(lo, hi)| {
-                self.model.area_stretch(lo) == self.model.area_stretch(hi)
-            });
-        self.tangency_free.set(Some(free));
-        free
-    }
-
-    fn areas(&self, t: f64) -> OrificeAreas {
-        self.position_and_areas(t).1
-    }
-
-    /// The jet pipe position at `t` and the orifice areas there.
-    fn position_and_areas(&self, t: f64) -> (f64, OrificeAreas) {
-        if let Some(known) = self.stage_areas.borrow().at(t) {
-            return known;
-        }
-        match self.areas_at.get() {
-            Some((cached, position, areas)) if cached == t => (position, areas),
-            _ => {
-                let position = if t == 0.0 {
-                    self.start_position
-                } else {
-                    self.trajectory.position(t)
-                };
-                let areas = self.model.areas(position);
-                self.areas_at.set(Some((t, position, areas)));
-                (position, areas)
-            }
-        }
-    }
-
-    /// The time in (a, b] at which the jet pipe, in `stretch_a` at a and not at b, reaches
-    /// `tangency`: regula falsi (Illinois) on the exact trajectory, returning a time already
-    /// past the crossing (within 1e-12 s), so a step ending there does not contain it.
-    fn crossing_time(&self, mut a: f64, mut b: f64, tangency: f64, stretch_a: i32) -> f64 {
-        let gap = |t: f64| self.trajectory.position(t) - tangency;
-        let (mut ga, mut gb) = (gap(a), gap(b));
-        let mut last_moved = 0;
-        for _ in 0..60 {
-            if b - a <= 1e-12 {
-                break;
-            }
-            let mut t = if ga != gb {
-                b - gb * (b - a) / (gb - ga)
-            } else {
-                0.5 * (a + b)
-            };
-            if !(t > a && t < b) {
-                t = 0.5 * (a + b);
-            }
-            let position = self.trajectory.position(t);
-            let g = position - tangency;
-            let past = self.model.area_stretch(position) != stretch_a;
-            if past {
-                b = t;
-                gb = g;
-                if last_moved == 1 {
-                    ga *= 0.5;
-                }
-                last_moved = 1;
-            } else {
-                a = t;
-                ga = g;
-                if last_moved == -1 {
-                    gb *= 0.5;
-                }
-                last_moved = -1;
-            }
-        }
-        b
-    }
-
-    /// The rates at t = 0, kept (see `start_rates`); out of line, so the stages' path stays
-    /// small enough to be inlined into the integrator.
-    #[inline(never)]
-    fn rates_at_start(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
-        match self.start_rates.get() {
-            Some((pressures, rates)) if pressures == *p => rates,
-            _ => {
-                let rates = self.rates(&self.areas(0.0), 0.0, p);
-                self.start_rates.set(Some((*p, rates)));
-                rates
-            }
-        }
-    }
-
-    /// The rates at t = duration, recorded with the position and pressures (see `end_rates`).
-    fn rates_at_end(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
-        let (position, areas) = self.position_and_areas(self.duration);
-        let rates = self.rates(&areas, self.duration, p);
-        self.end_rates.set(Some((position, *p, rates)));
-        rates
-    }
-
-    fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
-        let x_s = self.x_s + self.x_s_rate * t;
-        let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
-        SVector::<f64, 2>::new(a, b)
-    }
-}
-
-/// Jet pipe positions and orifice areas at the stage times of one step.
-#[derive(Default)]
-struct StageAreas {
-    count: usize,
-    times: [f64; MAX_NODES],
-    positions: [f64; MAX_NODES],
-    areas: [OrificeAreas; MAX_NODES],
-}
-
-impl StageAreas {
-    fn at(&self, t: f64) -> Option<(f64, OrificeAreas)> {
-        let i = self.times[..self.count].iter().position(|&time| time == t)?;
-        Some((self.positions[i], self.areas[i]))
-    }
-}
-
-impl OdeSystem<2> for ChamberSystem<'_> {
-    #[inline]
-    fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
-        if t == 0.0 {
-            return self.rates_at_start(p);
-        }
-        if t == self.duration {
-            return self.rates_at_end(p);
-        }
-        self.rates(&self.areas(t), t, p)
-    }
-    /// The jet pipe positions at all stages at once ([`Trajectory::node_positions`]), then
-    /// their areas (once for stages at the same position, like DP5's two at c = 1).
-    fn prepare_stages(&self, t: f64, h: f64, nodes: &[f64], times: &[f64]) {
-        let count = nodes.len().min(times.len());
-        if count > MAX_NODES {
-            return;
-        }
-        let mut positions = [0.0; MAX_NODES];
-        self.trajectory
-            .node_positions(t, h, &nodes[..count], &times[..count], &mut positions[..count]);
-        let mut table = self.stage_areas.borrow_mut();
-        for i in 0..count {
-            table.times[i] = times[i];
-            table.positions[i] = positions[i];
-            table.areas[i] = if i > 0 && positions[i] == positions[i - 1] {
-                table.areas[i - 1]
-            } else {
-                self.model.areas(positions[i])
-            };
-        }
-        table.count = count;
-    }
-    /// Where the jet pipe crosses a tangency of the orifice geometry: the areas, and so the
-    /// pressure rates, have a corner or a 3/2 power in time there. Looked for at the middle
-    /// and the end of the step (steps are at most a quarter of the ringing period, so only
-    /// a graze of a tangency can be missed, and a graze opens next to no area).
-    fn breakpoint(&self, t0: f64, t1: f64) -> Option<f64> {
-        if self.tangency_free() && t1 <= self.duration {
-            return None;
-        }
-        let stretch = |t: f64| self.model.area_stretch(self.trajectory.position(t));
-        let (mut a, mut stretch_a) = match self.stretch_at.get() {
-            Some((t, s)) if t == t0 => (t0, s),
-            _ => (t0, stretch(t0)),
-        };
-        for b in [0.5 * (t0 + t1), t1] {
-            let stretch_b = stretch(b);
-            if stretch_b != stretch_a {
-                let tangency = self.model.tangency_position(stretch_a, stretch_b);
-                let crossing = self.crossing_time(a, b, tangency, stretch_a);
-                self.stretch_at.set(Some((crossing, stretch(crossing))));
-                return Some(crossing);
-            }
-            (a, stretch_a) = (b, stretch_b);
-        }
-        self.stretch_at.set(Some((t1, stretch_a)));
-        None
-    }
-    fn jacobian(&self, t: f64, p: &SVector<f64, 2>, f_p: &SVector<f64, 2>) -> nalgebra::SMatrix<f64, 2, 2> {
-        let areas = self.areas(t);
-        finite_difference_jacobian(|q| self.rates(&areas, t, q), p, f_p)
-    }
-}
 
 /// How a step is integrated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -931,169 +652,14 @@ fn check_finite(name: &str, value: f64, unit: &str) -> Result<(), String> {
     }
 }
 
-/// The current at its static value and the jet pipe at rest at f3 of it; the pressures
-/// are set half-way between return and supply.
-pub fn equilibrium_of_electromechanics(model: &Actuator, v_da: f64) -> State {
-    let p = &model.params;
-    let seen = command_stage::static_map(p, v_da);
-    let current = current_driver::static_current(p.k_cd, p.i_offset, seen);
-    let x_jp = model.static_jet_position(current);
-    let mid = 0.5 * (p.p_s + p.p_r);
-    State::from([current, x_jp, 0.0, 0.0, mid, mid])
-}
-
-/// [`equilibrium`] with the constants that vary in time at their values at `time`.
-pub fn equilibrium_at(model: &Actuator, v_da: f64, x_s: f64, time: f64) -> Result<State, String> {
-    if !time_varying::varies(&model.params) {
-        return equilibrium(model, v_da, x_s);
-    }
-    let mut at = model.clone();
-    time_varying::set_at(&mut at.params, &model.params, time)?;
-    equilibrium(&at, v_da, x_s)
-}
-
-/// The equilibrium state for constant inputs: the current at its static value, the jet
-/// pipe at rest at f3 of it, and chamber pressures at which both net mass flows vanish.
-///
-/// The pressures come from a pseudo-transient run of the chamber equations (robust from
-/// any start) polished by Newton's method on the two net flows.
-pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, String> {
-    let p = &model.params;
-    let mut y = equilibrium_of_electromechanics(model, v_da);
-    let x_jp = y[index::JET_POSITION];
-    let rates = |p1: f64, p2: f64| {
-        let (a, b) = model.pressure_rates(x_jp, p1, p2, x_s, 0.0);
-        SVector::<f64, 2>::new(a, b)
-    };
-    let system = StepSystem {
-        model,
-        t0: 0.0,
-        v_da: command_stage::static_map(p, v_da),
-        v_da_rate: 0.0,
-        x_s,
-        x_s_rate: 0.0,
-        plays: None,
-    };
-    let tolerances = Tolerances {
-        relative: 1e-8,
-        absolute: model.state_scales() * 1e-8,
-    };
-    let mut integrator = Sdirk4::default();
-    let mut statistics = Statistics::default();
-    let pressure_scale = p.p_s.max(p.p_r);
-    let mut t = 0.0;
-    for _ in 0..400 {
-        y = integrator
-            .integrate(&system, t, y, t + 0.5, &tolerances, &mut statistics)
-            .map_err(|f| {
-                format!(
-                    "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m: {}",
-                    f.message
-                )
-            })?;
-        t += 0.5;
-        let r = rates(y[index::P1], y[index::P2]);
-        // Settled to where Newton converges quadratically: < 1 Pa of drift per 10 ms.
-        if r.amax() < 1e-4 * pressure_scale {
-            break;
-        }
-    }
-    let mut pressures = SVector::<f64, 2>::new(y[index::P1], y[index::P2]);
-    for _ in 0..50 {
-        let r = rates(pressures[0], pressures[1]);
-        if r.amax() == 0.0 {
-            break;
-        }
-        let jac = crate::integrator::finite_difference_jacobian(|q| rates(q[0], q[1]), &pressures, &r);
-        let delta = match jac.lu().solve(&(-r)) {
-            Some(delta) => delta,
-            None => break,
-        };
-        // Never jump further than a tenth of the supply pressure in one iteration.
-        let limit = 0.1 * pressure_scale;
-        let delta = if delta.amax() > limit {
-            delta * (limit / delta.amax())
-        } else {
-            delta
-        };
-        let trial = pressures + delta;
-        if rates(trial[0], trial[1]).amax() >= r.amax() && delta.amax() < 1e-9 * pressure_scale {
-            break;
-        }
-        pressures = trial;
-        if delta.amax() < 1e-12 * pressure_scale {
-            break;
-        }
-    }
-    y[index::P1] = pressures[0];
-    y[index::P2] = pressures[1];
-    let residual = rates(pressures[0], pressures[1]).amax();
-    if !residual.is_finite() || residual > 1e-3 * pressure_scale {
-        return Err(format!(
-            "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m: pressures still change by {residual} Pa/s"
-        ));
-    }
-    Ok(y)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::physics::parameters::Parameters;
 
-    fn thesis_model() -> Actuator {
+    pub(super) fn thesis_model() -> Actuator {
         Actuator::new(Parameters::default()).unwrap()
     }
-
-    #[test]
-    fn equilibrium_has_zero_net_flow_and_stays_put() {
-        let model = thesis_model();
-        for v in [-4.0, 0.0, 1.0, 2.5, 10.0] {
-            let mut sim = Simulation::at_equilibrium(model.clone(), v, 0.054, 0.0, 1e-8).unwrap();
-            let flows = model.mass_flows(
-                sim.state[index::JET_POSITION],
-                sim.state[index::P1],
-                sim.state[index::P2],
-            );
-            assert!(
-                flows.net_1().abs() < 1e-12 && flows.net_2().abs() < 1e-12,
-                "v = {v}: {flows:?}"
-            );
-            let before = sim.outputs();
-            sim.step(1.0).unwrap();
-            let after = sim.outputs();
-            assert!(
-                (after.f_act - before.f_act).abs() < 1e-6 * before.f_act.abs().max(1.0),
-                "v = {v}: {before:?} -> {after:?}"
-            );
-            let p = &model.params;
-            assert!(after.p1 >= p.p_r - 1.0 && after.p1 <= p.p_s + 1.0);
-            assert!(after.p2 >= p.p_r - 1.0 && after.p2 <= p.p_s + 1.0);
-        }
-    }
-
-    #[test]
-    fn static_force_is_independent_of_stopper_position() {
-        // §3.3.1: at equilibrium both net flows vanish, which fixes P1 and P2 independently
-        // of the volumes.
-        let model = thesis_model();
-        for v in [0.5, 2.5, 6.0] {
-            let f: Vec<f64> = [0.040, 0.054, 0.070]
-                .iter()
-                .map(|&x| {
-                    Simulation::at_equilibrium(model.clone(), v, x, 0.0, 1e-8)
-                        .unwrap()
-                        .outputs()
-                        .f_act
-                })
-                .collect();
-            assert!(
-                (f[0] - f[1]).abs() < 1e-6 && (f[2] - f[1]).abs() < 1e-6,
-                "v = {v}: {f:?}"
-            );
-        }
-    }
-
     #[test]
     fn sealed_chambers_conserve_air_when_the_stopper_moves() {
         let p = Parameters {
@@ -1267,90 +833,6 @@ mod tests {
         let (e_verner, e_capped) = (error(&verner), error(&capped));
         assert!(e_verner < 0.75 * e_capped, "Verner {e_verner} Pa, capped {e_capped} Pa");
         assert!(e_verner < 0.1, "{e_verner} Pa");
-    }
-
-    #[test]
-    fn steps_end_where_the_jet_pipe_crosses_a_tangency() {
-        let model = thesis_model();
-        let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
-        let propagator = sim.propagator.as_ref().unwrap();
-        let start = sim.electromechanical_state();
-        let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
-        // The chambers' time starts at the step's start, as the trajectory's does.
-        let system = ChamberSystem::new(
-            &model,
-            &trajectory,
-            0.002,
-            sim.state[index::JET_POSITION],
-            None,
-            sim.x_s,
-            0.0,
-        );
-        let stretch_at = |t: f64| model.area_stretch(trajectory.position(t));
-        assert_ne!(stretch_at(0.0), stretch_at(0.002), "the swing must cross a tangency");
-        // Walk through 2 ms in 0.1 ms pieces, as an integrator would.
-        let mut t: f64 = 0.0;
-        let mut crossings = vec![];
-        while t < 0.002 {
-            let end = (t + 1e-4).min(0.002);
-            match system.breakpoint(t, end) {
-                Some(b) => {
-                    assert!(b > t && b < end, "{b} outside ({t}, {end})");
-                    crossings.push(b);
-                    t = b;
-                }
-                None => t = end,
-            }
-        }
-        assert!(!crossings.is_empty());
-        for &b in &crossings {
-            let (before, after) = (stretch_at(b - 1e-11), stretch_at(b));
-            assert_ne!(before, after, "no tangency at {b}");
-            let tangency = model.tangency_position(before, after);
-            let speed = (trajectory.position(b + 1e-9) - trajectory.position(b)).abs() / 1e-9;
-            assert!(
-                (trajectory.position(b) - tangency).abs() <= 2e-12 * speed + 1e-15,
-                "{b}"
-            );
-        }
-    }
-
-    /// The rates at t = 0 are kept for the pressures last asked about there, and only there.
-    #[test]
-    fn chambers_keep_the_rates_at_the_start_for_the_same_pressures_only() {
-        let model = thesis_model();
-        let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
-        let propagator = sim.propagator.as_ref().unwrap();
-        let start = sim.electromechanical_state();
-        let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
-        let system = ChamberSystem::new(
-            &model,
-            &trajectory,
-            0.01,
-            sim.state[index::JET_POSITION],
-            None,
-            sim.x_s,
-            0.0,
-        );
-        // At t = 0 the chambers see the state's jet pipe position (the trajectory's agrees to
-        // rounding).
-        let position = |t: f64| {
-            if t == 0.0 {
-                sim.state[index::JET_POSITION]
-            } else {
-                trajectory.position(t)
-            }
-        };
-        let fresh = |t: f64, p: &SVector<f64, 2>| system.rates(&model.areas(position(t)), t, p);
-        let p = SVector::<f64, 2>::new(sim.state[index::P1], sim.state[index::P2]);
-        let q = p * 1.01;
-        for pressures in [p, p, q, p, q, q] {
-            assert_eq!(system.rhs(0.0, &pressures), fresh(0.0, &pressures));
-        }
-        assert_eq!(system.start_rates.get().map(|(kept, _)| kept), Some(q));
-        assert_eq!(system.rhs(1e-3, &p), fresh(1e-3, &p));
-        assert_eq!(system.start_rates.get().map(|(kept, _)| kept), Some(q));
-        assert_ne!(system.rhs(0.0, &p), system.rhs(0.0, &q));
     }
 
     #[test]

@@ -1,0 +1,281 @@
+//! The propagator: the current driver (2.1) and the jet pipe's linear dynamics (2.6) for one
+//! parameter set, as three modes with eigenvalues λk and input gains βk, plus what every
+//! step's closed forms share (the series terms' weights on the modes, and the exponentials
+//! e^{λk s} and e^{−ω_cd s} they are made of). Built once per parameter set, so a step costs
+//! multiplications; the hysteresis operator's linear stretches are recognised here too, as
+//! they decide whether the series applies.
+
+use crate::physics::effects::{PrandtlIshlinskii, PLAY_OPERATORS};
+use crate::physics::jet_pipe;
+use crate::physics::parameters::Parameters;
+
+use super::nodes::AdvanceCache;
+use super::series::MAX_SERIES_TERMS;
+use super::C64;
+
+/// Precomputed modal form of the jet pipe for one parameter set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ElectromechanicalPropagator {
+    pub(super) omega_cd: f64,
+    pub(super) k_cd: f64,
+    pub(super) i_offset: f64,
+    pub(super) k_m: f64,
+    pub(super) x_sat: f64,
+    pub(super) f_sat: f64,
+    pub(super) lambda: [C64; 3],
+    /// Rows of V⁻¹, V = [[1,1,1],[λ1,λ2,λ3],[λ1²,λ2²,λ3²]].
+    pub(super) inverse: [[C64; 3]; 3],
+    /// V⁻¹ b with b = [0, 0, ω1ω2²].
+    pub(super) beta: [C64; 3],
+    /// The jet_pipe_hysteresis operator between f3 and the dynamics (inactive when off).
+    pub(super) hysteresis: PrandtlIshlinskii,
+    /// What each term of a current transient's series does to the modes: see [`SeriesWeight`].
+    /// Built once, so a step's trajectory costs multiplications instead of 3 complex
+    /// divisions per term; it stops before the first n where λk + nω nearly vanishes.
+    pub(super) series_weights: Vec<SeriesWeight>,
+    /// The advances by cᵢh of the last few step sizes (see
+    /// [`Trajectory::node_positions`](super::Trajectory::node_positions)).
+    pub(super) advances: AdvanceCache,
+    /// e^{Re λ1 s} and e^{Re λ2 s} at the last s asked for: the position bounds over a
+    /// step and the ringing test ask at the same s every step of a regular grid.
+    pub(super) real_mode_growth: ExpMemo,
+    pub(super) ringing_envelope: ExpMemo,
+}
+
+/// e^{rate·s} for a fixed rate, kept for the last s asked for. A memo: it changes no result,
+/// so two propagators that differ only in it are equal.
+#[derive(Clone, Debug)]
+pub(super) struct ExpMemo {
+    pub(super) rate: f64,
+    pub(super) last: std::cell::Cell<Option<(f64, f64)>>,
+}
+
+impl ExpMemo {
+    pub(super) fn new(rate: f64) -> Self {
+        Self {
+            rate,
+            last: std::cell::Cell::new(None),
+        }
+    }
+
+    pub(super) fn at(&self, s: f64) -> f64 {
+        match self.last.get() {
+            Some((kept, value)) if kept == s => value,
+            _ => {
+                let value = (self.rate * s).exp();
+                self.last.set(Some((s, value)));
+                value
+            }
+        }
+    }
+}
+
+impl PartialEq for ExpMemo {
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
+}
+
+/// For term aₙ e^{−nω s} of the jet pipe input: each mode's weight wₖ = β_k/(λk + nω) and
+/// the moments Re Σ_k λk^m wₖ (m = 0, 1, 2) that give its share of position, velocity and
+/// acceleration.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct SeriesWeight {
+    pub(super) modes: [C64; 3],
+    pub(super) moments: [f64; 3],
+}
+
+impl ElectromechanicalPropagator {
+    /// `None` when the jet pipe's eigenvalues are (nearly) repeated, e.g. ζ2 ≥ 1 or ω1 on
+    /// the second-order pair: the modal form does not exist and callers integrate the
+    /// full system instead.
+    pub fn new(p: &Parameters) -> Option<Self> {
+        if p.zeta_2 >= 1.0 {
+            return None;
+        }
+        let damped = p.omega_2 * (1.0 - p.zeta_2 * p.zeta_2).sqrt();
+        let lambda = [
+            C64::new(-p.omega_1, 0.0),
+            C64::new(-p.zeta_2 * p.omega_2, damped),
+            C64::new(-p.zeta_2 * p.omega_2, -damped),
+        ];
+        let scale = lambda.iter().map(|l| l.norm()).fold(0.0, f64::max);
+        for a in 0..3 {
+            for b in a + 1..3 {
+                if (lambda[a] - lambda[b]).norm() < 1e-6 * scale {
+                    return None;
+                }
+            }
+        }
+        // Inverse of the Vandermonde matrix: row k holds the coefficients of the Lagrange
+        // polynomial ℓ_k(s) = Π_{j≠k} (s − λj)/(λk − λj), i.e. [λaλb, −(λa+λb), 1]/den.
+        let mut inverse = [[C64::new(0.0, 0.0); 3]; 3];
+        for k in 0..3 {
+            let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+            let den = (lambda[k] - lambda[a]) * (lambda[k] - lambda[b]);
+            inverse[k] = [
+                lambda[a] * lambda[b] / den,
+                -(lambda[a] + lambda[b]) / den,
+                C64::new(1.0, 0.0) / den,
+            ];
+        }
+        let gain = p.omega_1 * p.omega_2 * p.omega_2;
+        let beta = [inverse[0][2] * gain, inverse[1][2] * gain, inverse[2][2] * gain];
+        let mut series_weights = Vec::with_capacity(MAX_SERIES_TERMS);
+        'terms: for n in 0..MAX_SERIES_TERMS {
+            let n_omega = n as f64 * p.omega_cd;
+            let mut weight = SeriesWeight {
+                modes: [C64::new(0.0, 0.0); 3],
+                moments: [0.0; 3],
+            };
+            for k in 0..3 {
+                let denominator = lambda[k] + n_omega;
+                // Resonant: the term grows like s e^{λs}, which the series form does not hold.
+                if denominator.norm_sqr() <= (1e-9 * p.omega_cd).powi(2) {
+                    break 'terms;
+                }
+                let w = beta[k] / denominator;
+                weight.modes[k] = w;
+                weight.moments[0] += w.re;
+                weight.moments[1] += (lambda[k] * w).re;
+                weight.moments[2] += (lambda[k] * lambda[k] * w).re;
+            }
+            series_weights.push(weight);
+        }
+        Some(Self {
+            omega_cd: p.omega_cd,
+            k_cd: p.k_cd,
+            i_offset: p.i_offset,
+            k_m: p.k_m,
+            x_sat: p.x_jp_sat,
+            f_sat: p.f_jp_sat,
+            lambda,
+            inverse,
+            beta,
+            hysteresis: PrandtlIshlinskii::new(p.hysteresis_width, p.hysteresis_deadband),
+            series_weights,
+            advances: AdvanceCache::default(),
+            real_mode_growth: ExpMemo::new(lambda[0].re),
+            ringing_envelope: ExpMemo::new(lambda[1].re),
+        })
+    }
+}
+
+impl ElectromechanicalPropagator {
+    /// With a held command the static position moves monotonically from f3(i(0)) to
+    /// f3(ī). If no play of the hysteresis operator starts to move on the way, the
+    /// operator's output is affine in the static position, u = C + f·x̄ (f the fraction of
+    /// plays being dragged), and the closed-form series still applies: returns (C, f).
+    pub(super) fn hysteresis_as_linear(
+        &self,
+        current: f64,
+        static_current: f64,
+        plays: &[f64; PLAY_OPERATORS],
+    ) -> Option<(f64, f64)> {
+        let x_bar = |i: f64| jet_pipe::static_position(self.x_sat, self.f_sat, jet_pipe::tip_force(self.k_m, i));
+        let (from, to) = (x_bar(current), x_bar(static_current));
+        let rising = to >= from;
+        let (mut constant, mut dragged) = (0.0, 0usize);
+        for (p, r) in plays.iter().zip(&self.hysteresis.half_widths) {
+            // Where the play is pushed from: the edge of its band on the moving side.
+            let edge = if rising { from - r } else { from + r };
+            let engaged = if rising { *p <= edge } else { *p >= edge };
+            if engaged {
+                dragged += 1;
+                constant += if rising { -r } else { *r };
+            } else {
+                let engages_at = if rising { p + r } else { p - r };
+                if (rising && engages_at < to) || (!rising && engages_at > to) {
+                    return None;
+                }
+                constant += p;
+            }
+        }
+        let n = PLAY_OPERATORS as f64;
+        Some((constant / n, dragged as f64 / n))
+    }
+}
+
+/// Bounds over 0 ≤ s ≤ s_end on Re Σ_k amplitude_k e^{λk s}: the real mode moves
+/// monotonically between its ends, the decaying complex pair stays within its moduli.
+pub(super) fn modal_bounds(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s_end: f64) -> (f64, f64) {
+    let real = amplitude[0].re;
+    let real_end = real * p.real_mode_growth.at(s_end);
+    let ringing = modulus(amplitude[1]) + modulus(amplitude[2]);
+    (real.min(real_end) - ringing, real.max(real_end) + ringing)
+}
+
+/// |c| for a modal amplitude (metres, far from overflow and underflow): the root of the
+/// square, without the rescaling of `hypot`, which costs three times as much.
+pub(super) fn modulus(c: C64) -> f64 {
+    c.norm_sqr().sqrt()
+}
+
+/// e^{λk s}·amplitude_k for the three modes (λ3 = conj(λ2), so one complex exponential).
+pub(super) fn modal_growth(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s: f64) -> [C64; 3] {
+    growth_from(amplitude, &p.exponentials(s, false))
+}
+
+/// Weights (w₀, w₁, w₂) with Re Σ_k amplitude_k e^{λk s} = w₀ e^{λ1 s} + w₁ Re e^{λ2 s} +
+/// w₂ Im e^{λ2 s}: the position's modal part in three products instead of three complex ones
+/// (the pair's conjugate exponential folds into w₁ and w₂).
+pub(super) fn position_weights(amplitude: &[C64; 3]) -> [f64; 3] {
+    [
+        amplitude[0].re,
+        amplitude[1].re + amplitude[2].re,
+        amplitude[2].im - amplitude[1].im,
+    ]
+}
+
+pub(super) fn modal_position(weights: &[f64; 3], e: &Exponentials) -> f64 {
+    weights[0] * e.real + weights[1] * e.oscillation.re + weights[2] * e.oscillation.im
+}
+
+pub(super) fn growth_from(amplitude: &[C64; 3], e: &Exponentials) -> [C64; 3] {
+    [
+        amplitude[0] * e.real,
+        amplitude[1] * e.oscillation,
+        amplitude[2] * e.oscillation.conj(),
+    ]
+}
+
+/// The exponentials a closed-form trajectory is made of, at one time s: e^{λ1 s} of the
+/// real mode, e^{λ2 s} of the ringing pair (λ3 = conj λ2) and the current transient's
+/// e^{−ω_cd s}. Those at s + δ are the products of those at s and at δ.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Exponentials {
+    pub(super) real: f64,
+    pub(super) oscillation: C64,
+    pub(super) decay: f64,
+}
+
+impl Exponentials {
+    pub(super) fn then(&self, advance: &Exponentials) -> Exponentials {
+        Exponentials {
+            real: self.real * advance.real,
+            oscillation: self.oscillation * advance.oscillation,
+            decay: self.decay * advance.decay,
+        }
+    }
+}
+
+impl ElectromechanicalPropagator {
+    /// The exponentials at `s`; `decay` is left at 0 unless `with_decay`.
+    pub(super) fn exponentials(&self, s: f64, with_decay: bool) -> Exponentials {
+        // A step's start, where most are asked for: exactly 1, without the calls.
+        if s == 0.0 {
+            return Exponentials {
+                real: 1.0,
+                oscillation: C64::new(1.0, 0.0),
+                decay: if with_decay { 1.0 } else { 0.0 },
+            };
+        }
+        let envelope = (self.lambda[1].re * s).exp();
+        let (sin, cos) = (self.lambda[1].im * s).sin_cos();
+        Exponentials {
+            real: (self.lambda[0].re * s).exp(),
+            oscillation: C64::new(envelope * cos, envelope * sin),
+            decay: if with_decay { (-self.omega_cd * s).exp() } else { 0.0 },
+        }
+    }
+}

@@ -1,0 +1,360 @@
+//! The split method's integrated part: the two chamber pressures, driven by the jet pipe's
+//! exactly known trajectory. Most of what is here keeps the integrator from paying twice for
+//! the same thing (the orifice areas at a stage time, the rates at a step's start and end)
+//! and stops its steps at the tangencies of the orifice geometry, where the flows have kinks.
+
+use nalgebra::SVector;
+
+use crate::electromechanics::{Trajectory, MAX_NODES};
+use crate::integrator::{finite_difference_jacobian, OdeSystem};
+use crate::physics::actuator::Actuator;
+use crate::physics::orifice_geometry::OrificeAreas;
+
+/// The jet pipe position, pressures and pressure rates at the end of a step.
+pub(super) type EndRates = (f64, SVector<f64, 2>, SVector<f64, 2>);
+
+/// The chambers over one step, driven by the exactly known jet pipe trajectory. Its time
+/// is counted from the step's start, as the trajectory's is: a step size the integrator
+/// repeats (the cap, the rest of an equal communication step) is then the same to the last
+/// bit each time, which [`Trajectory::node_positions`] relies on.
+pub(super) struct ChamberSystem<'a> {
+    pub(super) model: &'a Actuator,
+    pub(super) trajectory: &'a Trajectory<'a>,
+    pub(super) x_s: f64,
+    pub(super) x_s_rate: f64,
+    /// The jet pipe position at t = 0: the state's, which the trajectory starts from (its
+    /// own value there agrees to rounding).
+    pub(super) start_position: f64,
+    /// The jet pipe position and orifice areas at the last time asked for: Newton
+    /// iterations and the Jacobian evaluate many pressures at one stage time, and the jet
+    /// pipe position and the areas (four lens areas) cost more than the flows.
+    pub(super) areas_at: std::cell::Cell<Option<(f64, f64, OrificeAreas)>>,
+    /// The areas at the stage times of the current explicit step, worked out together in
+    /// [`OdeSystem::prepare_stages`]. An entry from an earlier step is still right: the
+    /// areas depend on the time alone.
+    pub(super) stage_areas: std::cell::RefCell<StageAreas>,
+    /// The pressures and rates at the step's start (t = 0), asked for twice: by the ringing
+    /// test and by the integrator's first stage.
+    pub(super) start_rates: std::cell::Cell<Option<(SVector<f64, 2>, SVector<f64, 2>)>>,
+    /// The jet pipe position, pressures and rates of the last evaluation at t = duration:
+    /// the integrator's last stage, whose rates are the next step's rates at its start.
+    pub(super) end_rates: std::cell::Cell<Option<EndRates>>,
+    /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
+    /// question starts there.
+    pub(super) stretch_at: std::cell::Cell<Option<(f64, i32)>>,
+    /// Whether the trajectory's position bounds over [0, duration] lie within one
+    /// stretch of the orifice geometry (then no step inside has a breakpoint); found on the
+    /// first question.
+    pub(super) tangency_free: std::cell::Cell<Option<bool>>,
+    pub(super) duration: f64,
+}
+
+impl<'a> ChamberSystem<'a> {
+    /// The chambers over [0, duration], from the jet pipe position `start_position`; the
+    /// pressure rates at the start are `start_rates` when they are already known.
+    pub(super) fn new(
+        model: &'a Actuator,
+        trajectory: &'a Trajectory<'a>,
+        duration: f64,
+        start_position: f64,
+        start_rates: Option<(SVector<f64, 2>, SVector<f64, 2>)>,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> Self {
+        Self {
+            model,
+            trajectory,
+            x_s,
+            x_s_rate,
+            start_position,
+            areas_at: std::cell::Cell::new(None),
+            stage_areas: std::cell::RefCell::new(StageAreas::default()),
+            start_rates: std::cell::Cell::new(start_rates),
+            end_rates: std::cell::Cell::new(None),
+            stretch_at: std::cell::Cell::new(None),
+            tangency_free: std::cell::Cell::new(None),
+            duration,
+        }
+    }
+
+    /// Whether the jet pipe provably stays within one stretch over the whole system's time.
+    pub(super) fn tangency_free(&self) -> bool {
+        if let Some(free) = self.tangency_free.get() {
+            return free;
+        }
+        let free = self
+            .trajectory
+            .position_bounds(self.duration)
+            .map_or(false, |(lo, hi)| {
+                self.model.area_stretch(lo) == self.model.area_stretch(hi)
+            });
+        self.tangency_free.set(Some(free));
+        free
+    }
+
+    pub(super) fn areas(&self, t: f64) -> OrificeAreas {
+        self.position_and_areas(t).1
+    }
+
+    /// The jet pipe position at `t` and the orifice areas there.
+    pub(super) fn position_and_areas(&self, t: f64) -> (f64, OrificeAreas) {
+        if let Some(known) = self.stage_areas.borrow().at(t) {
+            return known;
+        }
+        match self.areas_at.get() {
+            Some((cached, position, areas)) if cached == t => (position, areas),
+            _ => {
+                let position = if t == 0.0 {
+                    self.start_position
+                } else {
+                    self.trajectory.position(t)
+                };
+                let areas = self.model.areas(position);
+                self.areas_at.set(Some((t, position, areas)));
+                (position, areas)
+            }
+        }
+    }
+
+    /// The time in (a, b] at which the jet pipe, in `stretch_a` at a and not at b, reaches
+    /// `tangency`: regula falsi (Illinois) on the exact trajectory, returning a time already
+    /// past the crossing (within 1e-12 s), so a step ending there does not contain it.
+    pub(super) fn crossing_time(&self, mut a: f64, mut b: f64, tangency: f64, stretch_a: i32) -> f64 {
+        let gap = |t: f64| self.trajectory.position(t) - tangency;
+        let (mut ga, mut gb) = (gap(a), gap(b));
+        let mut last_moved = 0;
+        for _ in 0..60 {
+            if b - a <= 1e-12 {
+                break;
+            }
+            let mut t = if ga != gb {
+                b - gb * (b - a) / (gb - ga)
+            } else {
+                0.5 * (a + b)
+            };
+            if !(t > a && t < b) {
+                t = 0.5 * (a + b);
+            }
+            let position = self.trajectory.position(t);
+            let g = position - tangency;
+            let past = self.model.area_stretch(position) != stretch_a;
+            if past {
+                b = t;
+                gb = g;
+                if last_moved == 1 {
+                    ga *= 0.5;
+                }
+                last_moved = 1;
+            } else {
+                a = t;
+                ga = g;
+                if last_moved == -1 {
+                    gb *= 0.5;
+                }
+                last_moved = -1;
+            }
+        }
+        b
+    }
+
+    /// The rates at t = 0, kept (see `start_rates`); out of line, so the stages' path stays
+    /// small enough to be inlined into the integrator.
+    #[inline(never)]
+    pub(super) fn rates_at_start(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+        match self.start_rates.get() {
+            Some((pressures, rates)) if pressures == *p => rates,
+            _ => {
+                let rates = self.rates(&self.areas(0.0), 0.0, p);
+                self.start_rates.set(Some((*p, rates)));
+                rates
+            }
+        }
+    }
+
+    /// The rates at t = duration, recorded with the position and pressures (see `end_rates`).
+    pub(super) fn rates_at_end(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+        let (position, areas) = self.position_and_areas(self.duration);
+        let rates = self.rates(&areas, self.duration, p);
+        self.end_rates.set(Some((position, *p, rates)));
+        rates
+    }
+
+    pub(super) fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+        let x_s = self.x_s + self.x_s_rate * t;
+        let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
+        SVector::<f64, 2>::new(a, b)
+    }
+}
+
+/// Jet pipe positions and orifice areas at the stage times of one step.
+#[derive(Default)]
+pub(super) struct StageAreas {
+    pub(super) count: usize,
+    pub(super) times: [f64; MAX_NODES],
+    pub(super) positions: [f64; MAX_NODES],
+    pub(super) areas: [OrificeAreas; MAX_NODES],
+}
+
+impl StageAreas {
+    pub(super) fn at(&self, t: f64) -> Option<(f64, OrificeAreas)> {
+        let i = self.times[..self.count].iter().position(|&time| time == t)?;
+        Some((self.positions[i], self.areas[i]))
+    }
+}
+
+impl OdeSystem<2> for ChamberSystem<'_> {
+    #[inline]
+    fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+        if t == 0.0 {
+            return self.rates_at_start(p);
+        }
+        if t == self.duration {
+            return self.rates_at_end(p);
+        }
+        self.rates(&self.areas(t), t, p)
+    }
+    /// The jet pipe positions at all stages at once ([`Trajectory::node_positions`]), then
+    /// their areas (once for stages at the same position, like DP5's two at c = 1).
+    fn prepare_stages(&self, t: f64, h: f64, nodes: &[f64], times: &[f64]) {
+        let count = nodes.len().min(times.len());
+        if count > MAX_NODES {
+            return;
+        }
+        let mut positions = [0.0; MAX_NODES];
+        self.trajectory
+            .node_positions(t, h, &nodes[..count], &times[..count], &mut positions[..count]);
+        let mut table = self.stage_areas.borrow_mut();
+        for i in 0..count {
+            table.times[i] = times[i];
+            table.positions[i] = positions[i];
+            table.areas[i] = if i > 0 && positions[i] == positions[i - 1] {
+                table.areas[i - 1]
+            } else {
+                self.model.areas(positions[i])
+            };
+        }
+        table.count = count;
+    }
+    /// Where the jet pipe crosses a tangency of the orifice geometry: the areas, and so the
+    /// pressure rates, have a corner or a 3/2 power in time there. Looked for at the middle
+    /// and the end of the step (steps are at most a quarter of the ringing period, so only
+    /// a graze of a tangency can be missed, and a graze opens next to no area).
+    fn breakpoint(&self, t0: f64, t1: f64) -> Option<f64> {
+        if self.tangency_free() && t1 <= self.duration {
+            return None;
+        }
+        let stretch = |t: f64| self.model.area_stretch(self.trajectory.position(t));
+        let (mut a, mut stretch_a) = match self.stretch_at.get() {
+            Some((t, s)) if t == t0 => (t0, s),
+            _ => (t0, stretch(t0)),
+        };
+        for b in [0.5 * (t0 + t1), t1] {
+            let stretch_b = stretch(b);
+            if stretch_b != stretch_a {
+                let tangency = self.model.tangency_position(stretch_a, stretch_b);
+                let crossing = self.crossing_time(a, b, tangency, stretch_a);
+                self.stretch_at.set(Some((crossing, stretch(crossing))));
+                return Some(crossing);
+            }
+            (a, stretch_a) = (b, stretch_b);
+        }
+        self.stretch_at.set(Some((t1, stretch_a)));
+        None
+    }
+    fn jacobian(&self, t: f64, p: &SVector<f64, 2>, f_p: &SVector<f64, 2>) -> nalgebra::SMatrix<f64, 2, 2> {
+        let areas = self.areas(t);
+        finite_difference_jacobian(|q| self.rates(&areas, t, q), p, f_p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::thesis_model;
+    use super::super::Simulation;
+    use super::*;
+    use crate::physics::actuator::index;
+
+    #[test]
+    fn steps_end_where_the_jet_pipe_crosses_a_tangency() {
+        let model = thesis_model();
+        let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
+        let propagator = sim.propagator.as_ref().unwrap();
+        let start = sim.electromechanical_state();
+        let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
+        // The chambers' time starts at the step's start, as the trajectory's does.
+        let system = ChamberSystem::new(
+            &model,
+            &trajectory,
+            0.002,
+            sim.state[index::JET_POSITION],
+            None,
+            sim.x_s,
+            0.0,
+        );
+        let stretch_at = |t: f64| model.area_stretch(trajectory.position(t));
+        assert_ne!(stretch_at(0.0), stretch_at(0.002), "the swing must cross a tangency");
+        // Walk through 2 ms in 0.1 ms pieces, as an integrator would.
+        let mut t: f64 = 0.0;
+        let mut crossings = vec![];
+        while t < 0.002 {
+            let end = (t + 1e-4).min(0.002);
+            match system.breakpoint(t, end) {
+                Some(b) => {
+                    assert!(b > t && b < end, "{b} outside ({t}, {end})");
+                    crossings.push(b);
+                    t = b;
+                }
+                None => t = end,
+            }
+        }
+        assert!(!crossings.is_empty());
+        for &b in &crossings {
+            let (before, after) = (stretch_at(b - 1e-11), stretch_at(b));
+            assert_ne!(before, after, "no tangency at {b}");
+            let tangency = model.tangency_position(before, after);
+            let speed = (trajectory.position(b + 1e-9) - trajectory.position(b)).abs() / 1e-9;
+            assert!(
+                (trajectory.position(b) - tangency).abs() <= 2e-12 * speed + 1e-15,
+                "{b}"
+            );
+        }
+    }
+
+    /// The rates at t = 0 are kept for the pressures last asked about there, and only there.
+    #[test]
+    fn chambers_keep_the_rates_at_the_start_for_the_same_pressures_only() {
+        let model = thesis_model();
+        let sim = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-6).unwrap();
+        let propagator = sim.propagator.as_ref().unwrap();
+        let start = sim.electromechanical_state();
+        let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
+        let system = ChamberSystem::new(
+            &model,
+            &trajectory,
+            0.01,
+            sim.state[index::JET_POSITION],
+            None,
+            sim.x_s,
+            0.0,
+        );
+        // At t = 0 the chambers see the state's jet pipe position (the trajectory's agrees to
+        // rounding).
+        let position = |t: f64| {
+            if t == 0.0 {
+                sim.state[index::JET_POSITION]
+            } else {
+                trajectory.position(t)
+            }
+        };
+        let fresh = |t: f64, p: &SVector<f64, 2>| system.rates(&model.areas(position(t)), t, p);
+        let p = SVector::<f64, 2>::new(sim.state[index::P1], sim.state[index::P2]);
+        let q = p * 1.01;
+        for pressures in [p, p, q, p, q, q] {
+            assert_eq!(system.rhs(0.0, &pressures), fresh(0.0, &pressures));
+        }
+        assert_eq!(system.start_rates.get().map(|(kept, _)| kept), Some(q));
+        assert_eq!(system.rhs(1e-3, &p), fresh(1e-3, &p));
+        assert_eq!(system.start_rates.get().map(|(kept, _)| kept), Some(q));
+        assert_ne!(system.rhs(0.0, &p), system.rhs(0.0, &q));
+    }
+}
