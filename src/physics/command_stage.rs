@@ -81,6 +81,11 @@ impl CommandStage {
             v
         };
         self.time = time;
+        self.current(p)
+    }
+
+    /// The command the current driver has seen since the last communication point.
+    pub fn current(&self, p: &Parameters) -> f64 {
         if p.command_lag > 0.0 {
             self.lagged
         } else {
@@ -88,7 +93,7 @@ impl CommandStage {
         }
     }
 
-    /// The stage as bytes (for FMU states): time, held, lagged.
+    /// The stage as numbers (for FMU states): time, held, lagged.
     pub fn to_values(&self) -> [f64; 3] {
         [self.time, self.held, self.lagged]
     }

@@ -340,8 +340,8 @@ impl Simulation {
         let applied = self.v_da;
         let staged = command_stage::is_active(&self.model.params);
         if staged {
+            let before = self.command_stage.current(&self.model.params);
             let seen = self.command_stage.next(&self.model.params, self.time, applied);
-            let before = self.command_history.last().map_or(f64::NAN, |c| c.v_da);
             self.input_changed |= seen != before;
             self.v_da = seen;
         }
@@ -350,12 +350,6 @@ impl Simulation {
             self.v_da_rate = 0.0;
         }
         let segments = self.command_segments(step);
-        if staged && self.model.params.command_delay == 0.0 {
-            // command_segments keeps the history only for the delay; the stage needs the
-            // last command seen to tell a change.
-            self.command_history.truncate(1);
-            self.command_history[0].v_da = self.v_da;
-        }
         self.v_da = applied;
         self.v_da_rate = rate;
         for (duration, v, v_rate) in segments {
