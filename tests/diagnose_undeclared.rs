@@ -197,3 +197,27 @@ fn every_mechanism_of_the_table_has_a_test_here() {
         );
     }
 }
+
+#[test]
+fn an_undeclared_back_pressure_and_named_friction_are_both_found() {
+    if std::env::var("JETPIPE_UNDECLARED").is_ok() {
+        return;
+    }
+    let mut effects = (undeclared_mechanism("return_back_pressure").unwrap().effects)();
+    effects.friction_coulomb = 2.0;
+    let dir = std::env::temp_dir().join(format!("jetpipe-undeclared-{}-both", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("recording.csv");
+    write_csv(&generate(&effects, 21, 80.0), &path).unwrap();
+    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    println!("{}", d.summary().join(" | "));
+    let named: Vec<&str> = d.effects.iter().map(|e| e.name).collect();
+    assert_eq!(named, ["piston_friction"]);
+    let found = d.discovered.first().expect("the back pressure discovered");
+    assert_eq!((found.location, found.family), ("return", "parameter_offset"), "{}", found.reading);
+    let p_r = d.parameters.p_r;
+    assert!((p_r - 141_325.0).abs() <= 0.2 * 40e3, "P_r = {p_r}");
+    assert!(d.after.heldout_rms < 0.1 * d.before.heldout_rms);
+}

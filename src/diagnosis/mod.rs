@@ -763,14 +763,21 @@ pub fn diagnose_with(
         let place_share = found.best_at(place).map_or(0.0, |s| s.explained);
         let mut added = None;
         // Named effects are the hypotheses tried first: once a term outside them has been
-        // added, a named effect found later would be absorbing what that term's form
-        // misses, and only further terms are tried.
-        let naming = discovered.is_empty();
-        if naming && round < MAX_EFFECTS && place != "unknown" {
+        // added, a named effect found later may be absorbing what that term's form misses,
+        // and only those whose own signature is tested in the residual (friction, the
+        // sensor's offset and gain, hysteresis) are still tried.
+        let nameable = |s: &&Scored| {
+            s.fit
+                .candidate
+                .named
+                .map_or(false, |name| discovered.is_empty() || named::has_signature_test(name))
+        };
+        if round < MAX_EFFECTS && place != "unknown" {
             let mut named: Vec<&Scored> = found
                 .candidates
                 .iter()
-                .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_some())
+                .filter(|s| s.fit.candidate.location == place)
+                .filter(nameable)
                 .collect();
             named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
             for s in named {
@@ -800,7 +807,7 @@ pub fn diagnose_with(
         // With pressures, the mechanics and the force sensor are judged on the force
         // against the pressures, where an upstream departure does not reach: a second
         // effect there is found even while a larger one upstream dominates the misfit.
-        if naming && added.is_none() && round < MAX_EFFECTS {
+        if added.is_none() && round < MAX_EFFECTS {
             if let Some(through) = force_through_mechanics(&model, recording) {
                 let downstream = Problem::new(recording, &params, &training, [mechanical_noise, 0.0, 0.0]);
                 let (_, misfit) = downstream.errors(&[through.force.clone(), vec![], vec![]]);
@@ -819,7 +826,8 @@ pub fn diagnose_with(
                     let mut named: Vec<&Scored> = side
                         .candidates
                         .iter()
-                        .filter(|s| s.fit.candidate.location == side.location && s.fit.candidate.named.is_some())
+                        .filter(|s| s.fit.candidate.location == side.location)
+                        .filter(nameable)
                         .collect();
                     named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
                     for s in named {

@@ -144,3 +144,8 @@ pub fn loop_with_command_direction(residual: &[f64], recording: &Recording, nois
         ),
     }
 }
+
+/// Whether a named effect has a signature test of its own here (the others pass by default).
+pub fn has_signature_test(name: &str) -> bool {
+    matches!(name, "sensor_offset_gain" | "piston_friction" | "jet_pipe_hysteresis")
+}
