@@ -216,7 +216,12 @@ fn an_undeclared_back_pressure_and_named_friction_are_both_found() {
     let named: Vec<&str> = d.effects.iter().map(|e| e.name).collect();
     assert_eq!(named, ["piston_friction"]);
     let found = d.discovered.first().expect("the back pressure discovered");
-    assert_eq!((found.location, found.family), ("return", "parameter_offset"), "{}", found.reading);
+    assert_eq!(
+        (found.location, found.family),
+        ("return", "parameter_offset"),
+        "{}",
+        found.reading
+    );
     let p_r = d.parameters.p_r;
     assert!((p_r - 141_325.0).abs() <= 0.2 * 40e3, "P_r = {p_r}");
     assert!(d.after.heldout_rms < 0.1 * d.before.heldout_rms);
