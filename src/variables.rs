@@ -832,7 +832,7 @@ pub const TABLE: &[Row] = &[
         .at_least(-1000.0).at_most(1000.0)
         .cite("")
         .because("1000 N/s: nine times the largest force every second"),
-    parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading held between communication points (0 = off)")
+    parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between communication points (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: a sensor that slow reads no dynamics at all"),

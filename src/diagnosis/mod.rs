@@ -807,7 +807,8 @@ pub fn diagnose_with(
         // With pressures, the mechanics and the force sensor are judged on the force
         // against the pressures, where an upstream departure does not reach: a second
         // effect there is found even while a larger one upstream dominates the misfit.
-        if added.is_none() && round < MAX_EFFECTS {
+        // (With the pressures within their noise the round's candidates were these already.)
+        if added.is_none() && round < MAX_EFFECTS && !pressures_agree {
             if let Some(through) = force_through_mechanics(&model, recording) {
                 let downstream = Problem::new(recording, &params, &training, [mechanical_noise, 0.0, 0.0]);
                 let (_, misfit) = downstream.errors(&[through.force.clone(), vec![], vec![]]);

@@ -8,7 +8,7 @@
 //! and the sensor may pass it through, in this order, a delay, a first-order lag and a
 //! play (backlash) of a given width. The filters act on the reading as it is sampled at
 //! communication points: the delay interpolates linearly between them, the lag is exact
-//! for the reading held over each interval. The FMU stepped at a recording's sample
+//! for the reading moving linearly over each interval. The FMU stepped at a recording's sample
 //! times and the replay of that recording read the same.
 
 use super::parameters::Parameters;
@@ -93,8 +93,14 @@ impl SensorMemory {
         let last = self.history.back().expect("the history is never empty").0;
         let delayed = self.delayed_at(p, time, reading);
         let lagged = if p.force_sensor_lag > 0.0 {
+            // Exact for a reading that moves linearly between communication points: a
+            // sensor reads a force that changes continuously, and holding it would lag the
+            // reading by half an interval more.
             let dt = (time - last).max(0.0);
-            self.lagged + (1.0 - (-dt / p.force_sensor_lag).exp()) * (self.delayed - self.lagged)
+            let tau = p.force_sensor_lag;
+            let decay = (-dt / tau).exp();
+            let ramp_part = if dt > 0.0 { 1.0 - tau * (1.0 - decay) / dt } else { 0.0 };
+            decay * self.lagged + (1.0 - decay) * self.delayed + ramp_part * (delayed - self.delayed)
         } else {
             delayed
         };
@@ -206,6 +212,23 @@ mod tests {
             assert!((y[k] - 1000.0 * (t[k] - 2.5e-3)).abs() < 1e-9, "{k}: {}", y[k]);
         }
         assert_eq!(y[0], 0.0);
+    }
+
+    #[test]
+    fn a_lagged_ramp_is_the_continuous_solution_at_every_sample() {
+        // y' = (x - y)/tau with x = y = 0 at t = 0 and x = r t: y = r (t - tau (1 - e^(-t/tau))).
+        let (tau, rate) = (0.01, 100.0);
+        let p = Parameters {
+            force_sensor_lag: tau,
+            ..Parameters::default()
+        };
+        let t: Vec<f64> = (0..200).map(|k| k as f64 * 1e-3).collect();
+        let f: Vec<f64> = t.iter().map(|t| rate * t).collect();
+        let y = readings(&p, &t, &f);
+        for k in 0..t.len() {
+            let exact = rate * (t[k] - tau * (1.0 - (-t[k] / tau).exp()));
+            assert!((y[k] - exact).abs() < 1e-9, "{k}: {} against {exact}", y[k]);
+        }
     }
 
     #[test]
