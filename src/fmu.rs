@@ -547,12 +547,7 @@ impl CoSimModel for ActuatorFmu {
             }
             let stopper_velocity = r.f64()?;
             let x_s_at_last_step = r.f64()?;
-            let changes = r.u32()? as usize;
-            if changes > bytes.len() / 24 {
-                return Err(format!(
-                    "the state claims {changes} command changes, more than its length holds"
-                ));
-            }
+            let changes = r.count(24, "command changes")?;
             let mut command_history = Vec::with_capacity(changes);
             for _ in 0..changes {
                 command_history.push(CommandChange {
@@ -565,12 +560,7 @@ impl CoSimModel for ActuatorFmu {
             for v in stage.iter_mut() {
                 *v = r.f64()?;
             }
-            let sensor_values = r.u32()? as usize;
-            if sensor_values > bytes.len() / 8 {
-                return Err(format!(
-                    "the state claims {sensor_values} force sensor values, more than its length holds"
-                ));
-            }
+            let sensor_values = r.count(8, "force sensor values")?;
             let mut sensor = Vec::with_capacity(sensor_values);
             for _ in 0..sensor_values {
                 sensor.push(r.f64()?);
@@ -691,6 +681,15 @@ impl<'a> ByteReader<'a> {
     }
     fn f64(&mut self) -> Result<f64, String> {
         Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+    }
+    /// A count of items of `item_bytes` each that follow, refused when the rest of the
+    /// state cannot hold them (so a forged count allocates nothing).
+    fn count(&mut self, item_bytes: usize, what: &str) -> Result<usize, String> {
+        let count = self.u32()? as usize;
+        if count.saturating_mul(item_bytes) > self.bytes.len() - self.at {
+            return Err(format!("the state claims {count} {what}, more than its length holds"));
+        }
+        Ok(count)
     }
     fn string(&mut self) -> Result<String, String> {
         let n = self.u32()? as usize;
