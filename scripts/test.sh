@@ -7,7 +7,9 @@ cd "$(dirname "$0")/.."
 run() {
     echo
     echo "==> $*"
+    local started=$SECONDS
     "$@"
+    echo "<== $(( SECONDS - started )) s: $*"
 }
 
 run cargo test --release
@@ -30,4 +32,4 @@ run cargo run --release --target-dir target/fmus -p antagonistic -- package
 run bash scripts/venv.sh
 run .venv/bin/python -m pytest fmu_tests -q
 echo
-echo "==> all tests passed"
+echo "==> all tests passed in $SECONDS s"
