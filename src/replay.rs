@@ -85,7 +85,6 @@ const JACOBIAN_REUSE: u64 = 8;
 pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Result<Replay, String> {
     use crate::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState};
     use crate::physics::actuator::{index, State};
-    use crate::physics::effects::PLAY_OPERATORS;
     use nalgebra::{Matrix2, Vector2};
 
     let Some(propagator) = ElectromechanicalPropagator::new(&model.params) else {
@@ -104,7 +103,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
     let commands = command_stage::seen_commands(&model.params, t, &recording.v_da);
     // A copy whose varying constants are set interval by interval.
     let mut varying = time_varying::varies(&model.params).then(|| model.clone());
-    let mut plays = [model.static_jet_position(em.current); PLAY_OPERATORS];
+    let mut plays = model.initial_hysteresis_memory(em.current);
     let mut velocity = 0.0;
     let delay = model.params.command_delay;
     let gamma = 1.0 + std::f64::consts::FRAC_1_SQRT_2;

@@ -49,6 +49,10 @@ pub mod vr {
     // Effects the thesis model lacks (MODEL.md), all off at their start values.
     pub const HYSTERESIS_WIDTH: u32 = 300;
     pub const HYSTERESIS_DEADBAND: u32 = 301;
+    pub const HYSTERESIS_EXPONENT: u32 = 302;
+    pub const HYSTERESIS_GAIN: u32 = 303;
+    pub const HYSTERESIS_BETA_SHARE: u32 = 304;
+    pub const HYSTERESIS_START: u32 = 305;
     pub const FRICTION_COULOMB: u32 = 310;
     pub const FRICTION_VELOCITY: u32 = 311;
     pub const FRICTION_STRIBECK: u32 = 312;
@@ -708,7 +712,7 @@ pub const TABLE: &[Row] = &[
         .above(0.0).at_most(1e7)
         .cite("(2.26)-(2.29)")
         .because(PRESSURE),
-    parameter("hysteresis_width", vr::HYSTERESIS_WIDTH, "m", 0.0, "jet_pipe_hysteresis: separation of the rising and falling branches of the static tip position in large sweeps (Prandtl-Ishlinskii operator after f3; 0 = off)")
+    parameter("hysteresis_width", vr::HYSTERESIS_WIDTH, "m", 0.0, "jet_pipe_hysteresis: separation of the rising and falling branches of the static tip position in large sweeps (an operator after f3 whose law hysteresis_exponent selects; 0 = off)")
         .at_least(0.0).at_most(0.01)
         .cite("§3.2.1-3.2.2")
         .because(TRAVEL),
@@ -716,6 +720,22 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(0.01)
         .cite("§3.2.1-3.2.2")
         .because(TRAVEL),
+    parameter("hysteresis_exponent", vr::HYSTERESIS_EXPONENT, "1", 0.0, "jet_pipe_hysteresis law: 0 = Prandtl-Ishlinskii plays (with hysteresis_deadband); n > 0 = Bouc-Wen law with exponent n, the sharpness of the bend onto a branch (large n approaches a backlash)")
+        .at_least(0.0).at_most(50.0)
+        .cite("§3.2.2")
+        .because("50: beyond it the bend is a corner to within 2 % of the width, the play law's shape"),
+    parameter("hysteresis_gain", vr::HYSTERESIS_GAIN, "1", 1.0, "jet_pipe_hysteresis, Bouc-Wen law: gain A of dz/dx = A [1 - (a sgn(dx z) + 1 - a) |z/r|^n] (output x - z; A = 1 with a = 0.5: the output stands still after a reversal)")
+        .above(0.0).at_most(2.0)
+        .cite("§3.2.2")
+        .because("2: with a = 0.5 the output would run backwards after a reversal as fast as the input moves"),
+    parameter("hysteresis_beta_share", vr::HYSTERESIS_BETA_SHARE, "1", 0.5, "jet_pipe_hysteresis, Bouc-Wen law: share a of beta in beta + gamma (0.5 = symmetric; with a < 0.5 the output starts to move back right after a reversal)")
+        .at_least(0.0).at_most(1.0)
+        .cite("§3.2.2")
+        .because("a share: beta and gamma are both >= 0"),
+    parameter("hysteresis_start", vr::HYSTERESIS_START, "1", 0.0, "jet_pipe_hysteresis: where the loop stands at the start, in half-widths of hysteresis_width: 0 = in its middle (after a long decaying oscillation), +1 = on the rising branch (the command came from below), -1 = on the falling branch")
+        .at_least(-1.0).at_most(1.0)
+        .cite("§3.2.2")
+        .because("the branches are one half-width either side of the middle"),
     parameter("friction_coulomb", vr::FRICTION_COULOMB, "N", 0.0, "piston_friction: Coulomb friction opposing stopper motion, (2.35) (0 = off)")
         .at_least(0.0).at_most(1000.0)
         .cite("(2.35)")

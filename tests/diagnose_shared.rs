@@ -166,19 +166,21 @@ fn the_clean_undeclared_example_is_explained_with_nothing_added() {
 fn rec_01_is_named_jet_pipe_hysteresis_and_nothing_else() {
     let Some(d) = run("rec_01.csv") else { return };
     assert_eq!(names(&d), ["jet_pipe_hysteresis"]);
-    assert!(d.after.heldout_rms < 0.2 * d.before.heldout_rms);
-    // The summary's first words agree with the numbers: what the play operator cannot
-    // follow of the bench's loops is not called noise.
+    // The bench's loops drift to their middle under the chirp (38-50 s), which only the
+    // smooth (Bouc–Wen) law does: the play law left 14.7 noise floors there.
+    let law = &d.effects[0].parameters;
+    assert!(
+        law.iter().any(|&(n, v)| n == "hysteresis_exponent" && v > 0.0),
+        "not the smooth law: {law:?}"
+    );
+    assert!(
+        d.after.heldout_rms < 1.5 * d.noise_floor,
+        "{} vs noise {}",
+        d.after.heldout_rms,
+        d.noise_floor
+    );
     let opening = &d.summary()[0];
-    if d.after.heldout_rms > 1.5 * d.noise_floor {
-        assert!(
-            opening.starts_with("Not explained by jet_pipe_hysteresis alone"),
-            "{opening}"
-        );
-        assert!(opening.contains(&format!("{:.4} N", d.after.heldout_rms)), "{opening}");
-    } else {
-        assert!(opening.starts_with("Explained with jet_pipe_hysteresis"), "{opening}");
-    }
+    assert!(opening.starts_with("Explained with jet_pipe_hysteresis"), "{opening}");
 }
 
 #[test]

@@ -237,6 +237,27 @@ fn term_off(name: &'static str, unit: &'static str, step: f64, upper: f64) -> Te
     }
 }
 
+/// Where the Bouc–Wen law's fit starts: exponent, gain and β share (a rounded bend, the
+/// output still at a reversal, symmetric).
+const BOUC_WEN_START: [f64; 3] = [2.0, 1.0, 0.5];
+/// The thesis's width of the position/current loop (§3.2.1, 0.16 mm): with the law on from
+/// the start, its shape parameters have sensitivities at the first step.
+const BOUC_WEN_START_WIDTH: f64 = 0.16e-3;
+
+/// A parameter whose fit starts at `start` rather than at the base model's value (a law's
+/// shape, which only matters once the law is on).
+fn started(name: &'static str, unit: &'static str, start: f64, step: f64, lower: f64, upper: f64) -> Term {
+    Term {
+        name,
+        unit,
+        mechanism: Mechanism::Parameter(name),
+        neutral: start,
+        step,
+        lower,
+        upper,
+    }
+}
+
 fn output(name: &'static str, unit: &'static str, channel: usize, regressor: Regressor, step: f64) -> Term {
     Term {
         name,
@@ -417,8 +438,28 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             vec![
                 term_off("hysteresis_width", "m", 2e-5, 1e-3),
                 term_off("hysteresis_deadband", "m", 5e-6, 1e-3),
+                offset("hysteresis_start", "1", 0.05, -1.0, 1.0),
             ],
         ),
+        Candidate {
+            settings: vec![
+                ("hysteresis_exponent", BOUC_WEN_START[0]),
+                ("hysteresis_width", BOUC_WEN_START_WIDTH),
+            ],
+            ..c(
+                "jet pipe hysteresis, smooth law",
+                "jet_pipe",
+                "hysteresis",
+                Some("jet_pipe_hysteresis"),
+                vec![
+                    started("hysteresis_width", "m", BOUC_WEN_START_WIDTH, 2e-6, 0.0, 1e-3),
+                    started("hysteresis_exponent", "1", BOUC_WEN_START[0], 0.1, 0.5, 50.0),
+                    started("hysteresis_gain", "1", BOUC_WEN_START[1], 0.02, 0.05, 2.0),
+                    started("hysteresis_beta_share", "1", BOUC_WEN_START[2], 0.02, 0.0, 1.0),
+                    offset("hysteresis_start", "1", 0.05, -1.0, 1.0),
+                ],
+            )
+        },
         c(
             "jet pipe null drift",
             "jet_pipe",

@@ -62,7 +62,7 @@ const DISCOVERY_TRIALS: usize = 3;
 const REFINED: usize = 3;
 /// Only candidates whose first step explains at least this share are refined.
 const WORTH_REFINING: f64 = 0.1;
-const REFINE_ITERATIONS: usize = 4;
+const REFINE_ITERATIONS: usize = 10;
 
 /// Errors of a force trace against the recording.
 #[derive(Clone, Copy, Debug, PartialEq)]

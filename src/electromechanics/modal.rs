@@ -5,13 +5,27 @@
 //! multiplications; the hysteresis operator's linear stretches are recognised here too, as
 //! they decide whether the series applies.
 
-use crate::physics::effects::{PrandtlIshlinskii, PLAY_OPERATORS};
+use crate::physics::effects::{Hysteresis, PLAY_OPERATORS};
 use crate::physics::jet_pipe;
 use crate::physics::parameters::Parameters;
 
 use super::nodes::AdvanceCache;
 use super::series::MAX_SERIES_TERMS;
 use super::C64;
+
+/// How far (in units of the hysteresis law's half-width) a parabola may depart from the
+/// Bouc–Wen branch over a step for the closed-form series to stand in for quadrature: far
+/// below the jet pipe position's own tolerance (1e-8 of a 0.08 mm half-width is 1e-12 m).
+const QUADRATIC_TOLERANCE: f64 = 1e-8;
+
+/// The hysteresis operator's output over a held command's step, where a closed form holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum HysteresisOverStep {
+    /// constant + slope·x̄ (plays that move or stay put throughout).
+    Affine { constant: f64, slope: f64 },
+    /// value + slope·d + curvature·d², d = x̄ − x̄(0) (a Bouc–Wen branch).
+    Parabola { value: f64, slope: f64, curvature: f64 },
+}
 
 /// Precomputed modal form of the jet pipe for one parameter set.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,7 +42,7 @@ pub struct ElectromechanicalPropagator {
     /// V⁻¹ b with b = [0, 0, ω1ω2²].
     pub(super) beta: [C64; 3],
     /// The jet_pipe_hysteresis operator between f3 and the dynamics (inactive when off).
-    pub(super) hysteresis: PrandtlIshlinskii,
+    pub(super) hysteresis: Hysteresis,
     /// What each term of a current transient's series does to the modes: see [`SeriesWeight`].
     /// Built once, so a step's trajectory costs multiplications instead of 3 complex
     /// divisions per term; it stops before the first n where λk + nω nearly vanishes.
@@ -152,7 +166,7 @@ impl ElectromechanicalPropagator {
             lambda,
             inverse,
             beta,
-            hysteresis: PrandtlIshlinskii::new(p.hysteresis_width, p.hysteresis_deadband),
+            hysteresis: p.hysteresis(),
             series_weights,
             advances: AdvanceCache::default(),
             real_mode_growth: ExpMemo::new(lambda[0].re),
@@ -165,18 +179,25 @@ impl ElectromechanicalPropagator {
     /// With a held command the static position moves monotonically from f3(i(0)) to
     /// f3(ī). If no play of the hysteresis operator starts to move on the way, the
     /// operator's output is affine in the static position, u = C + f·x̄ (f the fraction of
-    /// plays being dragged), and the closed-form series still applies: returns (C, f).
+    /// plays being dragged), and the closed-form series still applies. The Bouc–Wen law's
+    /// branch is smooth: where it is a parabola in x̄ to within [`QUADRATIC_TOLERANCE`] of
+    /// its half-width over the step's travel, so is the series (see
+    /// [`Self::branch_as_quadratic`]).
     pub(super) fn hysteresis_as_linear(
         &self,
         current: f64,
         static_current: f64,
         plays: &[f64; PLAY_OPERATORS],
-    ) -> Option<(f64, f64)> {
+    ) -> Option<HysteresisOverStep> {
         let x_bar = |i: f64| jet_pipe::static_position(self.x_sat, self.f_sat, jet_pipe::tip_force(self.k_m, i));
         let (from, to) = (x_bar(current), x_bar(static_current));
+        let half_widths = match self.hysteresis.play_half_widths() {
+            Some(half_widths) => half_widths,
+            None => return self.branch_as_quadratic(plays, from, to),
+        };
         let rising = to >= from;
         let (mut constant, mut dragged) = (0.0, 0usize);
-        for (p, r) in plays.iter().zip(&self.hysteresis.half_widths) {
+        for (p, r) in plays.iter().zip(half_widths) {
             // Where the play is pushed from: the edge of its band on the moving side.
             let edge = if rising { from - r } else { from + r };
             let engaged = if rising { *p <= edge } else { *p >= edge };
@@ -192,7 +213,42 @@ impl ElectromechanicalPropagator {
             }
         }
         let n = PLAY_OPERATORS as f64;
-        Some((constant / n, dragged as f64 / n))
+        Some(HysteresisOverStep::Affine {
+            constant: constant / n,
+            slope: dragged as f64 / n,
+        })
+    }
+
+    /// The hysteresis output along a monotone move of the static position from `from` to
+    /// `to` as c0 + c1 (x̄ − from) + c2 (x̄ − from)², through the law's exact values at both
+    /// ends and the middle, if it stays within [`QUADRATIC_TOLERANCE`] half-widths of the
+    /// law at the quarter points (`None` otherwise: the caller integrates by quadrature).
+    fn branch_as_quadratic(&self, memory: &[f64; PLAY_OPERATORS], from: f64, to: f64) -> Option<HysteresisOverStep> {
+        let law = &self.hysteresis;
+        let span = to - from;
+        let at = |fraction: f64| law.output_after(memory, from + fraction * span);
+        let (y0, y_mid, y1) = (at(0.0), at(0.5), at(1.0));
+        if span == 0.0 {
+            return Some(HysteresisOverStep::Parabola {
+                value: y0,
+                slope: 0.0,
+                curvature: 0.0,
+            });
+        }
+        // Through the three points: in d = x̄ − from, y = y0 + c1 d + c2 d².
+        let c2 = 2.0 * (y1 - 2.0 * y_mid + y0) / (span * span);
+        let c1 = (y1 - y0) / span - c2 * span;
+        let quadratic = |fraction: f64| {
+            let d = fraction * span;
+            y0 + c1 * d + c2 * d * d
+        };
+        let tolerance = QUADRATIC_TOLERANCE * law.scale();
+        let fits = [0.25, 0.75].iter().all(|&f| (quadratic(f) - at(f)).abs() <= tolerance);
+        fits.then(|| HysteresisOverStep::Parabola {
+            value: y0,
+            slope: c1,
+            curvature: c2,
+        })
     }
 }
 

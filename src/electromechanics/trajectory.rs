@@ -5,10 +5,10 @@
 //! then continued by a series-form trajectory started there. Also the ringing the chambers'
 //! integrator has to resolve, measured where it is exact.
 
-use crate::physics::effects::{PrandtlIshlinskii, PLAY_OPERATORS};
+use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::jet_pipe;
 
-use super::modal::{modulus, Exponentials};
+use super::modal::{modulus, Exponentials, HysteresisOverStep};
 use super::series::{
     tanh_series, RampForm, SeriesForm, LATE_SERIES_MARGIN, MAX_SERIES_TERMS, RAMP_TRANSIENT_LIMIT, SERIES_RATIO_LIMIT,
 };
@@ -77,11 +77,38 @@ impl ElectromechanicalPropagator {
             let radius = (centre * centre + std::f64::consts::FRAC_PI_2.powi(2)).sqrt();
             if epsilon.abs() <= SERIES_RATIO_LIMIT * radius {
                 series = tanh_series(centre, epsilon, MAX_SERIES_TERMS);
-                let (constant, slope) = linear_hysteresis.unwrap_or((0.0, 1.0));
-                for a in series.iter_mut() {
-                    *a *= self.x_sat * slope;
+                match linear_hysteresis {
+                    Some(HysteresisOverStep::Parabola {
+                        value,
+                        slope,
+                        curvature,
+                    }) => {
+                        // A Bouc–Wen branch as a parabola about the start: the series of
+                        // d = x̄ − x̄(0), then value + slope d + curvature d².
+                        for a in series.iter_mut() {
+                            *a *= self.x_sat;
+                        }
+                        let start: f64 = series.iter().sum();
+                        series[0] -= start;
+                        let squared: Coefficients = (0..series.len())
+                            .map(|n| (0..=n).map(|k| series[k] * series[n - k]).sum())
+                            .collect();
+                        for (a, d2) in series.iter_mut().zip(&squared) {
+                            *a = slope * *a + curvature * d2;
+                        }
+                        series[0] += value;
+                    }
+                    affine => {
+                        let (constant, slope) = match affine {
+                            Some(HysteresisOverStep::Affine { constant, slope }) => (constant, slope),
+                            _ => (0.0, 1.0),
+                        };
+                        for a in series.iter_mut() {
+                            *a *= self.x_sat * slope;
+                        }
+                        series[0] += constant;
+                    }
                 }
-                series[0] += constant;
             } else {
                 let shrunk = LATE_SERIES_MARGIN * SERIES_RATIO_LIMIT * radius;
                 series_from = Some((epsilon.abs() / shrunk).ln() / self.omega_cd);
@@ -210,7 +237,7 @@ impl Trajectory<'_> {
 
     pub(super) fn jet_input(&self, s: f64) -> f64 {
         if self.propagator.hysteresis.is_active() {
-            PrandtlIshlinskii::output(&self.plays_at(s))
+            self.propagator.hysteresis.output(&self.plays_at(s))
         } else {
             self.static_position(s)
         }
@@ -222,11 +249,15 @@ impl Trajectory<'_> {
     pub(super) fn find_kinks(&self) -> Vec<f64> {
         let mut kinks: Vec<f64> = self.turning_point.into_iter().collect();
         let operator = &self.propagator.hysteresis;
-        if operator.is_active() && self.ramp == 0.0 {
+        // The Bouc–Wen law bends smoothly: only plays have kinks.
+        let half_widths = operator
+            .play_half_widths()
+            .filter(|_| operator.is_active() && self.ramp == 0.0);
+        if let Some(half_widths) = half_widths {
             let settle = (self.delta.abs() / 1e-15).ln().max(0.0) / self.propagator.omega_cd;
             let (from, to) = (self.static_position(0.0), self.static_position(settle));
             let rising = to >= from;
-            for (p, r) in self.plays.iter().zip(&operator.half_widths) {
+            for (p, r) in self.plays.iter().zip(half_widths) {
                 let engages_at = if rising { p + r } else { p - r };
                 let inside = if rising {
                     engages_at > from && engages_at < to
@@ -574,5 +605,51 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_bouc_wen_branch_taken_as_a_parabola_agrees_with_quadrature() {
+        let mut p = Parameters::default();
+        p.hysteresis_width = 0.16e-3;
+        p.hysteresis_exponent = 3.7;
+        p.hysteresis_beta_share = 0.52;
+        p.hysteresis_gain = 0.99;
+        let propagator = ElectromechanicalPropagator::new(&p).unwrap();
+        let law = p.hysteresis();
+        let mut checked = 0;
+        for (v_from, v, z) in [
+            (2.0, 2.001, 0.3),
+            (2.0, 2.01, -0.5),
+            (3.0, 2.999, 0.9),
+            (1.0, 1.002, 0.0),
+            (2.5, 2.5, 0.2),
+        ] {
+            let current = p.k_cd * v_from + p.i_offset;
+            let x = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current));
+            let mut memory = [x; PLAY_OPERATORS];
+            memory[1] = x - z * 0.08e-3;
+            let start = ElectromechanicalState {
+                current,
+                position: law.output(&memory),
+                velocity: 0.0,
+                acceleration: 0.0,
+            };
+            let fast = propagator.trajectory(&start, v, 0.0, &memory);
+            if fast.series.is_empty() {
+                continue;
+            }
+            checked += 1;
+            let mut slow = propagator.trajectory(&start, v, 0.0, &memory);
+            slow.series.clear();
+            slow.series_form = None;
+            for s in [1e-5, 1e-4, 5e-4, 1e-3] {
+                let (a, b) = (fast.position(s), slow.position(s));
+                assert!(
+                    (a - b).abs() < 1e-11,
+                    "from {v_from} V to {v} V, z {z}: {a} vs {b} at {s} s"
+                );
+            }
+        }
+        assert!(checked >= 3, "only {checked} steps took the parabola");
     }
 }

@@ -6,7 +6,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::chambers::{pressure_rate, CylinderGeometry};
-use super::effects::{self, PrandtlIshlinskii, PLAY_OPERATORS};
+use super::effects::{self, Hysteresis, PLAY_OPERATORS};
 use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
@@ -82,7 +82,7 @@ pub struct Actuator {
     pub flow: FlowConstants,
     pub cylinder: CylinderGeometry,
     pub piston_area: f64,
-    pub hysteresis: PrandtlIshlinskii,
+    pub hysteresis: Hysteresis,
     /// Polytropic exponent of the chambers: γ unless the heat_transfer effect is on.
     pub polytropic_exponent: f64,
     /// C_d times the area factor of each orifice, [supply 1, return 1, supply 2, return 2]:
@@ -96,7 +96,7 @@ impl Actuator {
         let flow = params.flow_constants();
         let cylinder = params.cylinder();
         let piston_area = cylinder.piston_area();
-        let hysteresis = PrandtlIshlinskii::new(params.hysteresis_width, params.hysteresis_deadband);
+        let hysteresis = params.hysteresis();
         let polytropic_exponent = effects::polytropic_exponent(params.gamma, params.heat_transfer_fraction);
         let discharge = [
             params.c_d * params.supply_area_scale_1,
@@ -344,6 +344,23 @@ impl Actuator {
     pub fn spring_force(&self, x_s: f64) -> f64 {
         let p = &self.params;
         piston::spring_force(p.k_spring, p.l_spring0, p.l_s, p.l_p, x_s)
+    }
+
+    /// The hysteresis memory at the start of a run, at the static position of `current`
+    /// (`hysteresis_start` places it in the loop).
+    pub fn initial_hysteresis_memory(&self, current: f64) -> [f64; PLAY_OPERATORS] {
+        self.hysteresis
+            .initial_memory(self.static_jet_position(current), self.params.hysteresis_start)
+    }
+
+    /// The jet pipe input at rest at the start of a run: f3 of the current, or the
+    /// hysteresis output where `hysteresis_start` puts the loop away from its middle.
+    pub fn initial_jet_input(&self, current: f64) -> f64 {
+        if self.hysteresis.is_active() && self.params.hysteresis_start != 0.0 {
+            self.hysteresis.output(&self.initial_hysteresis_memory(current))
+        } else {
+            self.static_jet_position(current)
+        }
     }
 
     /// Input of the jet pipe dynamics: f3 of the tip force, through the hysteresis

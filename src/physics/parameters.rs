@@ -37,6 +37,10 @@ pub struct Parameters {
     /// Effects the thesis model lacks; each is off at its default (see [`super::effects`]).
     pub hysteresis_width: f64,
     pub hysteresis_deadband: f64,
+    pub hysteresis_exponent: f64,
+    pub hysteresis_gain: f64,
+    pub hysteresis_beta_share: f64,
+    pub hysteresis_start: f64,
     pub friction_coulomb: f64,
     pub friction_velocity: f64,
     pub friction_stribeck: f64,
@@ -125,6 +129,10 @@ impl Default for Parameters {
             k_spring: 0.0,
             hysteresis_width: 0.0,
             hysteresis_deadband: 0.0,
+            hysteresis_exponent: 0.0,
+            hysteresis_gain: 0.0,
+            hysteresis_beta_share: 0.0,
+            hysteresis_start: 0.0,
             friction_coulomb: 0.0,
             friction_velocity: 0.0,
             friction_stribeck: 0.0,
@@ -208,6 +216,10 @@ impl Parameters {
         vr::K_SPRING,
         vr::HYSTERESIS_WIDTH,
         vr::HYSTERESIS_DEADBAND,
+        vr::HYSTERESIS_EXPONENT,
+        vr::HYSTERESIS_GAIN,
+        vr::HYSTERESIS_BETA_SHARE,
+        vr::HYSTERESIS_START,
         vr::FRICTION_COULOMB,
         vr::FRICTION_VELOCITY,
         vr::FRICTION_STRIBECK,
@@ -284,6 +296,10 @@ impl Parameters {
             vr::K_SPRING => &mut self.k_spring,
             vr::HYSTERESIS_WIDTH => &mut self.hysteresis_width,
             vr::HYSTERESIS_DEADBAND => &mut self.hysteresis_deadband,
+            vr::HYSTERESIS_EXPONENT => &mut self.hysteresis_exponent,
+            vr::HYSTERESIS_GAIN => &mut self.hysteresis_gain,
+            vr::HYSTERESIS_BETA_SHARE => &mut self.hysteresis_beta_share,
+            vr::HYSTERESIS_START => &mut self.hysteresis_start,
             vr::FRICTION_COULOMB => &mut self.friction_coulomb,
             vr::FRICTION_VELOCITY => &mut self.friction_velocity,
             vr::FRICTION_STRIBECK => &mut self.friction_stribeck,
@@ -358,6 +374,17 @@ impl Parameters {
         Ok(())
     }
 
+    /// The jet_pipe_hysteresis operator these parameters describe.
+    pub fn hysteresis(&self) -> super::effects::Hysteresis {
+        super::effects::Hysteresis::new(
+            self.hysteresis_width,
+            self.hysteresis_deadband,
+            self.hysteresis_exponent,
+            self.hysteresis_gain,
+            self.hysteresis_beta_share,
+        )
+    }
+
     /// Checks that involve several parameters (run before initialisation).
     pub fn validate(&self) -> Result<(), String> {
         if self.p_s < self.p_r {
@@ -377,6 +404,12 @@ impl Parameters {
             return Err(format!(
                 "hysteresis_deadband = {} m is invalid: must not exceed hysteresis_width = {} m",
                 self.hysteresis_deadband, self.hysteresis_width
+            ));
+        }
+        if self.hysteresis_exponent > 0.0 && self.hysteresis_deadband > 0.0 {
+            return Err(format!(
+                "hysteresis_deadband = {} m is invalid with hysteresis_exponent = {}: the deadband belongs to the play law (exponent 0); the Bouc-Wen law has none",
+                self.hysteresis_deadband, self.hysteresis_exponent
             ));
         }
         if self.return_resistance > 0.0 && self.return_vent_area > 0.0 {
@@ -442,6 +475,22 @@ mod tests {
         assert_eq!(p.omega_cd, 7050.0);
         assert_eq!(p.c_dm_a_lpp, -0.0475e-6);
         assert_eq!(p.p_s, 652_925.0);
+        assert!(p.validate().is_ok());
+    }
+
+    #[test]
+    fn a_deadband_with_the_bouc_wen_law_is_refused_by_name() {
+        let mut p = Parameters::default();
+        p.hysteresis_width = 0.16e-3;
+        p.hysteresis_exponent = 2.0;
+        assert!(p.validate().is_ok());
+        p.hysteresis_deadband = 0.05e-3;
+        let e = p.validate().unwrap_err();
+        assert!(
+            e.contains("hysteresis_deadband = 0.00005") && e.contains("hysteresis_exponent = 2"),
+            "{e}"
+        );
+        p.hysteresis_exponent = 0.0;
         assert!(p.validate().is_ok());
     }
 

@@ -17,7 +17,7 @@ pub fn equilibrium_of_electromechanics(model: &Actuator, v_da: f64) -> State {
     let p = &model.params;
     let seen = command_stage::static_map(p, v_da);
     let current = current_driver::static_current(p.k_cd, p.i_offset, seen);
-    let x_jp = model.static_jet_position(current);
+    let x_jp = model.initial_jet_input(current);
     let mid = 0.5 * (p.p_s + p.p_r);
     State::from([current, x_jp, 0.0, 0.0, mid, mid])
 }
@@ -52,7 +52,9 @@ pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, Strin
         v_da_rate: 0.0,
         x_s,
         x_s_rate: 0.0,
-        plays: None,
+        // Held where hysteresis_start puts it (the command stays, so the memory does).
+        plays: (model.hysteresis.is_active() && p.hysteresis_start != 0.0)
+            .then(|| model.initial_hysteresis_memory(y[index::CURRENT])),
     };
     let tolerances = Tolerances {
         relative: 1e-8,

@@ -157,7 +157,7 @@ impl Simulation {
     /// A simulation from a given state.
     pub fn from_state(model: Actuator, state: State, v_da: f64, x_s: f64, time: f64, relative_tolerance: f64) -> Self {
         let propagator = ElectromechanicalPropagator::new(&model.params);
-        let x_bar = model.static_jet_position(state[index::CURRENT]);
+        let plays = model.initial_hysteresis_memory(state[index::CURRENT]);
         let command_stage = CommandStage::at_rest(&model.params, time, v_da);
         let force_sensor = force_sensor::filters(&model.params)
             .then(|| SensorMemory::at_rest(time, model.outputs_at(&state, x_s, 0.0, time).f_meas));
@@ -181,7 +181,7 @@ impl Simulation {
             statistics: Statistics::default(),
             input_changed: false,
             step_after_change: 1e-5,
-            plays: [x_bar; PLAY_OPERATORS],
+            plays,
             command_history: vec![CommandChange {
                 time: f64::NEG_INFINITY,
                 v_da,
