@@ -36,14 +36,15 @@ pub use nodes::MAX_NODES;
 pub use trajectory::Trajectory;
 
 use nalgebra::Complex;
-use smallvec::SmallVec;
+
+use crate::physics::jet_pipe;
 
 type C64 = Complex<f64>;
 
 /// Series coefficients: on the stack up to 16 terms (a command step of ordinary size needs
 /// fewer), so building a step's trajectory does not allocate.
-type Coefficients = SmallVec<[f64; INLINE_TERMS]>;
-const INLINE_TERMS: usize = 16;
+type Coefficients = jet_pipe::SeriesCoefficients;
+const INLINE_TERMS: usize = jet_pipe::SERIES_INLINE_TERMS;
 
 /// Current, jet pipe position and its first two derivatives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -59,7 +60,8 @@ pub struct ElectromechanicalState {
 mod tests {
     use super::*;
     use crate::integrator::{OdeSystem, Sdirk4, Statistics, Tolerances};
-    use crate::physics::jet_pipe;
+    use crate::physics::current_driver::CurrentDriver;
+    use crate::physics::jet_pipe::{LinearDynamics, StaticCurve, F3};
     use crate::physics::parameters::Parameters;
     use nalgebra::SVector;
 
@@ -77,7 +79,7 @@ mod tests {
     /// continued from the last step does (so the ramp's closed form applies).
     pub(super) fn ramp_start(p: &Parameters, v: f64, rate: f64) -> ElectromechanicalState {
         ElectromechanicalState {
-            current: p.k_cd * v + p.i_offset - p.k_cd * rate / p.omega_cd,
+            current: CurrentDriver::from_parameters(p).response(0.0, v, rate).base,
             ..swinging()
         }
     }
@@ -87,13 +89,14 @@ mod tests {
     impl OdeSystem<4> for Electromechanics {
         fn rhs(&self, t: f64, y: &SVector<f64, 4>) -> SVector<f64, 4> {
             let p = &self.0;
-            let i_bar = p.k_cd * (self.1 + self.2 * t) + p.i_offset;
-            let x_bar = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, y[0]));
+            let driver = CurrentDriver::from_parameters(p);
+            let i_bar = driver.static_current(self.1 + self.2 * t);
+            let x_bar = F3::from_parameters(p).value(jet_pipe::tip_force(p.k_m, y[0]));
             SVector::<f64, 4>::new(
-                p.omega_cd * (i_bar - y[0]),
+                driver.rate(i_bar, y[0]),
                 y[2],
                 y[3],
-                jet_pipe::third_derivative(p.omega_1, p.omega_2, p.zeta_2, x_bar, y[1], y[2], y[3]),
+                LinearDynamics::from_parameters(p).third_derivative(x_bar, y[1], y[2], y[3]),
             )
         }
     }

@@ -5,12 +5,13 @@
 //! then continued by a series-form trajectory started there. Also the ringing the chambers'
 //! integrator has to resolve, measured where it is exact.
 
+use crate::physics::current_driver;
 use crate::physics::effects::{PrandtlIshlinskii, PLAY_OPERATORS};
-use crate::physics::jet_pipe;
+use crate::physics::jet_pipe::{self, StaticCurve, F3};
 
 use super::modal::{modulus, Exponentials};
 use super::series::{
-    tanh_series, RampForm, SeriesForm, LATE_SERIES_MARGIN, MAX_SERIES_TERMS, RAMP_TRANSIENT_LIMIT, SERIES_RATIO_LIMIT,
+    RampForm, SeriesForm, LATE_SERIES_MARGIN, MAX_SERIES_TERMS, RAMP_TRANSIENT_LIMIT, SERIES_RATIO_LIMIT,
 };
 use super::{Coefficients, ElectromechanicalPropagator, ElectromechanicalState, C64};
 
@@ -37,7 +38,7 @@ pub(super) const GAUSS_WEIGHTS: [f64; 8] = [
     0.101_228_536_290_376_3,
 ];
 
-impl ElectromechanicalPropagator {
+impl<C: StaticCurve> ElectromechanicalPropagator<C> {
     /// The trajectory over a step starting from `start` with command v_DA(s) = v_da + v_da_rate·s.
     ///
     /// `plays` are the hysteresis operator's play states at the start; the current is
@@ -49,21 +50,17 @@ impl ElectromechanicalPropagator {
         v_da: f64,
         v_da_rate: f64,
         plays: &[f64; PLAY_OPERATORS],
-    ) -> Trajectory<'_> {
-        let static_current = self.k_cd * v_da + self.i_offset;
-        let ramp = self.k_cd * v_da_rate;
-        // i(s) = ī(0) + ramp·(s − 1/ω) + δ e^{−ω s}
-        let base = static_current - ramp / self.omega_cd;
-        let delta = start.current - base;
+    ) -> Trajectory<'_, C> {
+        // i(s) = ī(0) + ramp·(s − 1/ω) + δ e^{−ω s}, (2.1)–(2.3) solved.
+        let drive = self.driver.response(start.current, v_da, v_da_rate);
+        let (base, ramp, delta) = (drive.base, drive.ramp, drive.delta);
         let z = [start.position, start.velocity, start.acceleration];
         let mut q0 = [C64::new(0.0, 0.0); 3];
         for k in 0..3 {
             q0[k] = self.inverse[k][0] * z[0] + self.inverse[k][1] * z[1] + self.inverse[k][2] * z[2];
         }
         let mut series = Coefficients::new();
-        // i'(s) = ramp − ω δ e^{−ω s} vanishes once at most.
-        let ratio = ramp / (self.omega_cd * delta);
-        let turning_point = (ratio > 0.0 && ratio < 1.0).then(|| -ratio.ln() / self.omega_cd);
+        let turning_point = drive.turning_point();
         let linear_hysteresis = if ramp == 0.0 && self.hysteresis.is_active() {
             self.hysteresis_as_linear(start.current, base, plays)
         } else {
@@ -71,37 +68,39 @@ impl ElectromechanicalPropagator {
         };
         // Where a held command's jump is too large for the series: when it has shrunk enough.
         let mut series_from = None;
-        if ramp == 0.0 && (!self.hysteresis.is_active() || linear_hysteresis.is_some()) {
-            let centre = self.k_m * base / self.f_sat;
-            let epsilon = self.k_m * delta / self.f_sat;
-            let radius = (centre * centre + std::f64::consts::FRAC_PI_2.powi(2)).sqrt();
+        // f3's argument (2.4)–(2.5) for a current, and for a change of current.
+        let argument = |current: f64| self.curve.argument(jet_pipe::tip_force(self.k_m, current));
+        let centre = argument(base);
+        let series_applies = ramp == 0.0 && (!self.hysteresis.is_active() || linear_hysteresis.is_some());
+        let radius = if series_applies {
+            self.curve.series_radius(centre)
+        } else {
+            None
+        };
+        if let Some(radius) = radius {
+            let epsilon = argument(delta);
             if epsilon.abs() <= SERIES_RATIO_LIMIT * radius {
-                series = tanh_series(centre, epsilon, MAX_SERIES_TERMS);
                 let (constant, slope) = linear_hysteresis.unwrap_or((0.0, 1.0));
-                for a in series.iter_mut() {
-                    *a *= self.x_sat * slope;
+                if let Some(terms) = self.curve.series(centre, epsilon, MAX_SERIES_TERMS, slope) {
+                    series = terms;
+                    series[0] += constant;
                 }
-                series[0] += constant;
             } else {
                 let shrunk = LATE_SERIES_MARGIN * SERIES_RATIO_LIMIT * radius;
-                series_from = Some((epsilon.abs() / shrunk).ln() / self.omega_cd);
+                series_from = Some((epsilon.abs() / shrunk).ln() / self.driver.omega_cd);
             }
         }
         // A ramp whose current transient is below rounding (a ramp continued from the last
         // step): the input is a power series in time and the response has a closed form.
-        let ramp_form = if ramp != 0.0
-            && !self.hysteresis.is_active()
-            && (self.k_m * delta / self.f_sat).abs() <= RAMP_TRANSIENT_LIMIT
+        let ramp_form = if ramp != 0.0 && !self.hysteresis.is_active() && argument(delta).abs() <= RAMP_TRANSIENT_LIMIT
         {
-            RampForm::new(self, &q0, self.k_m * base / self.f_sat, self.k_m * ramp / self.f_sat).map(Box::new)
+            RampForm::new(self, &q0, centre, argument(ramp)).map(Box::new)
         } else {
             None
         };
         let mut trajectory = Trajectory {
             propagator: self,
-            base,
-            ramp,
-            delta,
+            drive,
             q0,
             ramp_form,
             series_form: SeriesForm::new(self, &q0, &series),
@@ -128,7 +127,7 @@ impl ElectromechanicalPropagator {
         }
         if trajectory.series.is_empty() && ramp == 0.0 {
             // |δ| e^{−ω s} below 1e-15 A: the input is constant to rounding.
-            let settled = (delta.abs() / 1e-15).ln().max(0.0) / self.omega_cd;
+            let settled = drive.transient_below(1e-15);
             let integral = trajectory.quadrature(settled);
             trajectory.settled = Some((settled, integral, trajectory.jet_input(settled)));
         }
@@ -137,11 +136,10 @@ impl ElectromechanicalPropagator {
 }
 
 /// The current driver and jet pipe over one step, evaluable at any time within it.
-pub struct Trajectory<'a> {
-    pub(super) propagator: &'a ElectromechanicalPropagator,
-    pub(super) base: f64,
-    pub(super) ramp: f64,
-    pub(super) delta: f64,
+pub struct Trajectory<'a, C = F3> {
+    pub(super) propagator: &'a ElectromechanicalPropagator<C>,
+    /// The current, (2.1)–(2.3) in closed form.
+    pub(super) drive: current_driver::Response,
     pub(super) q0: [C64; 3],
     /// x_sat·aₙ when the closed-form series applies; empty otherwise.
     pub(super) series: Coefficients,
@@ -165,14 +163,14 @@ pub struct Trajectory<'a> {
     pub(super) panel_ends: std::cell::RefCell<Vec<(f64, [C64; 3])>>,
     /// For a held command whose jump is too large for the series: from when on the
     /// trajectory is the series-form one started there (queries from then on go to it).
-    pub(super) late: Option<(f64, Box<Trajectory<'a>>)>,
+    pub(super) late: Option<(f64, Box<Trajectory<'a, C>>)>,
     /// The last stage time [`Self::node_positions`] took the series form's exponentials
     /// at (with the current transient's), and those exponentials: the step's end, where
     /// [`Self::state`] is asked next.
     pub(super) last_node: std::cell::Cell<Option<(f64, Exponentials)>>,
 }
 
-impl Trajectory<'_> {
+impl<C: StaticCurve> Trajectory<'_, C> {
     /// The late part of the trajectory and the time into it, for `s` from its start on.
     pub(super) fn late_at(&self, s: f64) -> Option<(&Self, f64)> {
         self.late
@@ -183,12 +181,11 @@ impl Trajectory<'_> {
 
     /// Coil current at `s` seconds into the step.
     pub fn current(&self, s: f64) -> f64 {
-        self.base + self.ramp * s + self.delta * (-self.propagator.omega_cd * s).exp()
+        self.drive.at(s)
     }
 
     pub(super) fn static_position(&self, s: f64) -> f64 {
-        let p = self.propagator;
-        jet_pipe::static_position(p.x_sat, p.f_sat, jet_pipe::tip_force(p.k_m, self.current(s)))
+        self.propagator.static_position(self.current(s))
     }
 
     /// The hysteresis operator's play states at `s` (all at f3's output when it is off).
@@ -222,8 +219,8 @@ impl Trajectory<'_> {
     pub(super) fn find_kinks(&self) -> Vec<f64> {
         let mut kinks: Vec<f64> = self.turning_point.into_iter().collect();
         let operator = &self.propagator.hysteresis;
-        if operator.is_active() && self.ramp == 0.0 {
-            let settle = (self.delta.abs() / 1e-15).ln().max(0.0) / self.propagator.omega_cd;
+        if operator.is_active() && self.drive.ramp == 0.0 {
+            let settle = self.drive.transient_below(1e-15);
             let (from, to) = (self.static_position(0.0), self.static_position(settle));
             let rising = to >= from;
             for (p, r) in self.plays.iter().zip(&operator.half_widths) {
@@ -323,13 +320,14 @@ impl Trajectory<'_> {
         ];
         if !self.series.is_empty() {
             // ∫₀ˢ e^{λ(s−σ)} e^{−nωσ} dσ = (e^{λs} − e^{−nωs}) / (λ + nω)
-            let decay = (-p.omega_cd * s).exp();
+            let omega_cd = p.driver.omega_cd;
+            let decay = (-omega_cd * s).exp();
             let mut decay_n = 1.0;
             for (n, a) in self.series.iter().enumerate() {
-                let n_omega = n as f64 * p.omega_cd;
+                let n_omega = n as f64 * omega_cd;
                 for k in 0..3 {
                     let denominator = p.lambda[k] + n_omega;
-                    integral[k] += if denominator.norm_sqr() > (1e-9 * p.omega_cd).powi(2) {
+                    integral[k] += if denominator.norm_sqr() > (1e-9 * omega_cd).powi(2) {
                         (growth[k] - decay_n) / denominator * *a
                     } else {
                         growth[k] * s * *a
@@ -427,7 +425,7 @@ impl Trajectory<'_> {
                 // The current's transient e^{−ω s} is among the exponentials kept there.
                 Some((at, e)) if at == s => (
                     form.derivatives_from(self.propagator, &self.series, &e),
-                    self.base + self.ramp * s + self.delta * e.decay,
+                    self.drive.with_decay(s, e.decay),
                 ),
                 _ => (form.derivatives(self.propagator, &self.series, s), self.current(s)),
             }),
@@ -482,8 +480,8 @@ mod tests {
         let p = Parameters::default();
         let propagator = ElectromechanicalPropagator::new(&p).unwrap();
         let settled = |v: f64| {
-            let current = p.k_cd * v + p.i_offset;
-            let position = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current));
+            let current = current_driver::static_current(p.k_cd, p.i_offset, v);
+            let position = propagator.static_position(current);
             ElectromechanicalState {
                 current,
                 position,
