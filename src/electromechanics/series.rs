@@ -244,17 +244,31 @@ impl RampForm {
             if u_j.is_empty() {
                 break;
             }
+            // β_k λ_k^{−(j+1)}
+            let weights = [
+                p.beta[0] * inverse_power[0],
+                p.beta[1] * inverse_power[1],
+                p.beta[2] * inverse_power[2],
+            ];
             let mut g = 0.0;
             for k in 0..3 {
                 // q_p,k(0) = −β_k Σ_j u^{(j)}(0) λ_k^{−(j+1)}
-                amplitude[k] += p.beta[k] * inverse_power[k] * (u_j[0] * scale);
-                g -= (p.beta[k] * inverse_power[k]).re;
+                amplitude[k] += weights[k] * (u_j[0] * scale);
+                g -= weights[k].re;
             }
-            for (m, c) in u_j.iter().enumerate() {
-                particular[m] += g * scale * c;
-                for k in 0..3 {
-                    particular_modes[k][m] -= p.beta[k] * inverse_power[k] * (scale * c);
-                }
+            // Element by element over the five polynomials at once (disjoint slices: no
+            // aliasing for the compiler to check at run time).
+            let [modes_0, modes_1, modes_2] = &mut particular_modes;
+            let terms = u_j.iter().zip(particular.iter_mut());
+            for ((((c, x), q_0), q_1), q_2) in terms
+                .zip(modes_0.iter_mut())
+                .zip(modes_1.iter_mut())
+                .zip(modes_2.iter_mut())
+            {
+                *x += g * scale * c;
+                *q_0 -= weights[0] * (scale * c);
+                *q_1 -= weights[1] * (scale * c);
+                *q_2 -= weights[2] * (scale * c);
             }
             u_j = derivative(&u_j);
             scale /= horizon;
