@@ -201,7 +201,7 @@ pub struct Modes {
     pub poles: [Complex<f64>; 3],
     /// Residues r_k of X/X̄ at the poles: the modes' input gains.
     pub residues: [Complex<f64>; 3],
-    /// Rows of V⁻¹, V = [[1,1,1],[λ1,λ2,λ3],[λ1²,λ2²,λ3²]]: the modal coordinates of a state
+    /// Rows of V⁻¹, V = `[[1,1,1],[λ1,λ2,λ3],[λ1²,λ2²,λ3²]]`: the modal coordinates of a state
     /// [x, ẋ, ẍ] are q = V⁻¹ [x, ẋ, ẍ].
     pub from_state: [[Complex<f64>; 3]; 3],
 }
