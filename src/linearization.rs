@@ -10,6 +10,7 @@
 use nalgebra::{Complex, SMatrix, SVector};
 
 use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, State, N_STATES};
+use crate::physics::current_driver::CurrentDriver;
 use crate::simulation::equilibrium;
 
 /// The operating point of a linearisation.
@@ -90,7 +91,7 @@ pub fn linearize(model: &Actuator, v_da: f64, x_s: f64) -> Result<LinearModel, S
         }
     }
     let mut b = SVector::<f64, N_STATES>::zeros();
-    b[index::CURRENT] = model.params.omega_cd * model.params.k_cd;
+    b[index::CURRENT] = CurrentDriver::from_parameters(&model.params).command_gain();
     let outputs = model.outputs(&y0, x_s, 0.0);
     let on_spring_floor = outputs.f_act > model.piston_area * (y0[index::P1] - y0[index::P2]);
     let mut c = SVector::<f64, N_STATES>::zeros();

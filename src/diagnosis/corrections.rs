@@ -16,6 +16,7 @@
 //! channel weighted by its noise floor) and scored on the held-out blocks.
 
 use crate::physics::actuator::Actuator;
+use crate::physics::current_driver;
 use crate::physics::force_sensor;
 use crate::physics::parameters::Parameters;
 use crate::recording::Recording;
@@ -1330,7 +1331,9 @@ impl Problem<'_> {
         let commands = self.recording.v_da.iter();
         let (lower, upper, logarithmic) = match term.mechanism {
             Mechanism::CurrentLimit => {
-                let largest = commands.map(|v| (p.k_cd * v + p.i_offset).abs()).fold(0.0, f64::max);
+                let largest = commands
+                    .map(|v| current_driver::static_current(p.k_cd, p.i_offset, *v).abs())
+                    .fold(0.0, f64::max);
                 (0.2 * largest, largest, false)
             }
             Mechanism::CommandLimit => {

@@ -1,12 +1,15 @@
-//! The propagator: the current driver (2.1) and the jet pipe's linear dynamics (2.6) for one
-//! parameter set, as three modes with eigenvalues λk and input gains βk, plus what every
-//! step's closed forms share (the series terms' weights on the modes, and the exponentials
-//! e^{λk s} and e^{−ω_cd s} they are made of). Built once per parameter set, so a step costs
+//! The propagator: the current driver (2.1)–(2.3) and the jet pipe's linear dynamics (2.6)
+//! for one parameter set, as the physics states them (`physics::current_driver::CurrentDriver`,
+//! the modes of `physics::jet_pipe::LinearDynamics`: eigenvalues λk, input gains βk, the
+//! residues), with f3 (2.5) as a `physics::jet_pipe::StaticCurve`. Plus what every step's
+//! closed forms share (the series terms' weights on the modes, and the exponentials e^{λk s}
+//! and e^{−ω_cd s} they are made of). Built once per parameter set, so a step costs
 //! multiplications; the hysteresis operator's linear stretches are recognised here too, as
 //! they decide whether the series applies.
 
+use crate::physics::current_driver::CurrentDriver;
 use crate::physics::effects::{Hysteresis, PLAY_OPERATORS};
-use crate::physics::jet_pipe;
+use crate::physics::jet_pipe::{self, LinearDynamics, StaticCurve, F3};
 use crate::physics::parameters::Parameters;
 
 use super::nodes::AdvanceCache;
@@ -27,19 +30,23 @@ pub(super) enum HysteresisOverStep {
     Parabola { value: f64, slope: f64, curvature: f64 },
 }
 
-/// Precomputed modal form of the jet pipe for one parameter set.
+/// Precomputed modal form of the jet pipe for one parameter set, with f3 the curve `C`
+/// (the model's [`F3`] unless a test asks for another).
 #[derive(Clone, Debug, PartialEq)]
-pub struct ElectromechanicalPropagator {
-    pub(super) omega_cd: f64,
-    pub(super) k_cd: f64,
-    pub(super) i_offset: f64,
+pub struct ElectromechanicalPropagator<C = F3> {
+    /// The current driver, (2.1)–(2.3).
+    pub(super) driver: CurrentDriver,
+    /// k_m of the tip force, (2.4).
     pub(super) k_m: f64,
+    /// f3, (2.5).
+    pub(super) curve: C,
+    /// x_jp_sat: the stroke against which a position is negligible.
     pub(super) x_sat: f64,
-    pub(super) f_sat: f64,
+    /// The poles of (2.6).
     pub(super) lambda: [C64; 3],
     /// Rows of V⁻¹, V = [[1,1,1],[λ1,λ2,λ3],[λ1²,λ2²,λ3²]].
     pub(super) inverse: [[C64; 3]; 3],
-    /// V⁻¹ b with b = [0, 0, ω1ω2²].
+    /// V⁻¹ b with b = [0, 0, ω1ω2²]: the residues of (2.6) at its poles.
     pub(super) beta: [C64; 3],
     /// The jet_pipe_hysteresis operator between f3 and the dynamics (inactive when off).
     pub(super) hysteresis: Hysteresis,
@@ -104,40 +111,25 @@ impl ElectromechanicalPropagator {
     /// the second-order pair: the modal form does not exist and callers integrate the
     /// full system instead.
     pub fn new(p: &Parameters) -> Option<Self> {
-        if p.zeta_2 >= 1.0 {
+        Self::with_curve(p, F3::from_parameters(p))
+    }
+}
+
+impl<C: StaticCurve> ElectromechanicalPropagator<C> {
+    /// [`ElectromechanicalPropagator::new`] with `curve` as f3 (2.5). A curve that offers
+    /// no power series has its input integrated by quadrature.
+    pub fn with_curve(p: &Parameters, curve: C) -> Option<Self> {
+        let dynamics = LinearDynamics::from_parameters(p);
+        // The exponentials below take λ3 = conj λ2: a complex pair.
+        if dynamics.zeta_2 >= 1.0 {
             return None;
         }
-        let damped = p.omega_2 * (1.0 - p.zeta_2 * p.zeta_2).sqrt();
-        let lambda = [
-            C64::new(-p.omega_1, 0.0),
-            C64::new(-p.zeta_2 * p.omega_2, damped),
-            C64::new(-p.zeta_2 * p.omega_2, -damped),
-        ];
-        let scale = lambda.iter().map(|l| l.norm()).fold(0.0, f64::max);
-        for a in 0..3 {
-            for b in a + 1..3 {
-                if (lambda[a] - lambda[b]).norm() < 1e-6 * scale {
-                    return None;
-                }
-            }
-        }
-        // Inverse of the Vandermonde matrix: row k holds the coefficients of the Lagrange
-        // polynomial ℓ_k(s) = Π_{j≠k} (s − λj)/(λk − λj), i.e. [λaλb, −(λa+λb), 1]/den.
-        let mut inverse = [[C64::new(0.0, 0.0); 3]; 3];
-        for k in 0..3 {
-            let (a, b) = ((k + 1) % 3, (k + 2) % 3);
-            let den = (lambda[k] - lambda[a]) * (lambda[k] - lambda[b]);
-            inverse[k] = [
-                lambda[a] * lambda[b] / den,
-                -(lambda[a] + lambda[b]) / den,
-                C64::new(1.0, 0.0) / den,
-            ];
-        }
-        let gain = p.omega_1 * p.omega_2 * p.omega_2;
-        let beta = [inverse[0][2] * gain, inverse[1][2] * gain, inverse[2][2] * gain];
+        let modes = dynamics.modes()?;
+        let (lambda, inverse, beta) = (modes.poles, modes.from_state, modes.residues);
+        let driver = CurrentDriver::from_parameters(p);
         let mut series_weights = Vec::with_capacity(MAX_SERIES_TERMS);
         'terms: for n in 0..MAX_SERIES_TERMS {
-            let n_omega = n as f64 * p.omega_cd;
+            let n_omega = n as f64 * driver.omega_cd;
             let mut weight = SeriesWeight {
                 modes: [C64::new(0.0, 0.0); 3],
                 moments: [0.0; 3],
@@ -145,7 +137,7 @@ impl ElectromechanicalPropagator {
             for k in 0..3 {
                 let denominator = lambda[k] + n_omega;
                 // Resonant: the term grows like s e^{λs}, which the series form does not hold.
-                if denominator.norm_sqr() <= (1e-9 * p.omega_cd).powi(2) {
+                if denominator.norm_sqr() <= (1e-9 * driver.omega_cd).powi(2) {
                     break 'terms;
                 }
                 let w = beta[k] / denominator;
@@ -157,12 +149,10 @@ impl ElectromechanicalPropagator {
             series_weights.push(weight);
         }
         Some(Self {
-            omega_cd: p.omega_cd,
-            k_cd: p.k_cd,
-            i_offset: p.i_offset,
+            driver,
             k_m: p.k_m,
+            curve,
             x_sat: p.x_jp_sat,
-            f_sat: p.f_jp_sat,
             lambda,
             inverse,
             beta,
@@ -175,7 +165,12 @@ impl ElectromechanicalPropagator {
     }
 }
 
-impl ElectromechanicalPropagator {
+impl<C: StaticCurve> ElectromechanicalPropagator<C> {
+    /// The static position f3(k_m i) for a current, (2.4)–(2.5).
+    pub(super) fn static_position(&self, current: f64) -> f64 {
+        self.curve.value(jet_pipe::tip_force(self.k_m, current))
+    }
+
     /// With a held command the static position moves monotonically from f3(i(0)) to
     /// f3(ī). If no play of the hysteresis operator starts to move on the way, the
     /// operator's output is affine in the static position, u = C + f·x̄ (f the fraction of
@@ -189,8 +184,7 @@ impl ElectromechanicalPropagator {
         static_current: f64,
         plays: &[f64; PLAY_OPERATORS],
     ) -> Option<HysteresisOverStep> {
-        let x_bar = |i: f64| jet_pipe::static_position(self.x_sat, self.f_sat, jet_pipe::tip_force(self.k_m, i));
-        let (from, to) = (x_bar(current), x_bar(static_current));
+        let (from, to) = (self.static_position(current), self.static_position(static_current));
         let half_widths = match self.hysteresis.play_half_widths() {
             Some(half_widths) => half_widths,
             None => return self.branch_as_quadratic(plays, from, to),
@@ -254,7 +248,7 @@ impl ElectromechanicalPropagator {
 
 /// Bounds over 0 ≤ s ≤ s_end on Re Σ_k amplitude_k e^{λk s}: the real mode moves
 /// monotonically between its ends, the decaying complex pair stays within its moduli.
-pub(super) fn modal_bounds(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s_end: f64) -> (f64, f64) {
+pub(super) fn modal_bounds<C>(p: &ElectromechanicalPropagator<C>, amplitude: &[C64; 3], s_end: f64) -> (f64, f64) {
     let real = amplitude[0].re;
     let real_end = real * p.real_mode_growth.at(s_end);
     let ringing = modulus(amplitude[1]) + modulus(amplitude[2]);
@@ -268,7 +262,7 @@ pub(super) fn modulus(c: C64) -> f64 {
 }
 
 /// e^{λk s}·amplitude_k for the three modes (λ3 = conj(λ2), so one complex exponential).
-pub(super) fn modal_growth(p: &ElectromechanicalPropagator, amplitude: &[C64; 3], s: f64) -> [C64; 3] {
+pub(super) fn modal_growth<C>(p: &ElectromechanicalPropagator<C>, amplitude: &[C64; 3], s: f64) -> [C64; 3] {
     growth_from(amplitude, &p.exponentials(s, false))
 }
 
@@ -315,7 +309,7 @@ impl Exponentials {
     }
 }
 
-impl ElectromechanicalPropagator {
+impl<C> ElectromechanicalPropagator<C> {
     /// The exponentials at `s`; `decay` is left at 0 unless `with_decay`.
     pub(super) fn exponentials(&self, s: f64, with_decay: bool) -> Exponentials {
         // A step's start, where most are asked for: exactly 1, without the calls.
@@ -331,7 +325,11 @@ impl ElectromechanicalPropagator {
         Exponentials {
             real: (self.lambda[0].re * s).exp(),
             oscillation: C64::new(envelope * cos, envelope * sin),
-            decay: if with_decay { (-self.omega_cd * s).exp() } else { 0.0 },
+            decay: if with_decay {
+                (-self.driver.omega_cd * s).exp()
+            } else {
+                0.0
+            },
         }
     }
 }

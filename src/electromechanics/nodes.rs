@@ -4,6 +4,8 @@
 //! sizes recur, so most steps need one set of transcendental functions instead of one per
 //! stage. The memo never changes a result, so a restored FMU state continues to the bit.
 
+use crate::physics::jet_pipe::StaticCurve;
+
 use super::modal::Exponentials;
 use super::series::{RampForm, SeriesForm};
 use super::{ElectromechanicalPropagator, Trajectory};
@@ -51,7 +53,7 @@ impl PartialEq for AdvanceCache {
     }
 }
 
-impl ElectromechanicalPropagator {
+impl<C> ElectromechanicalPropagator<C> {
     /// The exponentials at cᵢh for `nodes` cᵢ (`None` for more than [`MAX_NODES`]), kept
     /// per step size: stage positions are the product of the exponentials at the step's
     /// start and these, one set of transcendental functions per step instead of one per
@@ -106,7 +108,7 @@ impl ElectromechanicalPropagator {
     }
 }
 
-impl Trajectory<'_> {
+impl<C: StaticCurve> Trajectory<'_, C> {
     /// Jet pipe positions at the stage offsets `offsets` (sᵢ = s0 + cᵢh up to rounding) of
     /// one step of a one-step method from `s0` with size `h` and nodes cᵢ, into `out`.
     /// Where the response has a closed form and `h` has come before, the exponentials are
@@ -246,7 +248,8 @@ mod tests {
                     let rate_scale = propagator.lambda.iter().map(|l| modulus(*l)).fold(0.0, f64::max);
                     let scale = 1e-15 * p.x_jp_sat.max(largest_mode);
                     assert!(
-                        (kept.current - fresh.current).abs() <= 1e-15 * (fresh.current.abs() + trajectory.delta.abs()),
+                        (kept.current - fresh.current).abs()
+                            <= 1e-15 * (fresh.current.abs() + trajectory.drive.delta.abs()),
                         "{kept:?} {fresh:?}"
                     );
                     assert!((kept.position - fresh.position).abs() <= scale, "{kept:?} {fresh:?}");

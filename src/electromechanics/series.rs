@@ -1,9 +1,13 @@
-//! f3 (2.5) as a power series, and the closed forms it gives the jet pipe's response. With a
-//! held command the input tanh(F̄ + ε e^{−ω_cd s}) is a series in e^{−ω_cd s}; with a ramp
-//! once the current transient has died out, tanh(α + β s) is a series in s. Each term's
-//! response is known exactly, so a step's positions are two exponentials plus a polynomial
-//! (`SeriesForm`, `RampForm`) instead of quadrature. The limits on the jump and the horizon
-//! keep the series short and convergent; outside them the trajectory integrates.
+//! The closed forms that f3 (2.5) as a power series gives the jet pipe's response. The
+//! series come from the curve (`physics::jet_pipe::StaticCurve::series`: tanh's for the
+//! model's f3). With a held command the input f3(F̄ + ε e^{−ω_cd s}) is a series in
+//! e^{−ω_cd s}; with a ramp once the current transient has died out, f3(α + β s) is a series
+//! in s. Each term's response is known exactly, so a step's positions are two exponentials
+//! plus a polynomial (`SeriesForm`, `RampForm`) instead of quadrature. The limits on the jump
+//! and the horizon keep the series short and convergent; outside them, or for a curve that
+//! offers no series, the trajectory integrates.
+
+use crate::physics::jet_pipe::StaticCurve;
 
 use super::modal::{
     growth_from, modal_bounds, modal_growth, modal_position, position_weights, ElectromechanicalPropagator,
@@ -11,98 +15,21 @@ use super::modal::{
 };
 use super::{Coefficients, C64, INLINE_TERMS};
 
-/// Largest |ε|/ρ (jump over the distance to tanh's nearest pole) for which the series is used.
+/// Largest |ε|/ρ (jump over the series radius, the distance to f3's nearest singularity:
+/// `StaticCurve::series_radius`) for which the series is used.
 pub(super) const SERIES_RATIO_LIMIT: f64 = 0.5;
 /// A larger jump is integrated by quadrature until it has decayed to this fraction of the
 /// limit (rounding then cannot push the rest over it), and by the series from there.
 pub(super) const LATE_SERIES_MARGIN: f64 = 0.9;
 pub(super) const MAX_SERIES_TERMS: usize = 64;
-/// Largest |k_m δ / F_jp_sat| (the current transient's share of tanh's argument) that a
+/// Largest |k_m δ / F_jp_sat| (the current transient's share of f3's argument) that a
 /// ramp's closed form neglects: its effect on the jet pipe is below 1e-15·x_jp_sat.
 pub(super) const RAMP_TRANSIENT_LIMIT: f64 = 1e-15;
-/// Largest |β T| / ρ (the ramp's change of tanh's argument over the closed form's horizon,
-/// over the distance to tanh's nearest pole): the series terms shrink at least this fast.
+/// Largest |β T| / ρ (the ramp's change of f3's argument over the closed form's horizon,
+/// over the series radius): the series terms shrink at least this fast.
 pub(super) const RAMP_SERIES_RATIO: f64 = 0.2;
 /// Longest horizon of a ramp's closed form, s (queries beyond it use quadrature).
 pub(super) const RAMP_MAX_HORIZON: f64 = 1.0;
-
-/// 1/(n + 1) for the series recurrence: a multiplication per term instead of a division.
-pub(super) const RECIPROCALS: [f64; MAX_SERIES_TERMS] = {
-    let mut table = [0.0; MAX_SERIES_TERMS];
-    let mut n = 0;
-    while n < MAX_SERIES_TERMS {
-        table[n] = 1.0 / (n as f64 + 1.0);
-        n += 1;
-    }
-    table
-};
-
-/// Coefficients aₙ = cₙ εⁿ of tanh(x0 + ε r) = Σ aₙ rⁿ, truncated where they stop mattering.
-pub(super) fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> Coefficients {
-    let max_terms = max_terms.min(MAX_SERIES_TERMS);
-    // The terms go to an array first, and to the small vector whole (indexing a SmallVec
-    // checks where it lives at every element); only a series longer than the array spills.
-    let mut inline = [0.0; INLINE_TERMS];
-    inline[0] = x0.tanh();
-    if epsilon == 0.0 {
-        return Coefficients::from_buf_and_len(inline, 1);
-    }
-    let converged = |terms: &[f64]| match terms {
-        [.., before, last] => terms.len() > 3 && last.abs() < 1e-17 && before.abs() < 1e-17,
-        _ => false,
-    };
-    let mut count = 1;
-    while count < max_terms.min(INLINE_TERMS) {
-        inline[count] = next_tanh_term(&inline[..count], epsilon);
-        count += 1;
-        if converged(&inline[..count]) {
-            return Coefficients::from_buf_and_len(inline, count);
-        }
-    }
-    if count == max_terms {
-        return Coefficients::from_buf_and_len(inline, count);
-    }
-    let mut spilled = Coefficients::from_slice(&inline);
-    while spilled.len() < max_terms {
-        let term = next_tanh_term(&spilled, epsilon);
-        spilled.push(term);
-        if converged(&spilled) {
-            break;
-        }
-    }
-    spilled
-}
-
-/// The next coefficient of [`tanh_series`] from `terms` a₀ … aₙ: y' = 1 − y² in the
-/// variable εr gives (n+1) a_{n+1} = ε ([n = 0] − Σ_{k=0}^{n} a_k a_{n−k}). The newest term
-/// aₙ enters the sum only as 2a₀aₙ: the rest (pairs folded in half, over two accumulators)
-/// does not wait for it, so each term is three dependent operations after the one before.
-#[inline]
-pub(super) fn next_tanh_term(terms: &[f64], epsilon: f64) -> f64 {
-    let n = terms.len() - 1;
-    let scale = epsilon * RECIPROCALS[n];
-    if n == 0 {
-        return (1.0 - terms[0] * terms[0]) * scale;
-    }
-    // a_1 … a_{n−1}, paired from both ends.
-    let inner = &terms[1..n];
-    let (low, high) = inner.split_at(inner.len() / 2);
-    let (mut even, mut odd) = (0.0, 0.0);
-    let mut pairs = low.iter().zip(high.iter().rev());
-    while let Some((a, b)) = pairs.next() {
-        even += a * b;
-        if let Some((a, b)) = pairs.next() {
-            odd += a * b;
-        }
-    }
-    let middle = if inner.len() % 2 == 1 {
-        inner[inner.len() / 2] * inner[inner.len() / 2]
-    } else {
-        0.0
-    };
-    let older = 2.0 * (even + odd) + middle;
-    -((2.0 * terms[0]) * terms[n] + older) * scale
-}
 
 /// For a held command with the series form, each mode is
 ///   q_k(s) = e^{λk s} (q_k(0) + β_k Σₙ aₙ/(λk + nω)) − β_k Σₙ aₙ rⁿ/(λk + nω),  r = e^{−ω s},
@@ -126,7 +53,7 @@ pub(super) struct SeriesForm {
 impl SeriesForm {
     /// `None` when some λk + nω nearly vanishes (the term grows like s e^{λs}): the
     /// general per-query sum handles that case.
-    pub(super) fn new(p: &ElectromechanicalPropagator, q0: &[C64; 3], series: &[f64]) -> Option<Self> {
+    pub(super) fn new<C>(p: &ElectromechanicalPropagator<C>, q0: &[C64; 3], series: &[f64]) -> Option<Self> {
         if series.is_empty() || series.len() > p.series_weights.len() {
             return None;
         }
@@ -154,7 +81,7 @@ impl SeriesForm {
         let transient_over = if transient <= negligible {
             0.0
         } else {
-            ln_upper_bound(transient / negligible) / p.omega_cd
+            ln_upper_bound(transient / negligible) / p.driver.omega_cd
         };
         Some(Self {
             amplitude,
@@ -166,7 +93,7 @@ impl SeriesForm {
 
     /// Modal coordinates: q_k(s) = amplitude_k e^{λk s} − Σₙ wₖ,ₙ aₙ rⁿ, for the `series` the
     /// form was built from.
-    pub(super) fn modes(&self, p: &ElectromechanicalPropagator, series: &[f64], s: f64) -> [C64; 3] {
+    pub(super) fn modes<C>(&self, p: &ElectromechanicalPropagator<C>, series: &[f64], s: f64) -> [C64; 3] {
         let (mut q, r) = self.growth(p, s);
         let zero = C64::new(0.0, 0.0);
         let sum = series
@@ -187,7 +114,7 @@ impl SeriesForm {
     }
 
     /// The modal exponentials' parts e^{λk s}·amplitude_k, and r = e^{−ω s}.
-    pub(super) fn growth(&self, p: &ElectromechanicalPropagator, s: f64) -> ([C64; 3], f64) {
+    pub(super) fn growth<C>(&self, p: &ElectromechanicalPropagator<C>, s: f64) -> ([C64; 3], f64) {
         let e = p.exponentials(s, true);
         (growth_from(&self.amplitude, &e), e.decay)
     }
@@ -209,7 +136,7 @@ impl SeriesForm {
         even + r * odd
     }
 
-    pub(super) fn position(&self, p: &ElectromechanicalPropagator, s: f64) -> f64 {
+    pub(super) fn position<C>(&self, p: &ElectromechanicalPropagator<C>, s: f64) -> f64 {
         self.position_from(s, &p.exponentials(s, s < self.transient_over))
     }
 
@@ -225,21 +152,21 @@ impl SeriesForm {
     }
 
     /// Bounds on the position over [0, s_end].
-    pub(super) fn position_bounds(&self, p: &ElectromechanicalPropagator, s_end: f64) -> (f64, f64) {
+    pub(super) fn position_bounds<C>(&self, p: &ElectromechanicalPropagator<C>, s_end: f64) -> (f64, f64) {
         let (constant, transient) = constant_and_spread(&self.position, 1.0);
         let (lo, hi) = modal_bounds(p, &self.amplitude, s_end);
         (lo + constant - transient, hi + constant + transient)
     }
 
-    pub(super) fn derivatives(&self, p: &ElectromechanicalPropagator, series: &[f64], s: f64) -> [f64; 3] {
+    pub(super) fn derivatives<C>(&self, p: &ElectromechanicalPropagator<C>, series: &[f64], s: f64) -> [f64; 3] {
         self.derivatives_from(p, series, &p.exponentials(s, true))
     }
 
     /// [`Self::derivatives`] from the exponentials at `s` (with `decay`), for the `series`
     /// the form was built from.
-    pub(super) fn derivatives_from(
+    pub(super) fn derivatives_from<C>(
         &self,
-        p: &ElectromechanicalPropagator,
+        p: &ElectromechanicalPropagator<C>,
         series: &[f64],
         e: &Exponentials,
     ) -> [f64; 3] {
@@ -262,7 +189,7 @@ impl SeriesForm {
 }
 
 /// For a command ramp once the current transient has died out (i(s) = i0 + ramp·s), the
-/// jet pipe input u(s) = x_sat tanh(α + β s) is a power series in τ = s/T, Σ bₙ τⁿ, on a
+/// jet pipe input u(s) = f3 at the argument α + β s is a power series in τ = s/T, Σ bₙ τⁿ, on a
 /// horizon T short enough for it to converge fast. Each mode q' = λq + βu then has the
 /// polynomial particular solution q_p = −β Σ_j u⁽ʲ⁾/λ^{j+1} (a finite sum), so
 ///   x(s) = Σ_k Re[(q_k(0) − q_p,k(0)) e^{λk s}] + P(τ),  P = Σ_j g_j u⁽ʲ⁾, g_j = −Re Σ_k β_k/λ_k^{j+1}:
@@ -283,17 +210,19 @@ pub(super) struct RampForm {
 }
 
 impl RampForm {
-    /// `alpha`, `beta`: tanh's argument α + β s. `None` when the series would need too
-    /// many terms.
-    pub(super) fn new(p: &ElectromechanicalPropagator, q0: &[C64; 3], alpha: f64, beta: f64) -> Option<Self> {
-        let radius = (alpha * alpha + std::f64::consts::FRAC_PI_2.powi(2)).sqrt();
+    /// `alpha`, `beta`: f3's argument α + β s. `None` when the curve offers no series or
+    /// it would need too many terms.
+    pub(super) fn new<C: StaticCurve>(
+        p: &ElectromechanicalPropagator<C>,
+        q0: &[C64; 3],
+        alpha: f64,
+        beta: f64,
+    ) -> Option<Self> {
+        let radius = p.curve.series_radius(alpha)?;
         let horizon = RAMP_MAX_HORIZON.min(RAMP_SERIES_RATIO * radius / beta.abs());
-        let mut input = tanh_series(alpha, beta * horizon, MAX_SERIES_TERMS);
+        let input = p.curve.series(alpha, beta * horizon, MAX_SERIES_TERMS, 1.0)?;
         if input.len() >= MAX_SERIES_TERMS {
             return None;
-        }
-        for b in input.iter_mut() {
-            *b *= p.x_sat;
         }
         let n = input.len();
         // u^{(j)} in τ: (d/dτ)^j, and d/ds = (1/T) d/dτ.
@@ -315,17 +244,31 @@ impl RampForm {
             if u_j.is_empty() {
                 break;
             }
+            // β_k λ_k^{−(j+1)}
+            let weights = [
+                p.beta[0] * inverse_power[0],
+                p.beta[1] * inverse_power[1],
+                p.beta[2] * inverse_power[2],
+            ];
             let mut g = 0.0;
             for k in 0..3 {
                 // q_p,k(0) = −β_k Σ_j u^{(j)}(0) λ_k^{−(j+1)}
-                amplitude[k] += p.beta[k] * inverse_power[k] * (u_j[0] * scale);
-                g -= (p.beta[k] * inverse_power[k]).re;
+                amplitude[k] += weights[k] * (u_j[0] * scale);
+                g -= weights[k].re;
             }
-            for (m, c) in u_j.iter().enumerate() {
-                particular[m] += g * scale * c;
-                for k in 0..3 {
-                    particular_modes[k][m] -= p.beta[k] * inverse_power[k] * (scale * c);
-                }
+            // Element by element over the five polynomials at once (disjoint slices: no
+            // aliasing for the compiler to check at run time).
+            let [modes_0, modes_1, modes_2] = &mut particular_modes;
+            let terms = u_j.iter().zip(particular.iter_mut());
+            for ((((c, x), q_0), q_1), q_2) in terms
+                .zip(modes_0.iter_mut())
+                .zip(modes_1.iter_mut())
+                .zip(modes_2.iter_mut())
+            {
+                *x += g * scale * c;
+                *q_0 -= weights[0] * (scale * c);
+                *q_1 -= weights[1] * (scale * c);
+                *q_2 -= weights[2] * (scale * c);
             }
             u_j = derivative(&u_j);
             scale /= horizon;
@@ -348,11 +291,11 @@ impl RampForm {
         (0.0..=self.horizon).contains(&s)
     }
 
-    pub(super) fn growth(&self, p: &ElectromechanicalPropagator, s: f64) -> [C64; 3] {
+    pub(super) fn growth<C>(&self, p: &ElectromechanicalPropagator<C>, s: f64) -> [C64; 3] {
         modal_growth(p, &self.amplitude, s)
     }
 
-    pub(super) fn position(&self, p: &ElectromechanicalPropagator, s: f64) -> f64 {
+    pub(super) fn position<C>(&self, p: &ElectromechanicalPropagator<C>, s: f64) -> f64 {
         self.position_from(s, &p.exponentials(s, false))
     }
 
@@ -361,13 +304,13 @@ impl RampForm {
     }
 
     /// Bounds on the position over [0, s_end], s_end within the horizon.
-    pub(super) fn position_bounds(&self, p: &ElectromechanicalPropagator, s_end: f64) -> (f64, f64) {
+    pub(super) fn position_bounds<C>(&self, p: &ElectromechanicalPropagator<C>, s_end: f64) -> (f64, f64) {
         let (constant, spread) = constant_and_spread(&self.polynomials[0], s_end / self.horizon);
         let (lo, hi) = modal_bounds(p, &self.amplitude, s_end);
         (lo + constant - spread, hi + constant + spread)
     }
 
-    pub(super) fn derivatives(&self, p: &ElectromechanicalPropagator, s: f64) -> [f64; 3] {
+    pub(super) fn derivatives<C>(&self, p: &ElectromechanicalPropagator<C>, s: f64) -> [f64; 3] {
         let e = p.exponentials(s, false);
         let g = growth_from(&self.amplitude, &e);
         let (l, tau) = (&p.lambda, s / self.horizon);
@@ -380,7 +323,7 @@ impl RampForm {
     }
 
     /// Modal coordinates: q_k(s) = amplitude_k e^{λk s} + q_p,k(s).
-    pub(super) fn modes(&self, p: &ElectromechanicalPropagator, s: f64) -> [C64; 3] {
+    pub(super) fn modes<C>(&self, p: &ElectromechanicalPropagator<C>, s: f64) -> [C64; 3] {
         let tau = s / self.horizon;
         let mut q = self.growth(p, s);
         for (q_k, polynomial) in q.iter_mut().zip(&self.particular_modes) {
@@ -420,11 +363,10 @@ pub(super) fn constant_and_spread(coefficients: &[f64], z_max: f64) -> (f64, f64
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::reference;
+    use super::super::tests::{ramp_start, reference};
     use super::super::{ElectromechanicalPropagator, ElectromechanicalState};
     use super::*;
     use crate::physics::effects::PLAY_OPERATORS;
-    use crate::physics::jet_pipe;
     use crate::physics::parameters::Parameters;
     use nalgebra::SVector;
 
@@ -440,17 +382,6 @@ mod tests {
                 );
             }
             x *= 2.0;
-        }
-    }
-
-    #[test]
-    fn tanh_series_matches_tanh() {
-        for (x0, eps) in [(0.0, 0.3), (0.7, -0.5), (-1.2, 0.6), (2.0, 0.05)] {
-            let a = tanh_series(x0, eps, 64);
-            for r in [0.0f64, 0.3, 0.9, 1.0] {
-                let sum: f64 = a.iter().enumerate().map(|(n, c)| c * r.powi(n as i32)).sum();
-                assert!((sum - (x0 + eps * r).tanh()).abs() < 1e-13, "x0 {x0} eps {eps} r {r}");
-            }
         }
     }
 
@@ -534,13 +465,7 @@ mod tests {
         let propagator = ElectromechanicalPropagator::new(&p).unwrap();
         for (v, rate) in [(1.0, 2.5), (4.0, -2.5), (2.5, 400.0), (-3.0, -60.0), (6.0, 1e-3)] {
             // A ramp continued from the previous step: the current already lags it by rate/ω.
-            let current = p.k_cd * v + p.i_offset - p.k_cd * rate / p.omega_cd;
-            let start = ElectromechanicalState {
-                current,
-                position: 1.2e-4,
-                velocity: 0.02,
-                acceleration: -30.0,
-            };
+            let start = ramp_start(&p, v, rate);
             let plays = [start.position; PLAY_OPERATORS];
             let fast = propagator.trajectory(&start, v, rate, &plays);
             let form = fast.ramp_form.as_ref().expect("ramp form expected");
@@ -585,8 +510,8 @@ mod tests {
         // A ramp followed long enough does not ring: the jet pipe lags it, and that lag is not
         // taken for ringing (which would hold the chamber steps below a quarter period).
         let rate = 2.5;
-        let current = p.k_cd * 1.0 + p.i_offset - p.k_cd * rate / p.omega_cd;
-        let x0 = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current));
+        let current = ramp_start(&p, 1.0, rate).current;
+        let x0 = propagator.static_position(current);
         let start = ElectromechanicalState {
             current,
             position: x0,

@@ -5,12 +5,13 @@
 //! then continued by a series-form trajectory started there. Also the ringing the chambers'
 //! integrator has to resolve, measured where it is exact.
 
+use crate::physics::current_driver;
 use crate::physics::effects::PLAY_OPERATORS;
-use crate::physics::jet_pipe;
+use crate::physics::jet_pipe::{self, StaticCurve, F3};
 
 use super::modal::{modulus, Exponentials, HysteresisOverStep};
 use super::series::{
-    tanh_series, RampForm, SeriesForm, LATE_SERIES_MARGIN, MAX_SERIES_TERMS, RAMP_TRANSIENT_LIMIT, SERIES_RATIO_LIMIT,
+    RampForm, SeriesForm, LATE_SERIES_MARGIN, MAX_SERIES_TERMS, RAMP_TRANSIENT_LIMIT, SERIES_RATIO_LIMIT,
 };
 use super::{Coefficients, ElectromechanicalPropagator, ElectromechanicalState, C64};
 
@@ -37,7 +38,7 @@ pub(super) const GAUSS_WEIGHTS: [f64; 8] = [
     0.101_228_536_290_376_3,
 ];
 
-impl ElectromechanicalPropagator {
+impl<C: StaticCurve> ElectromechanicalPropagator<C> {
     /// The trajectory over a step starting from `start` with command v_DA(s) = v_da + v_da_rate·s.
     ///
     /// `plays` are the hysteresis operator's play states at the start; the current is
@@ -49,21 +50,17 @@ impl ElectromechanicalPropagator {
         v_da: f64,
         v_da_rate: f64,
         plays: &[f64; PLAY_OPERATORS],
-    ) -> Trajectory<'_> {
-        let static_current = self.k_cd * v_da + self.i_offset;
-        let ramp = self.k_cd * v_da_rate;
-        // i(s) = ī(0) + ramp·(s − 1/ω) + δ e^{−ω s}
-        let base = static_current - ramp / self.omega_cd;
-        let delta = start.current - base;
+    ) -> Trajectory<'_, C> {
+        // i(s) = ī(0) + ramp·(s − 1/ω) + δ e^{−ω s}, (2.1)–(2.3) solved.
+        let drive = self.driver.response(start.current, v_da, v_da_rate);
+        let (base, ramp, delta) = (drive.base, drive.ramp, drive.delta);
         let z = [start.position, start.velocity, start.acceleration];
         let mut q0 = [C64::new(0.0, 0.0); 3];
         for k in 0..3 {
             q0[k] = self.inverse[k][0] * z[0] + self.inverse[k][1] * z[1] + self.inverse[k][2] * z[2];
         }
         let mut series = Coefficients::new();
-        // i'(s) = ramp − ω δ e^{−ω s} vanishes once at most.
-        let ratio = ramp / (self.omega_cd * delta);
-        let turning_point = (ratio > 0.0 && ratio < 1.0).then(|| -ratio.ln() / self.omega_cd);
+        let turning_point = drive.turning_point();
         let linear_hysteresis = if ramp == 0.0 && self.hysteresis.is_active() {
             self.hysteresis_as_linear(start.current, base, plays)
         } else {
@@ -71,12 +68,18 @@ impl ElectromechanicalPropagator {
         };
         // Where a held command's jump is too large for the series: when it has shrunk enough.
         let mut series_from = None;
-        if ramp == 0.0 && (!self.hysteresis.is_active() || linear_hysteresis.is_some()) {
-            let centre = self.k_m * base / self.f_sat;
-            let epsilon = self.k_m * delta / self.f_sat;
-            let radius = (centre * centre + std::f64::consts::FRAC_PI_2.powi(2)).sqrt();
+        // f3's argument (2.4)–(2.5) for a current, and for a change of current.
+        let argument = |current: f64| self.curve.argument(jet_pipe::tip_force(self.k_m, current));
+        let centre = argument(base);
+        let series_applies = ramp == 0.0 && (!self.hysteresis.is_active() || linear_hysteresis.is_some());
+        let radius = if series_applies {
+            self.curve.series_radius(centre)
+        } else {
+            None
+        };
+        if let Some(radius) = radius {
+            let epsilon = argument(delta);
             if epsilon.abs() <= SERIES_RATIO_LIMIT * radius {
-                series = tanh_series(centre, epsilon, MAX_SERIES_TERMS);
                 match linear_hysteresis {
                     Some(HysteresisOverStep::Parabola {
                         value,
@@ -85,50 +88,46 @@ impl ElectromechanicalPropagator {
                     }) => {
                         // A Bouc–Wen branch as a parabola about the start: the series of
                         // d = x̄ − x̄(0), then value + slope d + curvature d².
-                        for a in series.iter_mut() {
-                            *a *= self.x_sat;
+                        if let Some(mut terms) = self.curve.series(centre, epsilon, MAX_SERIES_TERMS, 1.0) {
+                            let start: f64 = terms.iter().sum();
+                            terms[0] -= start;
+                            let squared: Coefficients = (0..terms.len())
+                                .map(|n| (0..=n).map(|k| terms[k] * terms[n - k]).sum())
+                                .collect();
+                            for (a, d2) in terms.iter_mut().zip(&squared) {
+                                *a = slope * *a + curvature * d2;
+                            }
+                            terms[0] += value;
+                            series = terms;
                         }
-                        let start: f64 = series.iter().sum();
-                        series[0] -= start;
-                        let squared: Coefficients = (0..series.len())
-                            .map(|n| (0..=n).map(|k| series[k] * series[n - k]).sum())
-                            .collect();
-                        for (a, d2) in series.iter_mut().zip(&squared) {
-                            *a = slope * *a + curvature * d2;
-                        }
-                        series[0] += value;
                     }
                     affine => {
                         let (constant, slope) = match affine {
                             Some(HysteresisOverStep::Affine { constant, slope }) => (constant, slope),
                             _ => (0.0, 1.0),
                         };
-                        for a in series.iter_mut() {
-                            *a *= self.x_sat * slope;
+                        if let Some(terms) = self.curve.series(centre, epsilon, MAX_SERIES_TERMS, slope) {
+                            series = terms;
+                            series[0] += constant;
                         }
-                        series[0] += constant;
                     }
                 }
             } else {
                 let shrunk = LATE_SERIES_MARGIN * SERIES_RATIO_LIMIT * radius;
-                series_from = Some((epsilon.abs() / shrunk).ln() / self.omega_cd);
+                series_from = Some((epsilon.abs() / shrunk).ln() / self.driver.omega_cd);
             }
         }
         // A ramp whose current transient is below rounding (a ramp continued from the last
         // step): the input is a power series in time and the response has a closed form.
-        let ramp_form = if ramp != 0.0
-            && !self.hysteresis.is_active()
-            && (self.k_m * delta / self.f_sat).abs() <= RAMP_TRANSIENT_LIMIT
+        let ramp_form = if ramp != 0.0 && !self.hysteresis.is_active() && argument(delta).abs() <= RAMP_TRANSIENT_LIMIT
         {
-            RampForm::new(self, &q0, self.k_m * base / self.f_sat, self.k_m * ramp / self.f_sat).map(Box::new)
+            RampForm::new(self, &q0, centre, argument(ramp)).map(Box::new)
         } else {
             None
         };
         let mut trajectory = Trajectory {
             propagator: self,
-            base,
-            ramp,
-            delta,
+            drive,
             q0,
             ramp_form,
             series_form: SeriesForm::new(self, &q0, &series),
@@ -155,7 +154,7 @@ impl ElectromechanicalPropagator {
         }
         if trajectory.series.is_empty() && ramp == 0.0 {
             // |δ| e^{−ω s} below 1e-15 A: the input is constant to rounding.
-            let settled = (delta.abs() / 1e-15).ln().max(0.0) / self.omega_cd;
+            let settled = drive.transient_below(1e-15);
             let integral = trajectory.quadrature(settled);
             trajectory.settled = Some((settled, integral, trajectory.jet_input(settled)));
         }
@@ -164,11 +163,10 @@ impl ElectromechanicalPropagator {
 }
 
 /// The current driver and jet pipe over one step, evaluable at any time within it.
-pub struct Trajectory<'a> {
-    pub(super) propagator: &'a ElectromechanicalPropagator,
-    pub(super) base: f64,
-    pub(super) ramp: f64,
-    pub(super) delta: f64,
+pub struct Trajectory<'a, C = F3> {
+    pub(super) propagator: &'a ElectromechanicalPropagator<C>,
+    /// The current, (2.1)–(2.3) in closed form.
+    pub(super) drive: current_driver::Response,
     pub(super) q0: [C64; 3],
     /// x_sat·aₙ when the closed-form series applies; empty otherwise.
     pub(super) series: Coefficients,
@@ -192,14 +190,14 @@ pub struct Trajectory<'a> {
     pub(super) panel_ends: std::cell::RefCell<Vec<(f64, [C64; 3])>>,
     /// For a held command whose jump is too large for the series: from when on the
     /// trajectory is the series-form one started there (queries from then on go to it).
-    pub(super) late: Option<(f64, Box<Trajectory<'a>>)>,
+    pub(super) late: Option<(f64, Box<Trajectory<'a, C>>)>,
     /// The last stage time [`Self::node_positions`] took the series form's exponentials
     /// at (with the current transient's), and those exponentials: the step's end, where
     /// [`Self::state`] is asked next.
     pub(super) last_node: std::cell::Cell<Option<(f64, Exponentials)>>,
 }
 
-impl Trajectory<'_> {
+impl<C: StaticCurve> Trajectory<'_, C> {
     /// The late part of the trajectory and the time into it, for `s` from its start on.
     pub(super) fn late_at(&self, s: f64) -> Option<(&Self, f64)> {
         self.late
@@ -210,12 +208,11 @@ impl Trajectory<'_> {
 
     /// Coil current at `s` seconds into the step.
     pub fn current(&self, s: f64) -> f64 {
-        self.base + self.ramp * s + self.delta * (-self.propagator.omega_cd * s).exp()
+        self.drive.at(s)
     }
 
     pub(super) fn static_position(&self, s: f64) -> f64 {
-        let p = self.propagator;
-        jet_pipe::static_position(p.x_sat, p.f_sat, jet_pipe::tip_force(p.k_m, self.current(s)))
+        self.propagator.static_position(self.current(s))
     }
 
     /// The hysteresis operator's play states at `s` (all at f3's output when it is off).
@@ -252,9 +249,9 @@ impl Trajectory<'_> {
         // The Bouc–Wen law bends smoothly: only plays have kinks.
         let half_widths = operator
             .play_half_widths()
-            .filter(|_| operator.is_active() && self.ramp == 0.0);
+            .filter(|_| operator.is_active() && self.drive.ramp == 0.0);
         if let Some(half_widths) = half_widths {
-            let settle = (self.delta.abs() / 1e-15).ln().max(0.0) / self.propagator.omega_cd;
+            let settle = self.drive.transient_below(1e-15);
             let (from, to) = (self.static_position(0.0), self.static_position(settle));
             let rising = to >= from;
             for (p, r) in self.plays.iter().zip(half_widths) {
@@ -354,13 +351,14 @@ impl Trajectory<'_> {
         ];
         if !self.series.is_empty() {
             // ∫₀ˢ e^{λ(s−σ)} e^{−nωσ} dσ = (e^{λs} − e^{−nωs}) / (λ + nω)
-            let decay = (-p.omega_cd * s).exp();
+            let omega_cd = p.driver.omega_cd;
+            let decay = (-omega_cd * s).exp();
             let mut decay_n = 1.0;
             for (n, a) in self.series.iter().enumerate() {
-                let n_omega = n as f64 * p.omega_cd;
+                let n_omega = n as f64 * omega_cd;
                 for k in 0..3 {
                     let denominator = p.lambda[k] + n_omega;
-                    integral[k] += if denominator.norm_sqr() > (1e-9 * p.omega_cd).powi(2) {
+                    integral[k] += if denominator.norm_sqr() > (1e-9 * omega_cd).powi(2) {
                         (growth[k] - decay_n) / denominator * *a
                     } else {
                         growth[k] * s * *a
@@ -458,7 +456,7 @@ impl Trajectory<'_> {
                 // The current's transient e^{−ω s} is among the exponentials kept there.
                 Some((at, e)) if at == s => (
                     form.derivatives_from(self.propagator, &self.series, &e),
-                    self.base + self.ramp * s + self.delta * e.decay,
+                    self.drive.with_decay(s, e.decay),
                 ),
                 _ => (form.derivatives(self.propagator, &self.series, s), self.current(s)),
             }),
@@ -491,6 +489,82 @@ mod tests {
     use crate::physics::parameters::Parameters;
     use nalgebra::SVector;
 
+    /// f3 with tanh's values and slope but no power series.
+    #[derive(Clone, Debug, PartialEq)]
+    struct WithoutSeries(F3);
+
+    impl StaticCurve for WithoutSeries {
+        fn value(&self, tip_force: f64) -> f64 {
+            self.0.value(tip_force)
+        }
+        fn slope(&self, tip_force: f64) -> f64 {
+            self.0.slope(tip_force)
+        }
+        fn argument(&self, tip_force: f64) -> f64 {
+            self.0.argument(tip_force)
+        }
+    }
+
+    /// A curve that offers no series is integrated by quadrature by the propagator itself,
+    /// and gives the trajectory of the series and ramp forms to 1e-12 of the scales (6e-14 measured).
+    #[test]
+    fn a_curve_without_a_series_gives_the_same_trajectory_by_quadrature() {
+        for hysteresis in [0.0, 4e-5] {
+            let p = Parameters {
+                hysteresis_width: hysteresis,
+                ..Parameters::default()
+            };
+            let series = ElectromechanicalPropagator::new(&p).unwrap();
+            let quadrature =
+                ElectromechanicalPropagator::with_curve(&p, WithoutSeries(F3::from_parameters(&p))).unwrap();
+            let mut closed_forms = 0;
+            for (start, v, rate) in [
+                (swinging(), 1.3, 0.0),
+                (swinging(), 3.1, 0.0),
+                (swinging(), -10.0, 0.0),
+                (ramp_start(&p, 1.0, 2.5), 1.0, 2.5),
+                (ramp_start(&p, -3.0, -60.0), -3.0, -60.0),
+                (swinging(), 1.0, 400.0),
+            ] {
+                // Plays as a rise to f3 of the start current leaves them: a rise from there
+                // drags them all, and the held commands' series form still applies.
+                let x0 = series.static_position(start.current);
+                let mut plays = [x0 - 1e-3; PLAY_OPERATORS];
+                series.hysteresis.advance(&mut plays, x0);
+                let fast = series.trajectory(&start, v, rate, &plays);
+                let slow = quadrature.trajectory(&start, v, rate, &plays);
+                assert!(slow.series.is_empty() && slow.series_form.is_none() && slow.ramp_form.is_none());
+                assert!(slow.late.is_none());
+                let late = fast.late.as_ref().map(|(_, late)| &**late);
+                let closed = |t: &Trajectory| t.series_form.is_some() || t.ramp_form.is_some();
+                closed_forms += usize::from(closed(&fast) || late.map_or(false, closed));
+                let w = modulus(series.lambda[1]);
+                for s in [0.0, 1e-5, 3e-4, 2e-3, 7.3e-3, 1e-2] {
+                    let (a, b) = (fast.state(s), slow.state(s));
+                    for (name, x, y, scale) in [
+                        ("i", a.current, b.current, 0.5),
+                        ("x", a.position, b.position, p.x_jp_sat),
+                        ("v", a.velocity, b.velocity, p.x_jp_sat * w),
+                        ("a", a.acceleration, b.acceleration, p.x_jp_sat * w * w),
+                    ] {
+                        assert!(
+                            (x - y).abs() <= 1e-12 * scale,
+                            "hysteresis {hysteresis} v {v} rate {rate} s {s} {name}: {x} vs {y}"
+                        );
+                    }
+                    assert!((fast.position(s) - slow.position(s)).abs() <= 1e-12 * p.x_jp_sat);
+                }
+            }
+            // The series path did take its closed forms: all but the fast ramp with its
+            // current transient; with hysteresis, the two rises that drag every play.
+            assert_eq!(
+                closed_forms,
+                if hysteresis == 0.0 { 5 } else { 2 },
+                "hysteresis {hysteresis}"
+            );
+        }
+    }
+
     #[test]
     fn gauss_rule_integrates_degree_15_exactly() {
         for degree in 0..=15 {
@@ -513,8 +587,8 @@ mod tests {
         let p = Parameters::default();
         let propagator = ElectromechanicalPropagator::new(&p).unwrap();
         let settled = |v: f64| {
-            let current = p.k_cd * v + p.i_offset;
-            let position = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current));
+            let current = current_driver::static_current(p.k_cd, p.i_offset, v);
+            let position = propagator.static_position(current);
             ElectromechanicalState {
                 current,
                 position,
@@ -625,7 +699,7 @@ mod tests {
             (2.5, 2.5, 0.2),
         ] {
             let current = p.k_cd * v_from + p.i_offset;
-            let x = jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current));
+            let x = F3::from_parameters(&p).value(jet_pipe::tip_force(p.k_m, current));
             let mut memory = [x; PLAY_OPERATORS];
             memory[1] = x - z * 0.08e-3;
             let start = ElectromechanicalState {

@@ -7,6 +7,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::chambers::{pressure_rate, CylinderGeometry};
 use super::effects::{self, Hysteresis, PLAY_OPERATORS};
+use super::jet_pipe::StaticCurve;
 use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
@@ -280,7 +281,7 @@ impl Actuator {
     /// Static jet pipe position x̄ for a current, (2.4)–(2.5).
     pub fn static_jet_position(&self, current: f64) -> f64 {
         let p = &self.params;
-        jet_pipe::static_position(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, current))
+        jet_pipe::F3::from_parameters(p).value(jet_pipe::tip_force(p.k_m, current))
     }
 
     /// The state equations (4.1).
@@ -294,10 +295,7 @@ impl Actuator {
             current_driver::current_rate(p.omega_cd, static_current, y[CURRENT]),
             y[JET_VELOCITY],
             y[JET_ACCELERATION],
-            jet_pipe::third_derivative(
-                p.omega_1,
-                p.omega_2,
-                p.zeta_2,
+            jet_pipe::LinearDynamics::from_parameters(p).third_derivative(
                 x_bar,
                 y[JET_POSITION],
                 y[JET_VELOCITY],
@@ -317,10 +315,8 @@ impl Actuator {
         jac[(CURRENT, CURRENT)] = -p.omega_cd;
         jac[(JET_POSITION, JET_VELOCITY)] = 1.0;
         jac[(JET_VELOCITY, JET_ACCELERATION)] = 1.0;
-        let c2 = 2.0 * p.zeta_2 * p.omega_2 + p.omega_1;
-        let c3 = p.omega_2 * p.omega_2 + 2.0 * p.zeta_2 * p.omega_1 * p.omega_2;
-        let c4 = p.omega_1 * p.omega_2 * p.omega_2;
-        let slope = jet_pipe::static_position_slope(p.x_jp_sat, p.f_jp_sat, jet_pipe::tip_force(p.k_m, y[CURRENT]));
+        let [c2, c3, c4] = jet_pipe::LinearDynamics::from_parameters(p).coefficients();
+        let slope = jet_pipe::F3::from_parameters(p).slope(jet_pipe::tip_force(p.k_m, y[CURRENT]));
         jac[(JET_ACCELERATION, CURRENT)] = c4 * slope * p.k_m;
         jac[(JET_ACCELERATION, JET_POSITION)] = -c4;
         jac[(JET_ACCELERATION, JET_VELOCITY)] = -c3;

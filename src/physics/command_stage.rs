@@ -13,6 +13,7 @@
 //! points (a sampled D/A stage): the FMU stepped at a recording's sample times and the
 //! replay of that recording see the same command.
 
+use super::current_driver;
 use super::parameters::Parameters;
 
 /// Whether any term of the command stage is on.
@@ -35,8 +36,8 @@ pub fn static_map(p: &Parameters, v_da: f64) -> f64 {
     }
     if p.current_limit > 0.0 && p.k_cd != 0.0 {
         let (a, b) = (
-            (-p.current_limit - p.i_offset) / p.k_cd,
-            (p.current_limit - p.i_offset) / p.k_cd,
+            current_driver::command_for_current(p.k_cd, p.i_offset, -p.current_limit),
+            current_driver::command_for_current(p.k_cd, p.i_offset, p.current_limit),
         );
         v = v.clamp(a.min(b), a.max(b));
     }
@@ -164,7 +165,7 @@ mod tests {
             ..Parameters::default()
         };
         let v = static_map(&p, 10.0);
-        assert!((p.k_cd * v + p.i_offset - 0.2).abs() < 1e-12);
+        assert!((current_driver::static_current(p.k_cd, p.i_offset, v) - 0.2).abs() < 1e-12);
         assert_eq!(static_map(&p, 1.0), 1.0);
     }
 }

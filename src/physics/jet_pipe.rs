@@ -1,39 +1,307 @@
 //! Jet pipe: tip force (2.4), static curve f3 (2.5), third-order dynamics (2.6) and the
 //! offset from the receiver centre (2.7).
+//!
+//! Each equation is stated here once, in the forms that consume it: the assembled model
+//! (`actuator`) evaluates them, and the exact propagator (`crate::electromechanics`) takes
+//! f3 as a [`StaticCurve`] (values and power series) and (2.6) as [`LinearDynamics`] (its
+//! characteristic polynomial and modes) instead of deriving either again.
+
+use nalgebra::Complex;
+use smallvec::SmallVec;
+
+use super::parameters::Parameters;
 
 /// Tip force from the coil current, (2.4): F_jp = k_m i.
 pub fn tip_force(k_m: f64, current: f64) -> f64 {
     k_m * current
 }
 
-/// Static tip position, (2.5): x̄ = f3(F_jp). The thesis's f3 is the midpoint line of
-/// Fig. 3.5, which the text does not give; MODEL.md fixes x̄ = x_sat tanh(F_jp / F_sat).
-pub fn static_position(x_jp_sat: f64, f_jp_sat: f64, tip_force: f64) -> f64 {
-    x_jp_sat * (tip_force / f_jp_sat).tanh()
+/// Power-series coefficients of a static curve: on the stack up to
+/// [`SERIES_INLINE_TERMS`] (a command step of ordinary size needs fewer), so a step's
+/// series does not allocate.
+pub type SeriesCoefficients = SmallVec<[f64; SERIES_INLINE_TERMS]>;
+pub const SERIES_INLINE_TERMS: usize = 16;
+
+/// The static curve f3 of (2.5), x̄ = f3(F_jp), as the model and the propagator use it.
+///
+/// Power series are in the curve's own argument x = [`Self::argument`]`(F_jp)`, which is
+/// proportional to the tip force (so a change of tip force maps to a change of argument the
+/// same way). A curve that offers no series keeps the defaults (`None`), and the propagator
+/// then integrates its input by quadrature.
+pub trait StaticCurve {
+    /// x̄ = f3(F_jp), m.
+    fn value(&self, tip_force: f64) -> f64;
+    /// dx̄/dF_jp, m/N (the linearisation's slope, Appendix A's c5 over k_m).
+    fn slope(&self, tip_force: f64) -> f64;
+    /// The argument the series are in, for a tip force (or a change of tip force).
+    fn argument(&self, tip_force: f64) -> f64;
+    /// Distance from the argument `x0` to the curve's nearest singularity in the complex
+    /// plane: the radius of convergence of its power series about `x0`.
+    fn series_radius(&self, _x0: f64) -> Option<f64> {
+        None
+    }
+    /// Coefficients aₙ of gain·f3 at the argument x0 + ε r as a series in r,
+    /// Σ aₙ rⁿ (0 ≤ r ≤ 1, |ε| within [`Self::series_radius`]), truncated where the terms stop
+    /// mattering or at `max_terms` (a series that long has not converged). `gain` is a
+    /// factor applied after f3 (the hysteresis operator's dragged fraction, 1 otherwise),
+    /// folded into the curve's amplitude so each coefficient is rounded once.
+    fn series(&self, _x0: f64, _epsilon: f64, _max_terms: usize, _gain: f64) -> Option<SeriesCoefficients> {
+        None
+    }
 }
 
-/// d x̄ / d F_jp, the slope of f3 (used by the linearisation, Appendix A's c5).
-pub fn static_position_slope(x_jp_sat: f64, f_jp_sat: f64, tip_force: f64) -> f64 {
-    let t = (tip_force / f_jp_sat).tanh();
-    x_jp_sat / f_jp_sat * (1.0 - t * t)
+/// f3 as MODEL.md fixes it: x̄ = x_jp_sat tanh(F_jp / F_jp_sat). The thesis's f3 is the
+/// midpoint line of Fig. 3.5, which the text does not give. Its argument is
+/// x = F_jp / F_jp_sat, and tanh's nearest singularities are the poles at x = ±iπ/2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TanhSaturation {
+    pub x_jp_sat: f64,
+    pub f_jp_sat: f64,
 }
 
-/// Third derivative of the tip position, (2.6) in state form (Appendix A, c2..c4):
-/// X(s)/X̄(s) = ω1/(s+ω1) · ω2²/(s² + 2ζ2ω2 s + ω2²), unity gain at DC, so
-/// x''' = ω1ω2² (x̄ − x) − (2ζ2ω2 + ω1) x'' − (ω2² + 2ζ2ω1ω2) x'.
-pub fn third_derivative(
-    omega_1: f64,
-    omega_2: f64,
-    zeta_2: f64,
-    static_position: f64,
-    position: f64,
-    velocity: f64,
-    acceleration: f64,
-) -> f64 {
-    let c2 = 2.0 * zeta_2 * omega_2 + omega_1;
-    let c3 = omega_2 * omega_2 + 2.0 * zeta_2 * omega_1 * omega_2;
-    let c4 = omega_1 * omega_2 * omega_2;
-    c4 * (static_position - position) - c2 * acceleration - c3 * velocity
+/// The static curve of (2.5) the model uses: the FMU, the assembled model's right-hand side
+/// and Jacobian, and the propagator all take it from here.
+pub type F3 = TanhSaturation;
+
+impl TanhSaturation {
+    pub fn new(x_jp_sat: f64, f_jp_sat: f64) -> Self {
+        Self { x_jp_sat, f_jp_sat }
+    }
+
+    pub fn from_parameters(p: &Parameters) -> Self {
+        Self::new(p.x_jp_sat, p.f_jp_sat)
+    }
+}
+
+impl StaticCurve for TanhSaturation {
+    fn value(&self, tip_force: f64) -> f64 {
+        self.x_jp_sat * self.argument(tip_force).tanh()
+    }
+
+    fn slope(&self, tip_force: f64) -> f64 {
+        let t = self.argument(tip_force).tanh();
+        self.x_jp_sat / self.f_jp_sat * (1.0 - t * t)
+    }
+
+    fn argument(&self, tip_force: f64) -> f64 {
+        tip_force / self.f_jp_sat
+    }
+
+    /// |x0 ± iπ/2|: the distance to tanh's nearest poles.
+    fn series_radius(&self, x0: f64) -> Option<f64> {
+        Some((x0 * x0 + std::f64::consts::FRAC_PI_2.powi(2)).sqrt())
+    }
+
+    fn series(&self, x0: f64, epsilon: f64, max_terms: usize, gain: f64) -> Option<SeriesCoefficients> {
+        let mut coefficients = tanh_series(x0, epsilon, max_terms);
+        for a in coefficients.iter_mut() {
+            *a *= self.x_jp_sat * gain;
+        }
+        Some(coefficients)
+    }
+}
+
+/// Most terms [`tanh_series`] computes (the length of its table of reciprocals).
+pub const TANH_SERIES_TERMS: usize = 64;
+
+/// 1/(n + 1) for the series recurrence: a multiplication per term instead of a division.
+const RECIPROCALS: [f64; TANH_SERIES_TERMS] = {
+    let mut table = [0.0; TANH_SERIES_TERMS];
+    let mut n = 0;
+    while n < TANH_SERIES_TERMS {
+        table[n] = 1.0 / (n as f64 + 1.0);
+        n += 1;
+    }
+    table
+};
+
+/// Coefficients aₙ = cₙ εⁿ of tanh(x0 + ε r) = Σ aₙ rⁿ, truncated where they stop mattering
+/// (at most [`TANH_SERIES_TERMS`]). They converge for |ε| below the distance to tanh's
+/// nearest pole, [`TanhSaturation::series_radius`].
+pub fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> SeriesCoefficients {
+    let max_terms = max_terms.min(TANH_SERIES_TERMS);
+    // The terms go to an array first, and to the small vector whole (indexing a SmallVec
+    // checks where it lives at every element); only a series longer than the array spills.
+    let mut inline = [0.0; SERIES_INLINE_TERMS];
+    inline[0] = x0.tanh();
+    if epsilon == 0.0 {
+        return SeriesCoefficients::from_buf_and_len(inline, 1);
+    }
+    let converged = |terms: &[f64]| match terms {
+        [.., before, last] => terms.len() > 3 && last.abs() < 1e-17 && before.abs() < 1e-17,
+        _ => false,
+    };
+    let mut count = 1;
+    while count < max_terms.min(SERIES_INLINE_TERMS) {
+        inline[count] = next_tanh_term(&inline[..count], epsilon);
+        count += 1;
+        if converged(&inline[..count]) {
+            return SeriesCoefficients::from_buf_and_len(inline, count);
+        }
+    }
+    if count == max_terms {
+        return SeriesCoefficients::from_buf_and_len(inline, count);
+    }
+    let mut spilled = SeriesCoefficients::from_slice(&inline);
+    while spilled.len() < max_terms {
+        let term = next_tanh_term(&spilled, epsilon);
+        spilled.push(term);
+        if converged(&spilled) {
+            break;
+        }
+    }
+    spilled
+}
+
+/// The next coefficient of [`tanh_series`] from `terms` a₀ … aₙ: y' = 1 − y² in the
+/// variable εr gives (n+1) a_{n+1} = ε ([n = 0] − Σ_{k=0}^{n} a_k a_{n−k}). The newest term
+/// aₙ enters the sum only as 2a₀aₙ: the rest (pairs folded in half, over two accumulators)
+/// does not wait for it, so each term is three dependent operations after the one before.
+#[inline]
+fn next_tanh_term(terms: &[f64], epsilon: f64) -> f64 {
+    let n = terms.len() - 1;
+    let scale = epsilon * RECIPROCALS[n];
+    if n == 0 {
+        return (1.0 - terms[0] * terms[0]) * scale;
+    }
+    // a_1 … a_{n−1}, paired from both ends.
+    let inner = &terms[1..n];
+    let (low, high) = inner.split_at(inner.len() / 2);
+    let (mut even, mut odd) = (0.0, 0.0);
+    let mut pairs = low.iter().zip(high.iter().rev());
+    while let Some((a, b)) = pairs.next() {
+        even += a * b;
+        if let Some((a, b)) = pairs.next() {
+            odd += a * b;
+        }
+    }
+    let middle = if inner.len() % 2 == 1 {
+        inner[inner.len() / 2] * inner[inner.len() / 2]
+    } else {
+        0.0
+    };
+    let older = 2.0 * (even + odd) + middle;
+    -((2.0 * terms[0]) * terms[n] + older) * scale
+}
+
+/// The jet pipe's linear dynamics, (2.6): X(s)/X̄(s) = ω1/(s+ω1) · ω2²/(s² + 2ζ2ω2 s + ω2²),
+/// i.e. X/X̄ = c4 / (s³ + c2 s² + c3 s + c4) with Appendix A's c2..c4, unity gain at DC.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearDynamics {
+    pub omega_1: f64,
+    pub omega_2: f64,
+    pub zeta_2: f64,
+}
+
+/// (2.6) in modal form: X/X̄ = Σ_k r_k / (s − λk) with distinct poles λk, so each modal
+/// coordinate obeys q_k' = λk q_k + r_k x̄ and x = Re Σ q_k.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Modes {
+    /// λ1 = −ω1 and the pair −ζ2ω2 ± jω2√(1−ζ2²) (real for ζ2 ≥ 1).
+    pub poles: [Complex<f64>; 3],
+    /// Residues r_k of X/X̄ at the poles: the modes' input gains.
+    pub residues: [Complex<f64>; 3],
+    /// Rows of V⁻¹, V = `[[1,1,1],[λ1,λ2,λ3],[λ1²,λ2²,λ3²]]`: the modal coordinates of a state
+    /// [x, ẋ, ẍ] are q = V⁻¹ [x, ẋ, ẍ].
+    pub from_state: [[Complex<f64>; 3]; 3],
+}
+
+impl LinearDynamics {
+    pub fn new(omega_1: f64, omega_2: f64, zeta_2: f64) -> Self {
+        Self {
+            omega_1,
+            omega_2,
+            zeta_2,
+        }
+    }
+
+    pub fn from_parameters(p: &Parameters) -> Self {
+        Self::new(p.omega_1, p.omega_2, p.zeta_2)
+    }
+
+    /// [c2, c3, c4] of the characteristic polynomial s³ + c2 s² + c3 s + c4 (Appendix A):
+    /// c2 = 2ζ2ω2 + ω1, c3 = ω2² + 2ζ2ω1ω2, c4 = ω1ω2², also the numerator's gain.
+    pub fn coefficients(&self) -> [f64; 3] {
+        let (omega_1, omega_2, zeta_2) = (self.omega_1, self.omega_2, self.zeta_2);
+        let c2 = 2.0 * zeta_2 * omega_2 + omega_1;
+        let c3 = omega_2 * omega_2 + 2.0 * zeta_2 * omega_1 * omega_2;
+        let c4 = omega_1 * omega_2 * omega_2;
+        [c2, c3, c4]
+    }
+
+    /// The gain b of the input in x''' = … + b x̄: the numerator ω1ω2² of X/X̄.
+    pub fn input_gain(&self) -> f64 {
+        self.omega_1 * self.omega_2 * self.omega_2
+    }
+
+    /// X/X̄ at s = 0: the numerator over c4, 1 (the jet pipe rests at x̄).
+    pub fn dc_gain(&self) -> f64 {
+        self.input_gain() / self.coefficients()[2]
+    }
+
+    /// Third derivative of the tip position, (2.6) in state form:
+    /// x''' = c4 (x̄ − x) − c2 x'' − c3 x'.
+    pub fn third_derivative(&self, static_position: f64, position: f64, velocity: f64, acceleration: f64) -> f64 {
+        let [c2, c3, c4] = self.coefficients();
+        c4 * (static_position - position) - c2 * acceleration - c3 * velocity
+    }
+
+    /// The roots of the characteristic polynomial: −ω1 and −ζ2ω2 ± jω2√(1−ζ2²) (a complex
+    /// pair for ζ2 < 1, two real poles −ζ2ω2 ± ω2√(ζ2²−1) otherwise).
+    pub fn poles(&self) -> [Complex<f64>; 3] {
+        let (omega_2, zeta_2) = (self.omega_2, self.zeta_2);
+        let real = Complex::new(-self.omega_1, 0.0);
+        if zeta_2 < 1.0 {
+            let damped = omega_2 * (1.0 - zeta_2 * zeta_2).sqrt();
+            [
+                real,
+                Complex::new(-zeta_2 * omega_2, damped),
+                Complex::new(-zeta_2 * omega_2, -damped),
+            ]
+        } else {
+            let spread = omega_2 * (zeta_2 * zeta_2 - 1.0).sqrt();
+            [
+                real,
+                Complex::new(-zeta_2 * omega_2 + spread, 0.0),
+                Complex::new(-zeta_2 * omega_2 - spread, 0.0),
+            ]
+        }
+    }
+
+    /// The modal form, `None` when two poles (nearly) coincide (e.g. ζ2 = 1, or ω1 on the
+    /// second-order pair): then it does not exist.
+    pub fn modes(&self) -> Option<Modes> {
+        let poles = self.poles();
+        let scale = poles.iter().map(|l| l.norm()).fold(0.0, f64::max);
+        for a in 0..3 {
+            for b in a + 1..3 {
+                if (poles[a] - poles[b]).norm() < 1e-6 * scale {
+                    return None;
+                }
+            }
+        }
+        // Inverse of the Vandermonde matrix: row k holds the coefficients of the Lagrange
+        // polynomial ℓ_k(s) = Π_{j≠k} (s − λj)/(λk − λj), i.e. [λaλb, −(λa+λb), 1]/den.
+        let one = Complex::new(1.0, 0.0);
+        let mut from_state = [[Complex::new(0.0, 0.0); 3]; 3];
+        for k in 0..3 {
+            let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+            let den = (poles[k] - poles[a]) * (poles[k] - poles[b]);
+            from_state[k] = [poles[a] * poles[b] / den, -(poles[a] + poles[b]) / den, one / den];
+        }
+        // r_k = b / Π_{j≠k}(λk − λj): the last column of V⁻¹ times the input gain.
+        let gain = self.input_gain();
+        let residues = [
+            from_state[0][2] * gain,
+            from_state[1][2] * gain,
+            from_state[2][2] * gain,
+        ];
+        Some(Modes {
+            poles,
+            residues,
+            from_state,
+        })
+    }
 }
 
 /// Absolute tip position relative to the receiver centre, (2.7).
@@ -47,19 +315,89 @@ mod tests {
 
     #[test]
     fn static_curve_is_odd_saturating_and_has_the_documented_slope() {
-        let (xs, fs) = (0.5e-3, 0.45);
-        assert_eq!(static_position(xs, fs, 0.0), 0.0);
-        assert!((static_position(xs, fs, 0.3) + static_position(xs, fs, -0.3)).abs() < 1e-18);
-        assert!(static_position(xs, fs, 100.0) <= xs);
+        let f3 = TanhSaturation::new(0.5e-3, 0.45);
+        let xs = f3.x_jp_sat;
+        assert_eq!(f3.value(0.0), 0.0);
+        assert!((f3.value(0.3) + f3.value(-0.3)).abs() < 1e-18);
+        assert!(f3.value(100.0) <= xs);
         let h = 1e-7;
-        let numeric = (static_position(xs, fs, 0.2 + h) - static_position(xs, fs, 0.2 - h)) / (2.0 * h);
-        assert!((numeric - static_position_slope(xs, fs, 0.2)).abs() < 1e-9);
+        let numeric = (f3.value(0.2 + h) - f3.value(0.2 - h)) / (2.0 * h);
+        assert!((numeric - f3.slope(0.2)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn tanh_series_matches_tanh() {
+        for (x0, eps) in [(0.0, 0.3), (0.7, -0.5), (-1.2, 0.6), (2.0, 0.05)] {
+            let a = tanh_series(x0, eps, 64);
+            for r in [0.0f64, 0.3, 0.9, 1.0] {
+                let sum: f64 = a.iter().enumerate().map(|(n, c)| c * r.powi(n as i32)).sum();
+                assert!((sum - (x0 + eps * r).tanh()).abs() < 1e-13, "x0 {x0} eps {eps} r {r}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_curves_series_are_its_values_within_the_radius() {
+        let f3 = TanhSaturation::new(0.5e-3, 0.45);
+        for (force, change) in [(0.1, 0.2), (-0.3, 0.25), (0.9, -0.4)] {
+            let x0 = f3.argument(force);
+            let epsilon = f3.argument(change);
+            assert!(epsilon.abs() < 0.5 * f3.series_radius(x0).unwrap());
+            let a = f3.series(x0, epsilon, 64, 0.5).unwrap();
+            for r in [0.0f64, 0.5, 1.0] {
+                let sum: f64 = a.iter().enumerate().map(|(n, c)| c * r.powi(n as i32)).sum();
+                let exact = 0.5 * f3.value(force + change * r);
+                assert!((sum - exact).abs() < 1e-13 * f3.x_jp_sat, "{force} {change} {r}");
+            }
+        }
+        // The radius is the distance to the poles at ±iπ/2: tanh's series about 0 has
+        // coefficients falling like (2/π)ⁿ.
+        assert!((f3.series_radius(0.0).unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
     }
 
     #[test]
     fn dynamics_have_unity_dc_gain() {
+        let dynamics = LinearDynamics::new(973.9, 1856.7, 0.019);
         // At rest at the static position every derivative vanishes.
-        assert_eq!(third_derivative(973.9, 1856.7, 0.019, 1e-4, 1e-4, 0.0, 0.0), 0.0);
-        assert!(third_derivative(973.9, 1856.7, 0.019, 1e-4, 0.0, 0.0, 0.0) > 0.0);
+        assert_eq!(dynamics.third_derivative(1e-4, 1e-4, 0.0, 0.0), 0.0);
+        assert!(dynamics.third_derivative(1e-4, 0.0, 0.0, 0.0) > 0.0);
+        assert_eq!(dynamics.dc_gain(), 1.0);
+        // The modes' static responses −r_k/λk add up to the DC gain.
+        let modes = dynamics.modes().unwrap();
+        let dc: f64 = (0..3).map(|k| (-modes.residues[k] / modes.poles[k]).re).sum();
+        assert!((dc - 1.0).abs() < 1e-12, "{dc}");
+    }
+
+    #[test]
+    fn poles_are_the_roots_of_the_characteristic_polynomial_and_modes_its_partial_fractions() {
+        for zeta in [0.019, 0.7, 1.0, 2.5] {
+            let dynamics = LinearDynamics::new(973.9, 1856.7, zeta);
+            let [c2, c3, c4] = dynamics.coefficients();
+            for l in dynamics.poles() {
+                let residual = ((l + c2) * l + c3) * l + c4;
+                assert!(residual.norm() < 1e-9 * c4, "ζ2 {zeta}: {l} leaves {residual}");
+            }
+            let modes = match dynamics.modes() {
+                Some(modes) => modes,
+                None => {
+                    assert_eq!(zeta, 1.0, "only the critically damped pair coincides");
+                    continue;
+                }
+            };
+            // Σ r_k/(s − λk) is the transfer function c4/(s³ + c2 s² + c3 s + c4) ...
+            let s = Complex::new(-300.0, 2000.0);
+            let fractions: Complex<f64> = (0..3).map(|k| modes.residues[k] / (s - modes.poles[k])).sum();
+            let transfer = c4 / (((s + c2) * s + c3) * s + c4);
+            assert!((fractions - transfer).norm() < 1e-12 * transfer.norm(), "ζ2 {zeta}");
+            // ... and V⁻¹ inverts the Vandermonde matrix of the poles.
+            for (row, inverse) in modes.from_state.iter().enumerate() {
+                for column in 0..3 {
+                    let l = modes.poles[column];
+                    let product = inverse[0] + inverse[1] * l + inverse[2] * l * l;
+                    let expected = if row == column { 1.0 } else { 0.0 };
+                    assert!((product - expected).norm() < 1e-12, "ζ2 {zeta} ({row}, {column})");
+                }
+            }
+        }
     }
 }

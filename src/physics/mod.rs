@@ -1,5 +1,8 @@
 //! The actuator's physics, one module per physical part, in plain Rust (no FFI types).
 //! Equation numbers are those of P.D. Henri's 1994 thesis; `MODEL.md` corrects its slips.
+//! Each equation is stated once, here: the exact propagator (`crate::electromechanics`)
+//! takes the current driver, f3 and the jet pipe's linear dynamics from `current_driver`
+//! and `jet_pipe` rather than deriving them again.
 //!
 //! | part | module | equations |
 //! |---|---|---|
