@@ -1,5 +1,5 @@
-//! The FMI 2.0 Co-Simulation functions, generic over the model. `crate::fmu_exports`
-//! forwards each exported C symbol to one of these.
+//! The FMI 2.0 Co-Simulation functions, generic over the model. The exported C symbols
+//! (`fmi2_cosimulation_exports!`, or a model crate's literal forwarders) forward to these.
 //!
 //! Every function that takes an instance:
 //! * returns fmi2Error for a NULL, freed or foreign instance: the handle is looked up in
@@ -842,7 +842,7 @@ pub unsafe fn serialize_fmu_state<M: CoSimModel>(
     })
 }
 
-/// `fmi2DeSerializeFMUstate`: parse and check the bytes (see [`crate::fmi2::fmu_state`]).
+/// `fmi2DeSerializeFMUstate`: parse and check the bytes (see [`crate::fmu_state`]).
 ///
 /// # Safety
 /// `bytes` must hold `size` bytes; `state` must point to NULL or to an FMU state.

@@ -3,8 +3,9 @@
 //!
 //! # Using it
 //! * Implement [`model::CoSimModel`] (variable table in a [`model::ModelInfo`]).
-//! * Point `crate::ExportedModel` (in `lib.rs`) at the type: the literal C symbols in
-//!   `crate::fmu_exports` forward to [`api`] instantiated for it.
+//! * Export the `fmi2*` C symbols as forwarders to [`api`] instantiated for the type: with
+//!   [`fmi2_cosimulation_exports!`] in the model's cdylib crate (the actuator's crate,
+//!   `crates/fmu`, writes the same forwarders out literally for cbindgen).
 //! * Write `modelDescription.xml` with
 //!   [`model_description::model_description_xml`]`(M::info())` (panics on a broken
 //!   table; [`model_description::try_model_description_xml`] returns the problems).
@@ -19,6 +20,7 @@
 //! * [`fmu_state`]: FMU-state snapshots and their checksummed byte format.
 //! * [`model_description`]: the XML generator and table validation.
 //! * [`testing`]: a dummy first-order-lag model for tests.
+//! * [`fmi2_cosimulation_exports!`]: the exported `fmi2*` symbols for a model.
 //!
 //! # Known limits
 //! * Instances and FMU states are recorded in a process-wide registry of live handles
@@ -36,6 +38,7 @@
 //!   stops at the first value the model rejects, earlier values stay set.
 
 pub mod api;
+mod exports_macro;
 pub mod fmu_state;
 pub mod instance;
 pub mod model;

@@ -352,3 +352,27 @@ impl CoSimModel for DummyModel {
         Ok(())
     }
 }
+
+/// A copy of `i` (a `ModelInfo` holds its GUID cache, so it is not `Clone`), for tests that
+/// change some fields: `ModelInfo { variables: ..., ..clone_info(M::info()) }`.
+pub fn clone_info(i: &ModelInfo) -> ModelInfo {
+    ModelInfo {
+        model_name: i.model_name,
+        model_identifier: i.model_identifier,
+        description: i.description,
+        author: i.author,
+        version: i.version,
+        generation_tool: i.generation_tool,
+        default_start_time: i.default_start_time,
+        default_stop_time: i.default_stop_time,
+        default_tolerance: i.default_tolerance,
+        default_step_size: i.default_step_size,
+        log_categories: i.log_categories,
+        units: i.units,
+        variables: i.variables,
+        can_interpolate_inputs: i.can_interpolate_inputs,
+        extent: i.extent,
+        dependencies: i.dependencies,
+        guid_cache: super::model::GuidCache::new(),
+    }
+}
