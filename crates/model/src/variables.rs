@@ -1,7 +1,8 @@
 //! The FMU's variable table: one row per variable. The model description, the getters
-//! and the setters all come from here, so they cannot drift apart.
+//! and the setters all come from here (the FMU crate turns the rows into FMI variables), so
+//! they cannot drift apart.
 
-use crate::fmi2::model::{Causality, UnitDefinition, VarType, Variability, Variable};
+pub use crate::variable::{Causality, VarType, Variability, Variable};
 
 /// Value references, named so code never uses bare numbers.
 pub mod vr {
@@ -97,208 +98,8 @@ pub mod vr {
     pub const X_JP_OFFSET_DRIFT: u32 = 494;
 }
 
-pub const UNITS: &[UnitDefinition] = &[
-    UnitDefinition {
-        name: "V",
-        kg: 1,
-        m: 2,
-        s: -3,
-        a: -1,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "m",
-        kg: 0,
-        m: 1,
-        s: 0,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "N",
-        kg: 1,
-        m: 1,
-        s: -2,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "Pa",
-        kg: 1,
-        m: -1,
-        s: -2,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "A",
-        kg: 0,
-        m: 0,
-        s: 0,
-        a: 1,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "K",
-        kg: 0,
-        m: 0,
-        s: 0,
-        a: 0,
-        k: 1,
-    },
-    UnitDefinition {
-        name: "J/(kg.K)",
-        kg: 0,
-        m: 2,
-        s: -2,
-        a: 0,
-        k: -1,
-    },
-    UnitDefinition {
-        name: "A/V",
-        kg: -1,
-        m: -2,
-        s: 3,
-        a: 2,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "rad/s",
-        kg: 0,
-        m: 0,
-        s: -1,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "N/A",
-        kg: 1,
-        m: 1,
-        s: -2,
-        a: -1,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "m2",
-        kg: 0,
-        m: 2,
-        s: 0,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "N/m",
-        kg: 1,
-        m: 0,
-        s: -2,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "1",
-        kg: 0,
-        m: 0,
-        s: 0,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "m3",
-        kg: 0,
-        m: 3,
-        s: 0,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "s",
-        kg: 0,
-        m: 0,
-        s: 1,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "Pa.s/kg",
-        kg: 0,
-        m: -1,
-        s: -1,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "m/N",
-        kg: -1,
-        m: 0,
-        s: 2,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "1/N",
-        kg: -1,
-        m: -1,
-        s: 2,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "1/N2",
-        kg: -2,
-        m: -2,
-        s: 4,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "N/s",
-        kg: 1,
-        m: 1,
-        s: -3,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "Hz",
-        kg: 0,
-        m: 0,
-        s: -1,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "N.s/m",
-        kg: 1,
-        m: 0,
-        s: -1,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "Pa/s",
-        kg: 1,
-        m: -1,
-        s: -3,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "m/s",
-        kg: 0,
-        m: 1,
-        s: -1,
-        a: 0,
-        k: 0,
-    },
-    UnitDefinition {
-        name: "A/s",
-        kg: 0,
-        m: 0,
-        s: -1,
-        a: 1,
-        k: 0,
-    },
-];
+/// The D/A converter's range: a command outside it is refused.
+pub const V_DA_RANGE: (f64, f64) = (-10.0, 10.0);
 
 /// One row of the table: the FMI variable (name, value reference, unit, start, `min`/`max` as
 /// the model description declares them, description) with what the model description cannot
@@ -908,15 +709,14 @@ const fn variables_of(rows: &[Row]) -> [Variable; N_VARIABLES] {
 
 const VARIABLE_ARRAY: [Variable; N_VARIABLES] = variables_of(TABLE);
 
-/// The FMI variables of [`TABLE`], in its order: what the model description, the getters and
-/// the setters of the FMI layer see.
+/// The variables of [`TABLE`], in its order (the FMU crate's `variables::VARIABLES` are these
+/// as the FMI layer's variables: what the model description, the getters and the setters see).
 pub const VARIABLES: &[Variable] = &VARIABLE_ARRAY;
 
 /// The interface table of docs/model.md, in Markdown (`jetpipe parameters` prints it; a test
 /// checks that the docs carry it unchanged): every variable with its causality, unit, start
 /// value, limits, thesis reference, meaning and the reason for its limits.
 pub fn interface_table() -> String {
-    use crate::fmi2::model::{Causality, VarType};
     let mut out = String::from(
         "| name | causality | unit | start | limits | thesis | meaning | why the limits |\n|---|---|---|---|---|---|---|---|\n",
     );
@@ -941,7 +741,7 @@ pub fn interface_table() -> String {
                 format!("in ({}, {}) m with the default geometry", number(lo), number(hi))
             }
             vr::V_DA => {
-                let (lo, hi) = crate::fmu::V_DA_RANGE;
+                let (lo, hi) = V_DA_RANGE;
                 format!("in [{}, {}] V", number(lo), number(hi))
             }
             _ => row.limits_text(),
@@ -969,7 +769,7 @@ mod tests {
     #[test]
     fn every_start_value_is_inside_its_own_limits() {
         for row in TABLE {
-            if row.variable.causality != crate::fmi2::model::Causality::Output {
+            if row.variable.causality != Causality::Output {
                 row.check(row.variable.start)
                     .unwrap_or_else(|e| panic!("the start value of {}: {e}", row.variable.name));
             }
@@ -1014,7 +814,7 @@ mod tests {
 
     #[test]
     fn the_docs_carry_the_interface_table() {
-        let docs = include_str!("../docs/model.md");
+        let docs = include_str!("../../../docs/model.md");
         assert!(
             docs.contains(&interface_table()),
             "docs/model.md's interface table is stale: replace it with the output of `cargo run --release --bin jetpipe -- parameters`"
