@@ -1,14 +1,14 @@
 //! The actuator behind the generic FMI layer: maps the variable table onto the physics
 //! and the simulation driver. No FFI types here.
 
-use crate::fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
-use crate::physics::actuator::{index, Actuator, State, N_STATES};
-use crate::physics::command_stage::CommandStage;
-use crate::physics::effects::PLAY_OPERATORS;
-use crate::physics::force_sensor::SensorMemory;
-use crate::physics::parameters::{variable_name, Parameters};
-use crate::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 use crate::variables::{vr, UNITS, VARIABLES};
+use fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
+use jetpipe_model::physics::actuator::{index, Actuator, State, N_STATES};
+use jetpipe_model::physics::command_stage::CommandStage;
+use jetpipe_model::physics::effects::PLAY_OPERATORS;
+use jetpipe_model::physics::force_sensor::SensorMemory;
+use jetpipe_model::physics::parameters::{variable_name, Parameters};
+use jetpipe_model::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logEvents", "initialisation, resets and state restores"),
@@ -19,8 +19,7 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logAll", "every message"),
 ];
 
-/// The D/A converter's range: a command outside it is refused.
-pub const V_DA_RANGE: (f64, f64) = (-10.0, 10.0);
+pub use jetpipe_model::variables::V_DA_RANGE;
 
 /// `min`, `max` and `nominal` of the model description. Parameters: the bounds that
 /// `Parameters::set` enforces (FMI has no open bounds, so "> 0" is `min="0"`) and the
@@ -187,7 +186,7 @@ pub struct ActuatorFmu {
 }
 
 fn start(value_reference: u32) -> f64 {
-    crate::physics::parameters::table_start(value_reference)
+    jetpipe_model::physics::parameters::table_start(value_reference)
 }
 
 impl ActuatorFmu {
@@ -198,7 +197,7 @@ impl ActuatorFmu {
         let mut simulation = if self.start_at_equilibrium {
             Simulation::at_equilibrium(model, self.v_da, self.x_s, self.start_time, self.tolerance)?
         } else {
-            let mut state = crate::simulation::equilibrium_of_electromechanics(&model, self.v_da);
+            let mut state = jetpipe_model::simulation::equilibrium_of_electromechanics(&model, self.v_da);
             state[index::P1] = self.p1_start;
             state[index::P2] = self.p2_start;
             Simulation::from_state(model, state, self.v_da, self.x_s, self.start_time, self.tolerance)
@@ -298,7 +297,7 @@ impl CoSimModel for ActuatorFmu {
                 None => Err(format!("x_s = {value} m is invalid: must be finite")),
             },
             vr::P1_START | vr::P2_START => {
-                crate::variables::check(value_reference, value)?;
+                jetpipe_model::variables::check(value_reference, value)?;
                 if value_reference == vr::P1_START {
                     self.p1_start = value;
                 } else {
@@ -760,7 +759,7 @@ mod tests {
 
     #[test]
     fn declared_dependencies_are_what_perturbations_show() {
-        let report = crate::fmi2::structure_check::check_dependencies::<ActuatorFmu>(1e-3);
+        let report = fmi2::structure_check::check_dependencies::<ActuatorFmu>(1e-3);
         assert!(report.problems.is_empty(), "{:#?}", report.problems);
         // Only the stopper acts within a step, on the pressures and the forces.
         let mut pairs = report.step_pairs.clone();
@@ -781,7 +780,7 @@ mod tests {
         let info = ActuatorFmu::info();
         let mut checked = 0;
         for v in info.variables {
-            if v.var_type != crate::fmi2::model::VarType::Real || v.causality == crate::fmi2::model::Causality::Output {
+            if v.var_type != fmi2::model::VarType::Real || v.causality == fmi2::model::Causality::Output {
                 continue;
             }
             let e = info.extent_of(v);
@@ -805,7 +804,7 @@ mod tests {
                 assert!(
                     message.contains(v.name)
                         && (message.contains(&format!("{outside}"))
-                            || message.contains(&crate::variables::number(outside))),
+                            || message.contains(&jetpipe_model::variables::number(outside))),
                     "{message}"
                 );
                 let mut fmu = ActuatorFmu::instantiate();
@@ -820,7 +819,7 @@ mod tests {
     #[test]
     fn nominals_are_positive_and_ranges_hold_the_defaults() {
         let info = ActuatorFmu::info();
-        crate::fmi2::model_description::validate_model_info(info).unwrap();
+        fmi2::model_description::validate_model_info(info).unwrap();
         let x_s = info.variables.iter().find(|v| v.value_reference == vr::X_S).unwrap();
         let e = info.extent_of(x_s);
         // The default geometry: the stopper between the support and the piston's travel.

@@ -1,14 +1,14 @@
 //! The exported FMI 2.0 Co-Simulation symbols. Each is a thin forwarder to the generic
-//! implementation in [`crate::fmi2::api`], instantiated for [`crate::ExportedModel`].
+//! implementation in [`fmi2::api`], instantiated for [`crate::ExportedModel`].
 //! Written out literally (no macros) so that cbindgen can read this file.
 #![allow(non_snake_case, clippy::missing_safety_doc)]
 
-use crate::fmi2::api;
-use crate::fmi2::types::{
+use crate::ExportedModel;
+use fmi2::api;
+use fmi2::types::{
     fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status,
     fmi2StatusKind, fmi2String, fmi2Type, fmi2ValueReference,
 };
-use crate::ExportedModel;
 use std::os::raw::c_char;
 
 // ---- Common functions ----------------------------------------------------------------

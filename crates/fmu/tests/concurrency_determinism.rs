@@ -15,8 +15,8 @@ use std::sync::Barrier;
 use std::time::Instant;
 
 use common::*;
-use jetpipe::fmi2::fmu_state::crc32;
-use jetpipe::fmi2::types::*;
+use fmi2::fmu_state::crc32;
+use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 

@@ -5,8 +5,8 @@
 use std::ffi::{CStr, CString};
 use std::ptr::{null, null_mut};
 
-use jetpipe::fmi2::model::CoSimModel;
-use jetpipe::fmi2::types::*;
+use fmi2::model::CoSimModel;
+use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::ExportedModel;
 
@@ -53,5 +53,59 @@ fn exported_symbols_drive_a_simulation() {
         fmi2FreeInstance(c);
         fmi2FreeInstance(null_mut());
         assert_eq!(fmi2DoStep(null_mut(), 0.0, 1.0, 0), fmi2Error);
+    }
+}
+
+// `fmi2::fmi2_cosimulation_exports!` (crates/fmi2/src/exports_macro.rs) must emit exactly the
+// signatures of the literal exports that cbindgen reads (src/fmu_exports.rs).
+
+/// The exported items of `text` (from the first `#[no_mangle]` after `begin` up to `stop`), with the
+/// paths the macro needs and the formatting removed, so the two files compare as code.
+fn exported_items(text: &str, begin: &str, stop: &str) -> Vec<String> {
+    let from = text.find(begin).expect("no begin marker");
+    let start = from + text[from..].find("#[no_mangle]").expect("no exported item");
+    let end = text[start..].find(stop).map_or(text.len(), |i| start + i);
+    let code: String = text[start..end]
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//") && !l.trim_start().starts_with("#[allow("))
+        .collect::<Vec<_>>()
+        .join("\n")
+        .replace("$crate::types::", "")
+        .replace("$crate::", "")
+        .replace("::std::os::raw::", "")
+        .replace("$model", "ExportedModel")
+        .split_whitespace()
+        .collect();
+    code.replace(",)", ")")
+        .split("#[no_mangle]")
+        .filter(|item| !item.is_empty())
+        .map(|item| item.trim_end_matches(['}', ';']).to_string())
+        .collect()
+}
+
+#[test]
+fn macro_signatures_are_the_literal_exports() {
+    let literal = exported_items(
+        include_str!("../src/fmu_exports.rs"),
+        "use crate::ExportedModel;",
+        "\u{0}",
+    );
+    let generated = exported_items(
+        include_str!("../../fmi2/src/exports_macro.rs"),
+        "macro_rules!",
+        "\n    };\n}",
+    );
+    assert_eq!(
+        literal.len(),
+        34,
+        "src/fmu_exports.rs should export the 34 FMI 2.0 Co-Simulation functions"
+    );
+    assert_eq!(
+        literal.len(),
+        generated.len(),
+        "the macro and src/fmu_exports.rs export different counts"
+    );
+    for (a, b) in literal.iter().zip(&generated) {
+        assert_eq!(a, b, "the macro's item differs from src/fmu_exports.rs");
     }
 }

@@ -5,7 +5,7 @@
 //! calls with valid and invalid arguments (NULL pointers, unknown value references,
 //! zero-length arrays, NaN, wrong sizes, corrupted and crafted FMU states, freed handles).
 //! A mirror of the state machine predicts each status from the legality table
-//! (`jetpipe::fmi2::state`) and the arguments; after every call the test checks:
+//! (`fmi2::state`) and the arguments; after every call the test checks:
 //! * illegal call -> fmi2Error and the message "fmi2Xxx: illegal call in state yyy";
 //! * legal call -> the predicted status (OK / Error / Discard), never fmi2Fatal;
 //! * every fmi2Error / fmi2Discard comes with a logged message of that status that names
@@ -35,9 +35,9 @@ use std::time::Instant;
 type Tally = BTreeMap<(&'static str, &'static str), [u32; 5]>;
 
 use common::*;
-use jetpipe::fmi2::fmu_state::crc32;
-use jetpipe::fmi2::state::{Function, State};
-use jetpipe::fmi2::types::*;
+use fmi2::fmu_state::crc32;
+use fmi2::state::{Function, State};
+use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::{vr, VARIABLES};
 
@@ -875,7 +875,7 @@ impl Fuzz {
         };
         let known = VARIABLES
             .iter()
-            .any(|v| v.value_reference == r && v.var_type == jetpipe::fmi2::model::VarType::Real);
+            .any(|v| v.value_reference == r && v.var_type == fmi2::model::VarType::Real);
         let before = if known { self.readback(r) } else { f64::NAN };
         let (d, s) = match self.rng.below(6) {
             0 => ("fmi2SetReal(vr NULL, 1)".to_string(), fmi2SetReal(c, null(), 1, &x)),

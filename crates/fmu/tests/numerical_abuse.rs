@@ -21,10 +21,10 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use common::*;
-use jetpipe::fmi2::types::*;
+use fmi2::types::*;
 use jetpipe::fmu_exports::*;
-use jetpipe::physics::parameters::Parameters;
 use jetpipe::variables::{vr, VARIABLES};
+use jetpipe_model::physics::parameters::Parameters;
 
 const RTOL: f64 = 1e-6;
 /// Commands cycled through in the sweeps. Kept on one side of 0 V: a command reversal

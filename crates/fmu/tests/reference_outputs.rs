@@ -19,7 +19,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use common::*;
-use jetpipe::fmi2::types::*;
+use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 
@@ -49,7 +49,7 @@ const STANDARD: Scenario = Scenario {
     name: "standard",
     step: 0.01,
     steps: 1000,
-    inputs: jetpipe::scenario::standard_inputs,
+    inputs: jetpipe_model::scenario::standard_inputs,
 };
 
 /// The chirp of the benchmarks (`benches/common/scenarios.rs`): v_DA = 2.5 + 1.5 sin φ(t),

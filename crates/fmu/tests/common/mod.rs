@@ -7,10 +7,10 @@ use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
 use std::sync::Mutex;
 
-use jetpipe::fmi2::instance::Instance;
-use jetpipe::fmi2::model::CoSimModel;
-use jetpipe::fmi2::state::State;
-use jetpipe::fmi2::types::*;
+use fmi2::instance::Instance;
+use fmi2::model::CoSimModel;
+use fmi2::state::State;
+use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 use jetpipe::ExportedModel;
