@@ -11,7 +11,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use jetpipe::physics::actuator::{index, Actuator, Inputs, State};
+use jetpipe_model::physics::actuator::{index, Actuator, Inputs, State};
 
 #[path = "common/scenarios.rs"]
 mod scenarios;

@@ -18,8 +18,8 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::hint::black_box;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
-use jetpipe::physics::actuator::{index, Inputs, State};
-use jetpipe::simulation::Simulation;
+use jetpipe_model::physics::actuator::{index, Inputs, State};
+use jetpipe_model::simulation::Simulation;
 
 #[path = "../benches/common/scenarios.rs"]
 mod scenarios;

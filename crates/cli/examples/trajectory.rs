@@ -9,8 +9,8 @@
 //! the given state; `--step` below 10 ms divides each sample into communication steps (the
 //! inputs stay held), which a tight reference run uses.
 
-use jetpipe::scenario;
-use jetpipe::simulation::{Method, Simulation};
+use jetpipe_model::scenario;
+use jetpipe_model::simulation::{Method, Simulation};
 
 #[path = "../benches/common/scenarios.rs"]
 mod scenarios;

@@ -9,8 +9,8 @@
 
 use nalgebra::{Complex, SMatrix, SVector};
 
-use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, State, N_STATES};
-use crate::simulation::equilibrium;
+use jetpipe_model::physics::actuator::{index, Actuator, Inputs, Jacobian, State, N_STATES};
+use jetpipe_model::simulation::equilibrium;
 
 /// The operating point of a linearisation.
 #[derive(Clone, Debug, PartialEq)]
@@ -210,7 +210,7 @@ pub fn operating_state(model: &Actuator, op: &OperatingPoint) -> Result<State, S
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::parameters::Parameters;
+    use jetpipe_model::physics::parameters::Parameters;
 
     fn at_45_newtons() -> LinearModel {
         let model = Actuator::new(Parameters::default()).unwrap();

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::diagnosis::Diagnosis;
-use crate::recording::Recording;
+use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::Diagnosis;
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));

@@ -1,4 +1,4 @@
-//! `jetpipe sweep`: the standard scenario ([`crate::scenario`]) for every point of a
+//! `jetpipe sweep`: the standard scenario ([`jetpipe_model::scenario`]) for every point of a
 //! parameter grid, spread over threads, with one CSV row per run and a measured speed-up.
 //!
 //! * Parameters are named as in the FMU's variable table (`C_d`, `P_s`, ...), so a sweep
@@ -17,12 +17,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use crate::fmi2::model::{Causality, VarType};
-use crate::physics::actuator::Actuator;
-use crate::physics::parameters::Parameters;
-use crate::scenario;
-use crate::simulation::{Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
-use crate::variables::VARIABLES;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::scenario;
+use jetpipe_model::simulation::{Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+use jetpipe_model::variables::VARIABLES;
+use jetpipe_model::variables::{Causality, VarType};
 
 /// More runs than this is almost certainly a typo in a grid count (e.g. `:1000` twice); every
 /// point's parameters are built up front (about 300 bytes each).
@@ -823,7 +823,7 @@ mod tests {
     #[test]
     fn the_sweep_refuses_with_the_message_of_the_table() {
         let e = refusal("k_spring=1e30");
-        let table = crate::variables::check(crate::variables::vr::K_SPRING, 1e30).unwrap_err();
+        let table = jetpipe_model::variables::check(jetpipe_model::variables::vr::K_SPRING, 1e30).unwrap_err();
         assert!(e.ends_with(&table), "{e}");
     }
 

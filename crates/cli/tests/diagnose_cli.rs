@@ -91,7 +91,7 @@ fn fuzzed_csv_text_never_crashes_the_reader() {
         state ^= state << 17;
         (state % m as u64) as usize
     };
-    let params = jetpipe::physics::parameters::Parameters::default();
+    let params = jetpipe_model::physics::parameters::Parameters::default();
     for _ in 0..5000 {
         let mut text: Vec<char> = good.chars().collect();
         for _ in 0..1 + next(6) {
@@ -105,7 +105,7 @@ fn fuzzed_csv_text_never_crashes_the_reader() {
             }
         }
         let text: String = text.into_iter().collect();
-        match std::panic::catch_unwind(|| jetpipe::recording::Recording::parse(&text, &params)) {
+        match std::panic::catch_unwind(|| jetpipe_diagnosis::recording::Recording::parse(&text, &params)) {
             Ok(Ok(recording)) => assert!(recording.len() >= 2),
             Ok(Err(message)) => assert!(
                 message.contains("row")
@@ -121,7 +121,7 @@ fn fuzzed_csv_text_never_crashes_the_reader() {
 
 /// A clean synthetic recording of `seconds`, rows of (t, v, x_s, F, p1, p2).
 fn clean_rows(seconds: f64) -> Vec<[f64; 6]> {
-    jetpipe::synthetic_bench::generate(&jetpipe::synthetic_bench::BenchEffects::default(), 7, seconds)
+    synthetic_bench::generate(&synthetic_bench::BenchEffects::default(), 7, seconds)
 }
 
 fn csv(rows: &[[f64; 6]], map: impl Fn([f64; 6]) -> [f64; 6]) -> String {

@@ -3,14 +3,16 @@
 //! below the return pressure, which involves two parameters set in any order, is refused when
 //! initialisation ends.
 
+// The FMU's test helpers (a logging callback and instances through the exported symbols).
+#[path = "../../fmu/tests/common/mod.rs"]
 mod common;
 
 use common::*;
-use jetpipe::fmi2::types::*;
+use fmi2::types::*;
 use jetpipe::fmu_exports::*;
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::sweep::{parse_axis, RunSettings, Sweep};
 use jetpipe::variables::vr;
+use jetpipe_cli::sweep::{parse_axis, RunSettings, Sweep};
+use jetpipe_model::physics::parameters::Parameters;
 
 /// The message `jetpipe sweep --param SPEC` refuses with.
 fn sweep_refusal(spec: &str) -> String {
@@ -59,7 +61,7 @@ fn the_fmu_refuses_a_spring_rate_of_1e30_with_the_sweeps_message() {
         exit, fmi2OK,
         "the refused value was not applied: the defaults initialise"
     );
-    let message = jetpipe::variables::check(vr::K_SPRING, 1e30).unwrap_err();
+    let message = jetpipe_model::variables::check(vr::K_SPRING, 1e30).unwrap_err();
     assert!(
         message.starts_with("k_spring = 1e30 N/m is invalid: must be in [0, 100000] N/m"),
         "{message}"

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::sweep::{parse_axis, run_all, run_indices, RunSettings, Sweep, RESULT_COLUMNS};
+use jetpipe_cli::sweep::{parse_axis, run_all, run_indices, RunSettings, Sweep, RESULT_COLUMNS};
+use jetpipe_model::physics::parameters::Parameters;
 
 /// Short runs keep the test quick; 2 s of the standard scenario still has both command
 /// sines, a stopper move and thousands of integrator steps.

@@ -5,10 +5,10 @@
 //! both signs of the command: a value that differs between them is absorbing a drift or an
 //! asymmetry that calibration would otherwise hide.
 
-use crate::physics::actuator::Actuator;
-use crate::physics::parameters::Parameters;
 use crate::recording::Recording;
 use crate::replay::replay_fast;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 use super::corrections::{parameter_value, set_parameter};
 

@@ -3,8 +3,8 @@
 //! the file with a message that names the column and the likely unit; a lesser one goes on
 //! with a sentence in the report's `input_checks` and in the summary.
 
-use crate::physics::parameters::Parameters;
 use crate::recording::Recording;
+use jetpipe_model::physics::parameters::Parameters;
 
 use super::BLOCK_SECONDS;
 

@@ -15,12 +15,12 @@
 //! Gauss–Newton with bounds on the training blocks of every measured channel at once (each
 //! channel weighted by its noise floor) and scored on the held-out blocks.
 
-use crate::physics::actuator::Actuator;
-use crate::physics::force_sensor;
-use crate::physics::parameters::Parameters;
 use crate::recording::Recording;
 use crate::replay::{replay_fast, Replay};
-use crate::variables::VARIABLES;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::force_sensor;
+use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::variables::VARIABLES;
 
 use super::signals::{difference, stopper_velocity, CHANNELS, FORCE, P1, P2};
 
@@ -869,10 +869,10 @@ impl<'a> Problem<'a> {
             Regressor::OwnCubed => own[k] * own[k] * own[k],
             Regressor::Friction if set_by_pressures && v.abs() > 1e-9 => -v.signum(),
             Regressor::SmoothFriction(vc) if set_by_pressures => {
-                -crate::physics::effects::friction_force(1.0, vc, 0.0, 0.0, v)
+                -jetpipe_model::physics::effects::friction_force(1.0, vc, 0.0, 0.0, v)
             }
             Regressor::Stribeck(vc, vs) if set_by_pressures => {
-                -crate::physics::effects::friction_force(0.0, vc, 1.0, vs, v)
+                -jetpipe_model::physics::effects::friction_force(0.0, vc, 1.0, vs, v)
             }
             Regressor::Viscous if set_by_pressures => -v,
             Regressor::Position if set_by_pressures => -(self.recording.x_s[k] - self.mean_position),
@@ -972,8 +972,13 @@ impl Problem<'_> {
         let area = std::f64::consts::PI * p.d_cyl * p.d_cyl / 4.0;
         (0..self.recording.len())
             .map(|k| {
-                let spring =
-                    crate::physics::piston::spring_force(p.k_spring, p.l_spring0, p.l_s, p.l_p, self.recording.x_s[k]);
+                let spring = jetpipe_model::physics::piston::spring_force(
+                    p.k_spring,
+                    p.l_spring0,
+                    p.l_s,
+                    p.l_p,
+                    self.recording.x_s[k],
+                );
                 area * (r.p1[k] - r.p2[k]) <= spring
             })
             .collect()

@@ -9,7 +9,7 @@
 
 use super::corrections::{parameter_value, Candidate, Mechanism, Modulation, Problem, Regressor};
 use super::signals::FORCE;
-use crate::physics::parameters::Parameters;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// The FMU parameters (name, value) that put the fitted `values` of `terms` into the
 /// model `base`, or `None` when the FMU cannot carry them exactly.
@@ -203,7 +203,7 @@ pub fn model_terms(
 
 /// The unit of an FMU parameter, from the variable table.
 pub fn unit_of(name: &str) -> &'static str {
-    crate::variables::VARIABLES
+    jetpipe_model::variables::VARIABLES
         .iter()
         .find(|v| v.name == name)
         .and_then(|v| v.unit)

@@ -14,6 +14,9 @@
 //!    channel worse, and the residual carries its own signature (`named.rs`). Repeat.
 //! 6. Verdict: explained when the held-out force error after is within 1.5 noise floors;
 //!    otherwise the remainder, where it sits in the chain and its signature.
+//!
+//! The recordings themselves are [`recording`]; [`replay`](mod@replay) runs their inputs
+//! through the model (crate `jetpipe-model`).
 
 pub mod calibrate;
 pub mod checks;
@@ -21,15 +24,17 @@ pub mod corrections;
 mod discover;
 mod named;
 pub mod noise;
+pub mod recording;
+pub mod replay;
 pub mod signals;
 pub mod signature;
 
 use serde_json::{json, Value};
 
-use crate::physics::actuator::Actuator;
-use crate::physics::parameters::Parameters;
 use crate::recording::Recording;
 use crate::replay::{replay, replay_fast, Replay};
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 use calibrate::Calibrated;
 use corrections::{catalogue, parameter_value, set_parameter, Candidate, Fit, Mechanism, Problem, Sensitivity, Term};
@@ -540,7 +545,7 @@ fn force_through_mechanics(model: &Actuator, recording: &Recording) -> Option<Re
     let velocity = signals::stopper_velocity(recording);
     let force = (0..recording.len())
         .map(|k| {
-            let state = crate::physics::actuator::State::from([0.0, 0.0, 0.0, 0.0, p1[k], p2[k]]);
+            let state = jetpipe_model::physics::actuator::State::from([0.0, 0.0, 0.0, 0.0, p1[k], p2[k]]);
             model.outputs(&state, recording.x_s[k], velocity[k]).f_meas
         })
         .collect();
@@ -1293,7 +1298,7 @@ impl Diagnosis {
             if value != thesis.get(value_reference) {
                 if let Some(v) = value {
                     start_values.insert(
-                        crate::physics::parameters::variable_name(value_reference).to_string(),
+                        jetpipe_model::physics::parameters::variable_name(value_reference).to_string(),
                         json!(v),
                     );
                 }

@@ -2,7 +2,7 @@
 //! columns `time_s, v_da_V, x_s_m, force_N`, optionally `p1_Pa, p2_Pa`, in SI units.
 //! Every problem is reported with its row (1-based, the header is row 1) and column.
 
-use crate::physics::parameters::Parameters;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// A checked recording.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,10 +1,10 @@
 //! Replaying a recording's inputs through the model: the command held between samples,
 //! the stopper moving linearly between samples (MODEL.md, "Measured data").
 
-use crate::physics::actuator::{Actuator, Outputs};
-use crate::physics::{command_stage, force_sensor, time_varying};
 use crate::recording::Recording;
-use crate::simulation::{Simulation, StepFailure};
+use jetpipe_model::physics::actuator::{Actuator, Outputs};
+use jetpipe_model::physics::{command_stage, force_sensor, time_varying};
+use jetpipe_model::simulation::{Simulation, StepFailure};
 
 /// The model's outputs at every sample of a recording.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -83,9 +83,9 @@ const JACOBIAN_REUSE: u64 = 8;
 /// replay checks the final figures. Falls back to [`replay`] when the jet pipe has no
 /// modal form.
 pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Result<Replay, String> {
-    use crate::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState};
-    use crate::physics::actuator::{index, State};
-    use crate::physics::effects::PLAY_OPERATORS;
+    use jetpipe_model::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState};
+    use jetpipe_model::physics::actuator::{index, State};
+    use jetpipe_model::physics::effects::PLAY_OPERATORS;
     use nalgebra::{Matrix2, Vector2};
 
     let Some(propagator) = ElectromechanicalPropagator::new(&model.params) else {
@@ -93,7 +93,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
     };
     let n = end.min(recording.len());
     let t = &recording.time;
-    let y0 = crate::simulation::equilibrium_at(model, recording.v_da[0], recording.x_s[0], t[0])?;
+    let y0 = jetpipe_model::simulation::equilibrium_at(model, recording.v_da[0], recording.x_s[0], t[0])?;
     let mut em = ElectromechanicalState {
         current: y0[index::CURRENT],
         position: y0[index::JET_POSITION],
@@ -203,7 +203,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::parameters::Parameters;
+    use jetpipe_model::physics::parameters::Parameters;
 
     /// 3 s at 1 kHz: command steps and a sine, the stopper moving in and out.
     fn protocol() -> Recording {

@@ -1,9 +1,9 @@
 //! The recording's channels and the model's, sample by sample: the residuals the
 //! diagnosis works on and the signals along the chain that a residual may follow.
 
-use crate::physics::actuator::Actuator;
 use crate::recording::Recording;
 use crate::replay::Replay;
+use jetpipe_model::physics::actuator::Actuator;
 
 /// Channels compared with the model: the force always, the two chamber pressures when the
 /// recording has them.

@@ -13,13 +13,13 @@
 
 use std::path::PathBuf;
 
-use jetpipe::diagnosis::{diagnose, Diagnosis};
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::recording::Recording;
+use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_model::physics::parameters::Parameters;
 
 fn shared(name: &str) -> Option<PathBuf> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/bench")
+        .join("../../../shared/bench")
         .join(name);
     if path.is_file() {
         return Some(path);
@@ -48,7 +48,7 @@ fn run(name: &str) -> Option<Diagnosis> {
 }
 
 fn value_reference(name: &str) -> u32 {
-    jetpipe::variables::VARIABLES
+    jetpipe_model::variables::VARIABLES
         .iter()
         .find(|v| v.name == name)
         .unwrap()

@@ -8,10 +8,10 @@
 //! The full protocol (80 s) runs for every case; set JETPIPE_DIAGNOSE_CASES to a comma
 //! list of case names to run a subset.
 
-use jetpipe::diagnosis::{diagnose, Diagnosis};
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::recording::Recording;
-use jetpipe::synthetic_bench::{generate, write_csv, BenchEffects};
+use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_model::physics::parameters::Parameters;
+use synthetic_bench::{generate, write_csv, BenchEffects};
 
 fn run(name: &str, effects: BenchEffects, seed: u64) -> Diagnosis {
     let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{name}", std::process::id()));

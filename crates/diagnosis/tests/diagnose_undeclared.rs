@@ -8,10 +8,10 @@
 //! Each mechanism is a test of its own; set JETPIPE_UNDECLARED to a comma list of names to
 //! run a subset.
 
-use jetpipe::diagnosis::{diagnose, Diagnosis};
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::recording::Recording;
-use jetpipe::synthetic_bench::{generate, undeclared_mechanism, write_csv};
+use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_model::physics::parameters::Parameters;
+use synthetic_bench::{generate, undeclared_mechanism, write_csv};
 
 fn run(name: &str, seed: u64) -> Option<(Diagnosis, &'static str, &'static str)> {
     if let Ok(list) = std::env::var("JETPIPE_UNDECLARED") {
@@ -66,7 +66,7 @@ fn placed(name: &str, seed: u64) {
         );
         let thesis = Parameters::default();
         for &(parameter, truth) in mechanism.model_parameters {
-            let reference = jetpipe::variables::VARIABLES
+            let reference = jetpipe_model::variables::VARIABLES
                 .iter()
                 .find(|v| v.name == parameter)
                 .unwrap()
@@ -189,7 +189,7 @@ fn a_force_sensor_with_backlash_is_found_at_the_force_sensor_as_hysteresis_not_j
 #[test]
 fn every_mechanism_of_the_table_has_a_test_here() {
     let source = include_str!("diagnose_undeclared.rs");
-    for m in jetpipe::synthetic_bench::UNDECLARED {
+    for m in synthetic_bench::UNDECLARED {
         assert!(
             source.contains(&format!("placed(\"{}\"", m.name)),
             "{} has no test",

@@ -4,9 +4,9 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::fmi2::model::{Causality, ModelInfo, VarType};
-use crate::fmi2::model_description::model_description_xml;
-use crate::fmu::MODEL_INFO;
+use fmi2::model::{Causality, ModelInfo, VarType};
+use fmi2::model_description::model_description_xml;
+use jetpipe::fmu::MODEL_INFO;
 
 /// The model description of the actuator FMU.
 pub fn actuator_model_description() -> String {
@@ -117,7 +117,7 @@ pub fn write_model_fmu_platforms(
     info: &ModelInfo,
     documentation: &str,
 ) -> Result<(), String> {
-    let model_description = crate::fmi2::model_description::try_model_description_xml(info)
+    let model_description = fmi2::model_description::try_model_description_xml(info)
         .map_err(|problems| format!("invalid variable table of {}: {}", info.model_name, problems.join("; ")))?;
     let mut binaries = Vec::new();
     for &(platform, library) in libraries {
@@ -171,7 +171,7 @@ mod tests {
 
     #[test]
     fn checked_in_model_description_is_the_generated_one() {
-        let checked = include_str!("../modelDescription.xml");
+        let checked = include_str!("../../../modelDescription.xml");
         assert_eq!(
             checked,
             actuator_model_description(),

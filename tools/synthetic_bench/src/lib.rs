@@ -351,7 +351,7 @@ fn std_force_sensor_lag() -> BenchEffects {
 /// all ten locations and all thirteen families (checked by a test).
 ///
 /// ```no_run
-/// use jetpipe::synthetic_bench::{generate, undeclared_mechanism, UNDECLARED};
+/// use synthetic_bench::{generate, undeclared_mechanism, UNDECLARED};
 /// for m in UNDECLARED {
 ///     let rows = generate(&(m.effects)(), 1, 80.0); // 80 s protocol with noise, seed 1
 ///     println!("{} at {}/{}: {} rows", m.name, m.location, m.family, rows.len());

@@ -23,11 +23,11 @@
 
 use std::f64::consts::PI;
 
-use jetpipe::integrator::Statistics;
-use jetpipe::physics::actuator::Actuator;
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::scenario;
-use jetpipe::simulation::Simulation;
+use jetpipe_model::integrator::Statistics;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::scenario;
+use jetpipe_model::simulation::Simulation;
 
 /// Simulated time of every scenario, s.
 pub const DURATION: f64 = 10.0;
@@ -296,5 +296,5 @@ impl Feedforward {
 /// CPU time of the calling thread, s: the simulation is single-threaded, and unlike wall
 /// time this does not count the time other processes on the machine take from it.
 pub fn thread_cpu_seconds() -> f64 {
-    jetpipe::sweep::thread_cpu_seconds().expect("a thread CPU clock (clock_gettime) on this platform")
+    jetpipe_cli::sweep::thread_cpu_seconds().expect("a thread CPU clock (clock_gettime) on this platform")
 }

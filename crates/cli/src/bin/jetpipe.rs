@@ -7,10 +7,10 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Parser, Subcommand};
-use jetpipe::physics::actuator::Actuator;
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::scenario;
-use jetpipe::simulation::{Simulation, DEFAULT_RELATIVE_TOLERANCE};
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::scenario;
+use jetpipe_model::simulation::{Simulation, DEFAULT_RELATIVE_TOLERANCE};
 
 #[derive(Parser)]
 #[command(
@@ -141,16 +141,16 @@ fn run(cli: Cli) -> Result<(), String> {
             if let Some(dll) = &win64 {
                 binaries.push(("win64", dll.as_path()));
             }
-            jetpipe::packaging::write_fmu_platforms(&out, &binaries)?;
+            jetpipe_packaging::write_fmu_platforms(&out, &binaries)?;
             println!("wrote {}", out.display());
             Ok(())
         }
         Command::ModelDescription => {
-            print!("{}", jetpipe::packaging::actuator_model_description());
+            print!("{}", jetpipe_packaging::actuator_model_description());
             Ok(())
         }
         Command::Parameters => {
-            print!("{}", jetpipe::variables::interface_table());
+            print!("{}", jetpipe_model::variables::interface_table());
             Ok(())
         }
         Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
@@ -165,11 +165,11 @@ fn run(cli: Cli) -> Result<(), String> {
             compare_serial,
             no_serial,
         } => {
-            let options = jetpipe::sweep::SweepOptions {
+            let options = jetpipe_cli::sweep::SweepOptions {
                 params,
                 threads,
                 out,
-                settings: jetpipe::sweep::RunSettings {
+                settings: jetpipe_cli::sweep::RunSettings {
                     duration,
                     step,
                     tolerance,
@@ -178,7 +178,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 compare_serial,
                 no_serial,
             };
-            jetpipe::sweep::run_command(&options, &mut std::io::stdout().lock())
+            jetpipe_cli::sweep::run_command(&options, &mut std::io::stdout().lock())
         }
         Command::Linearize { force, x_s, json } => linearize(force, x_s, json),
         Command::Diagnose {
@@ -199,12 +199,13 @@ fn run(cli: Cli) -> Result<(), String> {
     }
 }
 
-/// `cargo run --bin jetpipe` builds the library as an rlib only; the FMU needs the cdylib,
-/// so build it (a no-op when it is up to date) with the same profile as this executable.
+/// `cargo run --bin jetpipe` builds the FMU crate (crates/fmu) as a dependency only, and does
+/// not put its cdylib next to this executable; the FMU needs it, so build it (a no-op when it
+/// is up to date) with the same profile as this executable.
 fn build_shared_library() -> Result<PathBuf, String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot locate this executable: {e}"))?;
     let library = exe.with_file_name("libjetpipe.so");
-    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/../fmu/Cargo.toml");
     if std::path::Path::new(manifest).is_file() {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
         let mut command = std::process::Command::new(&cargo);
@@ -235,9 +236,9 @@ fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String>
         .as_object()
         .ok_or_else(|| format!("{}: expected a JSON object of parameter values", path.display()))?;
     for (name, v) in object {
-        let variable = jetpipe::variables::VARIABLES
+        let variable = jetpipe_model::variables::VARIABLES
             .iter()
-            .find(|var| var.name == name && var.causality == jetpipe::fmi2::model::Causality::Parameter)
+            .find(|var| var.name == name && var.causality == jetpipe_model::variables::Causality::Parameter)
             .ok_or_else(|| format!("{}: '{name}' is not a parameter of the model", path.display()))?;
         let x = v
             .as_f64()
@@ -265,7 +266,7 @@ impl TerminalBars {
     }
 }
 
-impl jetpipe::diagnosis::ProgressBars for TerminalBars {
+impl jetpipe_diagnosis::ProgressBars for TerminalBars {
     fn start(&self, phase: &str, total: usize) {
         let bar = indicatif::ProgressBar::new(total as u64);
         if let Ok(style) = indicatif::ProgressStyle::with_template("{prefix:>13} [{bar:30}] {pos}/{len} {elapsed}") {
@@ -305,13 +306,13 @@ fn diagnose(
     }
     let started = Instant::now();
     let base = read_parameters(params)?;
-    let recording = jetpipe::recording::Recording::read(recording_path, &base)?;
+    let recording = jetpipe_diagnosis::recording::Recording::read(recording_path, &base)?;
     let bars = std::sync::Arc::new(TerminalBars::default());
     let mut progress = |line: &str| {
         let line = format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
         bars.println(&line);
     };
-    let mut options = jetpipe::diagnosis::Options {
+    let mut options = jetpipe_diagnosis::Options {
         calibrate,
         bars: Some(bars.clone()),
         ..Default::default()
@@ -319,11 +320,11 @@ fn diagnose(
     if let Some(jobs) = jobs {
         options.jobs = jobs;
     }
-    let diagnosis = jetpipe::diagnosis::diagnose_with(&recording, &base, &options, &mut progress)?;
+    let diagnosis = jetpipe_diagnosis::diagnose_with(&recording, &base, &options, &mut progress)?;
     let name = recording_path.display().to_string();
     let json = diagnosis.to_json(&name);
     if let Some(dir) = plots {
-        jetpipe::plots::write_diagnosis_plots(dir, &recording, &diagnosis)?;
+        jetpipe_cli::plots::write_diagnosis_plots(dir, &recording, &diagnosis)?;
         eprintln!("plots written to {}", dir.display());
     }
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
@@ -353,8 +354,8 @@ fn linearize(force: f64, x_s: f64, json: bool) -> Result<(), String> {
     }
     let model = Actuator::new(Parameters::default())?;
     model.params.check_stopper(x_s)?;
-    let v = jetpipe::linearization::command_for_force(&model, force, x_s)?;
-    let lin = jetpipe::linearization::linearize(&model, v, x_s)?;
+    let v = jetpipe_cli::linearization::command_for_force(&model, force, x_s)?;
+    let lin = jetpipe_cli::linearization::linearize(&model, v, x_s)?;
     if json {
         println!(
             "{}",

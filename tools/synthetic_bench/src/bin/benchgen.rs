@@ -1,12 +1,12 @@
 //! `benchgen`: write a synthetic bench recording (protocol of `bench/README.md`) from the
-//! independent simulator in `jetpipe::synthetic_bench`, with chosen effects beyond the thesis model.
+//! independent simulator of the `synthetic_bench` library, with chosen effects beyond the thesis model.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::Parser;
-use jetpipe::synthetic_bench::{
+use synthetic_bench::{
     generate, undeclared_mechanism, write_csv, BenchEffects, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
 };
 
