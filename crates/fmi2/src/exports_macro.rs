@@ -4,9 +4,9 @@
 //!
 //! The actuator's `crates/fmu/src/fmu_exports.rs` stays literal because cbindgen reads it to
 //! write the C header whose compilation against the standard `fmi2Functions.h` proves the
-//! signatures. This macro must therefore emit exactly the same signatures: the test
-//! `macro_signatures_are_the_literal_exports` (crates/fmu/tests/exports.rs) compares the two
-//! texts, so an edit to one without the other fails.
+//! signatures. This macro must therefore emit exactly the same signatures:
+//! `tests::macro_signatures_are_the_literal_exports` compares the two texts (only as text:
+//! this crate does not depend on the actuator's), so an edit to one without the other fails.
 //!
 //! Invoke it once per cdylib; a second invocation, or the actuator's own symbols in the same
 //! library or test (any crate that links `crates/fmu`), would give duplicate `fmi2*`
@@ -14,7 +14,8 @@
 
 /// Emit the 34 `#[no_mangle] extern "C" fn fmi2*` functions of FMI 2.0 Co-Simulation as
 /// forwarders to [`crate::api`] instantiated for `$model` (a type implementing
-/// [`crate::model::CoSimModel`]).
+/// [`crate::model::CoSimModel`]). The expansion names them `$crate::fmi2::api` and
+/// `$crate::fmi2::types` (see `crate::fmi2`).
 ///
 /// ```ignore
 /// fmi2::fmi2_cosimulation_exports!(crate::fmu::TendonFmu);
@@ -27,38 +28,38 @@ macro_rules! fmi2_cosimulation_exports {
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub extern "C" fn fmi2GetTypesPlatform() -> *const ::std::os::raw::c_char {
-            $crate::api::get_types_platform()
+            $crate::fmi2::api::get_types_platform()
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub extern "C" fn fmi2GetVersion() -> *const ::std::os::raw::c_char {
-            $crate::api::get_version()
+            $crate::fmi2::api::get_version()
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetDebugLogging(
-            c: $crate::types::fmi2Component,
-            loggingOn: $crate::types::fmi2Boolean,
+            c: $crate::fmi2::types::fmi2Component,
+            loggingOn: $crate::fmi2::types::fmi2Boolean,
             nCategories: usize,
-            categories: *const $crate::types::fmi2String,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::set_debug_logging::<$model>(c, loggingOn, nCategories, categories)
+            categories: *const $crate::fmi2::types::fmi2String,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::set_debug_logging::<$model>(c, loggingOn, nCategories, categories)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2Instantiate(
-            instanceName: $crate::types::fmi2String,
-            fmuType: $crate::types::fmi2Type,
-            fmuGUID: $crate::types::fmi2String,
-            fmuResourceLocation: $crate::types::fmi2String,
-            functions: *const $crate::types::fmi2CallbackFunctions,
-            visible: $crate::types::fmi2Boolean,
-            loggingOn: $crate::types::fmi2Boolean,
-        ) -> $crate::types::fmi2Component {
-            $crate::api::instantiate::<$model>(
+            instanceName: $crate::fmi2::types::fmi2String,
+            fmuType: $crate::fmi2::types::fmi2Type,
+            fmuGUID: $crate::fmi2::types::fmi2String,
+            fmuResourceLocation: $crate::fmi2::types::fmi2String,
+            functions: *const $crate::fmi2::types::fmi2CallbackFunctions,
+            visible: $crate::fmi2::types::fmi2Boolean,
+            loggingOn: $crate::fmi2::types::fmi2Boolean,
+        ) -> $crate::fmi2::types::fmi2Component {
+            $crate::fmi2::api::instantiate::<$model>(
                 instanceName,
                 fmuType,
                 fmuGUID,
@@ -71,21 +72,21 @@ macro_rules! fmi2_cosimulation_exports {
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
-        pub unsafe extern "C" fn fmi2FreeInstance(c: $crate::types::fmi2Component) {
-            $crate::api::free_instance::<$model>(c);
+        pub unsafe extern "C" fn fmi2FreeInstance(c: $crate::fmi2::types::fmi2Component) {
+            $crate::fmi2::api::free_instance::<$model>(c);
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetupExperiment(
-            c: $crate::types::fmi2Component,
-            toleranceDefined: $crate::types::fmi2Boolean,
-            tolerance: $crate::types::fmi2Real,
-            startTime: $crate::types::fmi2Real,
-            stopTimeDefined: $crate::types::fmi2Boolean,
-            stopTime: $crate::types::fmi2Real,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::setup_experiment::<$model>(
+            c: $crate::fmi2::types::fmi2Component,
+            toleranceDefined: $crate::fmi2::types::fmi2Boolean,
+            tolerance: $crate::fmi2::types::fmi2Real,
+            startTime: $crate::fmi2::types::fmi2Real,
+            stopTimeDefined: $crate::fmi2::types::fmi2Boolean,
+            stopTime: $crate::fmi2::types::fmi2Real,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::setup_experiment::<$model>(
                 c,
                 toleranceDefined,
                 tolerance,
@@ -98,190 +99,192 @@ macro_rules! fmi2_cosimulation_exports {
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2EnterInitializationMode(
-            c: $crate::types::fmi2Component,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::enter_initialization_mode::<$model>(c)
+            c: $crate::fmi2::types::fmi2Component,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::enter_initialization_mode::<$model>(c)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2ExitInitializationMode(
-            c: $crate::types::fmi2Component,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::exit_initialization_mode::<$model>(c)
+            c: $crate::fmi2::types::fmi2Component,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::exit_initialization_mode::<$model>(c)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
-        pub unsafe extern "C" fn fmi2Terminate(c: $crate::types::fmi2Component) -> $crate::types::fmi2Status {
-            $crate::api::terminate::<$model>(c)
+        pub unsafe extern "C" fn fmi2Terminate(
+            c: $crate::fmi2::types::fmi2Component,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::terminate::<$model>(c)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
-        pub unsafe extern "C" fn fmi2Reset(c: $crate::types::fmi2Component) -> $crate::types::fmi2Status {
-            $crate::api::reset::<$model>(c)
+        pub unsafe extern "C" fn fmi2Reset(c: $crate::fmi2::types::fmi2Component) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::reset::<$model>(c)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetReal(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *mut $crate::types::fmi2Real,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_real::<$model>(c, vr, nvr, value)
+            value: *mut $crate::fmi2::types::fmi2Real,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_real::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetInteger(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *mut $crate::types::fmi2Integer,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_integer::<$model>(c, vr, nvr, value)
+            value: *mut $crate::fmi2::types::fmi2Integer,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_integer::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetBoolean(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *mut $crate::types::fmi2Boolean,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_boolean::<$model>(c, vr, nvr, value)
+            value: *mut $crate::fmi2::types::fmi2Boolean,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_boolean::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetString(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *mut $crate::types::fmi2String,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_string::<$model>(c, vr, nvr, value)
+            value: *mut $crate::fmi2::types::fmi2String,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_string::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetReal(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *const $crate::types::fmi2Real,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::set_real::<$model>(c, vr, nvr, value)
+            value: *const $crate::fmi2::types::fmi2Real,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::set_real::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetInteger(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *const $crate::types::fmi2Integer,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::set_integer::<$model>(c, vr, nvr, value)
+            value: *const $crate::fmi2::types::fmi2Integer,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::set_integer::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetBoolean(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *const $crate::types::fmi2Boolean,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::set_boolean::<$model>(c, vr, nvr, value)
+            value: *const $crate::fmi2::types::fmi2Boolean,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::set_boolean::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetString(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            value: *const $crate::types::fmi2String,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::set_string::<$model>(c, vr, nvr, value)
+            value: *const $crate::fmi2::types::fmi2String,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::set_string::<$model>(c, vr, nvr, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetFMUstate(
-            c: $crate::types::fmi2Component,
-            FMUstate: *mut $crate::types::fmi2FMUstate,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_fmu_state::<$model>(c, FMUstate)
+            c: $crate::fmi2::types::fmi2Component,
+            FMUstate: *mut $crate::fmi2::types::fmi2FMUstate,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_fmu_state::<$model>(c, FMUstate)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetFMUstate(
-            c: $crate::types::fmi2Component,
-            FMUstate: $crate::types::fmi2FMUstate,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::set_fmu_state::<$model>(c, FMUstate)
+            c: $crate::fmi2::types::fmi2Component,
+            FMUstate: $crate::fmi2::types::fmi2FMUstate,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::set_fmu_state::<$model>(c, FMUstate)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2FreeFMUstate(
-            c: $crate::types::fmi2Component,
-            FMUstate: *mut $crate::types::fmi2FMUstate,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::free_fmu_state::<$model>(c, FMUstate)
+            c: $crate::fmi2::types::fmi2Component,
+            FMUstate: *mut $crate::fmi2::types::fmi2FMUstate,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::free_fmu_state::<$model>(c, FMUstate)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
-            c: $crate::types::fmi2Component,
-            FMUstate: $crate::types::fmi2FMUstate,
+            c: $crate::fmi2::types::fmi2Component,
+            FMUstate: $crate::fmi2::types::fmi2FMUstate,
             size: *mut usize,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::serialized_fmu_state_size::<$model>(c, FMUstate, size)
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::serialized_fmu_state_size::<$model>(c, FMUstate, size)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SerializeFMUstate(
-            c: $crate::types::fmi2Component,
-            FMUstate: $crate::types::fmi2FMUstate,
-            serializedState: *mut $crate::types::fmi2Byte,
+            c: $crate::fmi2::types::fmi2Component,
+            FMUstate: $crate::fmi2::types::fmi2FMUstate,
+            serializedState: *mut $crate::fmi2::types::fmi2Byte,
             size: usize,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::serialize_fmu_state::<$model>(c, FMUstate, serializedState, size)
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::serialize_fmu_state::<$model>(c, FMUstate, serializedState, size)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
-            c: $crate::types::fmi2Component,
-            serializedState: *const $crate::types::fmi2Byte,
+            c: $crate::fmi2::types::fmi2Component,
+            serializedState: *const $crate::fmi2::types::fmi2Byte,
             size: usize,
-            FMUstate: *mut $crate::types::fmi2FMUstate,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::deserialize_fmu_state::<$model>(c, serializedState, size, FMUstate)
+            FMUstate: *mut $crate::fmi2::types::fmi2FMUstate,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::deserialize_fmu_state::<$model>(c, serializedState, size, FMUstate)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
-            c: $crate::types::fmi2Component,
-            vUnknown_ref: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vUnknown_ref: *const $crate::fmi2::types::fmi2ValueReference,
             nUnknown: usize,
-            vKnown_ref: *const $crate::types::fmi2ValueReference,
+            vKnown_ref: *const $crate::fmi2::types::fmi2ValueReference,
             nKnown: usize,
-            dvKnown: *const $crate::types::fmi2Real,
-            dvUnknown: *mut $crate::types::fmi2Real,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_directional_derivative::<$model>(
+            dvKnown: *const $crate::fmi2::types::fmi2Real,
+            dvUnknown: *mut $crate::fmi2::types::fmi2Real,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_directional_derivative::<$model>(
                 c,
                 vUnknown_ref,
                 nUnknown,
@@ -297,36 +300,36 @@ macro_rules! fmi2_cosimulation_exports {
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            order: *const $crate::types::fmi2Integer,
-            value: *const $crate::types::fmi2Real,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::set_real_input_derivatives::<$model>(c, vr, nvr, order, value)
+            order: *const $crate::fmi2::types::fmi2Integer,
+            value: *const $crate::fmi2::types::fmi2Real,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::set_real_input_derivatives::<$model>(c, vr, nvr, order, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
-            c: $crate::types::fmi2Component,
-            vr: *const $crate::types::fmi2ValueReference,
+            c: $crate::fmi2::types::fmi2Component,
+            vr: *const $crate::fmi2::types::fmi2ValueReference,
             nvr: usize,
-            order: *const $crate::types::fmi2Integer,
-            value: *mut $crate::types::fmi2Real,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_real_output_derivatives::<$model>(c, vr, nvr, order, value)
+            order: *const $crate::fmi2::types::fmi2Integer,
+            value: *mut $crate::fmi2::types::fmi2Real,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_real_output_derivatives::<$model>(c, vr, nvr, order, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2DoStep(
-            c: $crate::types::fmi2Component,
-            currentCommunicationPoint: $crate::types::fmi2Real,
-            communicationStepSize: $crate::types::fmi2Real,
-            noSetFMUStatePriorToCurrentPoint: $crate::types::fmi2Boolean,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::do_step::<$model>(
+            c: $crate::fmi2::types::fmi2Component,
+            currentCommunicationPoint: $crate::fmi2::types::fmi2Real,
+            communicationStepSize: $crate::fmi2::types::fmi2Real,
+            noSetFMUStatePriorToCurrentPoint: $crate::fmi2::types::fmi2Boolean,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::do_step::<$model>(
                 c,
                 currentCommunicationPoint,
                 communicationStepSize,
@@ -336,58 +339,110 @@ macro_rules! fmi2_cosimulation_exports {
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
-        pub unsafe extern "C" fn fmi2CancelStep(c: $crate::types::fmi2Component) -> $crate::types::fmi2Status {
-            $crate::api::cancel_step::<$model>(c)
+        pub unsafe extern "C" fn fmi2CancelStep(
+            c: $crate::fmi2::types::fmi2Component,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::cancel_step::<$model>(c)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetStatus(
-            c: $crate::types::fmi2Component,
-            s: $crate::types::fmi2StatusKind,
-            value: *mut $crate::types::fmi2Status,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_status::<$model>(c, s, value)
+            c: $crate::fmi2::types::fmi2Component,
+            s: $crate::fmi2::types::fmi2StatusKind,
+            value: *mut $crate::fmi2::types::fmi2Status,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_status::<$model>(c, s, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetRealStatus(
-            c: $crate::types::fmi2Component,
-            s: $crate::types::fmi2StatusKind,
-            value: *mut $crate::types::fmi2Real,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_real_status::<$model>(c, s, value)
+            c: $crate::fmi2::types::fmi2Component,
+            s: $crate::fmi2::types::fmi2StatusKind,
+            value: *mut $crate::fmi2::types::fmi2Real,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_real_status::<$model>(c, s, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetIntegerStatus(
-            c: $crate::types::fmi2Component,
-            s: $crate::types::fmi2StatusKind,
-            value: *mut $crate::types::fmi2Integer,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_integer_status::<$model>(c, s, value)
+            c: $crate::fmi2::types::fmi2Component,
+            s: $crate::fmi2::types::fmi2StatusKind,
+            value: *mut $crate::fmi2::types::fmi2Integer,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_integer_status::<$model>(c, s, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetBooleanStatus(
-            c: $crate::types::fmi2Component,
-            s: $crate::types::fmi2StatusKind,
-            value: *mut $crate::types::fmi2Boolean,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_boolean_status::<$model>(c, s, value)
+            c: $crate::fmi2::types::fmi2Component,
+            s: $crate::fmi2::types::fmi2StatusKind,
+            value: *mut $crate::fmi2::types::fmi2Boolean,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_boolean_status::<$model>(c, s, value)
         }
 
         #[no_mangle]
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         pub unsafe extern "C" fn fmi2GetStringStatus(
-            c: $crate::types::fmi2Component,
-            s: $crate::types::fmi2StatusKind,
-            value: *mut $crate::types::fmi2String,
-        ) -> $crate::types::fmi2Status {
-            $crate::api::get_string_status::<$model>(c, s, value)
+            c: $crate::fmi2::types::fmi2Component,
+            s: $crate::fmi2::types::fmi2StatusKind,
+            value: *mut $crate::fmi2::types::fmi2String,
+        ) -> $crate::fmi2::types::fmi2Status {
+            $crate::fmi2::api::get_string_status::<$model>(c, s, value)
         }
     };
+}
+
+#[cfg(test)]
+mod tests {
+    /// The exported items of `text` (from the first `#[no_mangle]` after `begin` up to `stop`), with the
+    /// paths the macro needs and the formatting removed, so the two files compare as code.
+    fn exported_items(text: &str, begin: &str, stop: &str) -> Vec<String> {
+        let from = text.find(begin).expect("no begin marker");
+        let start = from + text[from..].find("#[no_mangle]").expect("no exported item");
+        let end = text[start..].find(stop).map_or(text.len(), |i| start + i);
+        let code: String = text[start..end]
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//") && !l.trim_start().starts_with("#[allow("))
+            .collect::<Vec<_>>()
+            .join("\n")
+            .replace("$crate::fmi2::types::", "")
+            .replace("$crate::fmi2::", "")
+            .replace("::std::os::raw::", "")
+            .replace("$model", "ExportedModel")
+            .split_whitespace()
+            .collect();
+        code.replace(",)", ")")
+            .split("#[no_mangle]")
+            .filter(|item| !item.is_empty())
+            .map(|item| item.trim_end_matches(['}', ';']).to_string())
+            .collect()
+    }
+
+    #[test]
+    fn macro_signatures_are_the_literal_exports() {
+        let literal = exported_items(
+            include_str!("../../fmu/src/fmu_exports.rs"),
+            "use crate::ExportedModel;",
+            "\u{0}",
+        );
+        let generated = exported_items(include_str!("exports_macro.rs"), "macro_rules!", "\n    };\n}");
+        assert_eq!(
+            literal.len(),
+            34,
+            "crates/fmu/src/fmu_exports.rs should export the 34 FMI 2.0 Co-Simulation functions"
+        );
+        assert_eq!(
+            literal.len(),
+            generated.len(),
+            "the macro and crates/fmu/src/fmu_exports.rs export different counts"
+        );
+        for (a, b) in literal.iter().zip(&generated) {
+            assert_eq!(a, b, "the macro's item differs from crates/fmu/src/fmu_exports.rs");
+        }
+    }
 }

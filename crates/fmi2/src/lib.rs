@@ -50,3 +50,11 @@ pub mod types;
 
 #[cfg(test)]
 mod tests;
+
+/// The paths `fmi2_cosimulation_exports!` expands to, `$crate::fmi2::api` and
+/// `$crate::fmi2::types`: those of the time this layer was the module `fmi2` of the jetpipe
+/// crate, kept so that the macro's text did not change when the layer became a crate.
+#[doc(hidden)]
+pub mod fmi2 {
+    pub use crate::{api, types};
+}
