@@ -5,7 +5,7 @@ bandwidth near the 8 Hz reported for the Utah/MIT hand (thesis §1.1.1).
 
 Build what it needs with
     cargo run --release --bin jetpipe -- package
-    cargo run --release --target-dir target/fmus -p antagonistic -- package
+    cargo run --release -p antagonistic -- package
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ import ssp_sim  # noqa: E402
 
 # model identifier -> crate folder
 MODELS = {"Tendon": "tendon", "FingerJoint": "finger_joint", "JointController": "joint_controller"}
-BUILD = "cargo run --release --target-dir target/fmus -p antagonistic -- package"
+BUILD = "cargo run --release -p antagonistic -- package"
 
 FMI2_CS_FUNCTIONS = sorted(
     """fmi2GetTypesPlatform fmi2GetVersion fmi2SetDebugLogging fmi2Instantiate fmi2FreeInstance

@@ -5,7 +5,7 @@ FMI 2.0 XSD that FMPy ships, a GUID that is the version-5 UUID of the descriptio
 
 Build what it needs with
     cargo run --release --bin jetpipe -- package
-    cargo run --release --target-dir target/fmus -p antagonistic -- package
+    cargo run --release -p antagonistic -- package
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ toolbox's `add_start_value` (`masters.build_container`).
 
 Build what it needs with
     bash scripts/package.sh
-    cargo run --release --target-dir target/fmus -p antagonistic -- package
+    cargo run --release -p antagonistic -- package
 """
 
 from __future__ import annotations

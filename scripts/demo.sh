@@ -13,5 +13,5 @@ run() {
 run bash scripts/package.sh
 run bash scripts/venv.sh
 run .venv/bin/python fmu_tests/run_standard_scenario.py dist/JetPipeActuator.fmu
-run cargo run --release --target-dir target/fmus -p antagonistic -- package
+run cargo run --release -p antagonistic -- package
 run .venv/bin/python fmu_tests/antagonistic/run_example.py --out dist/antagonistic_joint.png

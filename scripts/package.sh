@@ -20,8 +20,8 @@ if [ "${JETPIPE_NATIVE:-0}" = "1" ]; then
 else
     bash scripts/venv.sh
     # cargo-zigbuild runs `python3 -m ziglang` when no `zig` is on PATH: the venv's python.
-    echo "==> cargo zigbuild --release --lib -p jetpipe --target $TARGET.$GLIBC"
-    PATH="$PWD/.venv/bin:$PATH" .venv/bin/cargo-zigbuild zigbuild --release --lib -p jetpipe --target "$TARGET.$GLIBC"
+    echo "==> cargo zigbuild --release --lib -p jetpipe-fmu --target $TARGET.$GLIBC"
+    PATH="$PWD/.venv/bin:$PATH" .venv/bin/cargo-zigbuild zigbuild --release --lib -p jetpipe-fmu --target "$TARGET.$GLIBC"
     args+=(--library "target/$TARGET/release/libjetpipe.so")
 fi
 case "${JETPIPE_WIN64:-auto}" in

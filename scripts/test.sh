@@ -21,14 +21,17 @@ RUSTDOCFLAGS="-D warnings" run cargo doc --no-deps --workspace --release
 run bash scripts/build_win64.sh
 JETPIPE_WIN64=1 run bash scripts/package.sh
 # The host build, linked against this machine's glibc: the platform test's counter-example.
-run cargo build --release --lib
+run cargo build --release --lib -p jetpipe-fmu
 if [ ! -f dist/JetPipeActuator.fmu ]; then
     echo "test.sh: dist/JetPipeActuator.fmu was not written" >&2
     exit 1
 fi
-run cargo test --release --target-dir target/fmus -p fmu_common -p tendon -p finger_joint -p joint_controller
-run cargo test --release --target-dir target/fmus -p antagonistic
-run cargo run --release --target-dir target/fmus -p antagonistic -- package
+# The other FMUs, on the FMI layer alone, in the same target directory (nothing of the actuator
+# is built twice). The antagonistic packager links the three models without their `exports`
+# feature, their own tests and FMUs need it on: two invocations, so cargo does not unify them.
+run cargo test --release -p fmu_common -p tendon -p finger_joint -p joint_controller
+run cargo test --release -p antagonistic
+run cargo run --release -p antagonistic -- package
 run bash scripts/venv.sh
 run .venv/bin/python -m pytest fmu_tests -q
 echo

@@ -40,7 +40,7 @@ def main():
     args = parser.parse_args()
     if not args.ssp.is_file():
         sys.exit(f"{args.ssp} not found: build it with "
-                 "`cargo run --release --target-dir target/fmus -p antagonistic -- package`")
+                 "`cargo run --release -p antagonistic -- package`")
 
     r, seconds = ssp_sim.simulate(reference, STOP, ssp=args.ssp)
     t = ssp_sim.output_time(r)

@@ -2,17 +2,15 @@
 //! AntagonisticJoint SSP.
 //!
 //! ```sh
-//! cargo run --release --target-dir target/fmus -p antagonistic -- package   # dist/{Tendon,FingerJoint,JointController}.fmu + dist/AntagonisticJoint.ssp
-//! cargo run --release --target-dir target/fmus -p antagonistic -- model-description Tendon
-//! cargo run --release --target-dir target/fmus -p antagonistic -- ssd       # SystemStructure.ssd to stdout
+//! cargo run --release -p antagonistic -- package   # dist/{Tendon,FingerJoint,JointController}.fmu + dist/AntagonisticJoint.ssp
+//! cargo run --release -p antagonistic -- model-description Tendon
+//! cargo run --release -p antagonistic -- ssd       # SystemStructure.ssd to stdout
 //! ```
 //!
 //! `package` needs `dist/JetPipeActuator.fmu` (`cargo run --release --bin jetpipe -- package`).
 //!
-//! Why `--target-dir target/fmus`: these crates use jetpipe without its `actuator-exports`
-//! feature, and cargo builds every crate type of a dependency, so jetpipe's cdylib gets built
-//! too, without the actuator's symbols, into the same `deps/libjetpipe.so` the actuator FMU is
-//! taken from. A separate target directory keeps the two builds of jetpipe apart.
+//! Run it in a cargo invocation of its own (as above): this crate links the three models
+//! without their `exports` feature, their FMUs need it on, and cargo would unify the two.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -61,7 +59,7 @@ fn run(args: &[String]) -> Result<(), String> {
         Some("model-description") => {
             let name = args.get(1).ok_or_else(|| format!("which model?\n{USAGE}"))?;
             let fmu = antagonistic::package::find(name).ok_or_else(|| format!("no model {name}\n{USAGE}"))?;
-            print!("{}", jetpipe::fmi2::model_description::model_description_xml(fmu.info));
+            print!("{}", fmi2::model_description::model_description_xml(fmu.info));
             Ok(())
         }
         Some("ssd") => {
@@ -75,9 +73,9 @@ fn run(args: &[String]) -> Result<(), String> {
 
 /// `cargo run -p antagonistic` builds the three model crates as rlibs without their exports;
 /// the FMUs need their cdylibs with them, so build them (a no-op when up to date) with this
-/// executable's profile, into this executable's target directory. Neither the root package
-/// nor this one may be in the same invocation: cargo would unify features, giving the
-/// libraries the actuator's `fmi2*` symbols too (root) or this binary three sets (here).
+/// executable's profile, into this executable's target directory. This package may not be in
+/// the same invocation: cargo would unify features, giving this binary three sets of `fmi2*`
+/// symbols next to the actuator's.
 fn build_shared_libraries() -> Result<PathBuf, String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot locate this executable: {e}"))?;
     let dir = exe.parent().map(Path::to_path_buf).unwrap_or_default();

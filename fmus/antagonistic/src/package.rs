@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use jetpipe::fmi2::model::ModelInfo;
+use fmi2::model::ModelInfo;
 
 use crate::system::{check, components, ssd_xml};
 
@@ -52,8 +52,8 @@ pub fn write_fmus(dist: &Path, library_dir: &Path) -> Result<Vec<PathBuf>, Strin
         let library = library_dir.join(f.library);
         check_exports(&library)?;
         let out = dist.join(format!("{}.fmu", f.info.model_identifier));
-        let documentation = jetpipe::packaging::documentation_page(f.info, f.notes);
-        jetpipe::packaging::write_model_fmu(&out, &library, f.info, &documentation)?;
+        let documentation = jetpipe_packaging::documentation_page(f.info, f.notes);
+        jetpipe_packaging::write_model_fmu(&out, &library, f.info, &documentation)?;
         written.push(out);
     }
     Ok(written)
@@ -70,7 +70,7 @@ fn check_exports(library: &Path) -> Result<(), String> {
         if !bytes.windows(needle.len()).any(|w| w == needle.as_bytes()) {
             return Err(format!(
                 "{} does not export {name}: it was built without its `exports` feature \
-                 (build it with `cargo build --release --target-dir target/fmus --lib -p tendon -p finger_joint -p joint_controller`)",
+                 (build it with `cargo build --release --lib -p tendon -p finger_joint -p joint_controller`)",
                 library.display()
             ));
         }

@@ -1,8 +1,8 @@
 //! The structure of the AntagonisticJoint system: components, connectors, connections and the
 //! parameter set, and their SSD XML (each component's start values inline).
 
-use jetpipe::fmi2::model::{Causality, ModelInfo, VarType};
-use jetpipe::fmi2::model_description::{format_double, xml_escape};
+use fmi2::model::{Causality, ModelInfo, VarType};
+use fmi2::model_description::{format_double, xml_escape};
 
 /// Name of the system and of the `.ssp`.
 pub const SYSTEM_NAME: &str = "AntagonisticJoint";
@@ -290,7 +290,7 @@ pub fn check() -> Result<(), Vec<String>> {
 }
 
 /// Units of the system's connectors, for `<ssd:Units>`.
-fn units_used() -> Vec<&'static jetpipe::fmi2::model::UnitDefinition> {
+fn units_used() -> Vec<&'static fmi2::model::UnitDefinition> {
     let mut names: Vec<&str> = Vec::new();
     let mut units = Vec::new();
     for c in components() {
@@ -456,7 +456,7 @@ mod tests {
         assert_eq!(get("tendon_flexor.F_act"), t_co);
         assert!((get("actuator_flexor.x_s") - (0.054 + t_co / 2e4)).abs() < 1e-12);
         // The actuator at that command is at T_co (the static map, to its interpolation error).
-        use jetpipe::fmi2::model::CoSimModel;
+        use fmi2::model::CoSimModel;
         let mut a = jetpipe::fmu::ActuatorFmu::instantiate();
         a.set_real(jetpipe::variables::vr::V_DA, get("actuator_flexor.v_DA"))
             .unwrap();
@@ -465,5 +465,27 @@ mod tests {
         a.exit_initialization().unwrap();
         let f = a.get_real(jetpipe::variables::vr::F_ACT).unwrap();
         assert!((f - t_co).abs() < 0.05, "{f} N vs {t_co} N");
+    }
+
+    /// The joint controller's feedforward table must be the actuator's own static curve:
+    /// recompute it from jetpipe's actuator FMU model (equilibrium at the default parameters).
+    /// Here, not in fmus/joint_controller: a test there would link the actuator's `fmi2*`
+    /// symbols next to the controller's own.
+    #[test]
+    fn static_force_map_is_the_actuators_equilibrium() {
+        use fmi2::model::CoSimModel;
+        use jetpipe::fmu::ActuatorFmu;
+        use jetpipe::variables::vr as actuator;
+        use joint_controller::control::STATIC_FORCE_MAP;
+        for &(v, f) in STATIC_FORCE_MAP {
+            let mut a = ActuatorFmu::instantiate();
+            a.set_real(actuator::V_DA, v).unwrap();
+            a.exit_initialization().unwrap();
+            let force = a.get_real(actuator::F_ACT).unwrap();
+            assert!(
+                (force - f).abs() < 2e-3,
+                "v_DA = {v} V: table {f} N, actuator {force} N"
+            );
+        }
     }
 }

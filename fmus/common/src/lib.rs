@@ -1,10 +1,10 @@
 //! What the three small FMUs of the antagonistic joint (`Tendon`, `FingerJoint`,
-//! `JointController`) share on top of jetpipe's generic FMI layer: a value store driven by the
-//! variable table (range checks with messages that name the variable), the versioned byte
-//! format of their FMU states, a monotone scalar solver for their implicit integrators, and
-//! what their `ModelInfo`, `CoSimModel` impls and interface tests would otherwise each repeat.
-//! No FFI types here. (The interface page of their archives is
-//! `jetpipe::packaging::documentation_page`, as the actuator's.)
+//! `JointController`) share on top of the generic FMI layer (crate `fmi2`): a value store
+//! driven by the variable table (range checks with messages that name the variable), the
+//! versioned byte format of their FMU states, a monotone scalar solver for their implicit
+//! integrators, and what their `ModelInfo`, `CoSimModel` impls and interface tests would
+//! otherwise each repeat. No FFI types here. (The interface page of their archives is
+//! `jetpipe_packaging::documentation_page`, as the actuator's.)
 
 pub mod solve;
 pub mod state_bytes;
@@ -16,9 +16,9 @@ pub use values::Values;
 
 // For `model_info!`, so that its expansion does not depend on the caller's imports.
 #[doc(hidden)]
-pub use jetpipe as __jetpipe;
+pub use fmi2 as __fmi2;
 
-use jetpipe::fmi2::model::StepError;
+use fmi2::model::StepError;
 
 /// The `ModelInfo` of one of these models, from what tells them apart; the author, default
 /// experiment, log categories and the lack of input interpolation are the same for all. A macro,
@@ -32,7 +32,7 @@ macro_rules! model_info {
         variables: $variables:expr,
         dependencies: $dependencies:expr $(,)?
     ) => {
-        $crate::__jetpipe::fmi2::model::ModelInfo {
+        $crate::__fmi2::model::ModelInfo {
             model_name: $name,
             model_identifier: $name,
             description: $description,
@@ -48,24 +48,21 @@ macro_rules! model_info {
             variables: $variables,
             can_interpolate_inputs: false,
             extent: {
-                fn extent(value_reference: u32) -> $crate::__jetpipe::fmi2::model::Extent {
+                fn extent(value_reference: u32) -> $crate::__fmi2::model::Extent {
                     $crate::nominal_from_start($variables, value_reference)
                 }
                 extent
             },
             dependencies: $dependencies,
-            guid_cache: $crate::__jetpipe::fmi2::model::GuidCache::new(),
+            guid_cache: $crate::__fmi2::model::GuidCache::new(),
         }
     };
 }
 
 /// The extent these models declare beyond their table rows' min/max: a nominal, the magnitude
 /// of the start value, for every Real parameter and input whose start is not 0.
-pub fn nominal_from_start(
-    variables: &[jetpipe::fmi2::model::Variable],
-    value_reference: u32,
-) -> jetpipe::fmi2::model::Extent {
-    use jetpipe::fmi2::model::{Causality, Extent, VarType};
+pub fn nominal_from_start(variables: &[fmi2::model::Variable], value_reference: u32) -> fmi2::model::Extent {
+    use fmi2::model::{Causality, Extent, VarType};
     let nominal = variables
         .iter()
         .find(|v| v.value_reference == value_reference)

@@ -1,8 +1,8 @@
 //! The interface checks every model's tests make. Not `#[cfg(test)]`: the tests that use
 //! them are in the model crates.
 
-use jetpipe::fmi2::model::{ModelInfo, Variable};
-use jetpipe::fmi2::model_description::model_description_xml;
+use fmi2::model::{ModelInfo, Variable};
+use fmi2::model_description::model_description_xml;
 
 /// The interface tests of a model's `fmu` module: `checked_in` is its
 /// `include_str!("../modelDescription.xml")`, `vrs` every constant of its `vr` module.
@@ -11,7 +11,7 @@ macro_rules! interface_tests {
     (model: $model:ty, info: $info:expr, dir: $dir:expr, checked_in: $checked_in:expr, vrs: [$($vr:expr),* $(,)?] $(,)?) => {
         #[test]
         fn declared_dependencies_are_what_perturbations_show() {
-            let report = $crate::__jetpipe::fmi2::structure_check::check_dependencies::<$model>(1e-3);
+            let report = $crate::__fmi2::structure_check::check_dependencies::<$model>(1e-3);
             assert!(report.problems.is_empty(), "{:#?}", report.problems);
         }
 

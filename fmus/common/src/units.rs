@@ -2,7 +2,7 @@
 //! dimensionless in FMI's `<BaseUnit>` (the `rad` exponent is optional), so `rad` and `1`
 //! share exponents but keep their names for the reader.
 
-use jetpipe::fmi2::model::UnitDefinition;
+use fmi2::model::UnitDefinition;
 
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32, a: i32) -> UnitDefinition {
     UnitDefinition {

@@ -1,7 +1,7 @@
 //! The values of a model's parameters and inputs, one per row of its variable table, so the
 //! getters, setters, range checks and FMU-state bytes all follow the table.
 
-use jetpipe::fmi2::model::{Causality, VarType, Variable};
+use fmi2::model::{Causality, VarType, Variable};
 
 #[derive(Clone, Debug)]
 pub struct Values {
@@ -109,7 +109,7 @@ pub fn check(v: &Variable, value: f64) -> Result<(), String> {
 
 /// Table-row constructors shared by the three models (Real variables).
 pub mod rows {
-    use jetpipe::fmi2::model::{Causality, VarType, Variability, Variable};
+    use fmi2::model::{Causality, VarType, Variability, Variable};
 
     const fn real(
         name: &'static str,

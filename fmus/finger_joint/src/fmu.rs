@@ -1,8 +1,8 @@
 //! The finger joint behind jetpipe's generic FMI layer. No FFI types here.
 
+use fmi2::model::{CoSimModel, DependencyKind, ModelInfo, OutputDependencies, StepError};
 use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
-use jetpipe::fmi2::model::{CoSimModel, DependencyKind, ModelInfo, OutputDependencies, StepError};
 
 use crate::physics::{Inputs, Parameters, State};
 use crate::variables::{vr, UNITS, VARIABLES};

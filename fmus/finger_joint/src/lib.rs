@@ -5,11 +5,11 @@
 //! * [`physics`]: inertia, damping, joint limits, pulley, implicit integrator (plain Rust);
 //! * [`variables`]: the variable table;
 //! * [`fmu`]: the model behind the layer; the `fmi2*` symbols come from
-//!   `jetpipe::fmi2_cosimulation_exports!` below.
+//!   `fmi2::fmi2_cosimulation_exports!` below.
 
 pub mod fmu;
 pub mod physics;
 pub mod variables;
 
 #[cfg(feature = "exports")]
-jetpipe::fmi2_cosimulation_exports!(crate::fmu::FingerJointFmu);
+fmi2::fmi2_cosimulation_exports!(crate::fmu::FingerJointFmu);

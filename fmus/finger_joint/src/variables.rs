@@ -1,9 +1,9 @@
 //! The FingerJoint FMU's variable table: the single source of its model description, getters
 //! and setters.
 
+use fmi2::model::{UnitDefinition, Variable};
 use fmu_common::units;
 use fmu_common::values::rows::{input, output, parameter, ANY, NON_NEGATIVE};
-use jetpipe::fmi2::model::{UnitDefinition, Variable};
 
 pub mod vr {
     pub const T_FLEXOR: u32 = 1;

@@ -22,7 +22,8 @@
 //!
 //! where K_F = 1.1 V/N is the thesis's k_p = 0.044 A/N divided by the driver's 0.04 A/V. The
 //! static map is the actuator model's equilibrium force against command at the default
-//! parameters (`STATIC_FORCE_MAP`; a test recomputes it from jetpipe's actuator).
+//! parameters (`STATIC_FORCE_MAP`; a test of fmus/antagonistic recomputes it from jetpipe's
+//! actuator).
 //!
 //! The controller is sampled: each communication step it reads its inputs at the step's
 //! start and holds its outputs over the next step, as a digital controller running at the

@@ -1,8 +1,8 @@
 //! The joint controller behind jetpipe's generic FMI layer. No FFI types here.
 
+use fmi2::model::{CoSimModel, ModelInfo, OutputDependencies, StepError};
 use fmu_common::state_bytes::StateFormat;
 use fmu_common::Values;
-use jetpipe::fmi2::model::{CoSimModel, ModelInfo, OutputDependencies, StepError};
 
 use crate::control::{Commands, Controller, Gains, Measurements};
 use crate::variables::{vr, UNITS, VARIABLES};
@@ -202,7 +202,7 @@ const STATE_FORMAT: StateFormat =
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::control::{static_command, STATIC_FORCE_MAP};
+    use crate::control::static_command;
 
     fmu_common::interface_tests! {
         model: JointControllerFmu,
@@ -215,24 +215,6 @@ mod tests {
             vr::R, vr::T_CO, vr::T_MIN, vr::T_MAX, vr::KP, vr::KI, vr::KD, vr::TAU_I_MAX, vr::K_F, vr::K_FF,
             vr::V_MIN, vr::V_MAX, vr::THETA_STEP, vr::T_STEP,
         ],
-    }
-
-    /// The feedforward table must be the actuator's own static curve: recompute it from
-    /// jetpipe's actuator FMU model (equilibrium at the default parameters).
-    #[test]
-    fn static_force_map_is_the_actuators_equilibrium() {
-        use jetpipe::fmu::ActuatorFmu;
-        use jetpipe::variables::vr as actuator;
-        for &(v, f) in STATIC_FORCE_MAP {
-            let mut a = ActuatorFmu::instantiate();
-            a.set_real(actuator::V_DA, v).unwrap();
-            a.exit_initialization().unwrap();
-            let force = a.get_real(actuator::F_ACT).unwrap();
-            assert!(
-                (force - f).abs() < 2e-3,
-                "v_DA = {v} V: table {f} N, actuator {force} N"
-            );
-        }
     }
 
     #[test]

@@ -7,11 +7,11 @@
 //!   static force map as feedforward;
 //! * [`variables`]: the variable table;
 //! * [`fmu`]: the model behind the layer; the `fmi2*` symbols come from
-//!   `jetpipe::fmi2_cosimulation_exports!` below.
+//!   `fmi2::fmi2_cosimulation_exports!` below.
 
 pub mod control;
 pub mod fmu;
 pub mod variables;
 
 #[cfg(feature = "exports")]
-jetpipe::fmi2_cosimulation_exports!(crate::fmu::JointControllerFmu);
+fmi2::fmi2_cosimulation_exports!(crate::fmu::JointControllerFmu);

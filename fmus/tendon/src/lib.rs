@@ -5,11 +5,11 @@
 //!   the pulleys, and the implicit integrator (plain Rust);
 //! * [`variables`]: the variable table (model description, getters and setters);
 //! * [`fmu`]: the model behind the layer; the `fmi2*` symbols come from
-//!   `jetpipe::fmi2_cosimulation_exports!` below.
+//!   `fmi2::fmi2_cosimulation_exports!` below.
 
 pub mod fmu;
 pub mod physics;
 pub mod variables;
 
 #[cfg(feature = "exports")]
-jetpipe::fmi2_cosimulation_exports!(crate::fmu::TendonFmu);
+fmi2::fmi2_cosimulation_exports!(crate::fmu::TendonFmu);

@@ -2,9 +2,9 @@
 //! setters. Defaults: see the parameter descriptions (values chosen for the Utah/MIT hand's
 //! tendon path where the thesis gives none; the README's co-simulation section says which).
 
+use fmi2::model::{Causality, UnitDefinition, VarType, Variability, Variable};
 use fmu_common::units;
 use fmu_common::values::rows::{input, output, parameter, ANY, NON_NEGATIVE};
-use jetpipe::fmi2::model::{Causality, UnitDefinition, VarType, Variability, Variable};
 
 pub mod vr {
     pub const F_ACT: u32 = 1;

@@ -20,11 +20,11 @@ use std::cell::{Cell, RefCell};
 use diffsol::{
     DiffsolError, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason, Vector,
 };
-use jetpipe::physics::actuator::{index, Actuator, Inputs, Jacobian, State};
-use jetpipe::physics::chambers::pressure_after_volume_jump;
-use jetpipe::physics::parameters::Parameters;
-use jetpipe::scenario::{self, SAMPLE_PERIOD};
-use jetpipe::simulation::{ChamberMethod, Simulation};
+use jetpipe_model::physics::actuator::{index, Actuator, Inputs, Jacobian, State};
+use jetpipe_model::physics::chambers::pressure_after_volume_jump;
+use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::scenario::{self, SAMPLE_PERIOD};
+use jetpipe_model::simulation::{ChamberMethod, Simulation};
 
 const TOLERANCES: [f64; 5] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
 const ERROR_LEVELS: [f64; 3] = [1e-4, 1e-5, 1e-6];

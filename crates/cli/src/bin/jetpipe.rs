@@ -1,0 +1,437 @@
+//! `jetpipe`: package the FMU, print its model description, run the standard scenario,
+//! sweep parameters over it.
+//! It drives the same library as the FMU; there is no second copy of the model.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::{Parser, Subcommand};
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::scenario;
+use jetpipe_model::simulation::{Simulation, DEFAULT_RELATIVE_TOLERANCE};
+
+#[derive(Parser)]
+#[command(
+    name = "jetpipe",
+    version,
+    about = "Jet-pipe electropneumatic actuator (Henri 1994) as an FMI 2.0 FMU"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Write dist/JetPipeActuator.fmu (model description, linux64 and optionally win64 binaries, documentation).
+    Package {
+        #[arg(long, default_value = "dist/JetPipeActuator.fmu")]
+        out: PathBuf,
+        /// The compiled linux64 shared library; by default libjetpipe.so next to this executable.
+        #[arg(long)]
+        library: Option<PathBuf>,
+        /// A win64 DLL of the same library, packaged as binaries/win64/JetPipeActuator.dll.
+        #[arg(long)]
+        win64: Option<PathBuf>,
+    },
+    /// Print the model description generated from the variable table.
+    ModelDescription,
+    /// Print every variable with its unit, start value, limits, thesis reference and meaning
+    /// (the Markdown table of docs/model.md, from the variable table).
+    Parameters,
+    /// Linearise at the equilibrium with the given force (§4.2.2): A, B, C, D, poles, zeros.
+    Linearize {
+        /// Actuator force of the operating point, N.
+        #[arg(long, default_value_t = 45.0)]
+        force: f64,
+        /// Stopper position of the operating point, m.
+        #[arg(long = "x-s", default_value_t = 0.054)]
+        x_s: f64,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Compare a bench recording with the model, find the effects it lacks, report before/after.
+    Diagnose {
+        /// The recording (CSV: time_s, v_da_V, x_s_m, force_N[, p1_Pa, p2_Pa]).
+        recording: PathBuf,
+        /// Where to write the JSON report (written only if the diagnosis succeeds).
+        #[arg(long)]
+        report: PathBuf,
+        /// JSON object of FMU parameter values to start from instead of the thesis's.
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Re-identify jet pipe offset, C_d and leakage (§3.3.1) first.
+        #[arg(long)]
+        calibrate: bool,
+        /// Directory for SVG plots of the residuals and force/current loops.
+        #[arg(long)]
+        plots: Option<PathBuf>,
+        /// Worker threads for the candidate fits (default: every core this process may use).
+        #[arg(long)]
+        jobs: Option<usize>,
+    },
+    /// Run the standard scenario in-process and print a summary.
+    Simulate {
+        /// Communication step in seconds.
+        #[arg(long, default_value_t = 0.01)]
+        step: f64,
+        /// Relative tolerance of the integrator.
+        #[arg(long, default_value_t = DEFAULT_RELATIVE_TOLERANCE)]
+        tolerance: f64,
+        /// Write time and outputs every 10 ms to this CSV file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
+    /// Run the standard scenario for every point of a parameter grid on all cores; write one
+    /// CSV row per run and print the speed-up over one thread.
+    Sweep {
+        /// NAME=START:STOP:N (N evenly spaced values), NAME=V1,V2,... or NAME=V, with NAME a
+        /// parameter of the FMU (e.g. C_d, P_s; `jetpipe parameters` lists them with their
+        /// limits, which every value must keep). Several --param give their Cartesian product.
+        #[arg(long = "param", value_name = "NAME=VALUES", required = true)]
+        params: Vec<String>,
+        /// Worker threads (default: every core this process may use).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// The CSV file to write.
+        #[arg(long, default_value = "sweep.csv")]
+        out: PathBuf,
+        /// Simulated seconds of the standard scenario (a multiple of 10 ms; default all 10 s).
+        #[arg(long, default_value_t = scenario::DURATION)]
+        duration: f64,
+        /// Communication step in seconds (divides 10 ms).
+        #[arg(long, default_value_t = scenario::SAMPLE_PERIOD)]
+        step: f64,
+        /// Relative tolerance of the integrator.
+        #[arg(long, default_value_t = DEFAULT_RELATIVE_TOLERANCE)]
+        tolerance: f64,
+        /// JSON object of FMU parameter values the grid starts from instead of the thesis's.
+        #[arg(long)]
+        base_params: Option<PathBuf>,
+        /// Time every run on one thread too (default: an evenly spaced subset of the runs).
+        #[arg(long, conflicts_with = "no_serial")]
+        compare_serial: bool,
+        /// Skip the one-thread reference run (no speed-up is printed).
+        #[arg(long)]
+        no_serial: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("jetpipe: error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<(), String> {
+    match cli.command {
+        Command::Package { out, library, win64 } => {
+            let library = match library {
+                Some(path) => path,
+                None => build_shared_library()?,
+            };
+            let mut binaries = vec![("linux64", library.as_path())];
+            if let Some(dll) = &win64 {
+                binaries.push(("win64", dll.as_path()));
+            }
+            jetpipe_packaging::write_fmu_platforms(&out, &binaries)?;
+            println!("wrote {}", out.display());
+            Ok(())
+        }
+        Command::ModelDescription => {
+            print!("{}", jetpipe_packaging::actuator_model_description());
+            Ok(())
+        }
+        Command::Parameters => {
+            print!("{}", jetpipe_model::variables::interface_table());
+            Ok(())
+        }
+        Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
+        Command::Sweep {
+            params,
+            threads,
+            out,
+            duration,
+            step,
+            tolerance,
+            base_params,
+            compare_serial,
+            no_serial,
+        } => {
+            let options = jetpipe_cli::sweep::SweepOptions {
+                params,
+                threads,
+                out,
+                settings: jetpipe_cli::sweep::RunSettings {
+                    duration,
+                    step,
+                    tolerance,
+                },
+                base: read_parameters(base_params.as_deref())?,
+                compare_serial,
+                no_serial,
+            };
+            jetpipe_cli::sweep::run_command(&options, &mut std::io::stdout().lock())
+        }
+        Command::Linearize { force, x_s, json } => linearize(force, x_s, json),
+        Command::Diagnose {
+            recording,
+            report,
+            params,
+            calibrate,
+            plots,
+            jobs,
+        } => diagnose(
+            &recording,
+            &report,
+            params.as_deref(),
+            calibrate,
+            plots.as_deref(),
+            jobs,
+        ),
+    }
+}
+
+/// `cargo run --bin jetpipe` builds the FMU crate (crates/fmu) as a dependency only, and does
+/// not put its cdylib next to this executable; the FMU needs it, so build it (a no-op when it
+/// is up to date) with the same profile as this executable.
+fn build_shared_library() -> Result<PathBuf, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot locate this executable: {e}"))?;
+    let library = exe.with_file_name("libjetpipe.so");
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/../fmu/Cargo.toml");
+    if std::path::Path::new(manifest).is_file() {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
+        let mut command = std::process::Command::new(&cargo);
+        command.args(["build", "--lib", "--manifest-path", manifest]);
+        if !cfg!(debug_assertions) {
+            command.arg("--release");
+        }
+        // Put the library next to this executable, wherever the target directory is.
+        if let Some(target_dir) = exe.parent().and_then(|p| p.parent()) {
+            command.arg("--target-dir").arg(target_dir);
+        }
+        let status = command.status().map_err(|e| format!("cannot run {cargo}: {e}"))?;
+        if !status.success() {
+            return Err(format!("`{cargo} build --lib` failed ({status})"));
+        }
+    }
+    Ok(library)
+}
+
+/// Parameters from a JSON object of FMU parameter names and values.
+fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String> {
+    let mut p = Parameters::default();
+    let Some(path) = path else { return Ok(p) };
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: not valid JSON: {e}", path.display()))?;
+    let object = value
+        .as_object()
+        .ok_or_else(|| format!("{}: expected a JSON object of parameter values", path.display()))?;
+    for (name, v) in object {
+        let variable = jetpipe_model::variables::VARIABLES
+            .iter()
+            .find(|var| var.name == name && var.causality == jetpipe_model::variables::Causality::Parameter)
+            .ok_or_else(|| format!("{}: '{name}' is not a parameter of the model", path.display()))?;
+        let x = v
+            .as_f64()
+            .ok_or_else(|| format!("{}: '{name}' must be a number, got {v}", path.display()))?;
+        p.set(variable.value_reference, x)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    p.validate().map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(p)
+}
+
+/// Progress bars on the diagnosis's long phases, on stderr when it is a terminal (indicatif
+/// draws nothing otherwise, and the progress lines go out as they are).
+#[derive(Default)]
+struct TerminalBars {
+    bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
+}
+
+impl TerminalBars {
+    fn println(&self, line: &str) {
+        match self.bar.lock().ok().as_deref().and_then(|b| b.clone()) {
+            Some(bar) if !bar.is_hidden() => bar.suspend(|| eprintln!("{line}")),
+            _ => eprintln!("{line}"),
+        }
+    }
+}
+
+impl jetpipe_diagnosis::ProgressBars for TerminalBars {
+    fn start(&self, phase: &str, total: usize) {
+        let bar = indicatif::ProgressBar::new(total as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{prefix:>13} [{bar:30}] {pos}/{len} {elapsed}") {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.set_prefix(phase.to_string());
+        if let Ok(mut slot) = self.bar.lock() {
+            *slot = Some(bar);
+        }
+    }
+    fn advance(&self) {
+        if let Ok(slot) = self.bar.lock() {
+            if let Some(bar) = slot.as_ref() {
+                bar.inc(1);
+            }
+        }
+    }
+    fn finish(&self) {
+        if let Ok(mut slot) = self.bar.lock() {
+            if let Some(bar) = slot.take() {
+                bar.finish_and_clear();
+            }
+        }
+    }
+}
+
+fn diagnose(
+    recording_path: &std::path::Path,
+    report: &std::path::Path,
+    params: Option<&std::path::Path>,
+    calibrate: bool,
+    plots: Option<&std::path::Path>,
+    jobs: Option<usize>,
+) -> Result<(), String> {
+    if jobs == Some(0) {
+        return Err("--jobs 0 is invalid: must be at least 1".to_string());
+    }
+    let started = Instant::now();
+    let base = read_parameters(params)?;
+    let recording = jetpipe_diagnosis::recording::Recording::read(recording_path, &base)?;
+    let bars = std::sync::Arc::new(TerminalBars::default());
+    let mut progress = |line: &str| {
+        let line = format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
+        bars.println(&line);
+    };
+    let mut options = jetpipe_diagnosis::Options {
+        calibrate,
+        bars: Some(bars.clone()),
+        ..Default::default()
+    };
+    if let Some(jobs) = jobs {
+        options.jobs = jobs;
+    }
+    let diagnosis = jetpipe_diagnosis::diagnose_with(&recording, &base, &options, &mut progress)?;
+    let name = recording_path.display().to_string();
+    let json = diagnosis.to_json(&name);
+    if let Some(dir) = plots {
+        jetpipe_cli::plots::write_diagnosis_plots(dir, &recording, &diagnosis)?;
+        eprintln!("plots written to {}", dir.display());
+    }
+    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
+    // Write beside the target and rename: an existing report is never left half-written.
+    let temporary = report.with_extension("json.partial");
+    std::fs::write(&temporary, text).map_err(|e| format!("cannot write {}: {e}", temporary.display()))?;
+    std::fs::rename(&temporary, report).map_err(|e| format!("cannot write {}: {e}", report.display()))?;
+    println!(
+        "{name}: {} samples, noise floor {:.4} N",
+        diagnosis.samples, diagnosis.noise_floor
+    );
+    println!("  verdict: {}", diagnosis.verdict());
+    for line in diagnosis.summary() {
+        println!("  {line}");
+    }
+    println!(
+        "  report: {} ({:.1} s)",
+        report.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn linearize(force: f64, x_s: f64, json: bool) -> Result<(), String> {
+    if !force.is_finite() {
+        return Err(format!("--force {force} is invalid: must be finite"));
+    }
+    let model = Actuator::new(Parameters::default())?;
+    model.params.check_stopper(x_s)?;
+    let v = jetpipe_cli::linearization::command_for_force(&model, force, x_s)?;
+    let lin = jetpipe_cli::linearization::linearize(&model, v, x_s)?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&lin.to_json()).map_err(|e| e.to_string())?
+        );
+        return Ok(());
+    }
+    let op = &lin.operating_point;
+    println!(
+        "operating point: F_act = {:.4} N, x_s = {} m, v_DA = {:.6} V, i = {:.6} A, P1 = {:.0} Pa, P2 = {:.0} Pa",
+        op.f_act, op.x_s, op.v_da, op.current, op.p1, op.p2
+    );
+    println!("poles (rad/s):");
+    for p in &lin.poles {
+        println!("  {:12.4} {:+12.4}j", p.re, p.im);
+    }
+    println!("zeros (rad/s):");
+    for z in &lin.zeros {
+        println!("  {:12.4} {:+12.4}j", z.re, z.im);
+    }
+    if let Some(bw) = lin.bandwidth_hz() {
+        println!("open-loop -3 dB bandwidth of F_act/v_DA: {bw:.3} Hz");
+    }
+    Ok(())
+}
+
+fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), String> {
+    if !(step.is_finite() && step > 0.0 && step <= scenario::SAMPLE_PERIOD) {
+        return Err(format!(
+            "--step {step} is invalid: must be in (0, {}] s",
+            scenario::SAMPLE_PERIOD
+        ));
+    }
+    let substeps = (scenario::SAMPLE_PERIOD / step).round().max(1.0) as usize;
+    let model = Actuator::new(Parameters::default())?;
+    let (v0, x0) = scenario::standard_inputs(0);
+    let started = Instant::now();
+    let mut sim = Simulation::at_equilibrium(model, v0, x0, 0.0, tolerance)?;
+    let mut rows = vec![(0.0, sim.outputs())];
+    for k in 0..scenario::standard_samples() {
+        let (v, x) = scenario::standard_inputs(k);
+        sim.set_command(v)?;
+        sim.set_stopper(x)?;
+        for _ in 0..substeps {
+            sim.step(scenario::SAMPLE_PERIOD / substeps as f64)
+                .map_err(|e| format!("{e:?}"))?;
+        }
+        rows.push((sim.time, sim.outputs()));
+    }
+    let elapsed = started.elapsed().as_secs_f64();
+    let force = rows.iter().map(|r| r.1.f_act);
+    let (f_min, f_max) = force.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f), b.max(f)));
+    let last = rows.last().expect("at least the initial row").1;
+    let st = sim.statistics;
+    println!(
+        "standard scenario: {} s, communication step {step} s, relative tolerance {tolerance:e}",
+        scenario::DURATION
+    );
+    println!("  F_act  min {f_min:.4} N  max {f_max:.4} N  final {:.6} N", last.f_act);
+    println!("  P1 final {:.1} Pa   P2 final {:.1} Pa", last.p1, last.p2);
+    println!(
+        "  work: {} steps ({} rejected), {} right-hand sides, {} Jacobians; {:.1} ms CPU ({:.0}x real time)",
+        st.steps,
+        st.rejected,
+        st.rhs_evaluations,
+        st.jacobians,
+        elapsed * 1e3,
+        scenario::DURATION / elapsed
+    );
+    if let Some(path) = csv {
+        let mut text = String::from("time_s,F_act_N,P1_Pa,P2_Pa,i_A,x_jp_m\n");
+        for (t, y) in &rows {
+            text.push_str(&format!("{t},{},{},{},{},{}\n", y.f_act, y.p1, y.p2, y.current, y.x_jp));
+        }
+        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        println!("  wrote {}", path.display());
+    }
+    Ok(())
+}

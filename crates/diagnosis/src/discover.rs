@@ -1,0 +1,231 @@
+//! Turning a fitted candidate into FMU parameters: a discovered term is added to the model
+//! only as parameters the FMU has, so that the FMU with the report's `fmu_start_values`
+//! is the model whose error the report gives.
+//!
+//! Terms that the fit applies on a measured channel (a sensor's curve or drift, a force
+//! on the piston) are composed with what the model already reads there; terms the FMU
+//! cannot carry (a pressure transducer's, a constant modulated in time) and compositions
+//! that would not be exact give `None`, and the candidate stays a located departure.
+
+use super::corrections::{parameter_value, Candidate, Mechanism, Modulation, Problem, Regressor};
+use super::signals::FORCE;
+use jetpipe_model::physics::parameters::Parameters;
+
+/// The FMU parameters (name, value) that put the fitted `values` of `terms` into the
+/// model `base`, or `None` when the FMU cannot carry them exactly.
+pub fn model_terms(
+    candidate: &Candidate,
+    values: &[f64],
+    base: &Parameters,
+    problem: &Problem,
+) -> Option<Vec<(&'static str, f64)>> {
+    let terms = &candidate.terms;
+    let mut set: Vec<(&'static str, f64)> = candidate.settings.clone();
+    // Coefficients of the force channel's regressors.
+    let mut one = 0.0;
+    let mut own = 0.0;
+    let mut squared = 0.0;
+    let mut cubed = 0.0;
+    let mut ramp = 0.0;
+    let mut sine: Option<(f64, f64, f64)> = None;
+    let mut friction = 0.0;
+    let mut viscous = 0.0;
+    let mut position = 0.0;
+    // Modulations of a constant: (parameter, ramp coefficient, sine, cosine, frequency).
+    let mut modulated: Vec<(&'static str, f64, f64, f64, f64)> = vec![];
+    for (term, &value) in terms.iter().zip(values) {
+        match term.mechanism {
+            Mechanism::Modulated { parameter, modulation } => {
+                let k = match modulated.iter().position(|m| m.0 == parameter) {
+                    Some(k) => k,
+                    None => {
+                        modulated.push((parameter, 0.0, 0.0, 0.0, 0.0));
+                        modulated.len() - 1
+                    }
+                };
+                let m = &mut modulated[k];
+                match modulation {
+                    Modulation::Ramp => m.1 += value,
+                    Modulation::Sine(f) => {
+                        m.2 += value;
+                        m.4 = f;
+                    }
+                    Modulation::Cosine(f) => {
+                        m.3 += value;
+                        m.4 = f;
+                    }
+                }
+            }
+            m if m.model_parameter().is_some() => set.push((m.model_parameter()?, value)),
+            Mechanism::OutputFilter { channel: FORCE, filter } => {
+                let name = filter.force_sensor_parameter();
+                if parameter_value(base, name) != 0.0 && value != 0.0 {
+                    return None;
+                }
+                set.push((name, value));
+            }
+            Mechanism::Output {
+                channel: FORCE,
+                regressor,
+            } => match regressor {
+                Regressor::One => one += value,
+                Regressor::Own => own += value,
+                Regressor::OwnSquared => squared += value,
+                Regressor::OwnCubed => cubed += value,
+                Regressor::Ramp => ramp += value,
+                Regressor::Sine(f) => {
+                    let s = sine.get_or_insert((f, 0.0, 0.0));
+                    s.1 += value;
+                }
+                Regressor::Cosine(f) => {
+                    let s = sine.get_or_insert((f, 0.0, 0.0));
+                    s.2 += value;
+                }
+                Regressor::Friction => friction += value,
+                Regressor::SmoothFriction(_) | Regressor::Stribeck(..) => return None,
+                Regressor::Viscous => viscous += value,
+                Regressor::Position => position += value,
+            },
+            _ => return None,
+        }
+    }
+    let p = base;
+    // A constant varying in time: c(t) = c + ramp (t − t_mid)/span + a sin ωt + b cos ωt.
+    for (parameter, ramp, a, b, f) in modulated {
+        let (drift, ripple) = match parameter {
+            "P_s" => ("supply_drift", true),
+            "x_jp_offset" => ("x_jp_offset_drift", false),
+            _ => return None,
+        };
+        if ramp != 0.0 {
+            if parameter_value(base, drift) != 0.0 {
+                return None;
+            }
+            let at_mid = set
+                .iter()
+                .find(|(n, _)| *n == parameter)
+                .map_or_else(|| parameter_value(base, parameter), |(_, v)| *v);
+            set.retain(|(n, _)| *n != parameter);
+            set.push((parameter, at_mid - ramp * problem.t_mid / problem.t_span));
+            set.push((drift, ramp / problem.t_span));
+        }
+        if a != 0.0 || b != 0.0 {
+            if !ripple || base.supply_ripple_sine != 0.0 || base.supply_ripple_cosine != 0.0 {
+                return None;
+            }
+            set.push(("supply_ripple_sine", a));
+            set.push(("supply_ripple_cosine", b));
+            set.push(("supply_ripple_frequency", f));
+        }
+    }
+    let g = p.force_sensor_gain;
+    // Forces on the piston read through the sensor's gain.
+    if friction != 0.0 {
+        set.push(("friction_coulomb", p.friction_coulomb + friction / g));
+    }
+    if viscous != 0.0 {
+        set.push(("viscous_friction", p.viscous_friction + viscous / g));
+    }
+    if position != 0.0 {
+        let (k0, x0) = (p.position_force_rate, p.position_force_reference);
+        let k = position / g;
+        if k0 + k == 0.0 {
+            return None;
+        }
+        set.push(("position_force_rate", k0 + k));
+        set.push((
+            "position_force_reference",
+            (k0 * x0 + k * problem.mean_position) / (k0 + k),
+        ));
+    }
+    // The sensor: new reading = (1 + own) s + one + squared s² + cubed s³ + ramp r(t) +
+    // pick-up, with s the reading so far, o + g F + …; exact when s is affine in F.
+    let curve = squared != 0.0 || cubed != 0.0;
+    let s_nonlinear = p.force_sensor_quadratic != 0.0
+        || p.force_sensor_cubic != 0.0
+        || p.force_sensor_drift != 0.0
+        || p.force_sensor_ripple_sine != 0.0
+        || p.force_sensor_ripple_cosine != 0.0;
+    if curve && s_nonlinear {
+        return None;
+    }
+    if one != 0.0 || own != 0.0 || curve || ramp != 0.0 {
+        let o = p.force_sensor_offset;
+        let m = 1.0 + own;
+        let (t_mid, t_span) = (problem.t_mid, problem.t_span);
+        set.push((
+            "force_sensor_offset",
+            m * o + one + squared * o * o + cubed * o * o * o - ramp * t_mid / t_span,
+        ));
+        set.push((
+            "force_sensor_gain",
+            m * g + 2.0 * squared * o * g + 3.0 * cubed * o * o * g,
+        ));
+        if curve || p.force_sensor_quadratic != 0.0 {
+            set.push((
+                "force_sensor_quadratic",
+                m * p.force_sensor_quadratic + squared * g * g + 3.0 * cubed * o * g * g,
+            ));
+        }
+        if cubed != 0.0 || p.force_sensor_cubic != 0.0 {
+            set.push(("force_sensor_cubic", m * p.force_sensor_cubic + cubed * g * g * g));
+        }
+        if ramp != 0.0 || p.force_sensor_drift != 0.0 {
+            set.push(("force_sensor_drift", m * p.force_sensor_drift + ramp / t_span));
+        }
+        if (p.force_sensor_ripple_sine != 0.0 || p.force_sensor_ripple_cosine != 0.0) && m != 1.0 && sine.is_none() {
+            set.push(("force_sensor_ripple_sine", m * p.force_sensor_ripple_sine));
+            set.push(("force_sensor_ripple_cosine", m * p.force_sensor_ripple_cosine));
+        }
+    }
+    if let Some((f, a, b)) = sine {
+        // a sin ωt + b cos ωt on top of what is there at the same frequency.
+        let m = 1.0 + own;
+        let (s0, c0) = (p.force_sensor_ripple_sine, p.force_sensor_ripple_cosine);
+        if (s0 != 0.0 || c0 != 0.0) && p.force_sensor_ripple_frequency != f {
+            return None;
+        }
+        set.push(("force_sensor_ripple_sine", m * s0 + a));
+        set.push(("force_sensor_ripple_cosine", m * c0 + b));
+        set.push(("force_sensor_ripple_frequency", f));
+    }
+    // A setting the fit refined appears twice: the last value holds.
+    let mut unique: Vec<(&'static str, f64)> = vec![];
+    for (name, value) in set {
+        unique.retain(|(n, _)| *n != name);
+        unique.push((name, value));
+    }
+    if unique.is_empty() {
+        return None;
+    }
+    Some(unique)
+}
+
+/// The unit of an FMU parameter, from the variable table.
+pub fn unit_of(name: &str) -> &'static str {
+    jetpipe_model::variables::VARIABLES
+        .iter()
+        .find(|v| v.name == name)
+        .and_then(|v| v.unit)
+        .unwrap_or("")
+}
+
+/// One sentence on what was added: each parameter against its value in the model before.
+pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, f64)], before: &Parameters) -> String {
+    let parts: Vec<String> = set
+        .iter()
+        .map(|&(name, value)| {
+            let was = parameter_value(before, name);
+            let unit = unit_of(name);
+            if was == 0.0 {
+                format!("{name} = {value:.4e} {unit} (0 before)")
+            } else {
+                format!(
+                    "{name} = {value:.4e} {unit} instead of {was:.4e} ({:+.1} %)",
+                    100.0 * (value / was - 1.0)
+                )
+            }
+        })
+        .collect();
+    format!("At the {location} ({family}), a {label}: {}.", parts.join(", "))
+}

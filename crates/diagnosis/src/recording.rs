@@ -1,0 +1,227 @@
+//! Bench recordings (MODEL.md, "Measured data"): a CSV file with a header row and the
+//! columns `time_s, v_da_V, x_s_m, force_N`, optionally `p1_Pa, p2_Pa`, in SI units.
+//! Every problem is reported with its row (1-based, the header is row 1) and column.
+
+use jetpipe_model::physics::parameters::Parameters;
+
+/// A checked recording.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recording {
+    pub time: Vec<f64>,
+    pub v_da: Vec<f64>,
+    pub x_s: Vec<f64>,
+    pub force: Vec<f64>,
+    pub p1: Option<Vec<f64>>,
+    pub p2: Option<Vec<f64>>,
+}
+
+const REQUIRED: [&str; 4] = ["time_s", "v_da_V", "x_s_m", "force_N"];
+const OPTIONAL: [&str; 2] = ["p1_Pa", "p2_Pa"];
+
+impl Recording {
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.time.is_empty()
+    }
+
+    /// Read and check a recording file.
+    pub fn read(path: &std::path::Path, params: &Parameters) -> Result<Self, String> {
+        let text = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let text = String::from_utf8(text).map_err(|e| {
+            format!(
+                "{}: not a text file (invalid UTF-8 at byte {})",
+                path.display(),
+                e.utf8_error().valid_up_to()
+            )
+        })?;
+        Self::parse(&text, params).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Parse and check CSV text.
+    pub fn parse(text: &str, params: &Parameters) -> Result<Self, String> {
+        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+        let (_, header) = lines
+            .next()
+            .ok_or("the file is empty: expected a header row and samples")?;
+        let names: Vec<&str> = header
+            .trim_start_matches('\u{feff}')
+            .split(',')
+            .map(str::trim)
+            .collect();
+        let mut columns = [usize::MAX; 6];
+        for (position, name) in names.iter().enumerate() {
+            let slot = REQUIRED
+                .iter()
+                .chain(OPTIONAL.iter())
+                .position(|c| c == name)
+                .ok_or_else(|| {
+                    format!(
+                        "row 1: unknown column '{name}' (column {}); the columns are {} and optionally {}",
+                        position + 1,
+                        REQUIRED.join(", "),
+                        OPTIONAL.join(", ")
+                    )
+                })?;
+            if columns[slot] != usize::MAX {
+                return Err(format!("row 1: column '{name}' appears twice"));
+            }
+            columns[slot] = position;
+        }
+        for (slot, name) in REQUIRED.iter().enumerate() {
+            if columns[slot] == usize::MAX {
+                return Err(format!("row 1: missing column '{name}' (found: {})", names.join(", ")));
+            }
+        }
+        if (columns[4] == usize::MAX) != (columns[5] == usize::MAX) {
+            return Err("row 1: give both p1_Pa and p2_Pa, or neither".to_string());
+        }
+        let has_pressures = columns[4] != usize::MAX;
+        let mut data: [Vec<f64>; 6] = Default::default();
+        for (index, line) in lines {
+            let row = index + 1;
+            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+            if cells.len() != names.len() {
+                return Err(format!(
+                    "row {row}: {} cells, the header has {}",
+                    cells.len(),
+                    names.len()
+                ));
+            }
+            for (slot, &position) in columns.iter().enumerate() {
+                if position == usize::MAX {
+                    continue;
+                }
+                let name = if slot < 4 { REQUIRED[slot] } else { OPTIONAL[slot - 4] };
+                let cell = cells[position];
+                let value: f64 = cell
+                    .parse()
+                    .map_err(|_| format!("row {row}, column {name}: '{cell}' is not a number"))?;
+                if !value.is_finite() {
+                    return Err(format!("row {row}, column {name}: {cell} is not a finite number"));
+                }
+                data[slot].push(value);
+            }
+        }
+        let [time, v_da, x_s, force, p1, p2] = data;
+        if time.is_empty() {
+            return Err("no samples after the header row".to_string());
+        }
+        if time.len() < 2 {
+            return Err("only one sample: a recording needs at least two".to_string());
+        }
+        for k in 1..time.len() {
+            if time[k] <= time[k - 1] {
+                return Err(format!(
+                    "row {}, column time_s: time {} s does not increase (previous row: {} s)",
+                    k + 2,
+                    time[k],
+                    time[k - 1]
+                ));
+            }
+        }
+        let (lo, hi) = params.cylinder().stopper_range();
+        // A stopper column in millimetres is the commonest unit slip: say so.
+        let typical = {
+            let mut sorted = x_s.clone();
+            sorted.sort_by(|a, b| a.total_cmp(b));
+            sorted[sorted.len() / 2]
+        };
+        if typical > 1000.0 * lo && typical < 1000.0 * hi {
+            return Err(format!(
+                "column x_s_m: values like {typical} look like millimetres; the recording must be in metres (e.g. {} m)",
+                typical / 1000.0
+            ));
+        }
+        for (k, &x) in x_s.iter().enumerate() {
+            if x <= lo || x >= hi {
+                return Err(format!(
+                    "row {}, column x_s_m: stopper position {x} m is outside the cylinder ({lo} < x_s < {hi} m)",
+                    k + 2
+                ));
+            }
+        }
+        if has_pressures {
+            for (name, values) in [("p1_Pa", &p1), ("p2_Pa", &p2)] {
+                if let Some(k) = values.iter().position(|&p| p <= 0.0) {
+                    return Err(format!(
+                        "row {}, column {name}: absolute pressure {} Pa is not positive (gauge pressure? the column must be absolute)",
+                        k + 2,
+                        values[k]
+                    ));
+                }
+            }
+        }
+        Ok(Recording {
+            time,
+            v_da,
+            x_s,
+            force,
+            p1: has_pressures.then_some(p1),
+            p2: has_pressures.then_some(p2),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Recording, String> {
+        Recording::parse(text, &Parameters::default())
+    }
+
+    const GOOD: &str =
+        "time_s,v_da_V,x_s_m,force_N,p1_Pa,p2_Pa\n0.000,1.0,0.054,10.0,3e5,2e5\n0.001,1.1,0.054,10.1,3e5,2e5\n";
+
+    #[test]
+    fn reads_a_good_file_with_any_column_order() {
+        let r = parse(GOOD).unwrap();
+        assert_eq!(r.len(), 2);
+        assert_eq!(r.p1.as_ref().unwrap()[1], 3e5);
+        let r = parse("force_N,time_s,x_s_m,v_da_V\n1,0,0.05,2\n2,0.1,0.05,2\n").unwrap();
+        assert_eq!((r.force[1], r.time[1], r.v_da[0]), (2.0, 0.1, 2.0));
+        assert!(r.p1.is_none());
+    }
+
+    #[test]
+    fn every_bad_file_gets_a_message_with_row_and_column() {
+        let cases = [
+            ("", "empty"),
+            ("time_s,v_da_V,x_s_m,force_N\n", "no samples"),
+            (
+                "time_s,v_da_V,x_s_m,force\n0,1,0.054,1\n0.1,1,0.054,1\n",
+                "unknown column 'force'",
+            ),
+            ("time_s,v_da_V,x_s_m\n0,1,0.054\n", "missing column 'force_N'"),
+            (
+                "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0.1,abc,0.054,1\n",
+                "row 3, column v_da_V: 'abc'",
+            ),
+            (
+                "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0.1,1,0.054,NaN\n",
+                "row 3, column force_N",
+            ),
+            (
+                "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0,1,0.054,1\n",
+                "row 3, column time_s",
+            ),
+            (
+                "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0.1,1,0.12,1\n",
+                "row 3, column x_s_m",
+            ),
+            ("time_s,v_da_V,x_s_m,force_N\n0,1,54,1\n0.1,1,54,1\n", "millimetres"),
+            (
+                "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0.1,1,0.054\n",
+                "row 3: 3 cells",
+            ),
+            ("time_s,v_da_V,x_s_m,force_N,p1_Pa\n0,1,0.054,1,1e5\n", "p2_Pa"),
+        ];
+        for (text, expected) in cases {
+            let e = parse(text).unwrap_err();
+            assert!(e.contains(expected), "{text:?}: {e}");
+        }
+    }
+}

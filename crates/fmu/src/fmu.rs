@@ -1,0 +1,888 @@
+//! The actuator behind the generic FMI layer: maps the variable table onto the physics
+//! and the simulation driver. No FFI types here.
+
+use crate::variables::{vr, UNITS, VARIABLES};
+use fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
+use jetpipe_model::physics::actuator::{index, Actuator, State, N_STATES};
+use jetpipe_model::physics::command_stage::CommandStage;
+use jetpipe_model::physics::effects::PLAY_OPERATORS;
+use jetpipe_model::physics::force_sensor::SensorMemory;
+use jetpipe_model::physics::parameters::{variable_name, Parameters};
+use jetpipe_model::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+
+pub const LOG_CATEGORIES: &[(&str, &str)] = &[
+    ("logEvents", "initialisation, resets and state restores"),
+    ("logStatusWarning", "messages with status fmi2Warning"),
+    ("logStatusDiscard", "messages with status fmi2Discard"),
+    ("logStatusError", "messages with status fmi2Error"),
+    ("logStatusFatal", "messages with status fmi2Fatal"),
+    ("logAll", "every message"),
+];
+
+pub use jetpipe_model::variables::V_DA_RANGE;
+
+/// `min`, `max` and `nominal` of the model description. Parameters: the bounds that
+/// `Parameters::set` enforces (FMI has no open bounds, so "> 0" is `min="0"`) and the
+/// default's magnitude as nominal. `x_s`: the stopper range of the default geometry (the
+/// run-time check uses the geometry actually set). `v_DA`: the D/A range.
+pub fn extent(value_reference: u32) -> Extent {
+    let defaults = Parameters::default();
+    let scale = |x: f64| if x != 0.0 && x.is_finite() { Some(x.abs()) } else { None };
+    match value_reference {
+        vr::V_DA => Extent {
+            min: Some(V_DA_RANGE.0),
+            max: Some(V_DA_RANGE.1),
+            nominal: Some(V_DA_RANGE.1),
+        },
+        vr::X_S => {
+            let (lo, hi) = defaults.cylinder().stopper_range();
+            Extent {
+                min: Some(lo),
+                max: Some(hi),
+                nominal: scale(start(vr::X_S)),
+            }
+        }
+        vr::P1 | vr::P2 => Extent {
+            min: Some(0.0),
+            max: None,
+            nominal: scale(defaults.p_s),
+        },
+        vr::I => Extent {
+            min: None,
+            max: None,
+            nominal: scale(defaults.k_cd * V_DA_RANGE.1),
+        },
+        vr::X_JP => Extent {
+            min: None,
+            max: None,
+            nominal: scale(defaults.x_jp_sat),
+        },
+        vr::F_ACT | vr::F_MEAS => Extent {
+            min: None,
+            max: None,
+            nominal: Some(100.0),
+        },
+        vr::P1_START | vr::P2_START => Extent {
+            min: Some(0.0),
+            max: None,
+            nominal: scale(start(value_reference)),
+        },
+        _ => match Parameters::declared_range(value_reference) {
+            Some((min, max)) => Extent {
+                min,
+                max,
+                nominal: scale(start(value_reference)),
+            },
+            None => Extent::default(),
+        },
+    }
+}
+
+const DEPENDS: DependencyKind = DependencyKind::Dependent;
+
+/// `<ModelStructure>`: a new x_s moves the stopper at once (the chamber pressures jump,
+/// conserving the air), so the pressures and forces depend on it directly; a new v_DA acts
+/// only through the current's dynamics, during the next step. After initialisation the
+/// current and the jet pipe are at the static values of v_DA; the pressures and forces
+/// depend on everything.
+pub const DEPENDENCIES: &[OutputDependencies] = &[
+    OutputDependencies {
+        output: vr::F_ACT,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::F_MEAS,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::P1,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::P2,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::I,
+        step: &[],
+        initial: Some(&[
+            (vr::V_DA, DEPENDS),
+            (vr::K_CD, DEPENDS),
+            (vr::I_OFFSET, DEPENDS),
+            (vr::COMMAND_LIMIT, DEPENDS),
+            (vr::CURRENT_LIMIT, DEPENDS),
+            (vr::F3_INPUT_CUBIC, DEPENDS),
+        ]),
+    },
+    OutputDependencies {
+        output: vr::X_JP,
+        step: &[],
+        initial: Some(&[
+            (vr::V_DA, DEPENDS),
+            (vr::K_CD, DEPENDS),
+            (vr::I_OFFSET, DEPENDS),
+            (vr::COMMAND_LIMIT, DEPENDS),
+            (vr::CURRENT_LIMIT, DEPENDS),
+            (vr::F3_INPUT_CUBIC, DEPENDS),
+            (vr::K_M, DEPENDS),
+            (vr::X_JP_SAT, DEPENDS),
+            (vr::F_JP_SAT, DEPENDS),
+        ]),
+    },
+];
+
+pub static MODEL_INFO: ModelInfo = ModelInfo {
+    model_name: "JetPipeActuator",
+    model_identifier: "JetPipeActuator",
+    description: "Jet-pipe electropneumatic actuator of the Utah/MIT Dextrous Hand (P.D. Henri, 1994): current driver, third-order jet pipe, orifice flows, leaky piston, two chambers with a moving stopper",
+    author: "jetpipe project",
+    version: env!("CARGO_PKG_VERSION"),
+    generation_tool: concat!("jetpipe ", env!("CARGO_PKG_VERSION")),
+    default_start_time: 0.0,
+    default_stop_time: 10.0,
+    default_tolerance: DEFAULT_RELATIVE_TOLERANCE,
+    default_step_size: 1e-3,
+    log_categories: LOG_CATEGORIES,
+    units: UNITS,
+    variables: VARIABLES,
+    can_interpolate_inputs: true,
+    extent,
+    dependencies: DEPENDENCIES,
+    guid_cache: GuidCache::new(),
+};
+
+/// v_DA within the D/A range; the message names the variable, the value and the range.
+fn check_command(v_da: f64) -> Result<(), String> {
+    let (lo, hi) = V_DA_RANGE;
+    if !(lo..=hi).contains(&v_da) {
+        return Err(format!(
+            "v_DA = {v_da} V is invalid: must be finite and within the D/A range [{lo}, {hi}] V"
+        ));
+    }
+    Ok(())
+}
+
+/// One FMU instance: parameters and inputs until initialisation, then a simulation.
+#[derive(Clone, Debug)]
+pub struct ActuatorFmu {
+    params: Parameters,
+    v_da: f64,
+    x_s: f64,
+    v_da_rate: f64,
+    x_s_rate: f64,
+    start_at_equilibrium: bool,
+    p1_start: f64,
+    p2_start: f64,
+    tolerance: f64,
+    start_time: f64,
+    simulation: Option<Simulation>,
+    /// The last x_s set before initialisation ended that was inside the cylinder (the table's
+    /// start at first): where the stopper starts if the last x_s set was not.
+    x_s_valid: f64,
+}
+
+fn start(value_reference: u32) -> f64 {
+    jetpipe_model::physics::parameters::table_start(value_reference)
+}
+
+impl ActuatorFmu {
+    /// The state the simulation would start from with the current settings.
+    fn initial_simulation(&self) -> Result<Simulation, String> {
+        let model = Actuator::new(self.params.clone())?;
+        model.params.check_stopper(self.x_s)?;
+        let mut simulation = if self.start_at_equilibrium {
+            Simulation::at_equilibrium(model, self.v_da, self.x_s, self.start_time, self.tolerance)?
+        } else {
+            let mut state = jetpipe_model::simulation::equilibrium_of_electromechanics(&model, self.v_da);
+            state[index::P1] = self.p1_start;
+            state[index::P2] = self.p2_start;
+            Simulation::from_state(model, state, self.v_da, self.x_s, self.start_time, self.tolerance)
+        };
+        simulation.set_command_rate(self.v_da_rate)?;
+        simulation.set_stopper_rate(self.x_s_rate)?;
+        Ok(simulation)
+    }
+
+    pub fn simulation(&self) -> Option<&Simulation> {
+        self.simulation.as_ref()
+    }
+}
+
+impl CoSimModel for ActuatorFmu {
+    fn info() -> &'static ModelInfo {
+        &MODEL_INFO
+    }
+
+    fn instantiate() -> Self {
+        Self {
+            params: Parameters::default(),
+            v_da: start(vr::V_DA),
+            x_s: start(vr::X_S),
+            v_da_rate: 0.0,
+            x_s_rate: 0.0,
+            start_at_equilibrium: start(vr::START_AT_EQUILIBRIUM) != 0.0,
+            p1_start: start(vr::P1_START),
+            p2_start: start(vr::P2_START),
+            tolerance: DEFAULT_RELATIVE_TOLERANCE,
+            start_time: 0.0,
+            simulation: None,
+            x_s_valid: start(vr::X_S),
+        }
+    }
+
+    fn get_real(&self, value_reference: u32) -> Result<f64, String> {
+        match value_reference {
+            vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, |s| s.v_da)),
+            vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, |s| s.x_s)),
+            vr::F_ACT | vr::F_MEAS | vr::P1 | vr::P2 | vr::I | vr::X_JP => {
+                let computed;
+                let simulation = match &self.simulation {
+                    Some(s) => s,
+                    None => {
+                        computed = self.initial_simulation()?;
+                        &computed
+                    }
+                };
+                let y = simulation.outputs();
+                Ok(match value_reference {
+                    vr::F_ACT => y.f_act,
+                    vr::F_MEAS => y.f_meas,
+                    vr::P1 => y.p1,
+                    vr::P2 => y.p2,
+                    vr::I => y.current,
+                    _ => y.x_jp,
+                })
+            }
+            vr::P1_START => Ok(self.p1_start),
+            vr::P2_START => Ok(self.p2_start),
+            _ => self
+                .params
+                .get(value_reference)
+                .ok_or_else(|| format!("no Real variable with value reference {value_reference}")),
+        }
+    }
+
+    fn set_real(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
+        match value_reference {
+            vr::V_DA => {
+                check_command(value)?;
+                match &mut self.simulation {
+                    Some(s) => s.set_command(value),
+                    None => {
+                        self.v_da = value;
+                        Ok(())
+                    }
+                }
+            }
+            vr::X_S => match &mut self.simulation {
+                Some(s) => {
+                    s.set_stopper(value)?;
+                    self.x_s = value;
+                    Ok(())
+                }
+                // Before initialisation ends, a master may start its connectors at 0 and
+                // propagate the other FMUs' outputs only afterwards: any finite value is taken,
+                // and checked when initialisation ends and at each step.
+                None if value.is_finite() => {
+                    self.x_s = value;
+                    if self.params.check_stopper(value).is_ok() {
+                        self.x_s_valid = value;
+                    }
+                    Ok(())
+                }
+                None => Err(format!("x_s = {value} m is invalid: must be finite")),
+            },
+            vr::P1_START | vr::P2_START => {
+                jetpipe_model::variables::check(value_reference, value)?;
+                if value_reference == vr::P1_START {
+                    self.p1_start = value;
+                } else {
+                    self.p2_start = value;
+                }
+                Ok(())
+            }
+            _ => self.params.set(value_reference, value),
+        }
+    }
+
+    fn get_boolean(&self, value_reference: u32) -> Result<bool, String> {
+        match value_reference {
+            vr::START_AT_EQUILIBRIUM => Ok(self.start_at_equilibrium),
+            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
+        }
+    }
+
+    fn set_boolean(&mut self, value_reference: u32, value: bool) -> Result<(), String> {
+        match value_reference {
+            vr::START_AT_EQUILIBRIUM => {
+                self.start_at_equilibrium = value;
+                Ok(())
+            }
+            _ => Err(format!("no Boolean variable with value reference {value_reference}")),
+        }
+    }
+
+    fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        _stop_time: Option<f64>,
+    ) -> Result<(), String> {
+        if let Some(t) = tolerance {
+            if !(t.is_finite() && t > 0.0 && t < 1.0) {
+                return Err(format!("tolerance = {t} is invalid: must be in (0, 1)"));
+            }
+            // Below 1e-12 the error estimate is rounding noise.
+            self.tolerance = t.max(1e-12);
+        }
+        if !start_time.is_finite() {
+            return Err(format!("startTime = {start_time} s is invalid: must be finite"));
+        }
+        self.start_time = start_time;
+        Ok(())
+    }
+
+    /// With an x_s outside the cylinder (a master that set its connectors to 0 and propagates
+    /// outputs only with the first step), the stopper starts at the last valid x_s set (or the
+    /// start value), and the first step is refused unless a valid x_s has been set by then.
+    fn exit_initialization(&mut self) -> Result<(), String> {
+        let simulation = match self.params.check_stopper(self.x_s) {
+            Ok(()) => self.initial_simulation()?,
+            Err(e) => {
+                let mut fallback = self.clone();
+                fallback.x_s = self.x_s_valid;
+                fallback.params.check_stopper(fallback.x_s).map_err(|_| e)?;
+                fallback.initial_simulation()?
+            }
+        };
+        self.simulation = Some(simulation);
+        Ok(())
+    }
+
+    fn set_real_input_derivative(&mut self, value_reference: u32, order: i32, value: f64) -> Result<(), String> {
+        if order != 1 {
+            return Err(format!(
+                "input derivative of order {order} for {} is not supported: only order 1",
+                variable_name(value_reference)
+            ));
+        }
+        match (value_reference, &mut self.simulation) {
+            (vr::V_DA, Some(s)) => s.set_command_rate(value),
+            (vr::X_S, Some(s)) => s.set_stopper_rate(value),
+            (vr::V_DA | vr::X_S, None) if !value.is_finite() => Err(format!(
+                "der({}) = {value} is invalid: must be finite",
+                variable_name(value_reference)
+            )),
+            (vr::V_DA, None) => {
+                self.v_da_rate = value;
+                Ok(())
+            }
+            (vr::X_S, None) => {
+                self.x_s_rate = value;
+                Ok(())
+            }
+            _ => Err(format!("value reference {value_reference} is not an input")),
+        }
+    }
+
+    fn do_step(&mut self, _current_time: f64, step_size: f64) -> Result<(), StepError> {
+        // An x_s set before initialisation ended and never corrected (see exit_initialization).
+        if self.simulation.is_some() {
+            if let Err(e) = self.params.check_stopper(self.x_s) {
+                return Err(StepError::Error(format!(
+                    "{e} (the x_s set during initialisation; set a valid x_s before the first step)"
+                )));
+            }
+        }
+        let simulation = self
+            .simulation
+            .as_mut()
+            .ok_or_else(|| StepError::Error("the model is not initialised".to_string()))?;
+        simulation.step(step_size).map_err(|failure| match failure {
+            StepFailure::InvalidRequest(message) => StepError::Error(message),
+            StepFailure::Integration { message, time } => StepError::Discard {
+                message,
+                last_successful_time: time,
+            },
+        })
+    }
+
+    fn time(&self) -> f64 {
+        self.simulation.as_ref().map_or(self.start_time, |s| s.time)
+    }
+
+    fn serialize(&self) -> Vec<u8> {
+        let mut w = ByteWriter::default();
+        w.bytes(STATE_MAGIC);
+        w.u32(STATE_FORMAT_VERSION);
+        w.string(env!("CARGO_PKG_VERSION"));
+        for &value_reference in Parameters::VALUE_REFERENCES {
+            w.f64(self.params.get(value_reference).unwrap_or(f64::NAN));
+        }
+        for v in [
+            self.v_da,
+            self.x_s,
+            self.v_da_rate,
+            self.x_s_rate,
+            self.p1_start,
+            self.p2_start,
+            self.tolerance,
+            self.start_time,
+        ] {
+            w.f64(v);
+        }
+        w.u32(self.start_at_equilibrium as u32);
+        match &self.simulation {
+            None => w.u32(0),
+            Some(s) => {
+                w.u32(1);
+                for v in [
+                    s.time,
+                    s.v_da,
+                    s.x_s,
+                    s.v_da_rate,
+                    s.x_s_rate,
+                    s.relative_tolerance,
+                    s.integrator.next_step,
+                    s.integrator.max_step,
+                    s.integrator.first_step,
+                    s.chamber_integrator.next_step,
+                    s.chamber_integrator.max_step,
+                    s.chamber_integrator.first_step,
+                    s.step_after_change,
+                    if s.input_changed { 1.0 } else { 0.0 },
+                    if s.method == Method::Split { 0.0 } else { 1.0 },
+                ] {
+                    w.f64(v);
+                }
+                for k in 0..N_STATES {
+                    w.f64(s.state[k]);
+                }
+                for p in s.plays {
+                    w.f64(p);
+                }
+                w.f64(s.stopper_velocity);
+                w.f64(s.x_s_at_last_step);
+                w.u32(s.command_history.len() as u32);
+                for change in &s.command_history {
+                    w.f64(change.time);
+                    w.f64(change.v_da);
+                    w.f64(change.rate);
+                }
+                for v in s.command_stage.to_values() {
+                    w.f64(v);
+                }
+                let sensor = s.force_sensor.as_ref().map(|m| m.to_values()).unwrap_or_default();
+                w.u32(sensor.len() as u32);
+                for v in sensor {
+                    w.f64(v);
+                }
+                let st = &s.statistics;
+                for v in [
+                    st.steps,
+                    st.rejected,
+                    st.rhs_evaluations,
+                    st.jacobians,
+                    st.newton_failures,
+                    st.stiff_handovers,
+                ] {
+                    w.u64(v);
+                }
+            }
+        }
+        w.0
+    }
+
+    fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let mut r = ByteReader { bytes, at: 0 };
+        if r.take(STATE_MAGIC.len())? != STATE_MAGIC {
+            return Err("the state was not written by the JetPipeActuator model".to_string());
+        }
+        let format = r.u32()?;
+        if format != STATE_FORMAT_VERSION {
+            return Err(format!(
+                "state format version {format} is not supported (this model reads version {STATE_FORMAT_VERSION})"
+            ));
+        }
+        let version = r.string()?;
+        if version != env!("CARGO_PKG_VERSION") {
+            return Err(format!(
+                "the state was written by model version {version}; this is version {}",
+                env!("CARGO_PKG_VERSION")
+            ));
+        }
+        let mut restored = Self::instantiate();
+        for &value_reference in Parameters::VALUE_REFERENCES {
+            restored.params.set(value_reference, r.f64()?)?;
+        }
+        restored.v_da = r.f64()?;
+        restored.x_s = r.f64()?;
+        restored.v_da_rate = r.f64()?;
+        restored.x_s_rate = r.f64()?;
+        restored.p1_start = r.f64()?;
+        restored.p2_start = r.f64()?;
+        restored.tolerance = r.f64()?;
+        restored.start_time = r.f64()?;
+        restored.start_at_equilibrium = r.u32()? != 0;
+        if r.u32()? == 1 {
+            let model = Actuator::new(restored.params.clone())?;
+            let mut values = [0.0; 15];
+            for v in values.iter_mut() {
+                *v = r.f64()?;
+            }
+            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step, first_step, chamber_next, chamber_max, chamber_first, after_change, changed, method] =
+                values;
+            let mut state = State::zeros();
+            for k in 0..N_STATES {
+                state[k] = r.f64()?;
+            }
+            let mut plays = [0.0; PLAY_OPERATORS];
+            for p in plays.iter_mut() {
+                *p = r.f64()?;
+            }
+            let stopper_velocity = r.f64()?;
+            let x_s_at_last_step = r.f64()?;
+            let changes = r.count(24, "command changes")?;
+            let mut command_history = Vec::with_capacity(changes);
+            for _ in 0..changes {
+                command_history.push(CommandChange {
+                    time: r.f64()?,
+                    v_da: r.f64()?,
+                    rate: r.f64()?,
+                });
+            }
+            let mut stage = [0.0; 3];
+            for v in stage.iter_mut() {
+                *v = r.f64()?;
+            }
+            let sensor_values = r.count(8, "force sensor values")?;
+            let mut sensor = Vec::with_capacity(sensor_values);
+            for _ in 0..sensor_values {
+                sensor.push(r.f64()?);
+            }
+            let mut simulation = Simulation::from_state(model, state, v_da, x_s, time, rtol);
+            simulation.command_stage = CommandStage::from_values(stage);
+            simulation.force_sensor = if sensor.is_empty() {
+                None
+            } else {
+                Some(SensorMemory::from_values(&sensor).ok_or("the state's force sensor memory is malformed")?)
+            };
+            simulation.v_da_rate = v_da_rate;
+            simulation.x_s_rate = x_s_rate;
+            simulation.integrator.next_step = next_step;
+            simulation.integrator.max_step = max_step;
+            simulation.integrator.first_step = first_step;
+            simulation.chamber_integrator.next_step = chamber_next;
+            simulation.chamber_integrator.max_step = chamber_max;
+            simulation.chamber_integrator.first_step = chamber_first;
+            simulation.step_after_change = after_change;
+            simulation.plays = plays;
+            simulation.stopper_velocity = stopper_velocity;
+            simulation.x_s_at_last_step = x_s_at_last_step;
+            simulation.command_history = command_history;
+            simulation.input_changed = changed != 0.0;
+            if method != 0.0 {
+                simulation.method = Method::Monolithic;
+            }
+            let st = &mut simulation.statistics;
+            st.steps = r.u64()?;
+            st.rejected = r.u64()?;
+            st.rhs_evaluations = r.u64()?;
+            st.jacobians = r.u64()?;
+            st.newton_failures = r.u64()?;
+            st.stiff_handovers = r.u64()?;
+            let finite = [
+                time,
+                v_da,
+                x_s,
+                v_da_rate,
+                x_s_rate,
+                rtol,
+                next_step,
+                first_step,
+                chamber_next,
+                chamber_first,
+                after_change,
+            ]
+            .iter()
+            .all(|v| v.is_finite())
+                && state.iter().all(|v| v.is_finite());
+            if !finite {
+                return Err("the state holds non-finite values".to_string());
+            }
+            simulation.model.params.check_stopper(x_s)?;
+            restored.simulation = Some(simulation);
+        }
+        if r.at != bytes.len() {
+            return Err(format!("{} unexpected bytes after the state", bytes.len() - r.at));
+        }
+        *self = restored;
+        Ok(())
+    }
+}
+
+const STATE_MAGIC: &[u8] = b"JetPipeActuatorState";
+const STATE_FORMAT_VERSION: u32 = 2;
+
+#[derive(Default)]
+struct ByteWriter(Vec<u8>);
+
+impl ByteWriter {
+    fn bytes(&mut self, b: &[u8]) {
+        self.0.extend_from_slice(b);
+    }
+    fn u32(&mut self, v: u32) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn u64(&mut self, v: u64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn string(&mut self, s: &str) {
+        self.u32(s.len() as u32);
+        self.bytes(s.as_bytes());
+    }
+}
+
+struct ByteReader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> ByteReader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        let end = self
+            .at
+            .checked_add(n)
+            .filter(|&e| e <= self.bytes.len())
+            .ok_or_else(|| {
+                format!(
+                    "the state is truncated: {} bytes, needed more than {}",
+                    self.bytes.len(),
+                    self.at
+                )
+            })?;
+        let slice = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(slice)
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+    }
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+    }
+    /// A count of items of `item_bytes` each that follow, refused when the rest of the
+    /// state cannot hold them (so a forged count allocates nothing).
+    fn count(&mut self, item_bytes: usize, what: &str) -> Result<usize, String> {
+        let count = self.u32()? as usize;
+        if count.saturating_mul(item_bytes) > self.bytes.len() - self.at {
+            return Err(format!("the state claims {count} {what}, more than its length holds"));
+        }
+        Ok(count)
+    }
+    fn string(&mut self) -> Result<String, String> {
+        let n = self.u32()? as usize;
+        if n > 64 {
+            return Err("the state's version string is implausibly long".to_string());
+        }
+        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| "the state's version string is not UTF-8".to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn initialised() -> ActuatorFmu {
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.setup_experiment(Some(1e-6), 0.0, None).unwrap();
+        fmu.set_real(vr::V_DA, 2.5).unwrap();
+        fmu.exit_initialization().unwrap();
+        fmu
+    }
+
+    #[test]
+    fn serialized_state_continues_bit_identically() {
+        let mut a = initialised();
+        a.do_step(0.0, 0.05).unwrap();
+        let bytes = a.serialize();
+        let mut b = ActuatorFmu::instantiate();
+        b.deserialize(&bytes).unwrap();
+        for fmu in [&mut a, &mut b] {
+            fmu.set_real(vr::V_DA, 6.0).unwrap();
+            fmu.do_step(0.05, 0.05).unwrap();
+        }
+        for value_reference in [vr::F_ACT, vr::P1, vr::P2, vr::I, vr::X_JP] {
+            assert_eq!(
+                a.get_real(value_reference).unwrap().to_bits(),
+                b.get_real(value_reference).unwrap().to_bits()
+            );
+        }
+    }
+
+    #[test]
+    fn corrupted_or_foreign_states_are_rejected_and_leave_the_instance_unchanged() {
+        let mut fmu = initialised();
+        let bytes = fmu.serialize();
+        let before = fmu.get_real(vr::F_ACT).unwrap();
+        let mut truncated = bytes.clone();
+        truncated.truncate(bytes.len() - 3);
+        assert!(fmu.deserialize(&truncated).unwrap_err().contains("truncated"));
+        let mut foreign = bytes.clone();
+        foreign[0] ^= 0xff;
+        assert!(fmu.deserialize(&foreign).is_err());
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(fmu.deserialize(&longer).is_err());
+        assert_eq!(fmu.get_real(vr::F_ACT).unwrap(), before);
+    }
+
+    #[test]
+    fn outputs_before_initialisation_are_the_equilibrium() {
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.set_real(vr::V_DA, 2.5).unwrap();
+        let early = fmu.get_real(vr::F_ACT).unwrap();
+        fmu.exit_initialization().unwrap();
+        assert_eq!(early, fmu.get_real(vr::F_ACT).unwrap());
+        assert!(early > 10.0 && early < 112.0, "{early}");
+    }
+
+    #[test]
+    fn declared_dependencies_are_what_perturbations_show() {
+        let report = fmi2::structure_check::check_dependencies::<ActuatorFmu>(1e-3);
+        assert!(report.problems.is_empty(), "{:#?}", report.problems);
+        // Only the stopper acts within a step, on the pressures and the forces.
+        let mut pairs = report.step_pairs.clone();
+        pairs.sort();
+        assert_eq!(
+            pairs,
+            vec![("F_act", "x_s"), ("F_meas", "x_s"), ("P1", "x_s"), ("P2", "x_s")]
+        );
+        // Nothing but the pair (deadband > width) that validate() refuses is skipped.
+        assert!(report.skipped.len() <= 1, "{:#?}", report.skipped);
+    }
+
+    /// Every declared min/max is what the FMU enforces: a value just outside is refused
+    /// with a message that names the variable and the value, and a value just inside (or
+    /// on a closed bound) is taken.
+    #[test]
+    fn declared_bounds_are_the_enforced_ones() {
+        let info = ActuatorFmu::info();
+        let mut checked = 0;
+        for v in info.variables {
+            if v.var_type != fmi2::model::VarType::Real || v.causality == fmi2::model::Causality::Output {
+                continue;
+            }
+            let e = info.extent_of(v);
+            for (bound, outward) in [(e.min, -1.0), (e.max, 1.0)] {
+                let Some(b) = bound else { continue };
+                let step = 1e-9 * b.abs().max(1e-3);
+                let outside = b + outward * step;
+                let inside = b - outward * step;
+                let mut fmu = ActuatorFmu::instantiate();
+                fmu.setup_experiment(None, 0.0, None).unwrap();
+                // Refused when set, when initialisation ends, or (x_s) at the first step.
+                let refused = fmu
+                    .set_real(v.value_reference, outside)
+                    .and_then(|_| fmu.exit_initialization())
+                    .and_then(|_| {
+                        fmu.do_step(0.0, 1e-3).map_err(|e| match e {
+                            StepError::Error(m) | StepError::Discard { message: m, .. } => m,
+                        })
+                    });
+                let message = refused.expect_err(&format!("{} = {outside} was taken", v.name));
+                assert!(
+                    message.contains(v.name)
+                        && (message.contains(&format!("{outside}"))
+                            || message.contains(&jetpipe_model::variables::number(outside))),
+                    "{message}"
+                );
+                let mut fmu = ActuatorFmu::instantiate();
+                fmu.set_real(v.value_reference, inside)
+                    .unwrap_or_else(|e| panic!("{} = {inside} refused: {e}", v.name));
+                checked += 1;
+            }
+        }
+        assert!(checked >= 30, "{checked}");
+    }
+
+    #[test]
+    fn nominals_are_positive_and_ranges_hold_the_defaults() {
+        let info = ActuatorFmu::info();
+        fmi2::model_description::validate_model_info(info).unwrap();
+        let x_s = info.variables.iter().find(|v| v.value_reference == vr::X_S).unwrap();
+        let e = info.extent_of(x_s);
+        // The default geometry: the stopper between the support and the piston's travel.
+        assert!(
+            (e.min.unwrap() - 0.026).abs() < 1e-12 && (e.max.unwrap() - 0.096).abs() < 1e-12,
+            "{e:?}"
+        );
+    }
+
+    /// A master may start its connectors at 0 before initialisation and propagate the other
+    /// FMUs' outputs only afterwards: x_s = 0 is taken then; the stopper starts at the last
+    /// valid x_s, and a step is refused, with the message of a step-time x_s, until a valid
+    /// x_s has been set.
+    #[test]
+    fn stopper_checked_when_initialisation_ends_and_at_each_step() {
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.setup_experiment(None, 0.0, None).unwrap();
+        fmu.enter_initialization().unwrap();
+        fmu.set_real(vr::X_S, 0.0).unwrap();
+        fmu.set_real(vr::X_S, 0.05).unwrap();
+        fmu.exit_initialization().unwrap();
+        assert_eq!(fmu.get_real(vr::X_S).unwrap(), 0.05);
+        let during_steps = fmu.set_real(vr::X_S, 0.0).unwrap_err();
+        assert!(
+            during_steps.contains("x_s = 0 m") && during_steps.contains("0.026"),
+            "{during_steps}"
+        );
+
+        // Connectors started at 0: initialised at the last valid x_s (here the start, 0.054).
+        let mut reference = ActuatorFmu::instantiate();
+        reference.set_real(vr::V_DA, 2.0).unwrap();
+        reference.exit_initialization().unwrap();
+        let mut fmu = ActuatorFmu::instantiate();
+        fmu.enter_initialization().unwrap();
+        fmu.set_real(vr::V_DA, 2.0).unwrap();
+        fmu.set_real(vr::X_S, 0.0).unwrap();
+        fmu.exit_initialization().unwrap();
+        assert_eq!(
+            fmu.get_real(vr::F_ACT).unwrap().to_bits(),
+            reference.get_real(vr::F_ACT).unwrap().to_bits()
+        );
+        let StepError::Error(refused) = fmu.do_step(0.0, 1e-3).unwrap_err() else {
+            panic!("not an error")
+        };
+        assert!(refused.starts_with(&during_steps), "{refused}");
+        assert_eq!(fmu.time(), 0.0, "nothing was stepped");
+        // Propagated before the first step: the step runs, as from that x_s at once.
+        fmu.set_real(vr::X_S, 0.055).unwrap();
+        reference.set_real(vr::X_S, 0.055).unwrap();
+        fmu.do_step(0.0, 1e-3).unwrap();
+        reference.do_step(0.0, 1e-3).unwrap();
+        assert_eq!(
+            fmu.get_real(vr::F_ACT).unwrap().to_bits(),
+            reference.get_real(vr::F_ACT).unwrap().to_bits()
+        );
+        assert!(fmu.set_real(vr::X_S, f64::NAN).unwrap_err().contains("x_s = NaN"));
+    }
+
+    #[test]
+    fn v_da_outside_the_d_a_range_is_refused() {
+        let mut fmu = initialised();
+        let e = fmu.set_real(vr::V_DA, 10.5).unwrap_err();
+        assert!(e.contains("v_DA = 10.5 V") && e.contains("[-10, 10]"), "{e}");
+        fmu.set_real(vr::V_DA, -10.0).unwrap();
+    }
+}

@@ -1,0 +1,343 @@
+//! The FMU's variables: the rows of the model's table (`jetpipe_model::variables::TABLE`) as
+//! the FMI layer's variables, in the table's order, and the units of the model description.
+
+use fmi2::model::{Causality, UnitDefinition, VarType, Variability, Variable};
+use jetpipe_model::variables::{self as table, Row, TABLE};
+
+/// Value references, named so code never uses bare numbers (the model table's).
+pub use jetpipe_model::variables::vr;
+
+/// The units of the table's variables, with their SI base-unit exponents (`<UnitDefinitions>`).
+pub const UNITS: &[UnitDefinition] = &[
+    UnitDefinition {
+        name: "V",
+        kg: 1,
+        m: 2,
+        s: -3,
+        a: -1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m",
+        kg: 0,
+        m: 1,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N",
+        kg: 1,
+        m: 1,
+        s: -2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Pa",
+        kg: 1,
+        m: -1,
+        s: -2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "A",
+        kg: 0,
+        m: 0,
+        s: 0,
+        a: 1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "K",
+        kg: 0,
+        m: 0,
+        s: 0,
+        a: 0,
+        k: 1,
+    },
+    UnitDefinition {
+        name: "J/(kg.K)",
+        kg: 0,
+        m: 2,
+        s: -2,
+        a: 0,
+        k: -1,
+    },
+    UnitDefinition {
+        name: "A/V",
+        kg: -1,
+        m: -2,
+        s: 3,
+        a: 2,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "rad/s",
+        kg: 0,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N/A",
+        kg: 1,
+        m: 1,
+        s: -2,
+        a: -1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m2",
+        kg: 0,
+        m: 2,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N/m",
+        kg: 1,
+        m: 0,
+        s: -2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "1",
+        kg: 0,
+        m: 0,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m3",
+        kg: 0,
+        m: 3,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "s",
+        kg: 0,
+        m: 0,
+        s: 1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Pa.s/kg",
+        kg: 0,
+        m: -1,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m/N",
+        kg: -1,
+        m: 0,
+        s: 2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "1/N",
+        kg: -1,
+        m: -1,
+        s: 2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "1/N2",
+        kg: -2,
+        m: -2,
+        s: 4,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N/s",
+        kg: 1,
+        m: 1,
+        s: -3,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Hz",
+        kg: 0,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N.s/m",
+        kg: 1,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Pa/s",
+        kg: 1,
+        m: -1,
+        s: -3,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m/s",
+        kg: 0,
+        m: 1,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "A/s",
+        kg: 0,
+        m: 0,
+        s: -1,
+        a: 1,
+        k: 0,
+    },
+];
+
+const fn causality(c: table::Causality) -> Causality {
+    match c {
+        table::Causality::Parameter => Causality::Parameter,
+        table::Causality::Input => Causality::Input,
+        table::Causality::Output => Causality::Output,
+        table::Causality::Local => Causality::Local,
+    }
+}
+
+const fn variability(v: table::Variability) -> Variability {
+    match v {
+        table::Variability::Fixed => Variability::Fixed,
+        table::Variability::Tunable => Variability::Tunable,
+        table::Variability::Discrete => Variability::Discrete,
+        table::Variability::Continuous => Variability::Continuous,
+    }
+}
+
+const fn var_type(t: table::VarType) -> VarType {
+    match t {
+        table::VarType::Real => VarType::Real,
+        table::VarType::Integer => VarType::Integer,
+        table::VarType::Boolean => VarType::Boolean,
+    }
+}
+
+/// The FMI variable of a row (const: the variables are a constant array).
+const fn fmi_variable(row: &Row) -> Variable {
+    let v = &row.variable;
+    Variable {
+        name: v.name,
+        value_reference: v.value_reference,
+        var_type: var_type(v.var_type),
+        causality: causality(v.causality),
+        variability: variability(v.variability),
+        unit: v.unit,
+        start: v.start,
+        min: v.min,
+        max: v.max,
+        description: v.description,
+    }
+}
+
+const N_VARIABLES: usize = TABLE.len();
+
+const fn variables_of(rows: &[Row]) -> [Variable; N_VARIABLES] {
+    let mut out = [fmi_variable(&rows[0]); N_VARIABLES];
+    let mut k = 1;
+    while k < N_VARIABLES {
+        out[k] = fmi_variable(&rows[k]);
+        k += 1;
+    }
+    out
+}
+
+const VARIABLE_ARRAY: [Variable; N_VARIABLES] = variables_of(TABLE);
+
+/// The FMI variables of the table, in its order: what the model description, the getters and
+/// the setters of the FMI layer see.
+pub const VARIABLES: &[Variable] = &VARIABLE_ARRAY;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2::model::{CoSimModel, ModelInfo};
+    use fmi2::model_description::try_model_description_xml;
+    use fmi2::testing::{clone_info, DummyModel as M};
+
+    #[test]
+    fn the_fmi_variables_are_the_table_rows() {
+        assert_eq!(VARIABLES.len(), TABLE.len());
+        for (v, row) in VARIABLES.iter().zip(TABLE) {
+            let r = &row.variable;
+            assert_eq!(
+                (v.name, v.value_reference, v.unit, v.description),
+                (r.name, r.value_reference, r.unit, r.description)
+            );
+            assert_eq!((v.start.to_bits(), v.min, v.max), (r.start.to_bits(), r.min, r.max));
+            assert_eq!(
+                format!("{:?}", (v.var_type, v.causality, v.variability)),
+                format!("{:?}", (r.var_type, r.causality, r.variability))
+            );
+        }
+    }
+
+    #[test]
+    fn model_description_of_the_actuator_table() {
+        let info = ModelInfo {
+            variables: VARIABLES,
+            units: UNITS,
+            extent: crate::fmu::extent,
+            dependencies: crate::fmu::DEPENDENCIES,
+            ..clone_info(M::info())
+        };
+        let xml = try_model_description_xml(&info).unwrap();
+        assert!(xml.contains(r#"<ScalarVariable name="P_s" valueReference="100""#));
+        assert!(xml.contains(r#"start="652925.0""#));
+        assert!(xml.contains(r#"<Unit name="Pa">"#) && xml.contains(r#"<BaseUnit kg="1" m="-1" s="-2"/>"#));
+        let outputs: Vec<usize> = info
+            .variables
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.causality == Causality::Output)
+            .map(|(i, _)| i + 1)
+            .collect();
+        assert_eq!(outputs, vec![3, 4, 5, 6, 7, 8], "F_act, P1, P2, i, F_meas, x_jp");
+        for i in outputs {
+            assert_eq!(
+                xml.matches(&format!(r#"<Unknown index="{i}" dependencies="#)).count(),
+                2
+            );
+        }
+        // Within a step only x_s (index 2) acts, on F_act, P1, P2 and F_meas; i and x_jp on nothing.
+        for i in [3, 4, 5, 7] {
+            assert!(xml.contains(&format!(
+                r#"<Unknown index="{i}" dependencies="2" dependenciesKind="dependent"/>"#
+            )));
+        }
+        for i in [6, 8] {
+            assert!(xml.contains(&format!(
+                r#"<Unknown index="{i}" dependencies="" dependenciesKind=""/>"#
+            )));
+        }
+        assert!(
+            xml.contains(r#"<Real unit="m" start="0.054" min="0.026" max="0.096" nominal="0.054"/>"#),
+            "{xml}"
+        );
+        assert!(xml.contains(r#"<Real unit="1" start="0.696" min="0.0" max="1.0" nominal="0.696"/>"#));
+    }
+}

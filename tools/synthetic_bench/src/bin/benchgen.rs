@@ -1,0 +1,240 @@
+//! `benchgen`: write a synthetic bench recording (protocol of `bench/README.md`) from the
+//! independent simulator of the `synthetic_bench` library, with chosen effects beyond the thesis model.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::Parser;
+use synthetic_bench::{
+    generate, undeclared_mechanism, write_csv, BenchEffects, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
+};
+
+#[derive(Parser)]
+#[command(
+    name = "benchgen",
+    about = "Synthetic bench recordings of the jet-pipe actuator (test oracle)"
+)]
+struct Cli {
+    /// Output CSV file.
+    #[arg(long)]
+    out: PathBuf,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Length of the recording, s (at most 80: the protocol is truncated).
+    #[arg(long, default_value_t = PROTOCOL_DURATION)]
+    duration: f64,
+    /// jet_pipe_hysteresis: full branch separation of the static jet pipe position, m (e.g. 0.16e-3).
+    #[arg(long, default_value_t = 0.0)]
+    hysteresis_width: f64,
+    /// piston_friction: Coulomb level of the Stribeck curve, N.
+    #[arg(long, default_value_t = 0.0)]
+    friction_coulomb: f64,
+    /// dead_volume of chamber 1, m³.
+    #[arg(long, default_value_t = 0.0)]
+    dead_volume_1: f64,
+    /// dead_volume of chamber 2, m³.
+    #[arg(long, default_value_t = 0.0)]
+    dead_volume_2: f64,
+    /// supply_pressure_drop: supply line resistance dP/dṁ at 2e-4 kg/s, Pa·s/kg.
+    #[arg(long, default_value_t = 0.0)]
+    supply_resistance: f64,
+    /// heat_transfer: 0 (adiabatic, thesis) .. 1 (nearly isothermal).
+    #[arg(long, default_value_t = 0.0)]
+    heat_transfer: f64,
+    /// transport_delay: delay of the command seen by the current driver, s.
+    #[arg(long, default_value_t = 0.0)]
+    command_delay: f64,
+    /// sensor_offset_gain: force sensor offset, N.
+    #[arg(long, default_value_t = 0.0)]
+    force_sensor_offset: f64,
+    /// sensor_offset_gain: force sensor gain.
+    #[arg(long, default_value_t = 1.0)]
+    force_sensor_gain: f64,
+    /// Switch on one undeclared mechanism at its standard size (see --list-undeclared); the
+    /// flags below, where given, override its parameters.
+    #[arg(long)]
+    undeclared: Option<String>,
+    /// List the undeclared mechanisms (name, location, family, truth) and exit.
+    #[arg(long)]
+    list_undeclared: bool,
+    /// p1_sensor_offset: offset of the chamber 1 pressure transducer, Pa (e.g. 8000).
+    #[arg(long)]
+    pressure_sensor_offset_1: Option<f64>,
+    /// supply_drift: linear fall of the supply pressure over 80 s, Pa (e.g. 30000).
+    #[arg(long)]
+    supply_drift: Option<f64>,
+    /// supply_ripple: amplitude of a supply pressure ripple, Pa (e.g. 15000).
+    #[arg(long)]
+    supply_ripple_amplitude: Option<f64>,
+    /// supply_ripple: frequency of the ripple, Hz (e.g. 7).
+    #[arg(long)]
+    supply_ripple_frequency: Option<f64>,
+    /// command_limit: D/A output seen by the current driver saturates at ± this, V (e.g. 7).
+    #[arg(long)]
+    command_limit: Option<f64>,
+    /// current_slew_limit: largest rate of the coil current, A/s (e.g. 3).
+    #[arg(long)]
+    current_slew_limit: Option<f64>,
+    /// jet_pipe_lag: extra first-order lag after the static jet pipe curve, s (e.g. 0.015).
+    #[arg(long)]
+    jet_pipe_lag: Option<f64>,
+    /// chamber_1_leak: C_d·A of a leak from chamber 1 to the atmosphere, m² (e.g. 1e-8).
+    #[arg(long)]
+    chamber_leak_1: Option<f64>,
+    /// viscous_friction: coefficient on the stopper velocity, N·s/m (e.g. 60).
+    #[arg(long)]
+    viscous_friction: Option<f64>,
+    /// contact_compliance: stiffness between piston and stopper, N/m (e.g. 2e4).
+    #[arg(long)]
+    contact_stiffness: Option<f64>,
+    /// force_sensor_lag: first-order lag of the force sensor, s (e.g. 0.01).
+    #[arg(long)]
+    force_sensor_lag: Option<f64>,
+    /// return_back_pressure: the return (exhaust) pressure is higher by this, Pa (e.g. 20000).
+    #[arg(long)]
+    return_back_pressure: Option<f64>,
+    /// p2_sensor_delay: the chamber 2 pressure is logged this late, s (whole ms; e.g. 0.005).
+    #[arg(long)]
+    pressure_sensor_delay_2: Option<f64>,
+    /// receiver_offset: receivers further from the jet pipe null than x_jp_offset, m (e.g. 1e-5).
+    #[arg(long)]
+    receiver_offset: Option<f64>,
+    /// force_sensor_backlash: full width of a play operator on the force reading, N (e.g. 1.5).
+    #[arg(long)]
+    force_sensor_backlash: Option<f64>,
+    /// jet_pipe_curve: blend 0..1 of the static jet pipe curve towards u/sqrt(1+u²) (e.g. 1).
+    #[arg(long)]
+    jet_pipe_curve_blend: Option<f64>,
+    /// return_area_reduction: fractional reduction 0..1 of both return areas (e.g. 0.05).
+    #[arg(long)]
+    return_area_reduction: Option<f64>,
+    /// port_1_restriction: C_d·A of an orifice between receiver port 1 and chamber 1, m² (e.g. 2e-7).
+    #[arg(long)]
+    port_1_restriction: Option<f64>,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if cli.list_undeclared {
+        for m in UNDECLARED {
+            println!("{}\t{}\t{}\t{}", m.name, m.location, m.family, m.truth);
+        }
+        return ExitCode::SUCCESS;
+    }
+    let mut und = match cli.undeclared.as_deref() {
+        None => UndeclaredEffects::default(),
+        Some(name) => match undeclared_mechanism(name) {
+            Some(m) => (m.effects)().undeclared,
+            None => {
+                let names: Vec<&str> = UNDECLARED.iter().map(|m| m.name).collect();
+                eprintln!("benchgen: unknown undeclared mechanism {name:?}; one of {names:?}");
+                return ExitCode::from(2);
+            }
+        },
+    };
+    let set = |dst: &mut f64, v: Option<f64>| {
+        if let Some(v) = v {
+            *dst = v;
+        }
+    };
+    set(&mut und.pressure_sensor_offset_1, cli.pressure_sensor_offset_1);
+    set(&mut und.supply_drift, cli.supply_drift);
+    set(&mut und.supply_ripple_amplitude, cli.supply_ripple_amplitude);
+    set(&mut und.supply_ripple_frequency, cli.supply_ripple_frequency);
+    set(&mut und.command_limit, cli.command_limit);
+    set(&mut und.current_slew_limit, cli.current_slew_limit);
+    set(&mut und.jet_pipe_lag, cli.jet_pipe_lag);
+    set(&mut und.chamber_leak_1, cli.chamber_leak_1);
+    set(&mut und.viscous_friction, cli.viscous_friction);
+    set(&mut und.contact_stiffness, cli.contact_stiffness);
+    set(&mut und.force_sensor_lag, cli.force_sensor_lag);
+    set(&mut und.return_back_pressure, cli.return_back_pressure);
+    set(&mut und.pressure_sensor_delay_2, cli.pressure_sensor_delay_2);
+    set(&mut und.receiver_offset, cli.receiver_offset);
+    set(&mut und.force_sensor_backlash, cli.force_sensor_backlash);
+    set(&mut und.jet_pipe_curve_blend, cli.jet_pipe_curve_blend);
+    set(&mut und.return_area_reduction, cli.return_area_reduction);
+    set(&mut und.port_1_restriction, cli.port_1_restriction);
+    let und_bad = [
+        und.supply_ripple_frequency,
+        und.command_limit,
+        und.current_slew_limit,
+        und.jet_pipe_lag,
+        und.chamber_leak_1,
+        und.viscous_friction,
+        und.contact_stiffness,
+        und.force_sensor_lag,
+        und.pressure_sensor_delay_2,
+        und.force_sensor_backlash,
+        und.jet_pipe_curve_blend,
+        und.return_area_reduction,
+        und.port_1_restriction,
+    ]
+    .iter()
+    .any(|&x| !x.is_finite() || x < 0.0)
+        || ![
+            und.pressure_sensor_offset_1,
+            und.supply_drift,
+            und.supply_ripple_amplitude,
+            und.return_back_pressure,
+            und.receiver_offset,
+        ]
+        .iter()
+        .all(|x| x.is_finite());
+    let und_bad = und_bad || und.jet_pipe_curve_blend > 1.0 || und.return_area_reduction > 1.0;
+    if und_bad {
+        eprintln!(
+            "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
+             friction, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
+             blend and return area reduction in 0..1"
+        );
+        return ExitCode::from(2);
+    }
+    let effects = BenchEffects {
+        hysteresis_width: cli.hysteresis_width,
+        friction_coulomb: cli.friction_coulomb,
+        dead_volume_1: cli.dead_volume_1,
+        dead_volume_2: cli.dead_volume_2,
+        supply_resistance: cli.supply_resistance,
+        heat_transfer: cli.heat_transfer,
+        command_delay: cli.command_delay,
+        force_sensor_offset: cli.force_sensor_offset,
+        force_sensor_gain: cli.force_sensor_gain,
+        undeclared: und,
+    };
+    let bad = |x: f64| !x.is_finite() || x < 0.0;
+    if bad(cli.duration)
+        || [
+            effects.hysteresis_width,
+            effects.friction_coulomb,
+            effects.dead_volume_1,
+            effects.dead_volume_2,
+            effects.supply_resistance,
+            effects.heat_transfer,
+            effects.command_delay,
+        ]
+        .iter()
+        .any(|&x| bad(x))
+        || effects.heat_transfer > 1.0
+        || !effects.force_sensor_offset.is_finite()
+        || !effects.force_sensor_gain.is_finite()
+    {
+        eprintln!("benchgen: effect parameters must be finite and non-negative (heat transfer ≤ 1)");
+        return ExitCode::from(2);
+    }
+    let start = Instant::now();
+    let rows = generate(&effects, cli.seed, cli.duration);
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Err(e) = write_csv(&rows, &cli.out) {
+        eprintln!("benchgen: cannot write {}: {e}", cli.out.display());
+        return ExitCode::FAILURE;
+    }
+    eprintln!(
+        "benchgen: {} rows to {} in {elapsed:.2} s ({effects:?})",
+        rows.len(),
+        cli.out.display()
+    );
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,49 @@
+//! The `benchgen` binary writes what the library generates. (Also why `cargo test --release`
+//! builds `target/release/benchgen`, which fmu_tests/test_diagnose_fmu.py runs.)
+
+use std::process::Command;
+
+use synthetic_bench::{generate, write_csv, BenchEffects, UNDECLARED};
+
+#[test]
+fn benchgen_lists_the_undeclared_mechanisms() {
+    let output = Command::new(env!("CARGO_BIN_EXE_benchgen"))
+        .args(["--out", "unused.csv", "--list-undeclared"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let text = String::from_utf8(output.stdout).unwrap();
+    let names: Vec<&str> = text.lines().map(|l| l.split('\t').next().unwrap()).collect();
+    let expected: Vec<&str> = UNDECLARED.iter().map(|m| m.name).collect();
+    assert_eq!(names, expected);
+}
+
+#[test]
+fn benchgen_writes_the_recording_of_the_library() {
+    let dir = std::env::temp_dir().join(format!("benchgen-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (cli, library) = (dir.join("cli.csv"), dir.join("library.csv"));
+    let output = Command::new(env!("CARGO_BIN_EXE_benchgen"))
+        .args(["--out", cli.to_str().unwrap(), "--seed", "3", "--duration", "1"])
+        .args(["--friction-coulomb", "2"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let effects = BenchEffects {
+        friction_coulomb: 2.0,
+        ..BenchEffects::default()
+    };
+    write_csv(&generate(&effects, 3, 1.0), &library).unwrap();
+    assert_eq!(std::fs::read(&cli).unwrap(), std::fs::read(&library).unwrap());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn benchgen_refuses_an_unknown_mechanism() {
+    let output = Command::new(env!("CARGO_BIN_EXE_benchgen"))
+        .args(["--out", "unused.csv", "--undeclared", "no_such_mechanism"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("unknown undeclared mechanism"));
+}
