@@ -238,7 +238,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
         };
         let tolerance = QUADRATIC_TOLERANCE * law.scale();
         let fits = [0.25, 0.75].iter().all(|&f| (quadratic(f) - at(f)).abs() <= tolerance);
-        fits.then(|| HysteresisOverStep::Parabola {
+        fits.then_some(HysteresisOverStep::Parabola {
             value: y0,
             slope: c1,
             curvature: c2,

@@ -683,11 +683,13 @@ mod tests {
 
     #[test]
     fn a_bouc_wen_branch_taken_as_a_parabola_agrees_with_quadrature() {
-        let mut p = Parameters::default();
-        p.hysteresis_width = 0.16e-3;
-        p.hysteresis_exponent = 3.7;
-        p.hysteresis_beta_share = 0.52;
-        p.hysteresis_gain = 0.99;
+        let p = Parameters {
+            hysteresis_width: 0.16e-3,
+            hysteresis_exponent: 3.7,
+            hysteresis_beta_share: 0.52,
+            hysteresis_gain: 0.99,
+            ..Default::default()
+        };
         let propagator = ElectromechanicalPropagator::new(&p).unwrap();
         let law = p.hysteresis();
         let mut checked = 0;

@@ -331,7 +331,7 @@ struct Branch {
 }
 
 thread_local! {
-    static BRANCH: std::cell::RefCell<Branch> = std::cell::RefCell::new(Branch { key: None, knots: Vec::new() });
+    static BRANCH: std::cell::RefCell<Branch> = const { std::cell::RefCell::new(Branch { key: None, knots: Vec::new() }) };
 }
 
 /// Polytropic exponent of the chambers: γ for adiabatic chambers (the thesis, (2.29)),

@@ -480,9 +480,11 @@ mod tests {
 
     #[test]
     fn a_deadband_with_the_bouc_wen_law_is_refused_by_name() {
-        let mut p = Parameters::default();
-        p.hysteresis_width = 0.16e-3;
-        p.hysteresis_exponent = 2.0;
+        let mut p = Parameters {
+            hysteresis_width: 0.16e-3,
+            hysteresis_exponent: 2.0,
+            ..Default::default()
+        };
         assert!(p.validate().is_ok());
         p.hysteresis_deadband = 0.05e-3;
         let e = p.validate().unwrap_err();
