@@ -85,3 +85,29 @@ def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
           f"before {report['before']['force_rms_N']:.4f} N")
     assert rms < 0.5 * report["before"]["force_rms_N"]
     assert abs(rms - reported) <= 0.05 * reported
+
+
+# The Bouc–Wen law of jet_pipe_hysteresis, with the loop's starting state: its memory is the
+# FMU state's hysteresis array, and the step's closed form (a parabola per step) must give
+# through the FMU what the diagnosis's fast replay gave.
+@pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
+                    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
+def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
+        unzipdir, model_description, vrs, tmp_path):
+    recording_path = tmp_path / "hysteresis.csv"
+    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "105",
+                    "--hysteresis-width", "0.16e-3"], check=True, capture_output=True)
+    report_path = tmp_path / "report.json"
+    subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
+                   check=True, capture_output=True)
+    report = json.loads(report_path.read_text())
+    assert [e["name"] for e in report["effects"]] == ["jet_pipe_hysteresis"], report["effects"]
+    start_values = report["fmu_start_values"]
+    assert start_values.get("hysteresis_exponent", 0) > 0, start_values
+    assert start_values.get("hysteresis_start", 0) < -0.5, start_values
+    recording = np.genfromtxt(recording_path, delimiter=",", names=True)
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values)
+    rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
+    reported = report["after"]["force_rms_N"]
+    print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
+    assert abs(rms - reported) <= 0.05 * reported
