@@ -4,7 +4,7 @@
 //! residues), with f3 (2.5) as a `physics::jet_pipe::StaticCurve`. Plus what every step's
 //! closed forms share (the series terms' weights on the modes, and the exponentials e^{λk s}
 //! and e^{−ω_cd s} they are made of). Built once per parameter set, so a step costs
-//! multiplications; the hysteresis operator's linear stretches are recognised here too, as
+//! multiplications; the hysteresis operator's affine stretches (plays) and parabolas (a Bouc–Wen branch) are recognised here too, as
 //! they decide whether the series applies.
 
 use crate::physics::current_driver::CurrentDriver;
@@ -178,7 +178,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
     /// branch is smooth: where it is a parabola in x̄ to within [`QUADRATIC_TOLERANCE`] of
     /// its half-width over the step's travel, so is the series (see
     /// [`Self::branch_as_quadratic`]).
-    pub(super) fn hysteresis_as_linear(
+    pub(super) fn hysteresis_over_step(
         &self,
         current: f64,
         static_current: f64,

@@ -61,8 +61,8 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
         }
         let mut series = Coefficients::new();
         let turning_point = drive.turning_point();
-        let linear_hysteresis = if ramp == 0.0 && self.hysteresis.is_active() {
-            self.hysteresis_as_linear(start.current, base, plays)
+        let hysteresis_form = if ramp == 0.0 && self.hysteresis.is_active() {
+            self.hysteresis_over_step(start.current, base, plays)
         } else {
             None
         };
@@ -71,7 +71,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
         // f3's argument (2.4)–(2.5) for a current, and for a change of current.
         let argument = |current: f64| self.curve.argument(jet_pipe::tip_force(self.k_m, current));
         let centre = argument(base);
-        let series_applies = ramp == 0.0 && (!self.hysteresis.is_active() || linear_hysteresis.is_some());
+        let series_applies = ramp == 0.0 && (!self.hysteresis.is_active() || hysteresis_form.is_some());
         let radius = if series_applies {
             self.curve.series_radius(centre)
         } else {
@@ -80,7 +80,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
         if let Some(radius) = radius {
             let epsilon = argument(delta);
             if epsilon.abs() <= SERIES_RATIO_LIMIT * radius {
-                match linear_hysteresis {
+                match hysteresis_form {
                     Some(HysteresisOverStep::Parabola {
                         value,
                         slope,
