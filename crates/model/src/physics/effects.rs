@@ -259,9 +259,9 @@ impl BoucWen {
     /// A branch (the law integrated from the memory in one direction) is a function of the
     /// memory alone, so its knots, one Runge–Kutta step apart on a grid anchored at the
     /// memory's input, are kept per thread and shared by every query from that memory: the
-    /// propagator asks for the output at about 160 instants of each step, all from the
-    /// step's starting memory. The result depends only on the arguments (the knots are a
-    /// cache, not a state).
+    /// propagator asks for the output at up to about 160 instants of a step (its quadrature),
+    /// or at 5 (to place a parabola), all from the step's starting memory. The result depends
+    /// only on the arguments (the knots are a cache, not a state).
     pub fn output_after(&self, memory: &[f64; PLAY_OPERATORS], input: f64) -> f64 {
         let r = self.half_width;
         let from = memory[Self::INPUT];
