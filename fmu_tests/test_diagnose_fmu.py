@@ -20,22 +20,23 @@ ROOT = Path(__file__).resolve().parent.parent
 BIN = ROOT / "target" / "release"
 
 
-def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values):
+def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, outputs=("F_meas",)):
+    """The FMU's `outputs` at every sample of the recording (one array, or a tuple of them)."""
     fmu = make_slave(unzipdir, model_description)
     try:
         initialize(fmu, vrs, inputs=(recording["v_da_V"][0], recording["x_s_m"][0]), parameters=start_values)
         t, v, x = recording["time_s"], recording["v_da_V"], recording["x_s_m"]
-        force = np.empty(len(t))
-        vr_v, vr_x, vr_f = [vrs["v_DA"]], [vrs["x_s"]], [vrs["F_meas"]]
+        read = np.empty((len(outputs), len(t)))
+        vr_v, vr_x, vr_out = [vrs["v_DA"]], [vrs["x_s"]], [vrs[name] for name in outputs]
         for k in range(len(t)):
-            force[k] = fmu.getReal(vr_f)[0]
+            read[:, k] = fmu.getReal(vr_out)
             if k + 1 == len(t):
                 break
             dt = t[k + 1] - t[k]
             fmu.setReal(vr_v, [v[k]])
             fmu.setRealInputDerivatives(vr_x, [1], [(x[k + 1] - x[k]) / dt])
             fmu.doStep(currentCommunicationPoint=t[k], communicationStepSize=dt)
-        return force
+        return read[0] if len(outputs) == 1 else tuple(read)
     finally:
         release(fmu)
 
@@ -112,3 +113,33 @@ def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
     reported = report["after"]["force_rms_N"]
     print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
     assert abs(rms - reported) <= 0.05 * reported
+
+
+# A pressure transducer's terms act on P1_meas and P2_meas alone: the report's pressure errors
+# after must come back through the FMU's transducer outputs, a delay's memory included.
+@pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
+                    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
+@pytest.mark.parametrize("mechanism,parameter", [("p1_sensor_offset", "p1_sensor_offset"),
+                                                 ("p2_sensor_delay", "p2_sensor_delay")])
+def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors_after(
+        unzipdir, model_description, vrs, tmp_path, mechanism, parameter):
+    recording_path = tmp_path / f"{mechanism}.csv"
+    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "43", "--duration", "40",
+                    "--undeclared", mechanism], check=True, capture_output=True)
+    report_path = tmp_path / "report.json"
+    subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
+                   check=True, capture_output=True)
+    report = json.loads(report_path.read_text())
+    assert report["effects"] == [], report["effects"]
+    assert parameter in report["discovered"][0]["parameters"], report["discovered"]
+    assert report["discovered"][0]["location"] == "pressure_sensors", report["discovered"]
+    recording = np.genfromtxt(recording_path, delimiter=",", names=True)
+    p1, p2 = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"],
+                                outputs=("P1_meas", "P2_meas"))
+    through_fmu = [float(np.sqrt(np.mean((recording[c] - p) ** 2))) for c, p in (("p1_Pa", p1), ("p2_Pa", p2))]
+    reported = report["after"]["pressure_rms_Pa"]
+    before = report["before"]["pressure_rms_Pa"]
+    print(f"{mechanism}: pressure errors after reported {reported}, FMU replay {through_fmu}; before {before}")
+    for c in range(2):
+        assert abs(through_fmu[c] - reported[c]) <= 0.05 * reported[c]
+    assert max(through_fmu) < 0.5 * max(before)

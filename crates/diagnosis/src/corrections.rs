@@ -19,8 +19,8 @@ use crate::recording::Recording;
 use crate::replay::{replay_fast, Replay};
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::current_driver;
-use jetpipe_model::physics::force_sensor;
 use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::physics::sensors::{self, Channel, SensorLaw};
 use jetpipe_model::variables::VARIABLES;
 
 use super::signals::{difference, stopper_velocity, CHANNELS, FORCE, P1, P2};
@@ -60,25 +60,31 @@ pub enum Filter {
 }
 
 impl Filter {
-    /// The reading of `x` through the filter with coefficient `value`: the force
-    /// sensor's own filter law (any channel's transducer is read the same way).
+    /// The reading of `x` through the filter with coefficient `value`: the model's own
+    /// transducer law (every channel's transducer is read the same way).
     pub fn apply(self, time: &[f64], x: &[f64], value: f64) -> Vec<f64> {
-        let mut p = Parameters::default();
+        let mut law = SensorLaw::of(&Parameters::default(), Channel::Force);
         match self {
-            Filter::Delay => p.force_sensor_delay = value,
-            Filter::Lag => p.force_sensor_lag = value,
-            Filter::Play => p.force_sensor_play = value,
+            Filter::Delay => law.delay = value,
+            Filter::Lag => law.lag = value,
+            Filter::Play => law.play = value,
         }
-        force_sensor::filtered(&p, time, x.to_vec())
+        sensors::filtered(&law, time, x.to_vec())
     }
 
-    /// The force sensor parameter that carries this filter.
-    pub fn force_sensor_parameter(self) -> &'static str {
-        match self {
-            Filter::Delay => "force_sensor_delay",
-            Filter::Lag => "force_sensor_lag",
-            Filter::Play => "force_sensor_play",
-        }
+    /// The model parameter that carries this filter on the measured `channel`, if the
+    /// model's transducer there has it.
+    pub fn sensor_parameter(self, channel: usize) -> Option<&'static str> {
+        Some(match (channel, self) {
+            (FORCE, Filter::Delay) => "force_sensor_delay",
+            (FORCE, Filter::Lag) => "force_sensor_lag",
+            (FORCE, Filter::Play) => "force_sensor_play",
+            (P1, Filter::Delay) => "p1_sensor_delay",
+            (P1, Filter::Lag) => "p1_sensor_lag",
+            (P2, Filter::Delay) => "p2_sensor_delay",
+            (P2, Filter::Lag) => "p2_sensor_lag",
+            _ => return None,
+        })
     }
 }
 

@@ -2,13 +2,14 @@
 //! only as parameters the FMU has, so that the FMU with the report's `fmu_start_values`
 //! is the model whose error the report gives.
 //!
-//! Terms that the fit applies on a measured channel (a sensor's curve or drift, a force
-//! on the piston) are composed with what the model already reads there; terms the FMU
-//! cannot carry (a pressure transducer's, a constant modulated in time) and compositions
-//! that would not be exact give `None`, and the candidate stays a located departure.
+//! Terms that the fit applies on a measured channel (a transducer's offset, gain, curve or
+//! drift, a force on the piston) are composed with what the model already reads there;
+//! terms the FMU cannot carry (a constant modulated in time other than the supply's and the
+//! jet pipe null's) and compositions that would not be exact give `None`, and the candidate
+//! stays a located departure.
 
 use super::corrections::{parameter_value, Candidate, Mechanism, Modulation, Problem, Regressor};
-use super::signals::FORCE;
+use super::signals::{FORCE, P1, P2};
 use jetpipe_model::physics::parameters::Parameters;
 
 /// The FMU parameters (name, value) that put the fitted `values` of `terms` into the
@@ -31,6 +32,8 @@ pub fn model_terms(
     let mut friction = 0.0;
     let mut viscous = 0.0;
     let mut position = 0.0;
+    // Coefficients of the pressure channels' regressors: (one, own, ramp) per transducer.
+    let mut transducer = [[0.0; 3]; 2];
     // Modulations of a constant: (parameter, ramp coefficient, sine, cosine, frequency).
     let mut modulated: Vec<(&'static str, f64, f64, f64, f64)> = vec![];
     for (term, &value) in terms.iter().zip(values) {
@@ -57,12 +60,21 @@ pub fn model_terms(
                 }
             }
             m if m.model_parameter().is_some() => set.push((m.model_parameter()?, value)),
-            Mechanism::OutputFilter { channel: FORCE, filter } => {
-                let name = filter.force_sensor_parameter();
+            Mechanism::OutputFilter { channel, filter } => {
+                let name = filter.sensor_parameter(channel)?;
                 if parameter_value(base, name) != 0.0 && value != 0.0 {
                     return None;
                 }
                 set.push((name, value));
+            }
+            Mechanism::Output { channel, regressor } if channel == P1 || channel == P2 => {
+                let k = if channel == P1 { 0 } else { 1 };
+                match regressor {
+                    Regressor::One => transducer[k][0] += value,
+                    Regressor::Own => transducer[k][1] += value,
+                    Regressor::Ramp => transducer[k][2] += value,
+                    _ => return None,
+                }
             }
             Mechanism::Output {
                 channel: FORCE,
@@ -116,6 +128,27 @@ pub fn model_terms(
             set.push(("supply_ripple_sine", a));
             set.push(("supply_ripple_cosine", b));
             set.push(("supply_ripple_frequency", f));
+        }
+    }
+    // A pressure transducer: new reading = (1 + own) s + one + ramp (t − t_mid)/span, with
+    // s = offset + gain P + drift t the reading so far.
+    for (k, &[one, own, ramp]) in transducer.iter().enumerate() {
+        if one == 0.0 && own == 0.0 && ramp == 0.0 {
+            continue;
+        }
+        let (offset, gain, drift) = if k == 0 {
+            ("p1_sensor_offset", "p1_sensor_gain", "p1_sensor_drift")
+        } else {
+            ("p2_sensor_offset", "p2_sensor_gain", "p2_sensor_drift")
+        };
+        let m = 1.0 + own;
+        let (t_mid, t_span) = (problem.t_mid, problem.t_span);
+        set.push((offset, m * parameter_value(base, offset) + one - ramp * t_mid / t_span));
+        if own != 0.0 {
+            set.push((gain, m * parameter_value(base, gain)));
+        }
+        if ramp != 0.0 || parameter_value(base, drift) != 0.0 {
+            set.push((drift, m * parameter_value(base, drift) + ramp / t_span));
         }
     }
     let g = p.force_sensor_gain;

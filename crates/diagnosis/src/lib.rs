@@ -76,6 +76,9 @@ pub struct Errors {
     pub nrmse: f64,
     pub train_rms: f64,
     pub heldout_rms: f64,
+    /// RMS of each measured pressure minus the model's reading of it, Pa, over the whole
+    /// recording (when it has pressure channels).
+    pub pressure_rms: Option<[f64; 2]>,
 }
 
 /// Training samples: those in even-numbered blocks.
@@ -86,8 +89,8 @@ pub fn training_mask(time: &[f64]) -> Vec<bool> {
         .collect()
 }
 
-fn errors(model: &[f64], recording: &Recording, mask: &[bool]) -> Errors {
-    let residual = difference(&recording.force, model);
+fn errors(model: &Replay, recording: &Recording, mask: &[bool]) -> Errors {
+    let residual = difference(&recording.force, &model.force);
     let (lo, hi) = recording
         .force
         .iter()
@@ -98,6 +101,10 @@ fn errors(model: &[f64], recording: &Recording, mask: &[bool]) -> Errors {
         nrmse: if hi > lo { total / (hi - lo) } else { 0.0 },
         train_rms: rms_where(&residual, mask, true),
         heldout_rms: rms_where(&residual, mask, false),
+        pressure_rms: match (&recording.p1, &recording.p2) {
+            (Some(p1), Some(p2)) => Some([rms(&difference(p1, &model.p1)), rms(&difference(p2, &model.p2))]),
+            _ => None,
+        },
     }
 }
 
@@ -249,6 +256,9 @@ pub struct DiscoveredTerm {
     pub heldout_after: f64,
     /// Share of the held-out force mean square it removes.
     pub share: f64,
+    /// For a term on the pressure transducers, which the force does not see: the held-out
+    /// RMS of each pressure, Pa, before and after.
+    pub pressures_heldout: Option<([f64; 2], [f64; 2])>,
 }
 
 /// What is left when the verdict is not "explained".
@@ -541,7 +551,7 @@ fn pressure_split(
 /// (friction, spring floor) and sensor: what the force should be when only the
 /// mechanics and the force sensor are in question.
 fn force_through_mechanics(model: &Actuator, recording: &Recording) -> Option<Replay> {
-    let (p1, p2) = (recording.p1.as_ref()?, recording.p2.as_ref()?);
+    let (p1, p2) = signals::chamber_pressures(model, recording)?;
     let velocity = signals::stopper_velocity(recording);
     let force = (0..recording.len())
         .map(|k| {
@@ -551,8 +561,8 @@ fn force_through_mechanics(model: &Actuator, recording: &Recording) -> Option<Re
         .collect();
     Some(Replay {
         force,
-        p1: p1.clone(),
-        p2: p2.clone(),
+        p1,
+        p2,
         ..Replay::default()
     })
 }
@@ -912,12 +922,37 @@ pub fn diagnose_with(
                 progress(&format!(
                     "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
                 ));
-                if gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise {
-                    kept = Some((s.fit.candidate.clone(), set, trial, after));
+                // A pressure transducer's term leaves the force as it is: it is judged on
+                // the pressures, by the same rule in their noise, and must leave the force
+                // no worse.
+                let pressures = if s.fit.candidate.location == "pressure_sensors" {
+                    let (_, replayed) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
+                    let in_noise = |h: &[f64; CHANNELS]| ((h[1] + h[2]) / count).sqrt();
+                    let (was, now) = (in_noise(&heldout), in_noise(&replayed));
+                    progress(&format!(
+                        "  {label}: in the model, pressures held-out {was:.2} -> {now:.2} noise floors"
+                    ));
+                    let rms_pa = |series: [&[f64]; 2]| {
+                        let measured = [recording.p1.as_deref(), recording.p2.as_deref()];
+                        [0, 1].map(|c| {
+                            measured[c].map_or(0.0, |m| rms_where(&difference(m, series[c]), &training, false))
+                        })
+                    };
+                    let better = was - now >= MIN_RELATIVE_GAIN * was
+                        && was - now >= MIN_GAIN_IN_NOISE
+                        && after <= force_before + 0.05 * noise;
+                    better.then(|| (rms_pa([&current.p1, &current.p2]), rms_pa([&with.p1, &with.p2])))
+                } else {
+                    None
+                };
+                if pressures.is_some()
+                    || (gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise)
+                {
+                    kept = Some((s.fit.candidate.clone(), set, trial, after, pressures));
                     break;
                 }
             }
-            if let Some((candidate, set, trial, after)) = kept {
+            if let Some((candidate, set, trial, after, pressures_heldout)) = kept {
                 progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
                 discovered.push(DiscoveredTerm {
                     location: candidate.location,
@@ -928,6 +963,7 @@ pub fn diagnose_with(
                     heldout_before: force_before,
                     heldout_after: after,
                     share: 1.0 - (after / force_before).powi(2),
+                    pressures_heldout,
                 });
                 params = trial;
                 reusable = None;
@@ -1076,7 +1112,7 @@ pub fn diagnose_with(
     });
     let (before, after) = (before?, after?);
     let after_residual = difference(&recording.force, &after.force);
-    let after_errors = errors(&after.force, recording, &training);
+    let after_errors = errors(&after, recording, &training);
     let split = pressure_noise.and_then(|pn| pressure_split(&final_model, recording, &after, noise, pn));
     let chain = ChainSignals::new(&final_model, recording, &after);
     let remainder = Signature::of(&recording.time, &after_residual, &chain, "N");
@@ -1164,7 +1200,7 @@ pub fn diagnose_with(
         noise_floor: noise,
         pressure_noise,
         input_checks,
-        before: errors(&before.force, recording, &training),
+        before: errors(&before, recording, &training),
         after: after_errors,
         calibrated,
         effects,
@@ -1225,6 +1261,14 @@ impl Diagnosis {
                 "Explained: the thesis model reproduces the force to within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N); nothing was added.",
                 self.after.heldout_rms, self.noise_floor
             ),
+            (None, false) if self.effects.is_empty() && self.discovered.iter().all(|d| d.pressures_heldout.is_some()) => {
+                format!(
+                    "Explained with {}: the pressures now agree with the recording's, and the force stays within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N).",
+                    names.join(" and "),
+                    self.after.heldout_rms,
+                    self.noise_floor
+                )
+            }
             (None, false) => format!(
                 "Explained with {}: the held-out force error falls from {:.4} N to {:.4} N, {ratio:.1}× the noise floor {:.4} N.",
                 names.join(" and "),
@@ -1260,13 +1304,19 @@ impl Diagnosis {
             ));
         }
         for d in &self.discovered {
-            lines.push(format!(
-                "+ discovered: {} It lowers the held-out force error from {:.4} N to {:.4} N in the model ({:.1} % of its mean square).",
-                d.reading,
-                d.heldout_before,
-                d.heldout_after,
-                100.0 * d.share
-            ));
+            lines.push(match d.pressures_heldout {
+                Some((before, after)) => format!(
+                    "+ discovered: {} It lowers the held-out pressure errors from {:.0} and {:.0} Pa to {:.0} and {:.0} Pa in the model; the force error stays at {:.4} N.",
+                    d.reading, before[0], before[1], after[0], after[1], d.heldout_after
+                ),
+                None => format!(
+                    "+ discovered: {} It lowers the held-out force error from {:.4} N to {:.4} N in the model ({:.1} % of its mean square).",
+                    d.reading,
+                    d.heldout_before,
+                    d.heldout_after,
+                    100.0 * d.share
+                ),
+            });
         }
         for e in &self.effects {
             let values: Vec<String> = e.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
@@ -1288,7 +1338,10 @@ impl Diagnosis {
     }
 
     pub fn to_json(&self, recording_name: &str) -> Value {
-        let err = |e: &Errors| json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse});
+        let err = |e: &Errors| match e.pressure_rms {
+            Some(p) => json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse, "pressure_rms_Pa": p.to_vec()}),
+            None => json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse}),
+        };
         // Every parameter of the final model that is not the thesis's: with these the FMU
         // is the model whose errors the report gives.
         let thesis = Parameters::default();
@@ -1334,6 +1387,8 @@ impl Diagnosis {
                 "heldout_before_rms_N": d.heldout_before,
                 "heldout_after_rms_N": d.heldout_after,
                 "share_of_heldout_explained": d.share,
+                "pressures_heldout_before_rms_Pa": d.pressures_heldout.map(|(b, _)| b.to_vec()),
+                "pressures_heldout_after_rms_Pa": d.pressures_heldout.map(|(_, a)| a.to_vec()),
             })).collect::<Vec<_>>(),
             "calibrated": self.calibrated.iter().map(|c| (c.name.to_string(), json!({
                 "value": c.value,

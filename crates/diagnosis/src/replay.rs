@@ -3,7 +3,8 @@
 
 use crate::recording::Recording;
 use jetpipe_model::physics::actuator::{Actuator, Outputs};
-use jetpipe_model::physics::{command_stage, force_sensor, time_varying};
+use jetpipe_model::physics::sensors::{self, Channel, SensorLaw};
+use jetpipe_model::physics::{command_stage, time_varying};
 use jetpipe_model::simulation::{Simulation, StepFailure};
 
 /// The model's outputs at every sample of a recording.
@@ -11,6 +12,7 @@ use jetpipe_model::simulation::{Simulation, StepFailure};
 pub struct Replay {
     /// The force the bench's sensor would read (`F_meas`).
     pub force: Vec<f64>,
+    /// The chamber pressures as the transducers would read them (`P1_meas`, `P2_meas`).
     pub p1: Vec<f64>,
     pub p2: Vec<f64>,
     pub current: Vec<f64>,
@@ -34,8 +36,8 @@ impl Replay {
 
     fn record(&mut self, y: &Outputs) {
         self.force.push(y.f_meas);
-        self.p1.push(y.p1);
-        self.p2.push(y.p2);
+        self.p1.push(y.p1_meas);
+        self.p2.push(y.p2_meas);
         self.current.push(y.current);
         self.x_jp.push(y.x_jp);
     }
@@ -192,9 +194,17 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
         }
         velocity = rate;
     }
-    if force_sensor::filters(&model.params) {
-        let statics = std::mem::take(&mut out.force);
-        out.force = force_sensor::filtered(&model.params, &t[..n], statics);
+    for channel in Channel::ALL {
+        let law = SensorLaw::of(&model.params, channel);
+        if law.filters() {
+            let readings = match channel {
+                Channel::Force => &mut out.force,
+                Channel::Pressure1 => &mut out.p1,
+                Channel::Pressure2 => &mut out.p2,
+            };
+            let statics = std::mem::take(readings);
+            *readings = sensors::filtered(&law, &t[..n], statics);
+        }
     }
     Ok(out)
 }

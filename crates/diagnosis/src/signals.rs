@@ -4,6 +4,7 @@
 use crate::recording::Recording;
 use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 
 /// Channels compared with the model: the force always, the two chamber pressures when the
 /// recording has them.
@@ -62,12 +63,28 @@ pub fn command_direction(v_da: &[f64]) -> Vec<f64> {
 /// The force the measured pressures give through the piston, with the spring floor
 /// (2.36)–(2.38): what the force sensor should read if the mechanics are the thesis's.
 pub fn force_from_pressures(model: &Actuator, recording: &Recording) -> Option<Vec<f64>> {
-    let (p1, p2) = (recording.p1.as_ref()?, recording.p2.as_ref()?);
+    let (p1, p2) = chamber_pressures(model, recording)?;
     Some(
         (0..recording.len())
             .map(|k| (model.piston_area * (p1[k] - p2[k])).max(model.spring_force(recording.x_s[k])))
             .collect(),
     )
+}
+
+/// The chamber pressures that gave the recording's pressure readings, through the model's
+/// transducer laws (the readings themselves while those are off); `None` without pressure
+/// channels, or where a law has no inverse.
+pub fn chamber_pressures(model: &Actuator, recording: &Recording) -> Option<(Vec<f64>, Vec<f64>)> {
+    let (p1, p2) = (recording.p1.as_ref()?, recording.p2.as_ref()?);
+    let back = |channel: Channel, readings: &Vec<f64>| {
+        let law = SensorLaw::of(&model.params, channel);
+        if law.is_identity() {
+            Some(readings.clone())
+        } else {
+            law.unread(&recording.time, readings)
+        }
+    };
+    Some((back(Channel::Pressure1, p1)?, back(Channel::Pressure2, p2)?))
 }
 
 /// The signals along the chain, in the chain's order, for binned conditional means.
@@ -87,10 +104,7 @@ impl ChainSignals {
             supply.push(f.supply_1 + f.supply_2);
             returns.push(f.return_1 + f.return_2);
         }
-        let (p1, p2) = match (&recording.p1, &recording.p2) {
-            (Some(a), Some(b)) => (a.clone(), b.clone()),
-            _ => (replay.p1.clone(), replay.p2.clone()),
-        };
+        let (p1, p2) = chamber_pressures(model, recording).unwrap_or_else(|| (replay.p1.clone(), replay.p2.clone()));
         let volume_1: Vec<f64> = recording.x_s.iter().map(|&x| model.cylinder.volumes(x).0).collect();
         let pairs: Vec<(&'static str, Vec<f64>)> = vec![
             ("command level v_DA", recording.v_da.clone()),

@@ -6,8 +6,8 @@ use fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, Outp
 use jetpipe_model::physics::actuator::{index, Actuator, State, N_STATES};
 use jetpipe_model::physics::command_stage::CommandStage;
 use jetpipe_model::physics::effects::PLAY_OPERATORS;
-use jetpipe_model::physics::force_sensor::SensorMemory;
 use jetpipe_model::physics::parameters::{variable_name, Parameters};
+use jetpipe_model::physics::sensors::SensorMemory;
 use jetpipe_model::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
@@ -62,6 +62,11 @@ pub fn extent(value_reference: u32) -> Extent {
             max: None,
             nominal: Some(100.0),
         },
+        vr::P1_MEAS | vr::P2_MEAS => Extent {
+            min: None,
+            max: None,
+            nominal: scale(defaults.p_s),
+        },
         vr::P1_START | vr::P2_START => Extent {
             min: Some(0.0),
             max: None,
@@ -103,6 +108,16 @@ pub const DEPENDENCIES: &[OutputDependencies] = &[
     },
     OutputDependencies {
         output: vr::P2,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::P1_MEAS,
+        step: &[(vr::X_S, DEPENDS)],
+        initial: None,
+    },
+    OutputDependencies {
+        output: vr::P2_MEAS,
         step: &[(vr::X_S, DEPENDS)],
         initial: None,
     },
@@ -238,7 +253,7 @@ impl CoSimModel for ActuatorFmu {
         match value_reference {
             vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, |s| s.v_da)),
             vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, |s| s.x_s)),
-            vr::F_ACT | vr::F_MEAS | vr::P1 | vr::P2 | vr::I | vr::X_JP => {
+            vr::F_ACT | vr::F_MEAS | vr::P1 | vr::P2 | vr::P1_MEAS | vr::P2_MEAS | vr::I | vr::X_JP => {
                 let computed;
                 let simulation = match &self.simulation {
                     Some(s) => s,
@@ -253,6 +268,8 @@ impl CoSimModel for ActuatorFmu {
                     vr::F_MEAS => y.f_meas,
                     vr::P1 => y.p1,
                     vr::P2 => y.p2,
+                    vr::P1_MEAS => y.p1_meas,
+                    vr::P2_MEAS => y.p2_meas,
                     vr::I => y.current,
                     _ => y.x_jp,
                 })
@@ -476,10 +493,12 @@ impl CoSimModel for ActuatorFmu {
                 for v in s.command_stage.to_values() {
                     w.f64(v);
                 }
-                let sensor = s.force_sensor.as_ref().map(|m| m.to_values()).unwrap_or_default();
-                w.u32(sensor.len() as u32);
-                for v in sensor {
-                    w.f64(v);
+                for memory in &s.transducers {
+                    let sensor = memory.as_ref().map(|m| m.to_values()).unwrap_or_default();
+                    w.u32(sensor.len() as u32);
+                    for v in sensor {
+                        w.f64(v);
+                    }
                 }
                 let st = &s.statistics;
                 for v in [
@@ -559,18 +578,21 @@ impl CoSimModel for ActuatorFmu {
             for v in stage.iter_mut() {
                 *v = r.f64()?;
             }
-            let sensor_values = r.count(8, "force sensor values")?;
-            let mut sensor = Vec::with_capacity(sensor_values);
-            for _ in 0..sensor_values {
-                sensor.push(r.f64()?);
+            let mut transducers = [None, None, None];
+            for memory in transducers.iter_mut() {
+                let sensor_values = r.count(8, "transducer values")?;
+                let mut sensor = Vec::with_capacity(sensor_values);
+                for _ in 0..sensor_values {
+                    sensor.push(r.f64()?);
+                }
+                if !sensor.is_empty() {
+                    *memory =
+                        Some(SensorMemory::from_values(&sensor).ok_or("the state's transducer memory is malformed")?);
+                }
             }
             let mut simulation = Simulation::from_state(model, state, v_da, x_s, time, rtol);
             simulation.command_stage = CommandStage::from_values(stage);
-            simulation.force_sensor = if sensor.is_empty() {
-                None
-            } else {
-                Some(SensorMemory::from_values(&sensor).ok_or("the state's force sensor memory is malformed")?)
-            };
+            simulation.transducers = transducers;
             simulation.v_da_rate = v_da_rate;
             simulation.x_s_rate = x_s_rate;
             simulation.integrator.next_step = next_step;
@@ -626,7 +648,7 @@ impl CoSimModel for ActuatorFmu {
 }
 
 const STATE_MAGIC: &[u8] = b"JetPipeActuatorState";
-const STATE_FORMAT_VERSION: u32 = 2;
+const STATE_FORMAT_VERSION: u32 = 3;
 
 #[derive(Default)]
 struct ByteWriter(Vec<u8>);
@@ -766,7 +788,14 @@ mod tests {
         pairs.sort();
         assert_eq!(
             pairs,
-            vec![("F_act", "x_s"), ("F_meas", "x_s"), ("P1", "x_s"), ("P2", "x_s")]
+            vec![
+                ("F_act", "x_s"),
+                ("F_meas", "x_s"),
+                ("P1", "x_s"),
+                ("P1_meas", "x_s"),
+                ("P2", "x_s"),
+                ("P2_meas", "x_s")
+            ]
         );
         // Nothing but the pair (deadband > width) that validate() refuses is skipped.
         assert!(report.skipped.len() <= 1, "{:#?}", report.skipped);

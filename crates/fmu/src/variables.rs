@@ -316,20 +316,25 @@ mod tests {
             .filter(|(_, v)| v.causality == Causality::Output)
             .map(|(i, _)| i + 1)
             .collect();
-        assert_eq!(outputs, vec![3, 4, 5, 6, 7, 8], "F_act, P1, P2, i, F_meas, x_jp");
+        assert_eq!(
+            outputs,
+            vec![3, 4, 5, 6, 7, 8, 9, 10],
+            "F_act, P1, P2, i, F_meas, P1_meas, P2_meas, x_jp"
+        );
         for i in outputs {
             assert_eq!(
                 xml.matches(&format!(r#"<Unknown index="{i}" dependencies="#)).count(),
                 2
             );
         }
-        // Within a step only x_s (index 2) acts, on F_act, P1, P2 and F_meas; i and x_jp on nothing.
-        for i in [3, 4, 5, 7] {
+        // Within a step only x_s (index 2) acts, on the forces and the pressures as they are
+        // and as read; i and x_jp on nothing.
+        for i in [3, 4, 5, 7, 8, 9] {
             assert!(xml.contains(&format!(
                 r#"<Unknown index="{i}" dependencies="2" dependenciesKind="dependent"/>"#
             )));
         }
-        for i in [6, 8] {
+        for i in [6, 10] {
             assert!(xml.contains(&format!(
                 r#"<Unknown index="{i}" dependencies="" dependenciesKind=""/>"#
             )));

@@ -15,6 +15,8 @@ pub mod vr {
     pub const I: u32 = 13;
     pub const X_JP: u32 = 14;
     pub const F_MEAS: u32 = 15;
+    pub const P1_MEAS: u32 = 16;
+    pub const P2_MEAS: u32 = 17;
 
     pub const P_S: u32 = 100;
     pub const P_R: u32 = 101;
@@ -100,6 +102,16 @@ pub mod vr {
     pub const SUPPLY_RIPPLE_FREQUENCY: u32 = 492;
     pub const SUPPLY_RIPPLE_COSINE: u32 = 493;
     pub const X_JP_OFFSET_DRIFT: u32 = 494;
+    pub const P1_SENSOR_OFFSET: u32 = 500;
+    pub const P1_SENSOR_GAIN: u32 = 501;
+    pub const P1_SENSOR_DRIFT: u32 = 502;
+    pub const P1_SENSOR_LAG: u32 = 503;
+    pub const P1_SENSOR_DELAY: u32 = 504;
+    pub const P2_SENSOR_OFFSET: u32 = 510;
+    pub const P2_SENSOR_GAIN: u32 = 511;
+    pub const P2_SENSOR_DRIFT: u32 = 512;
+    pub const P2_SENSOR_LAG: u32 = 513;
+    pub const P2_SENSOR_DELAY: u32 = 514;
 }
 
 /// The D/A converter's range: a command outside it is refused.
@@ -306,6 +318,8 @@ pub const TABLE: &[Row] = &[
     output("P2", vr::P2, "Pa", "absolute pressure of chamber 2 (venting side)").cite("(2.26)-(2.29)"),
     output("i", vr::I, "A", "coil current").cite("(2.1)-(2.3)"),
     output("F_meas", vr::F_MEAS, "N", "force as the force sensor reads it: F_act unless the force_sensor_* parameters give it an offset, gain, curve, drift, pick-up, delay, lag or play"),
+    output("P1_meas", vr::P1_MEAS, "Pa", "chamber 1 pressure as its transducer reads it: P1 unless the p1_sensor_* parameters give it an offset, gain, drift, delay or lag"),
+    output("P2_meas", vr::P2_MEAS, "Pa", "chamber 2 pressure as its transducer reads it: P2 unless the p2_sensor_* parameters give it an offset, gain, drift, delay or lag"),
     output(
         "x_jp",
         vr::X_JP,
@@ -713,6 +727,46 @@ pub const TABLE: &[Row] = &[
         .at_least(-0.01).at_most(0.01)
         .cite("(2.7)")
         .because("10 mm/s: the whole receiver travel in a third of a second"),
+    parameter("p1_sensor_offset", vr::P1_SENSOR_OFFSET, "Pa", 0.0, "pressure transducer 1: offset of P1_meas (0 = off)")
+        .at_least(-1e6).at_most(1e6)
+        .cite("")
+        .because("1 MPa: more than the supply's gauge pressure (551.6 kPa)"),
+    parameter("p1_sensor_gain", vr::P1_SENSOR_GAIN, "1", 1.0, "pressure transducer 1: gain of P1_meas (1 = off)")
+        .above(0.0).at_most(10.0)
+        .cite("")
+        .because("a transducer reads a rise as a rise (gain > 0); ten times is no longer a calibration error"),
+    parameter("p1_sensor_drift", vr::P1_SENSOR_DRIFT, "Pa/s", 0.0, "pressure transducer 1: P1_meas gains this times the time (0 = off)")
+        .at_least(-1e5).at_most(1e5)
+        .cite("")
+        .because("1e5 Pa/s: the supply's gauge pressure in under six seconds"),
+    parameter("p1_sensor_lag", vr::P1_SENSOR_LAG, "s", 0.0, "pressure transducer 1: P1_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between communication points (0 = off)")
+        .at_least(0.0).at_most(1.0)
+        .cite("")
+        .because("1 s: a transducer that slow reads no dynamics at all"),
+    parameter("p1_sensor_delay", vr::P1_SENSOR_DELAY, "s", 0.0, "pressure transducer 1: P1_meas is the reading this long ago, interpolated between communication points (0 = off)")
+        .at_least(0.0).at_most(1.0)
+        .cite("")
+        .because("1 s: as the command delay"),
+    parameter("p2_sensor_offset", vr::P2_SENSOR_OFFSET, "Pa", 0.0, "pressure transducer 2: offset of P2_meas (0 = off)")
+        .at_least(-1e6).at_most(1e6)
+        .cite("")
+        .because("1 MPa: more than the supply's gauge pressure (551.6 kPa)"),
+    parameter("p2_sensor_gain", vr::P2_SENSOR_GAIN, "1", 1.0, "pressure transducer 2: gain of P2_meas (1 = off)")
+        .above(0.0).at_most(10.0)
+        .cite("")
+        .because("a transducer reads a rise as a rise (gain > 0); ten times is no longer a calibration error"),
+    parameter("p2_sensor_drift", vr::P2_SENSOR_DRIFT, "Pa/s", 0.0, "pressure transducer 2: P2_meas gains this times the time (0 = off)")
+        .at_least(-1e5).at_most(1e5)
+        .cite("")
+        .because("1e5 Pa/s: the supply's gauge pressure in under six seconds"),
+    parameter("p2_sensor_lag", vr::P2_SENSOR_LAG, "s", 0.0, "pressure transducer 2: P2_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between communication points (0 = off)")
+        .at_least(0.0).at_most(1.0)
+        .cite("")
+        .because("1 s: a transducer that slow reads no dynamics at all"),
+    parameter("p2_sensor_delay", vr::P2_SENSOR_DELAY, "s", 0.0, "pressure transducer 2: P2_meas is the reading this long ago, interpolated between communication points (0 = off)")
+        .at_least(0.0).at_most(1.0)
+        .cite("")
+        .because("1 s: as the command delay"),
 ];
 
 const N_VARIABLES: usize = TABLE.len();

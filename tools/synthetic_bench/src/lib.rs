@@ -366,7 +366,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "parameter_offset",
         truth: "the chamber 1 pressure transducer reads 8 kPa high; force and p2 are unaffected",
         effects: std_p1_sensor_offset,
-        model_parameters: &[],
+        model_parameters: &[("p1_sensor_offset", 8e3)],
     },
     UndeclaredMechanism {
         name: "supply_drift",
@@ -454,7 +454,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "delay",
         truth: "the chamber 2 pressure is logged 10 ms late; force and p1 are unaffected",
         effects: std_p2_sensor_delay,
-        model_parameters: &[],
+        model_parameters: &[("p2_sensor_delay", 10e-3)],
     },
     UndeclaredMechanism {
         name: "receiver_offset",

@@ -11,7 +11,8 @@ use super::jet_pipe::StaticCurve;
 use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
-use super::{current_driver, force_sensor, jet_pipe, piston};
+use super::sensors::{Channel, SensorLaw};
+use super::{current_driver, jet_pipe, piston};
 
 pub const N_STATES: usize = 6;
 pub type State = SVector<f64, N_STATES>;
@@ -72,8 +73,22 @@ pub struct Outputs {
     pub p2: f64,
     pub current: f64,
     pub x_jp: f64,
-    /// The force a sensor with the sensor_offset_gain effect reads.
+    /// The force as the force sensor reads it.
     pub f_meas: f64,
+    /// The chamber pressures as their transducers read them.
+    pub p1_meas: f64,
+    pub p2_meas: f64,
+}
+
+impl Outputs {
+    /// The transducers' readings, in the order of [`Channel::ALL`].
+    pub fn readings(&self) -> [f64; 3] {
+        [self.f_meas, self.p1_meas, self.p2_meas]
+    }
+
+    pub fn readings_mut(&mut self) -> [&mut f64; 3] {
+        [&mut self.f_meas, &mut self.p1_meas, &mut self.p2_meas]
+    }
 }
 
 /// The thesis model with fixed parameters; derived constants computed once.
@@ -374,8 +389,8 @@ impl Actuator {
         self.outputs_at(y, x_s, stopper_velocity, 0.0)
     }
 
-    /// The outputs at time `time` (the force sensor's drift and pick-up depend on it; its
-    /// filters are the caller's: see [`super::force_sensor::SensorMemory`]).
+    /// The outputs at time `time` (the transducers' drifts and pick-up depend on it; their
+    /// filters are the caller's: see [`super::sensors::SensorMemory`]).
     pub fn outputs_at(&self, y: &State, x_s: f64, stopper_velocity: f64, time: f64) -> Outputs {
         use index::*;
         let p = &self.params;
@@ -391,7 +406,9 @@ impl Actuator {
         let f_act = piston::actuator_force(pressure_force, self.spring_force(x_s));
         Outputs {
             f_act,
-            f_meas: force_sensor::static_reading(p, f_act, time),
+            f_meas: SensorLaw::of(p, Channel::Force).static_reading(f_act, time),
+            p1_meas: SensorLaw::of(p, Channel::Pressure1).static_reading(y[P1], time),
+            p2_meas: SensorLaw::of(p, Channel::Pressure2).static_reading(y[P2], time),
             p1: y[P1],
             p2: y[P2],
             current: y[CURRENT],

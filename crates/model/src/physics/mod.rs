@@ -15,7 +15,7 @@
 //! | piston force and spring | [`piston`] | (2.36)–(2.38) |
 //! | effects the thesis model lacks (off by default) | [`effects`] | docs/model.md |
 //! | the command as the current driver sees it (off by default) | [`command_stage`] | (2.1) |
-//! | what the force sensor reads | [`force_sensor`] | docs/model.md |
+//! | what the force and pressure transducers read | [`sensors`] | docs/model.md |
 //! | constants that vary in time (off by default) | [`time_varying`] | docs/model.md |
 //! | the assembled six-state model | [`actuator`] | (4.1) |
 
@@ -24,10 +24,10 @@ pub mod chambers;
 pub mod command_stage;
 pub mod current_driver;
 pub mod effects;
-pub mod force_sensor;
 pub mod jet_pipe;
 pub mod orifice_flow;
 pub mod orifice_geometry;
 pub mod parameters;
 pub mod piston;
+pub mod sensors;
 pub mod time_varying;

@@ -86,6 +86,16 @@ pub struct Parameters {
     pub supply_ripple_frequency: f64,
     pub supply_ripple_cosine: f64,
     pub x_jp_offset_drift: f64,
+    pub p1_sensor_offset: f64,
+    pub p1_sensor_gain: f64,
+    pub p1_sensor_drift: f64,
+    pub p1_sensor_lag: f64,
+    pub p1_sensor_delay: f64,
+    pub p2_sensor_offset: f64,
+    pub p2_sensor_gain: f64,
+    pub p2_sensor_drift: f64,
+    pub p2_sensor_lag: f64,
+    pub p2_sensor_delay: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -177,6 +187,16 @@ impl Default for Parameters {
             supply_ripple_frequency: 0.0,
             supply_ripple_cosine: 0.0,
             x_jp_offset_drift: 0.0,
+            p1_sensor_offset: 0.0,
+            p1_sensor_gain: 0.0,
+            p1_sensor_drift: 0.0,
+            p1_sensor_lag: 0.0,
+            p1_sensor_delay: 0.0,
+            p2_sensor_offset: 0.0,
+            p2_sensor_gain: 0.0,
+            p2_sensor_drift: 0.0,
+            p2_sensor_lag: 0.0,
+            p2_sensor_delay: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -264,6 +284,16 @@ impl Parameters {
         vr::SUPPLY_RIPPLE_FREQUENCY,
         vr::SUPPLY_RIPPLE_COSINE,
         vr::X_JP_OFFSET_DRIFT,
+        vr::P1_SENSOR_OFFSET,
+        vr::P1_SENSOR_GAIN,
+        vr::P1_SENSOR_DRIFT,
+        vr::P1_SENSOR_LAG,
+        vr::P1_SENSOR_DELAY,
+        vr::P2_SENSOR_OFFSET,
+        vr::P2_SENSOR_GAIN,
+        vr::P2_SENSOR_DRIFT,
+        vr::P2_SENSOR_LAG,
+        vr::P2_SENSOR_DELAY,
     ];
 
     fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
@@ -344,6 +374,16 @@ impl Parameters {
             vr::SUPPLY_RIPPLE_FREQUENCY => &mut self.supply_ripple_frequency,
             vr::SUPPLY_RIPPLE_COSINE => &mut self.supply_ripple_cosine,
             vr::X_JP_OFFSET_DRIFT => &mut self.x_jp_offset_drift,
+            vr::P1_SENSOR_OFFSET => &mut self.p1_sensor_offset,
+            vr::P1_SENSOR_GAIN => &mut self.p1_sensor_gain,
+            vr::P1_SENSOR_DRIFT => &mut self.p1_sensor_drift,
+            vr::P1_SENSOR_LAG => &mut self.p1_sensor_lag,
+            vr::P1_SENSOR_DELAY => &mut self.p1_sensor_delay,
+            vr::P2_SENSOR_OFFSET => &mut self.p2_sensor_offset,
+            vr::P2_SENSOR_GAIN => &mut self.p2_sensor_gain,
+            vr::P2_SENSOR_DRIFT => &mut self.p2_sensor_drift,
+            vr::P2_SENSOR_LAG => &mut self.p2_sensor_lag,
+            vr::P2_SENSOR_DELAY => &mut self.p2_sensor_delay,
             _ => return None,
         })
     }

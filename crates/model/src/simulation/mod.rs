@@ -28,7 +28,7 @@ use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
-use crate::physics::force_sensor::{self, SensorMemory};
+use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
 use crate::physics::time_varying;
 
 /// The default relative tolerance (also the model description's default experiment).
@@ -112,8 +112,9 @@ pub struct Simulation {
     pub x_s_at_last_step: f64,
     /// The command stage's memory (see [`crate::physics::command_stage`]).
     pub command_stage: CommandStage,
-    /// The force sensor's memory, when it filters (see [`crate::physics::force_sensor`]).
-    pub force_sensor: Option<SensorMemory>,
+    /// The transducers' memories, in the order of [`Channel::ALL`], for those that filter
+    /// (see [`crate::physics::sensors`]).
+    pub transducers: [Option<SensorMemory>; 3],
     propagator: Option<ElectromechanicalPropagator>,
     /// The chambers' pressure rates at the end of the last split step, with what they are a
     /// function of: when the next step starts from the same jet pipe position, pressures and
@@ -159,8 +160,12 @@ impl Simulation {
         let propagator = ElectromechanicalPropagator::new(&model.params);
         let plays = model.initial_hysteresis_memory(state[index::CURRENT]);
         let command_stage = CommandStage::at_rest(&model.params, time, v_da);
-        let force_sensor = force_sensor::filters(&model.params)
-            .then(|| SensorMemory::at_rest(time, model.outputs_at(&state, x_s, 0.0, time).f_meas));
+        let readings = model.outputs_at(&state, x_s, 0.0, time).readings();
+        let transducers = [0, 1, 2].map(|k| {
+            SensorLaw::of(&model.params, Channel::ALL[k])
+                .filters()
+                .then(|| SensorMemory::at_rest(time, readings[k]))
+        });
         Self {
             model,
             time,
@@ -190,7 +195,7 @@ impl Simulation {
             stopper_velocity: 0.0,
             x_s_at_last_step: x_s,
             command_stage,
-            force_sensor,
+            transducers,
             propagator,
             chamber_rates_at_end: None,
         }
@@ -200,8 +205,10 @@ impl Simulation {
         let mut y = self
             .model
             .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time);
-        if let Some(memory) = &self.force_sensor {
-            y.f_meas = memory.output(&self.model.params, self.time, y.f_meas);
+        for ((memory, reading), channel) in self.transducers.iter().zip(y.readings_mut()).zip(Channel::ALL) {
+            if let Some(memory) = memory {
+                *reading = memory.output(&SensorLaw::of(&self.model.params, channel), self.time, *reading);
+            }
         }
         y
     }
@@ -367,13 +374,15 @@ impl Simulation {
         self.input_changed = false;
         self.stopper_velocity = (self.x_s - self.x_s_at_last_step) / step;
         self.x_s_at_last_step = self.x_s;
-        if self.force_sensor.is_some() {
-            let reading = self
+        if self.transducers.iter().any(Option::is_some) {
+            let readings = self
                 .model
                 .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time)
-                .f_meas;
-            if let Some(memory) = &mut self.force_sensor {
-                memory.record(&self.model.params, self.time, reading);
+                .readings();
+            for ((memory, reading), channel) in self.transducers.iter_mut().zip(readings).zip(Channel::ALL) {
+                if let Some(memory) = memory {
+                    memory.record(&SensorLaw::of(&self.model.params, channel), self.time, reading);
+                }
             }
         }
         Ok(())
