@@ -431,6 +431,13 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             ],
         ),
         c(
+            "jet pipe static curve with a softer knee",
+            "jet_pipe",
+            "nonlinearity",
+            None,
+            vec![term_off("f3_algebraic_share", "1", 0.05, 1.0)],
+        ),
+        c(
             "jet pipe lag",
             "jet_pipe",
             "dynamics",

@@ -84,6 +84,7 @@ pub mod vr {
     pub const CURRENT_LIMIT: u32 = 452;
     pub const CURRENT_SLEW_LIMIT: u32 = 453;
     pub const F3_INPUT_CUBIC: u32 = 454;
+    pub const F3_ALGEBRAIC_SHARE: u32 = 455;
     pub const FORCE_SENSOR_QUADRATIC: u32 = 460;
     pub const FORCE_SENSOR_CUBIC: u32 = 461;
     pub const FORCE_SENSOR_DRIFT: u32 = 462;
@@ -655,6 +656,10 @@ pub const TABLE: &[Row] = &[
         .at_least(-100.0).at_most(100.0)
         .cite("(2.5)")
         .because("100 V at full command: ten times the D/A range"),
+    parameter("f3_algebraic_share", vr::F3_ALGEBRAIC_SHARE, "1", 0.0, "jet pipe static curve: f3 blends tanh u with the algebraic sigmoid u/sqrt(1 + u^2) in this share, u = F_jp/F_jp_sat: the same slope at 0 and saturation, a softer knee (0 = off: the tanh)")
+        .at_least(0.0).at_most(1.0)
+        .cite("(2.5)")
+        .because("0 is the tanh alone and 1 the algebraic sigmoid alone; outside, the blend is no longer between two saturations"),
     parameter("force_sensor_quadratic", vr::FORCE_SENSOR_QUADRATIC, "1/N", 0.0, "force sensor curve: F_meas gains this times F_act^2 (0 = off)")
         .at_least(-1.0).at_most(1.0)
         .cite("")

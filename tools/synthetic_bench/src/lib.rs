@@ -478,7 +478,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "nonlinearity",
         truth: "the static jet pipe curve is x_sat u/sqrt(1 + u^2) instead of x_sat tanh u (same slope at 0, same saturation)",
         effects: std_jet_pipe_curve,
-        model_parameters: &[],
+        model_parameters: &[("f3_algebraic_share", 1.0)],
     },
     UndeclaredMechanism {
         name: "return_area_reduction",

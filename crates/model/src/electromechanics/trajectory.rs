@@ -509,9 +509,12 @@ mod tests {
     /// and gives the trajectory of the series and ramp forms to 1e-12 of the scales (6e-14 measured).
     #[test]
     fn a_curve_without_a_series_gives_the_same_trajectory_by_quadrature() {
-        for hysteresis in [0.0, 4e-5] {
+        // The tanh of (2.5), with a play hysteresis, and the tanh blended with the algebraic
+        // sigmoid (whose series the blend's are).
+        for (hysteresis, algebraic_share) in [(0.0, 0.0), (4e-5, 0.0), (0.0, 0.8)] {
             let p = Parameters {
                 hysteresis_width: hysteresis,
+                f3_algebraic_share: algebraic_share,
                 ..Parameters::default()
             };
             let series = ElectromechanicalPropagator::new(&p).unwrap();
@@ -549,7 +552,7 @@ mod tests {
                     ] {
                         assert!(
                             (x - y).abs() <= 1e-12 * scale,
-                            "hysteresis {hysteresis} v {v} rate {rate} s {s} {name}: {x} vs {y}"
+                            "hysteresis {hysteresis} share {algebraic_share} v {v} rate {rate} s {s} {name}: {x} vs {y}"
                         );
                     }
                     assert!((fast.position(s) - slow.position(s)).abs() <= 1e-12 * p.x_jp_sat);

@@ -60,8 +60,104 @@ pub struct TanhSaturation {
 }
 
 /// The static curve of (2.5) the model uses: the FMU, the assembled model's right-hand side
-/// and Jacobian, and the propagator all take it from here.
-pub type F3 = TanhSaturation;
+/// and Jacobian, and the propagator all take it from here. It is MODEL.md's tanh, blended
+/// with the algebraic sigmoid u/√(1 + u²) in the share `f3_algebraic_share` (0 by
+/// default): x̄ = x_jp_sat [(1 − β) tanh u + β u/√(1 + u²)], u = F_jp / F_jp_sat. Both have
+/// the slope x_jp_sat/F_jp_sat at 0 and saturate at x_jp_sat; the algebraic one has the
+/// softer knee. With β = 0 every method is the tanh's, to the bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct F3 {
+    pub tanh: TanhSaturation,
+    pub algebraic_share: f64,
+}
+
+impl F3 {
+    pub fn from_parameters(p: &Parameters) -> Self {
+        Self {
+            tanh: TanhSaturation::from_parameters(p),
+            algebraic_share: p.f3_algebraic_share,
+        }
+    }
+}
+
+impl StaticCurve for F3 {
+    fn value(&self, tip_force: f64) -> f64 {
+        if self.algebraic_share == 0.0 {
+            return self.tanh.value(tip_force);
+        }
+        let u = self.tanh.argument(tip_force);
+        let beta = self.algebraic_share;
+        self.tanh.x_jp_sat * ((1.0 - beta) * u.tanh() + beta * u / (1.0 + u * u).sqrt())
+    }
+
+    fn slope(&self, tip_force: f64) -> f64 {
+        if self.algebraic_share == 0.0 {
+            return self.tanh.slope(tip_force);
+        }
+        let u = self.tanh.argument(tip_force);
+        let (t, beta) = (u.tanh(), self.algebraic_share);
+        let algebraic = (1.0 + u * u).powf(-1.5);
+        self.tanh.x_jp_sat / self.tanh.f_jp_sat * ((1.0 - beta) * (1.0 - t * t) + beta * algebraic)
+    }
+
+    fn argument(&self, tip_force: f64) -> f64 {
+        self.tanh.argument(tip_force)
+    }
+
+    /// The nearer of tanh's poles at ±iπ/2 and the algebraic sigmoid's branch points at ±i.
+    fn series_radius(&self, x0: f64) -> Option<f64> {
+        let tanh = self.tanh.series_radius(x0)?;
+        if self.algebraic_share == 0.0 {
+            return Some(tanh);
+        }
+        Some(tanh.min((x0 * x0 + 1.0).sqrt()))
+    }
+
+    fn series(&self, x0: f64, epsilon: f64, max_terms: usize, gain: f64) -> Option<SeriesCoefficients> {
+        let beta = self.algebraic_share;
+        if beta == 0.0 {
+            return self.tanh.series(x0, epsilon, max_terms, gain);
+        }
+        let tanh = tanh_series(x0, epsilon, max_terms);
+        let algebraic = algebraic_sigmoid_series(x0, epsilon, max_terms);
+        let amplitude = self.tanh.x_jp_sat * gain;
+        let terms = tanh.len().max(algebraic.len());
+        let term = |a: &SeriesCoefficients, n: usize| a.get(n).copied().unwrap_or(0.0);
+        Some(
+            (0..terms)
+                .map(|n| amplitude * ((1.0 - beta) * term(&tanh, n) + beta * term(&algebraic, n)))
+                .collect(),
+        )
+    }
+}
+
+/// Coefficients gₙ of g(x0 + ε r) = Σ gₙ rⁿ for the algebraic sigmoid g(x) = x/√(1 + x²),
+/// truncated where they stop mattering (at most [`TANH_SERIES_TERMS`]). With
+/// q = 1 + (x0 + εr)² = a + b r + c r² and h = q^(−1/2) = Σ hₙ rⁿ, q h' = −q'h/2 gives
+/// (n+1) a h_{n+1} = −b (n + ½) hₙ − c n h_{n−1}, and gₙ = x0 hₙ + ε h_{n−1}. They converge
+/// for |ε| below the distance to the branch points at ±i, √(x0² + 1).
+pub fn algebraic_sigmoid_series(x0: f64, epsilon: f64, max_terms: usize) -> SeriesCoefficients {
+    let max_terms = max_terms.clamp(1, TANH_SERIES_TERMS);
+    let (a, b, c) = (1.0 + x0 * x0, 2.0 * x0 * epsilon, epsilon * epsilon);
+    let mut h_before = 0.0;
+    let mut h = 1.0 / a.sqrt();
+    let mut g = SeriesCoefficients::new();
+    g.push(x0 * h);
+    if epsilon == 0.0 {
+        return g;
+    }
+    for n in 0..max_terms - 1 {
+        let h_next = -(b * (n as f64 + 0.5) * h + c * n as f64 * h_before) * RECIPROCALS[n] / a;
+        g.push(x0 * h_next + epsilon * h);
+        h_before = h;
+        h = h_next;
+        let k = g.len();
+        if k > 3 && g[k - 1].abs() < 1e-17 && g[k - 2].abs() < 1e-17 {
+            break;
+        }
+    }
+    g
+}
 
 impl TanhSaturation {
     pub fn new(x_jp_sat: f64, f_jp_sat: f64) -> Self {
@@ -353,6 +449,56 @@ mod tests {
         // The radius is the distance to the poles at ±iπ/2: tanh's series about 0 has
         // coefficients falling like (2/π)ⁿ.
         assert!((f3.series_radius(0.0).unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_algebraic_sigmoids_series_is_its_value_within_the_radius() {
+        for (x0, eps) in [(0.0f64, 0.5f64), (0.7, -0.6), (-1.5, 0.9), (3.0, 0.1)] {
+            assert!(eps.abs() < 0.7 * f64::sqrt(x0 * x0 + 1.0));
+            let g = algebraic_sigmoid_series(x0, eps, 64);
+            for r in [0.0f64, 0.3, 0.9, 1.0] {
+                let x = x0 + eps * r;
+                let sum: f64 = g.iter().enumerate().map(|(n, c)| c * r.powi(n as i32)).sum();
+                assert!(
+                    (sum - x / (1.0 + x * x).sqrt()).abs() < 1e-13,
+                    "x0 {x0} eps {eps} r {r}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_blended_curve_keeps_the_slope_and_saturation_and_softens_the_knee() {
+        let p = Parameters {
+            f3_algebraic_share: 0.6,
+            ..Parameters::default()
+        };
+        let (blended, tanh) = (F3::from_parameters(&p), F3::from_parameters(&Parameters::default()));
+        assert_eq!(blended.slope(0.0), tanh.slope(0.0));
+        assert!((blended.value(1e3) - p.x_jp_sat).abs() < 1e-6 * p.x_jp_sat);
+        // At the knee (F_jp = F_jp_sat) the blend sits 0.6 of the way from tanh 1 = 0.7616
+        // to 1/√2 = 0.7071 of x_jp_sat.
+        let knee = 0.4 * 1f64.tanh() + 0.6 * std::f64::consts::FRAC_1_SQRT_2;
+        assert!((blended.value(p.f_jp_sat) - knee * p.x_jp_sat).abs() < 1e-15);
+        let h = 1e-7;
+        for force in [-0.9, 0.1, 0.45, 1.3] {
+            let numeric = (blended.value(force + h) - blended.value(force - h)) / (2.0 * h);
+            assert!((numeric - blended.slope(force)).abs() < 1e-9, "{force}");
+        }
+        for (force, change) in [(0.1, 0.2), (-0.3, 0.25), (0.9, -0.3)] {
+            let x0 = blended.argument(force);
+            let epsilon = blended.argument(change);
+            assert!(epsilon.abs() < 0.7 * blended.series_radius(x0).unwrap());
+            let a = blended.series(x0, epsilon, 64, 0.5).unwrap();
+            for r in [0.0f64, 0.5, 1.0] {
+                let sum: f64 = a.iter().enumerate().map(|(n, c)| c * r.powi(n as i32)).sum();
+                let exact = 0.5 * blended.value(force + change * r);
+                assert!((sum - exact).abs() < 1e-13 * p.x_jp_sat, "{force} {change} {r}");
+            }
+        }
+        // Without the share every method is the tanh's.
+        assert_eq!(tanh.value(0.37), tanh.tanh.value(0.37));
+        assert_eq!(tanh.series(0.2, 0.3, 64, 1.0), tanh.tanh.series(0.2, 0.3, 64, 1.0));
     }
 
     #[test]
