@@ -75,7 +75,8 @@ impl FixedStep {
 
     /// Advance to the sample at `time`, the stopper moving linearly to `x_s` there. Time and
     /// stopper land on the values given, so a recording's samples are met to the last bit.
-    /// On failure the simulation stays at the last sample.
+    /// On failure the state, time and stopper stay at the last sample (the command stage and
+    /// the delay line have taken the step's command).
     pub fn step_to(&mut self, time: f64, x_s: f64) -> Result<(), StepFailure> {
         let t0 = self.simulation.time;
         let step = time - t0;
@@ -95,6 +96,7 @@ impl FixedStep {
             time_varying::set_at(&mut self.simulation.model.params, nominal, 0.5 * (t0 + time))
                 .map_err(StepFailure::InvalidRequest)?;
         }
+        let jacobians = self.chambers.jacobians;
         let result = self.advance(step, rate);
         if let Some(nominal) = &self.nominal {
             time_varying::reset(&mut self.simulation.model.params, nominal);
@@ -112,10 +114,11 @@ impl FixedStep {
         sim.x_s_rate = 0.0;
         sim.input_changed = false;
         sim.chamber_rates_at_end = None;
+        // Three right-hand sides per ROS2 step, two more per Jacobian (one per pressure).
+        let new_jacobians = self.chambers.jacobians - jacobians;
         sim.statistics.steps += substeps;
-        // Three right-hand sides per ROS2 step; the Jacobians' two more are counted apart.
-        sim.statistics.rhs_evaluations += 3 * substeps;
-        sim.statistics.jacobians = self.chambers.jacobians;
+        sim.statistics.rhs_evaluations += 3 * substeps + 2 * new_jacobians;
+        sim.statistics.jacobians += new_jacobians;
         let mut y = sim.model.outputs_at(&sim.state, x_s, rate, time);
         if let Some(memory) = &mut sim.force_sensor {
             y.f_meas = memory.record(&sim.model.params, time, y.f_meas);
@@ -294,7 +297,12 @@ mod tests {
         assert_eq!(sim.simulation().time, 0.1 + 1e-3);
         assert_eq!(sim.simulation().x_s, 0.055);
         assert_eq!(sim.simulation().model.params, model.params);
-        assert_eq!(sim.simulation().statistics.steps, 1);
+        let work = sim.simulation().statistics;
+        assert_eq!(
+            (work.steps, work.jacobians, work.rhs_evaluations),
+            (1, 1, 5),
+            "{work:?}"
+        );
         assert!(matches!(sim.step_to(0.1, 0.055), Err(StepFailure::InvalidRequest(_))));
     }
 
