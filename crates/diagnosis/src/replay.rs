@@ -3,9 +3,7 @@
 
 use crate::recording::Recording;
 use jetpipe_model::physics::actuator::{Actuator, Outputs};
-use jetpipe_model::physics::sensors::{self, Channel, SensorLaw};
-use jetpipe_model::physics::{command_stage, time_varying};
-use jetpipe_model::simulation::{Simulation, StepFailure};
+use jetpipe_model::simulation::{FixedStep, Simulation, StepFailure};
 
 /// The model's outputs at every sample of a recording.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -64,10 +62,7 @@ pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usiz
         let dt = recording.time[k + 1] - recording.time[k];
         sim.set_command(recording.v_da[k])?;
         sim.set_stopper_rate((recording.x_s[k + 1] - recording.x_s[k]) / dt)?;
-        sim.step(dt).map_err(|e| match e {
-            StepFailure::InvalidRequest(m) => format!("sample {}: {m}", k + 1),
-            StepFailure::Integration { message, time } => format!("sample {} (t = {time} s): {message}", k + 1),
-        })?;
+        sim.step(dt).map_err(|e| describe(e, k + 1))?;
         // Land exactly on the recorded stopper position (no drift from rounding).
         sim.x_s = recording.x_s[k + 1];
     }
@@ -75,138 +70,38 @@ pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usiz
     Ok(out)
 }
 
-/// The chamber Jacobian of the fast replay is refreshed every this many steps.
-const JACOBIAN_REUSE: u64 = 8;
-
-/// A cheaper replay for fitting: one two-stage Rosenbrock step (ROS2, L-stable, order 2;
-/// Verwer et al. 1999) of the chamber pressures per sample interval, with the current
-/// driver and jet pipe still propagated exactly. No error control: the sample period
-/// (1 ms on the bench) is far below the chambers' time constants, and the accurate
-/// replay checks the final figures. Falls back to [`replay`] when the jet pipe has no
-/// modal form.
+/// A cheaper replay for fitting: the model's fixed-step simulation ([`FixedStep`]: one ROS2
+/// step of the chamber pressures per sample interval, the current driver and jet pipe still
+/// propagated exactly). No error control: the sample period (1 ms on the bench) is far
+/// below the chambers' time constants, and the accurate replay checks the final figures.
+/// Falls back to [`replay`] when the jet pipe has no modal form.
 pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Result<Replay, String> {
-    use jetpipe_model::electromechanics::{ElectromechanicalPropagator, ElectromechanicalState};
-    use jetpipe_model::physics::actuator::{index, State};
-    use nalgebra::{Matrix2, Vector2};
-
-    let Some(propagator) = ElectromechanicalPropagator::new(&model.params) else {
-        return replay(model, recording, 1e-5, end);
-    };
     let n = end.min(recording.len());
     let t = &recording.time;
-    let y0 = jetpipe_model::simulation::equilibrium_at(model, recording.v_da[0], recording.x_s[0], t[0])?;
-    let mut em = ElectromechanicalState {
-        current: y0[index::CURRENT],
-        position: y0[index::JET_POSITION],
-        velocity: y0[index::JET_VELOCITY],
-        acceleration: y0[index::JET_ACCELERATION],
+    let mut sim = match FixedStep::at_equilibrium(model.clone(), recording.v_da[0], recording.x_s[0], t[0])? {
+        Some(sim) => sim,
+        None => return replay(model, recording, 1e-5, end),
     };
-    let mut pressures = Vector2::new(y0[index::P1], y0[index::P2]);
-    let commands = command_stage::seen_commands(&model.params, t, &recording.v_da);
-    // A copy whose varying constants are set interval by interval.
-    let mut varying = time_varying::varies(&model.params).then(|| model.clone());
-    let mut plays = model.initial_hysteresis_memory(em.current);
-    let mut velocity = 0.0;
-    let delay = model.params.command_delay;
-    let gamma = 1.0 + std::f64::consts::FRAC_1_SQRT_2;
     let mut out = Replay::with_capacity(n);
-    // Index of the sample whose held command the current driver sees at time `at`.
-    let seen = |at: f64, hint: usize| -> usize {
-        let mut j = hint;
-        while j + 1 < recording.len() && t[j + 1] <= at {
-            j += 1;
-        }
-        j
-    };
-    let mut source = 0usize;
-    let mut jac = Matrix2::zeros();
-    let mut w = Matrix2::identity();
-    let mut last_h = f64::NAN;
     for k in 0..n {
-        let x_s = recording.x_s[k];
-        let state = State::from([
-            em.current,
-            em.position,
-            em.velocity,
-            em.acceleration,
-            pressures[0],
-            pressures[1],
-        ]);
-        let y = model.outputs_at(&state, x_s, velocity, t[k]);
-        out.record(&y);
+        out.record(&sim.outputs());
         if k + 1 == n {
             break;
         }
-        let (t0, t1) = (t[k], t[k + 1]);
-        let held: &Actuator = match varying.as_mut() {
-            Some(m) => {
-                time_varying::set_at(&mut m.params, &model.params, 0.5 * (t0 + t1))?;
-                m
-            }
-            None => model,
-        };
-        let rate = (recording.x_s[k + 1] - x_s) / (t1 - t0);
-        let mut a = t0;
-        while a < t1 {
-            source = seen(a - delay, source);
-            // The delayed command switches when the next sample's time plus the delay comes.
-            let b = if delay > 0.0 && source + 1 < recording.len() {
-                (t[source + 1] + delay).min(t1)
-            } else {
-                t1
-            };
-            let b = if b <= a { t1 } else { b };
-            let v = if delay > 0.0 && a - delay < t[0] {
-                commands[0]
-            } else {
-                commands[source]
-            };
-            let trajectory = propagator.trajectory(&em, v, 0.0, &plays);
-            let h = b - a;
-            let rates = |x_jp: f64, s: f64, p: &Vector2<f64>| {
-                let (d1, d2) = held.pressure_rates(x_jp, p[0], p[1], x_s + rate * (a + s - t0), rate);
-                Vector2::new(d1, d2)
-            };
-            let f = |s: f64, p: &Vector2<f64>| rates(trajectory.position(s), s, p);
-            let f0 = rates(em.position, 0.0, &pressures);
-            let eps = 1e-7 * h;
-            let f_t = (f(eps, &pressures) - f0) / eps;
-            // The Jacobian changes slowly: refresh it every few steps.
-            if out.steps % JACOBIAN_REUSE == 0 || h != last_h {
-                for c in 0..2 {
-                    let mut q = pressures;
-                    let dp = 1e-6 * q[c].abs().max(1e3);
-                    q[c] += dp;
-                    jac.set_column(c, &((rates(em.position, 0.0, &q) - f0) / dp));
-                }
-                w = (Matrix2::identity() - jac * (gamma * h))
-                    .try_inverse()
-                    .ok_or("singular chamber Jacobian")?;
-                last_h = h;
-            }
-            let k1 = w * (f0 + f_t * (gamma * h));
-            let k2 = w * (f(h, &(pressures + k1 * h)) - k1 * 2.0 - f_t * (gamma * h));
-            pressures += k1 * (1.5 * h) + k2 * (0.5 * h);
-            em = trajectory.state(h);
-            plays = trajectory.plays_at(h);
-            out.steps += 1;
-            a = b;
-        }
-        velocity = rate;
+        sim.set_command(recording.v_da[k])?;
+        sim.step_to(t[k + 1], recording.x_s[k + 1])
+            .map_err(|e| describe(e, k + 1))?;
     }
-    for channel in Channel::ALL {
-        let law = SensorLaw::of(&model.params, channel);
-        if law.filters() {
-            let readings = match channel {
-                Channel::Force => &mut out.force,
-                Channel::Pressure1 => &mut out.p1,
-                Channel::Pressure2 => &mut out.p2,
-            };
-            let statics = std::mem::take(readings);
-            *readings = sensors::filtered(&law, &t[..n], statics);
-        }
-    }
+    out.steps = sim.simulation().statistics.steps;
     Ok(out)
+}
+
+/// A failed step as the diagnosis reports it, naming the sample it was to reach.
+fn describe(failure: StepFailure, sample: usize) -> String {
+    match failure {
+        StepFailure::InvalidRequest(m) => format!("sample {sample}: {m}"),
+        StepFailure::Integration { message, time } => format!("sample {sample} (t = {time} s): {message}"),
+    }
 }
 
 #[cfg(test)]

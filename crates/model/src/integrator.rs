@@ -16,11 +16,16 @@
 //! now and then
 //! ([`Sdirk4::integrate_nonstiff_first`] hands over between the two), and both end their
 //! steps at the breakpoints a system reports ([`OdeSystem::breakpoint`]).
+//!
+//! [`rosenbrock`] holds ROS2, a fixed-step L-stable Rosenbrock method without error control,
+//! for steps imposed from outside (a recording's samples) that are already small enough.
 
 use nalgebra::{Const, DimMin, SMatrix, SVector};
 
 #[path = "integrator/explicit.rs"]
 pub mod explicit;
+#[path = "integrator/rosenbrock.rs"]
+pub mod rosenbrock;
 
 /// A system y' = f(t, y) of `N` equations.
 pub trait OdeSystem<const N: usize> {

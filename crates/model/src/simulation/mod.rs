@@ -14,9 +14,11 @@
 
 mod chambers;
 mod equilibrium;
+mod fixed_step;
 mod monolithic;
 
 pub use equilibrium::{equilibrium, equilibrium_at, equilibrium_of_electromechanics};
+pub use fixed_step::FixedStep;
 
 use nalgebra::SVector;
 
@@ -166,6 +168,9 @@ impl Simulation {
                 .filters()
                 .then(|| SensorMemory::at_rest(time, readings[k]))
         });
+        // What the driver has seen since long before (the delay line's past): the command
+        // through the stage, as every later entry of the line is.
+        let seen_before = command_stage.current(&model.params);
         Self {
             model,
             time,
@@ -189,7 +194,7 @@ impl Simulation {
             plays,
             command_history: vec![CommandChange {
                 time: f64::NEG_INFINITY,
-                v_da,
+                v_da: seen_before,
                 rate: 0.0,
             }],
             stopper_velocity: 0.0,
@@ -342,23 +347,7 @@ impl Simulation {
             })?;
         }
         let t_end = self.time + step;
-        // The command stage holds what the driver sees over the step (a command ramp
-        // reaches it at the next communication point).
-        let applied = self.v_da;
-        let staged = command_stage::is_active(&self.model.params);
-        if staged {
-            let before = self.command_stage.current(&self.model.params);
-            let seen = self.command_stage.next(&self.model.params, self.time, applied);
-            self.input_changed |= seen != before;
-            self.v_da = seen;
-        }
-        let rate = self.v_da_rate;
-        if staged {
-            self.v_da_rate = 0.0;
-        }
-        let segments = self.command_segments(step);
-        self.v_da = applied;
-        self.v_da_rate = rate;
+        let segments = self.seen_command_segments(step);
         for (duration, v, v_rate) in segments {
             self.advance(duration, v, v_rate).map_err(|failure| {
                 self.v_da_rate = 0.0;
@@ -386,6 +375,30 @@ impl Simulation {
             }
         }
         Ok(())
+    }
+
+    /// The command the current driver sees over the next `step`, through the command stage
+    /// and the delay line, as [`Self::command_segments`] pieces; shared by the
+    /// error-controlled and the fixed steps.
+    fn seen_command_segments(&mut self, step: f64) -> smallvec::SmallVec<[(f64, f64, f64); 2]> {
+        // The command stage holds what the driver sees over the step (a command ramp
+        // reaches it at the next communication point).
+        let applied = self.v_da;
+        let staged = command_stage::is_active(&self.model.params);
+        if staged {
+            let before = self.command_stage.current(&self.model.params);
+            let seen = self.command_stage.next(&self.model.params, self.time, applied);
+            self.input_changed |= seen != before;
+            self.v_da = seen;
+        }
+        let rate = self.v_da_rate;
+        if staged {
+            self.v_da_rate = 0.0;
+        }
+        let segments = self.command_segments(step);
+        self.v_da = applied;
+        self.v_da_rate = rate;
+        segments
     }
 
     /// The command the current driver sees over the next `step`: v_DA itself, or (with the
