@@ -3,6 +3,7 @@
 
 use crate::variables::{vr, UNITS, VARIABLES};
 use fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
+use fmi2::state_bytes::StateFormat;
 use jetpipe_model::physics::actuator::{index, Actuator, State, N_STATES};
 use jetpipe_model::physics::command_stage::CommandStage;
 use jetpipe_model::physics::effects::PLAY_OPERATORS;
@@ -416,10 +417,7 @@ impl CoSimModel for ActuatorFmu {
     }
 
     fn serialize(&self) -> Vec<u8> {
-        let mut w = ByteWriter::default();
-        w.bytes(STATE_MAGIC);
-        w.u32(STATE_FORMAT_VERSION);
-        w.string(env!("CARGO_PKG_VERSION"));
+        let mut w = STATE_FORMAT.writer();
         for &value_reference in Parameters::VALUE_REFERENCES {
             w.f64(self.params.get(value_reference).unwrap_or(f64::NAN));
         }
@@ -494,27 +492,11 @@ impl CoSimModel for ActuatorFmu {
                 }
             }
         }
-        w.0
+        w.into_bytes()
     }
 
     fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let mut r = ByteReader { bytes, at: 0 };
-        if r.take(STATE_MAGIC.len())? != STATE_MAGIC {
-            return Err("the state was not written by the JetPipeActuator model".to_string());
-        }
-        let format = r.u32()?;
-        if format != STATE_FORMAT_VERSION {
-            return Err(format!(
-                "state format version {format} is not supported (this model reads version {STATE_FORMAT_VERSION})"
-            ));
-        }
-        let version = r.string()?;
-        if version != env!("CARGO_PKG_VERSION") {
-            return Err(format!(
-                "the state was written by model version {version}; this is version {}",
-                env!("CARGO_PKG_VERSION")
-            ));
-        }
+        let mut r = STATE_FORMAT.reader(bytes)?;
         let mut restored = Self::instantiate();
         for &value_reference in Parameters::VALUE_REFERENCES {
             restored.params.set(value_reference, r.f64()?)?;
@@ -617,87 +599,15 @@ impl CoSimModel for ActuatorFmu {
             simulation.model.params.check_stopper(x_s)?;
             restored.simulation = Some(simulation);
         }
-        if r.at != bytes.len() {
-            return Err(format!("{} unexpected bytes after the state", bytes.len() - r.at));
-        }
+        r.finish()?;
         *self = restored;
         Ok(())
     }
 }
 
-const STATE_MAGIC: &[u8] = b"JetPipeActuatorState";
-const STATE_FORMAT_VERSION: u32 = 2;
-
-#[derive(Default)]
-struct ByteWriter(Vec<u8>);
-
-impl ByteWriter {
-    fn bytes(&mut self, b: &[u8]) {
-        self.0.extend_from_slice(b);
-    }
-    fn u32(&mut self, v: u32) {
-        self.bytes(&v.to_le_bytes());
-    }
-    fn u64(&mut self, v: u64) {
-        self.bytes(&v.to_le_bytes());
-    }
-    fn f64(&mut self, v: f64) {
-        self.bytes(&v.to_le_bytes());
-    }
-    fn string(&mut self, s: &str) {
-        self.u32(s.len() as u32);
-        self.bytes(s.as_bytes());
-    }
-}
-
-struct ByteReader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl<'a> ByteReader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self
-            .at
-            .checked_add(n)
-            .filter(|&e| e <= self.bytes.len())
-            .ok_or_else(|| {
-                format!(
-                    "the state is truncated: {} bytes, needed more than {}",
-                    self.bytes.len(),
-                    self.at
-                )
-            })?;
-        let slice = &self.bytes[self.at..end];
-        self.at = end;
-        Ok(slice)
-    }
-    fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
-    }
-    fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
-    }
-    fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
-    }
-    /// A count of items of `item_bytes` each that follow, refused when the rest of the
-    /// state cannot hold them (so a forged count allocates nothing).
-    fn count(&mut self, item_bytes: usize, what: &str) -> Result<usize, String> {
-        let count = self.u32()? as usize;
-        if count.saturating_mul(item_bytes) > self.bytes.len() - self.at {
-            return Err(format!("the state claims {count} {what}, more than its length holds"));
-        }
-        Ok(count)
-    }
-    fn string(&mut self) -> Result<String, String> {
-        let n = self.u32()? as usize;
-        if n > 64 {
-            return Err("the state's version string is implausibly long".to_string());
-        }
-        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| "the state's version string is not UTF-8".to_string())
-    }
-}
+/// The header of the actuator's state bytes (the layer's byte format, as the other FMUs').
+const STATE_FORMAT: StateFormat =
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 2, model: "JetPipeActuator");
 
 #[cfg(test)]
 mod tests {
