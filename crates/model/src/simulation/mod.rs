@@ -15,8 +15,10 @@
 mod chambers;
 mod equilibrium;
 mod monolithic;
+mod snapshot;
 
 pub use equilibrium::{equilibrium, equilibrium_at, equilibrium_of_electromechanics};
+pub use snapshot::{SimulationSnapshot, SNAPSHOT_LAYOUT};
 
 use nalgebra::SVector;
 
