@@ -189,7 +189,10 @@ impl<'a> ByteReader<'a> {
     pub fn count(&mut self, item_bytes: usize, what: &str) -> Result<usize, String> {
         let count = self.u32()? as usize;
         if count.saturating_mul(item_bytes) > self.remaining() {
-            return Err(format!("the state claims {count} {what}, more than its length holds"));
+            return Err(format!(
+                "the state is truncated (or its count corrupted): it claims {count} {what}, more than its remaining {} bytes hold",
+                self.remaining()
+            ));
         }
         Ok(count)
     }
@@ -319,7 +322,7 @@ mod tests {
         forged.u32(u32::MAX);
         let forged = forged.into_bytes();
         let mut r = FORMAT.reader(&forged).unwrap();
-        assert!(r.f64s().unwrap_err().contains("more than its length holds"));
+        assert!(r.f64s().unwrap_err().contains("more than its remaining 0 bytes hold"));
         let mut longer = bytes.clone();
         longer.push(0);
         let mut r = FORMAT.reader(&longer).unwrap();

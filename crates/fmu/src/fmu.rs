@@ -4,12 +4,9 @@
 use crate::variables::{vr, UNITS, VARIABLES};
 use fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
 use fmi2::state_bytes::StateFormat;
-use jetpipe_model::physics::actuator::{index, Actuator, State, N_STATES};
-use jetpipe_model::physics::command_stage::CommandStage;
-use jetpipe_model::physics::effects::PLAY_OPERATORS;
-use jetpipe_model::physics::force_sensor::SensorMemory;
+use jetpipe_model::physics::actuator::{index, Actuator};
 use jetpipe_model::physics::parameters::{variable_name, Parameters};
-use jetpipe_model::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+use jetpipe_model::simulation::{Simulation, SimulationSnapshot, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logEvents", "initialisation, resets and state restores"),
@@ -433,63 +430,12 @@ impl CoSimModel for ActuatorFmu {
         ] {
             w.f64(v);
         }
-        w.u32(self.start_at_equilibrium as u32);
+        w.bool(self.start_at_equilibrium);
         match &self.simulation {
-            None => w.u32(0),
+            None => w.bool(false),
             Some(s) => {
-                w.u32(1);
-                for v in [
-                    s.time,
-                    s.v_da,
-                    s.x_s,
-                    s.v_da_rate,
-                    s.x_s_rate,
-                    s.relative_tolerance,
-                    s.integrator.next_step,
-                    s.integrator.max_step,
-                    s.integrator.first_step,
-                    s.chamber_integrator.next_step,
-                    s.chamber_integrator.max_step,
-                    s.chamber_integrator.first_step,
-                    s.step_after_change,
-                    if s.input_changed { 1.0 } else { 0.0 },
-                    if s.method == Method::Split { 0.0 } else { 1.0 },
-                ] {
-                    w.f64(v);
-                }
-                for k in 0..N_STATES {
-                    w.f64(s.state[k]);
-                }
-                for p in s.plays {
-                    w.f64(p);
-                }
-                w.f64(s.stopper_velocity);
-                w.f64(s.x_s_at_last_step);
-                w.u32(s.command_history.len() as u32);
-                for change in &s.command_history {
-                    w.f64(change.time);
-                    w.f64(change.v_da);
-                    w.f64(change.rate);
-                }
-                for v in s.command_stage.to_values() {
-                    w.f64(v);
-                }
-                let sensor = s.force_sensor.as_ref().map(|m| m.to_values()).unwrap_or_default();
-                w.u32(sensor.len() as u32);
-                for v in sensor {
-                    w.f64(v);
-                }
-                let st = &s.statistics;
-                for v in [
-                    st.steps,
-                    st.rejected,
-                    st.rhs_evaluations,
-                    st.jacobians,
-                    st.newton_failures,
-                    st.stiff_handovers,
-                ] {
-                    w.u64(v);
-                }
+                w.bool(true);
+                w.f64s(&s.snapshot().to_values());
             }
         }
         w.into_bytes()
@@ -509,95 +455,12 @@ impl CoSimModel for ActuatorFmu {
         restored.p2_start = r.f64()?;
         restored.tolerance = r.f64()?;
         restored.start_time = r.f64()?;
-        restored.start_at_equilibrium = r.u32()? != 0;
-        if r.u32()? == 1 {
+        restored.start_at_equilibrium = r.bool("startAtEquilibrium")?;
+        if r.bool("initialised")? {
             let model = Actuator::new(restored.params.clone())?;
-            let mut values = [0.0; 15];
-            for v in values.iter_mut() {
-                *v = r.f64()?;
-            }
-            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step, first_step, chamber_next, chamber_max, chamber_first, after_change, changed, method] =
-                values;
-            let mut state = State::zeros();
-            for k in 0..N_STATES {
-                state[k] = r.f64()?;
-            }
-            let mut plays = [0.0; PLAY_OPERATORS];
-            for p in plays.iter_mut() {
-                *p = r.f64()?;
-            }
-            let stopper_velocity = r.f64()?;
-            let x_s_at_last_step = r.f64()?;
-            let changes = r.count(24, "command changes")?;
-            let mut command_history = Vec::with_capacity(changes);
-            for _ in 0..changes {
-                command_history.push(CommandChange {
-                    time: r.f64()?,
-                    v_da: r.f64()?,
-                    rate: r.f64()?,
-                });
-            }
-            let mut stage = [0.0; 3];
-            for v in stage.iter_mut() {
-                *v = r.f64()?;
-            }
-            let sensor_values = r.count(8, "force sensor values")?;
-            let mut sensor = Vec::with_capacity(sensor_values);
-            for _ in 0..sensor_values {
-                sensor.push(r.f64()?);
-            }
-            let mut simulation = Simulation::from_state(model, state, v_da, x_s, time, rtol);
-            simulation.command_stage = CommandStage::from_values(stage);
-            simulation.force_sensor = if sensor.is_empty() {
-                None
-            } else {
-                Some(SensorMemory::from_values(&sensor).ok_or("the state's force sensor memory is malformed")?)
-            };
-            simulation.v_da_rate = v_da_rate;
-            simulation.x_s_rate = x_s_rate;
-            simulation.integrator.next_step = next_step;
-            simulation.integrator.max_step = max_step;
-            simulation.integrator.first_step = first_step;
-            simulation.chamber_integrator.next_step = chamber_next;
-            simulation.chamber_integrator.max_step = chamber_max;
-            simulation.chamber_integrator.first_step = chamber_first;
-            simulation.step_after_change = after_change;
-            simulation.plays = plays;
-            simulation.stopper_velocity = stopper_velocity;
-            simulation.x_s_at_last_step = x_s_at_last_step;
-            simulation.command_history = command_history;
-            simulation.input_changed = changed != 0.0;
-            if method != 0.0 {
-                simulation.method = Method::Monolithic;
-            }
-            let st = &mut simulation.statistics;
-            st.steps = r.u64()?;
-            st.rejected = r.u64()?;
-            st.rhs_evaluations = r.u64()?;
-            st.jacobians = r.u64()?;
-            st.newton_failures = r.u64()?;
-            st.stiff_handovers = r.u64()?;
-            let finite = [
-                time,
-                v_da,
-                x_s,
-                v_da_rate,
-                x_s_rate,
-                rtol,
-                next_step,
-                first_step,
-                chamber_next,
-                chamber_first,
-                after_change,
-            ]
-            .iter()
-            .all(|v| v.is_finite())
-                && state.iter().all(|v| v.is_finite());
-            if !finite {
-                return Err("the state holds non-finite values".to_string());
-            }
-            simulation.model.params.check_stopper(x_s)?;
-            restored.simulation = Some(simulation);
+            let values = r.f64s_at_most(MAX_SIMULATION_VALUES, "simulation values")?;
+            let snapshot = SimulationSnapshot::from_values(&values)?;
+            restored.simulation = Some(Simulation::restore(model, &snapshot)?);
         }
         r.finish()?;
         *self = restored;
@@ -605,9 +468,17 @@ impl CoSimModel for ActuatorFmu {
     }
 }
 
-/// The header of the actuator's state bytes (the layer's byte format, as the other FMUs').
+/// The header of the actuator's state bytes (the layer's byte format, as the other FMUs'),
+/// then the parameters, the inputs and settings of the instance, and, once initialised, the
+/// simulation's snapshot as one counted array (`SimulationSnapshot::to_values`). Version 3:
+/// the snapshot replaced the simulation's fields written one by one.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 2, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 3, model: "JetPipeActuator");
+
+/// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
+/// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped
+/// every microsecond), so that a corrupted count is refused with its own message.
+const MAX_SIMULATION_VALUES: usize = 1 << 24;
 
 #[cfg(test)]
 mod tests {
@@ -653,8 +524,28 @@ mod tests {
         assert!(fmu.deserialize(&foreign).is_err());
         let mut longer = bytes.clone();
         longer.push(0);
-        assert!(fmu.deserialize(&longer).is_err());
+        assert!(fmu.deserialize(&longer).unwrap_err().contains("trailing"));
         assert_eq!(fmu.get_real(vr::F_ACT).unwrap(), before);
+    }
+
+    #[test]
+    fn states_of_another_format_or_with_a_malformed_snapshot_are_refused_with_the_reason() {
+        let mut fmu = initialised();
+        fmu.do_step(0.0, 0.01).unwrap();
+        let bytes = fmu.serialize();
+        let before = fmu.serialize();
+        let mut older = bytes.clone();
+        let at = STATE_FORMAT.magic.len();
+        older[at..at + 4].copy_from_slice(&2u32.to_le_bytes());
+        let e = fmu.deserialize(&older).unwrap_err();
+        assert!(e.contains("format version 2 is not supported"), "{e}");
+        // The last number is the snapshot's count of force sensor values (none here).
+        let mut malformed = bytes.clone();
+        let n = malformed.len();
+        malformed[n - 8..].copy_from_slice(&0.5f64.to_le_bytes());
+        let e = fmu.deserialize(&malformed).unwrap_err();
+        assert!(e.contains("force sensor value count is 0.5"), "{e}");
+        assert_eq!(fmu.serialize(), before);
     }
 
     #[test]
