@@ -67,9 +67,9 @@ pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usiz
             StepFailure::Integration { message, time } => format!("sample {} (t = {time} s): {message}", k + 1),
         })?;
         // Land exactly on the recorded stopper position (no drift from rounding).
-        sim.x_s = recording.x_s[k + 1];
+        sim.land_stopper_at(recording.x_s[k + 1]);
     }
-    out.steps = sim.statistics.steps;
+    out.steps = sim.statistics().steps;
     Ok(out)
 }
 

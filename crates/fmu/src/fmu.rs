@@ -234,8 +234,8 @@ impl CoSimModel for ActuatorFmu {
 
     fn get_real(&self, value_reference: u32) -> Result<f64, String> {
         match value_reference {
-            vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, |s| s.v_da)),
-            vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, |s| s.x_s)),
+            vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, Simulation::v_da)),
+            vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, Simulation::x_s)),
             vr::F_ACT | vr::F_MEAS | vr::P1 | vr::P2 | vr::I | vr::X_JP => {
                 let computed;
                 let simulation = match &self.simulation {
@@ -410,7 +410,7 @@ impl CoSimModel for ActuatorFmu {
     }
 
     fn time(&self) -> f64 {
-        self.simulation.as_ref().map_or(self.start_time, |s| s.time)
+        self.simulation.as_ref().map_or(self.start_time, Simulation::time)
     }
 
     fn serialize(&self) -> Vec<u8> {
