@@ -30,12 +30,12 @@ fn sample_points(model: &Actuator, count: usize) -> Vec<(State, Inputs)> {
         .run_on(&mut sim, |s| {
             if k % every == 0 && points.len() < count {
                 let inputs = Inputs {
-                    v_da: s.v_da,
-                    x_s: s.x_s,
+                    v_da: s.v_da(),
+                    x_s: s.x_s(),
                     x_s_rate: 0.0,
                     plays: None,
                 };
-                points.push((s.state, inputs));
+                points.push((*s.state(), inputs));
             }
             k += 1;
         })

@@ -135,11 +135,11 @@ fn measure(scenario: Scenario, runs: usize) -> Result<Figures, String> {
     let mut sim = prepared.initial.clone();
     let allocations_before = ALLOCATIONS.load(Ordering::Relaxed);
     let base = reset_peak();
-    let start_counts = sim.statistics;
+    let start_counts = sim.statistics();
     prepared.run_on(&mut sim, |_| {})?;
     let peak_extra_heap = PEAK.load(Ordering::Relaxed).saturating_sub(base);
     let allocations = ALLOCATIONS.load(Ordering::Relaxed) - allocations_before;
-    let work = work_between(&start_counts, &sim.statistics);
+    let work = work_between(&start_counts, &sim.statistics());
     drop(sim);
 
     let mut times = Vec::with_capacity(runs);
@@ -216,10 +216,10 @@ fn rhs_costs() -> Result<(usize, f64, f64, f64), String> {
     prepared.run_on(&mut sim, |s| {
         if k % 16 == 0 {
             points.push((
-                s.state,
+                *s.state(),
                 Inputs {
-                    v_da: s.v_da,
-                    x_s: s.x_s,
+                    v_da: s.v_da(),
+                    x_s: s.x_s(),
                     x_s_rate: 0.0,
                     plays: None,
                 },

@@ -72,11 +72,11 @@ fn main() -> Result<(), String> {
     let (v0, x0) = scenario::standard_inputs(0);
     let mut initial = Simulation::at_equilibrium(scenarios::thesis_model(), v0, x0, 0.0, o.rtol)?;
     if o.monolithic {
-        initial.method = Method::Monolithic;
+        initial.set_method(Method::Monolithic);
     }
     let mut best = f64::INFINITY;
     let mut forces = Vec::with_capacity(samples + 1);
-    let mut work = initial.statistics;
+    let mut work = initial.statistics();
     for _ in 0..o.runs {
         let mut sim = initial.clone();
         forces.clear();
@@ -92,10 +92,10 @@ fn main() -> Result<(), String> {
             forces.push(sim.outputs().f_act);
         }
         best = best.min(scenarios::thread_cpu_seconds() - start);
-        work = scenarios::work_between(&initial.statistics, &sim.statistics);
+        work = scenarios::work_between(&initial.statistics(), &sim.statistics());
     }
     // The start state, for an independent integrator to start from the same equilibrium.
-    let y0: Vec<String> = initial.state.iter().map(|v| format!("{v:.17e}")).collect();
+    let y0: Vec<String> = initial.state().iter().map(|v| format!("{v:.17e}")).collect();
     let mut out = format!(
         "# initial_state {}\n# cpu_seconds {best:e}\n# runs {}\n# steps {}\n# rejected {}\n# rhs_evaluations {}\n# jacobians {}\ntime_s,F_act_N\n",
         y0.join(" "),

@@ -64,9 +64,9 @@ pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usiz
         sim.set_stopper_rate((recording.x_s[k + 1] - recording.x_s[k]) / dt)?;
         sim.step(dt).map_err(|e| describe(e, k + 1))?;
         // Land exactly on the recorded stopper position (no drift from rounding).
-        sim.x_s = recording.x_s[k + 1];
+        sim.land_stopper_at(recording.x_s[k + 1]);
     }
-    out.steps = sim.statistics.steps;
+    out.steps = sim.statistics().steps;
     Ok(out)
 }
 
@@ -92,7 +92,7 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
         sim.step_to(t[k + 1], recording.x_s[k + 1])
             .map_err(|e| describe(e, k + 1))?;
     }
-    out.steps = sim.simulation().statistics.steps;
+    out.steps = sim.simulation().statistics().steps;
     Ok(out)
 }
 

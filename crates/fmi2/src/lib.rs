@@ -18,6 +18,8 @@
 //!   logging is on for their category).
 //! * [`api`]: one generic function per FMI call (argument checks, `catch_unwind`).
 //! * [`fmu_state`]: FMU-state snapshots and their checksummed byte format.
+//! * [`state_bytes`]: the byte format of a model's own state inside it (magic, versions,
+//!   little-endian numbers), with [`state_format!`].
 //! * [`model_description`]: the XML generator and table validation.
 //! * [`testing`]: a dummy first-order-lag model for tests.
 //! * [`fmi2_cosimulation_exports!`]: the exported `fmi2*` symbols for a model.
@@ -44,6 +46,7 @@ pub mod instance;
 pub mod model;
 pub mod model_description;
 pub mod state;
+pub mod state_bytes;
 pub mod structure_check;
 pub mod testing;
 pub mod types;

@@ -3,12 +3,10 @@
 
 use crate::variables::{vr, UNITS, VARIABLES};
 use fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
-use jetpipe_model::physics::actuator::{index, Actuator, State, N_STATES};
-use jetpipe_model::physics::command_stage::CommandStage;
-use jetpipe_model::physics::effects::PLAY_OPERATORS;
+use fmi2::state_bytes::StateFormat;
+use jetpipe_model::physics::actuator::{index, Actuator};
 use jetpipe_model::physics::parameters::{variable_name, Parameters};
-use jetpipe_model::physics::sensors::SensorMemory;
-use jetpipe_model::simulation::{CommandChange, Method, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+use jetpipe_model::simulation::{Simulation, SimulationSnapshot, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logEvents", "initialisation, resets and state restores"),
@@ -251,8 +249,8 @@ impl CoSimModel for ActuatorFmu {
 
     fn get_real(&self, value_reference: u32) -> Result<f64, String> {
         match value_reference {
-            vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, |s| s.v_da)),
-            vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, |s| s.x_s)),
+            vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, Simulation::v_da)),
+            vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, Simulation::x_s)),
             vr::F_ACT | vr::F_MEAS | vr::P1 | vr::P2 | vr::P1_MEAS | vr::P2_MEAS | vr::I | vr::X_JP => {
                 let computed;
                 let simulation = match &self.simulation {
@@ -429,14 +427,11 @@ impl CoSimModel for ActuatorFmu {
     }
 
     fn time(&self) -> f64 {
-        self.simulation.as_ref().map_or(self.start_time, |s| s.time)
+        self.simulation.as_ref().map_or(self.start_time, Simulation::time)
     }
 
     fn serialize(&self) -> Vec<u8> {
-        let mut w = ByteWriter::default();
-        w.bytes(STATE_MAGIC);
-        w.u32(STATE_FORMAT_VERSION);
-        w.string(env!("CARGO_PKG_VERSION"));
+        let mut w = STATE_FORMAT.writer();
         for &value_reference in Parameters::VALUE_REFERENCES {
             w.f64(self.params.get(value_reference).unwrap_or(f64::NAN));
         }
@@ -452,88 +447,19 @@ impl CoSimModel for ActuatorFmu {
         ] {
             w.f64(v);
         }
-        w.u32(self.start_at_equilibrium as u32);
+        w.bool(self.start_at_equilibrium);
         match &self.simulation {
-            None => w.u32(0),
+            None => w.bool(false),
             Some(s) => {
-                w.u32(1);
-                for v in [
-                    s.time,
-                    s.v_da,
-                    s.x_s,
-                    s.v_da_rate,
-                    s.x_s_rate,
-                    s.relative_tolerance,
-                    s.integrator.next_step,
-                    s.integrator.max_step,
-                    s.integrator.first_step,
-                    s.chamber_integrator.next_step,
-                    s.chamber_integrator.max_step,
-                    s.chamber_integrator.first_step,
-                    s.step_after_change,
-                    if s.input_changed { 1.0 } else { 0.0 },
-                    if s.method == Method::Split { 0.0 } else { 1.0 },
-                ] {
-                    w.f64(v);
-                }
-                for k in 0..N_STATES {
-                    w.f64(s.state[k]);
-                }
-                for p in s.plays {
-                    w.f64(p);
-                }
-                w.f64(s.stopper_velocity);
-                w.f64(s.x_s_at_last_step);
-                w.u32(s.command_history.len() as u32);
-                for change in &s.command_history {
-                    w.f64(change.time);
-                    w.f64(change.v_da);
-                    w.f64(change.rate);
-                }
-                for v in s.command_stage.to_values() {
-                    w.f64(v);
-                }
-                for memory in &s.transducers {
-                    let sensor = memory.as_ref().map(|m| m.to_values()).unwrap_or_default();
-                    w.u32(sensor.len() as u32);
-                    for v in sensor {
-                        w.f64(v);
-                    }
-                }
-                let st = &s.statistics;
-                for v in [
-                    st.steps,
-                    st.rejected,
-                    st.rhs_evaluations,
-                    st.jacobians,
-                    st.newton_failures,
-                    st.stiff_handovers,
-                ] {
-                    w.u64(v);
-                }
+                w.bool(true);
+                w.f64s(&s.snapshot().to_values());
             }
         }
-        w.0
+        w.into_bytes()
     }
 
     fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let mut r = ByteReader { bytes, at: 0 };
-        if r.take(STATE_MAGIC.len())? != STATE_MAGIC {
-            return Err("the state was not written by the JetPipeActuator model".to_string());
-        }
-        let format = r.u32()?;
-        if format != STATE_FORMAT_VERSION {
-            return Err(format!(
-                "state format version {format} is not supported (this model reads version {STATE_FORMAT_VERSION})"
-            ));
-        }
-        let version = r.string()?;
-        if version != env!("CARGO_PKG_VERSION") {
-            return Err(format!(
-                "the state was written by model version {version}; this is version {}",
-                env!("CARGO_PKG_VERSION")
-            ));
-        }
+        let mut r = STATE_FORMAT.reader(bytes)?;
         let mut restored = Self::instantiate();
         for &value_reference in Parameters::VALUE_REFERENCES {
             restored.params.set(value_reference, r.f64()?)?;
@@ -546,180 +472,30 @@ impl CoSimModel for ActuatorFmu {
         restored.p2_start = r.f64()?;
         restored.tolerance = r.f64()?;
         restored.start_time = r.f64()?;
-        restored.start_at_equilibrium = r.u32()? != 0;
-        if r.u32()? == 1 {
+        restored.start_at_equilibrium = r.bool("startAtEquilibrium")?;
+        if r.bool("initialised")? {
             let model = Actuator::new(restored.params.clone())?;
-            let mut values = [0.0; 15];
-            for v in values.iter_mut() {
-                *v = r.f64()?;
-            }
-            let [time, v_da, x_s, v_da_rate, x_s_rate, rtol, next_step, max_step, first_step, chamber_next, chamber_max, chamber_first, after_change, changed, method] =
-                values;
-            let mut state = State::zeros();
-            for k in 0..N_STATES {
-                state[k] = r.f64()?;
-            }
-            let mut plays = [0.0; PLAY_OPERATORS];
-            for p in plays.iter_mut() {
-                *p = r.f64()?;
-            }
-            let stopper_velocity = r.f64()?;
-            let x_s_at_last_step = r.f64()?;
-            let changes = r.count(24, "command changes")?;
-            let mut command_history = Vec::with_capacity(changes);
-            for _ in 0..changes {
-                command_history.push(CommandChange {
-                    time: r.f64()?,
-                    v_da: r.f64()?,
-                    rate: r.f64()?,
-                });
-            }
-            let mut stage = [0.0; 3];
-            for v in stage.iter_mut() {
-                *v = r.f64()?;
-            }
-            let mut transducers = [None, None, None];
-            for memory in transducers.iter_mut() {
-                let sensor_values = r.count(8, "transducer values")?;
-                let mut sensor = Vec::with_capacity(sensor_values);
-                for _ in 0..sensor_values {
-                    sensor.push(r.f64()?);
-                }
-                if !sensor.is_empty() {
-                    *memory =
-                        Some(SensorMemory::from_values(&sensor).ok_or("the state's transducer memory is malformed")?);
-                }
-            }
-            let mut simulation = Simulation::from_state(model, state, v_da, x_s, time, rtol);
-            simulation.command_stage = CommandStage::from_values(stage);
-            simulation.transducers = transducers;
-            simulation.v_da_rate = v_da_rate;
-            simulation.x_s_rate = x_s_rate;
-            simulation.integrator.next_step = next_step;
-            simulation.integrator.max_step = max_step;
-            simulation.integrator.first_step = first_step;
-            simulation.chamber_integrator.next_step = chamber_next;
-            simulation.chamber_integrator.max_step = chamber_max;
-            simulation.chamber_integrator.first_step = chamber_first;
-            simulation.step_after_change = after_change;
-            simulation.plays = plays;
-            simulation.stopper_velocity = stopper_velocity;
-            simulation.x_s_at_last_step = x_s_at_last_step;
-            simulation.command_history = command_history;
-            simulation.input_changed = changed != 0.0;
-            if method != 0.0 {
-                simulation.method = Method::Monolithic;
-            }
-            let st = &mut simulation.statistics;
-            st.steps = r.u64()?;
-            st.rejected = r.u64()?;
-            st.rhs_evaluations = r.u64()?;
-            st.jacobians = r.u64()?;
-            st.newton_failures = r.u64()?;
-            st.stiff_handovers = r.u64()?;
-            let finite = [
-                time,
-                v_da,
-                x_s,
-                v_da_rate,
-                x_s_rate,
-                rtol,
-                next_step,
-                first_step,
-                chamber_next,
-                chamber_first,
-                after_change,
-            ]
-            .iter()
-            .all(|v| v.is_finite())
-                && state.iter().all(|v| v.is_finite());
-            if !finite {
-                return Err("the state holds non-finite values".to_string());
-            }
-            simulation.model.params.check_stopper(x_s)?;
-            restored.simulation = Some(simulation);
+            let values = r.f64s_at_most(MAX_SIMULATION_VALUES, "simulation values")?;
+            let snapshot = SimulationSnapshot::from_values(&values)?;
+            restored.simulation = Some(Simulation::restore(model, &snapshot)?);
         }
-        if r.at != bytes.len() {
-            return Err(format!("{} unexpected bytes after the state", bytes.len() - r.at));
-        }
+        r.finish()?;
         *self = restored;
         Ok(())
     }
 }
 
-const STATE_MAGIC: &[u8] = b"JetPipeActuatorState";
-const STATE_FORMAT_VERSION: u32 = 3;
+/// The header of the actuator's state bytes (the layer's byte format, as the other FMUs'),
+/// then the parameters, the inputs and settings of the instance, and, once initialised, the
+/// simulation's snapshot as one counted array (`SimulationSnapshot::to_values`). Version 3:
+/// the snapshot replaced the simulation's fields written one by one.
+const STATE_FORMAT: StateFormat =
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 3, model: "JetPipeActuator");
 
-#[derive(Default)]
-struct ByteWriter(Vec<u8>);
-
-impl ByteWriter {
-    fn bytes(&mut self, b: &[u8]) {
-        self.0.extend_from_slice(b);
-    }
-    fn u32(&mut self, v: u32) {
-        self.bytes(&v.to_le_bytes());
-    }
-    fn u64(&mut self, v: u64) {
-        self.bytes(&v.to_le_bytes());
-    }
-    fn f64(&mut self, v: f64) {
-        self.bytes(&v.to_le_bytes());
-    }
-    fn string(&mut self, s: &str) {
-        self.u32(s.len() as u32);
-        self.bytes(s.as_bytes());
-    }
-}
-
-struct ByteReader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl<'a> ByteReader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self
-            .at
-            .checked_add(n)
-            .filter(|&e| e <= self.bytes.len())
-            .ok_or_else(|| {
-                format!(
-                    "the state is truncated: {} bytes, needed more than {}",
-                    self.bytes.len(),
-                    self.at
-                )
-            })?;
-        let slice = &self.bytes[self.at..end];
-        self.at = end;
-        Ok(slice)
-    }
-    fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
-    }
-    fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
-    }
-    fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
-    }
-    /// A count of items of `item_bytes` each that follow, refused when the rest of the
-    /// state cannot hold them (so a forged count allocates nothing).
-    fn count(&mut self, item_bytes: usize, what: &str) -> Result<usize, String> {
-        let count = self.u32()? as usize;
-        if count.saturating_mul(item_bytes) > self.bytes.len() - self.at {
-            return Err(format!("the state claims {count} {what}, more than its length holds"));
-        }
-        Ok(count)
-    }
-    fn string(&mut self) -> Result<String, String> {
-        let n = self.u32()? as usize;
-        if n > 64 {
-            return Err("the state's version string is implausibly long".to_string());
-        }
-        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| "the state's version string is not UTF-8".to_string())
-    }
-}
+/// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
+/// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped
+/// every microsecond), so that a corrupted count is refused with its own message.
+const MAX_SIMULATION_VALUES: usize = 1 << 24;
 
 #[cfg(test)]
 mod tests {
@@ -765,8 +541,28 @@ mod tests {
         assert!(fmu.deserialize(&foreign).is_err());
         let mut longer = bytes.clone();
         longer.push(0);
-        assert!(fmu.deserialize(&longer).is_err());
+        assert!(fmu.deserialize(&longer).unwrap_err().contains("trailing"));
         assert_eq!(fmu.get_real(vr::F_ACT).unwrap(), before);
+    }
+
+    #[test]
+    fn states_of_another_format_or_with_a_malformed_snapshot_are_refused_with_the_reason() {
+        let mut fmu = initialised();
+        fmu.do_step(0.0, 0.01).unwrap();
+        let bytes = fmu.serialize();
+        let before = fmu.serialize();
+        let mut older = bytes.clone();
+        let at = STATE_FORMAT.magic.len();
+        older[at..at + 4].copy_from_slice(&2u32.to_le_bytes());
+        let e = fmu.deserialize(&older).unwrap_err();
+        assert!(e.contains("format version 2 is not supported"), "{e}");
+        // The last number is the snapshot's count of chamber 2 transducer values (none here).
+        let mut malformed = bytes.clone();
+        let n = malformed.len();
+        malformed[n - 8..].copy_from_slice(&0.5f64.to_le_bytes());
+        let e = fmu.deserialize(&malformed).unwrap_err();
+        assert!(e.contains("transducer value count is 0.5"), "{e}");
+        assert_eq!(fmu.serialize(), before);
     }
 
     #[test]

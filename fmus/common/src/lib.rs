@@ -1,13 +1,13 @@
 //! What the three small FMUs of the antagonistic joint (`Tendon`, `FingerJoint`,
 //! `JointController`) share on top of the generic FMI layer (crate `fmi2`): a value store
-//! driven by the variable table (range checks with messages that name the variable), the
-//! versioned byte format of their FMU states, a monotone scalar solver for their implicit
-//! integrators, and what their `ModelInfo`, `CoSimModel` impls and interface tests would
-//! otherwise each repeat. No FFI types here. (The interface page of their archives is
-//! `jetpipe_packaging::documentation_page`, as the actuator's.)
+//! driven by the variable table (range checks with messages that name the variable), a
+//! monotone scalar solver for their implicit integrators, and what their `ModelInfo`,
+//! `CoSimModel` impls and interface tests would otherwise each repeat. No FFI types here.
+//! (The byte format of their FMU states is the layer's `fmi2::state_bytes`, shared with the
+//! actuator; the interface page of their archives is `jetpipe_packaging::documentation_page`,
+//! as the actuator's.)
 
 pub mod solve;
-pub mod state_bytes;
 pub mod testing;
 pub mod units;
 pub mod values;

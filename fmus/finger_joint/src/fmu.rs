@@ -1,7 +1,7 @@
 //! The finger joint behind jetpipe's generic FMI layer. No FFI types here.
 
 use fmi2::model::{CoSimModel, DependencyKind, ModelInfo, OutputDependencies, StepError};
-use fmu_common::state_bytes::StateFormat;
+use fmi2::state_bytes::StateFormat;
 use fmu_common::Values;
 
 use crate::physics::{Inputs, Parameters, State};
@@ -192,8 +192,7 @@ impl CoSimModel for FingerJointFmu {
     }
 }
 
-const STATE_FORMAT: StateFormat =
-    fmu_common::state_format!(magic: b"FingerJointState", version: 1, model: "FingerJoint");
+const STATE_FORMAT: StateFormat = fmi2::state_format!(magic: b"FingerJointState", version: 1, model: "FingerJoint");
 
 #[cfg(test)]
 mod tests {

@@ -1,7 +1,7 @@
 //! The joint controller behind jetpipe's generic FMI layer. No FFI types here.
 
 use fmi2::model::{CoSimModel, ModelInfo, OutputDependencies, StepError};
-use fmu_common::state_bytes::StateFormat;
+use fmi2::state_bytes::StateFormat;
 use fmu_common::Values;
 
 use crate::control::{Commands, Controller, Gains, Measurements};
@@ -197,7 +197,7 @@ impl CoSimModel for JointControllerFmu {
 }
 
 const STATE_FORMAT: StateFormat =
-    fmu_common::state_format!(magic: b"JointControllerState", version: 1, model: "JointController");
+    fmi2::state_format!(magic: b"JointControllerState", version: 1, model: "JointController");
 
 #[cfg(test)]
 mod tests {

@@ -1,7 +1,7 @@
 //! The tendon behind jetpipe's generic FMI layer. No FFI types here.
 
 use fmi2::model::{CoSimModel, ModelInfo, OutputDependencies, StepError};
-use fmu_common::state_bytes::StateFormat;
+use fmi2::state_bytes::StateFormat;
 use fmu_common::Values;
 
 use crate::physics::{JointEnd, Parameters, State};
@@ -203,7 +203,7 @@ impl CoSimModel for TendonFmu {
     }
 }
 
-const STATE_FORMAT: StateFormat = fmu_common::state_format!(magic: b"TendonState", version: 1, model: "Tendon");
+const STATE_FORMAT: StateFormat = fmi2::state_format!(magic: b"TendonState", version: 1, model: "Tendon");
 
 #[cfg(test)]
 mod tests {

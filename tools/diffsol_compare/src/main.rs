@@ -93,7 +93,7 @@ fn run_jetpipe(initial: &Simulation, samples: usize, substeps: usize) -> Result<
         }
         forces.push(sim.outputs().f_act);
     }
-    let (a, b) = (&initial.statistics, &sim.statistics);
+    let (a, b) = (initial.statistics(), sim.statistics());
     Ok(Run {
         forces,
         steps: b.steps - a.steps,
@@ -262,7 +262,7 @@ fn main() -> Result<(), String> {
     println!("load average (before): {}", load());
     let (reference, ref_cpu) = timed(1, || run_jetpipe(&start(1e-10)?, samples, 100))?;
     println!("reference: jetpipe Simulation, rtol 1e-10, 0.1 ms communication steps ({ref_cpu:.3} s CPU)\n");
-    let y0 = start(1e-10)?.state;
+    let y0 = *start(1e-10)?.state();
 
     let methods = [
         Method::Jetpipe,
@@ -282,7 +282,7 @@ fn main() -> Result<(), String> {
                 // Each tolerance starts from its own equilibrium solve, outside the clock.
                 let mut initial = start(rtol)?;
                 if method == Method::JetpipeSdirk4 {
-                    initial.chamber_method = ChamberMethod::Sdirk4;
+                    initial.set_chamber_method(ChamberMethod::Sdirk4);
                 }
                 timed(runs, || run_jetpipe(&initial, samples, 1))
             } else {

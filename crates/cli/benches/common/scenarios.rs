@@ -151,7 +151,7 @@ impl Prepared {
             self.scenario,
             model,
             self.feedforward.as_ref(),
-            self.initial.relative_tolerance,
+            self.initial.relative_tolerance(),
         )
     }
 
@@ -187,7 +187,7 @@ impl Prepared {
                 Scenario::ClosedLoop => {
                     let feedforward = self.feedforward.as_ref().expect("prepared with the closed loop");
                     let f_ref = force_reference(t);
-                    let gain = K_P / sim.model.params.k_cd;
+                    let gain = K_P / sim.model().params.k_cd;
                     let v = feedforward.command(f_ref) + gain * (f_ref - sim.outputs().f_meas);
                     sim.set_command(v.clamp(-V_LIMIT, V_LIMIT))?;
                 }

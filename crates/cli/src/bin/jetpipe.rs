@@ -403,13 +403,13 @@ fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), Strin
             sim.step(scenario::SAMPLE_PERIOD / substeps as f64)
                 .map_err(|e| format!("{e:?}"))?;
         }
-        rows.push((sim.time, sim.outputs()));
+        rows.push((sim.time(), sim.outputs()));
     }
     let elapsed = started.elapsed().as_secs_f64();
     let force = rows.iter().map(|r| r.1.f_act);
     let (f_min, f_max) = force.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f), b.max(f)));
     let last = rows.last().expect("at least the initial row").1;
-    let st = sim.statistics;
+    let st = sim.statistics();
     println!(
         "standard scenario: {} s, communication step {step} s, relative tolerance {tolerance:e}",
         scenario::DURATION

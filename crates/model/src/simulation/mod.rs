@@ -16,9 +16,11 @@ mod chambers;
 mod equilibrium;
 mod fixed_step;
 mod monolithic;
+mod snapshot;
 
 pub use equilibrium::{equilibrium, equilibrium_at, equilibrium_of_electromechanics};
 pub use fixed_step::FixedStep;
+pub use snapshot::{SimulationSnapshot, SNAPSHOT_LAYOUT};
 
 use nalgebra::SVector;
 
@@ -82,41 +84,41 @@ pub enum StepFailure {
 /// A running simulation of one actuator.
 #[derive(Clone, Debug)]
 pub struct Simulation {
-    pub model: Actuator,
-    pub time: f64,
-    pub state: State,
-    pub v_da: f64,
-    pub x_s: f64,
+    model: Actuator,
+    time: f64,
+    state: State,
+    v_da: f64,
+    x_s: f64,
     /// First-order input derivatives for the next step only (cleared after it).
-    pub v_da_rate: f64,
-    pub x_s_rate: f64,
-    pub relative_tolerance: f64,
-    pub method: Method,
-    pub chamber_method: ChamberMethod,
+    v_da_rate: f64,
+    x_s_rate: f64,
+    relative_tolerance: f64,
+    method: Method,
+    chamber_method: ChamberMethod,
     /// Step-size memory of the six-state integrator (monolithic method).
-    pub integrator: Sdirk4,
+    integrator: Sdirk4,
     /// Step-size memory of the chamber integrator (split method).
-    pub chamber_integrator: Sdirk4,
-    pub statistics: Statistics,
+    chamber_integrator: Sdirk4,
+    statistics: Statistics,
     /// An input changed since the last step (the jet pipe will move and ring).
-    pub input_changed: bool,
+    input_changed: bool,
     /// First chamber step size that was accepted after the last input change: where the
     /// next step after a change starts, instead of the long steps that suit the end of a
     /// quiet interval.
-    pub step_after_change: f64,
+    step_after_change: f64,
     /// Play operators of the jet_pipe_hysteresis effect (when it is off, f3's output at the
     /// start, and not followed).
-    pub plays: [f64; PLAY_OPERATORS],
+    plays: [f64; PLAY_OPERATORS],
     /// Commands of the recent past, for the transport_delay effect.
-    pub command_history: Vec<CommandChange>,
+    command_history: Vec<CommandChange>,
     /// Mean stopper velocity over the last step (for piston friction).
-    pub stopper_velocity: f64,
-    pub x_s_at_last_step: f64,
+    stopper_velocity: f64,
+    x_s_at_last_step: f64,
     /// The command stage's memory (see [`crate::physics::command_stage`]).
-    pub command_stage: CommandStage,
+    command_stage: CommandStage,
     /// The transducers' memories, in the order of [`Channel::ALL`], for those that filter
     /// (see [`crate::physics::sensors`]).
-    pub transducers: [Option<SensorMemory>; 3],
+    transducers: [Option<SensorMemory>; 3],
     propagator: Option<ElectromechanicalPropagator>,
     /// The chambers' pressure rates at the end of the last split step, with what they are a
     /// function of: when the next step starts from the same jet pipe position, pressures and
@@ -204,6 +206,58 @@ impl Simulation {
             propagator,
             chamber_rates_at_end: None,
         }
+    }
+
+    /// The simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// The six states (see [`index`]).
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// The command v_DA, V: as set, or where its ramp ended (the driver may see another
+    /// through the command stage and the transport delay).
+    pub fn v_da(&self) -> f64 {
+        self.v_da
+    }
+
+    /// The stopper position, m.
+    pub fn x_s(&self) -> f64 {
+        self.x_s
+    }
+
+    pub fn relative_tolerance(&self) -> f64 {
+        self.relative_tolerance
+    }
+
+    pub fn model(&self) -> &Actuator {
+        &self.model
+    }
+
+    /// The integrators' work so far.
+    pub fn statistics(&self) -> Statistics {
+        self.statistics
+    }
+
+    /// For comparisons with the six-state integrator. Without the jet pipe's modal form
+    /// (ζ2 ≥ 1) the split method is not available and a step integrates all six states anyway.
+    pub fn set_method(&mut self, method: Method) {
+        self.method = method;
+    }
+
+    /// For comparisons of the chamber integrators; the default suits every scenario.
+    pub fn set_chamber_method(&mut self, method: ChamberMethod) {
+        self.chamber_method = method;
+    }
+
+    /// Puts the stopper at `x_s` without the air-conserving jump of [`Self::set_stopper`]: for
+    /// a caller that moved it with a rate over the step and lands it on the position it
+    /// meant, a rounding error away.
+    pub fn land_stopper_at(&mut self, x_s: f64) {
+        self.x_s = x_s;
     }
 
     pub fn outputs(&self) -> Outputs {
