@@ -4,7 +4,8 @@ A recording with a named effect, or with an undeclared one that the diagnosis di
 comes from the independent generator (benchgen); `jetpipe diagnose` adds the effect or the
 term and reports `fmu_start_values`. Setting those on the packaged FMU and replaying the
 recording through FMPy (command held between samples, the stopper moving linearly via
-fmi2SetRealInputDerivatives) must give the reported `after` error within 5 %.
+fmi2SetRealInputDerivatives between the averaged positions the report's `stopper_positions`
+names) must give the reported `after` error within 5 %.
 """
 
 import json
@@ -20,12 +21,19 @@ ROOT = Path(__file__).resolve().parent.parent
 BIN = ROOT / "target" / "release"
 
 
+def stopper_positions(x):
+    """The report's `stopper_positions`: x_s averaged over samples k-3..k+4 (fewer at the ends)."""
+    n = len(x)
+    return np.array([x[k] + np.mean(x[max(k - 3, 0):min(k + 5, n)] - x[k]) for k in range(n)])
+
+
 def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, outputs=("F_meas",)):
-    """The FMU's `outputs` at every sample of the recording (one array, or a tuple of them)."""
+    """The FMU's `outputs` at every sample of the recording (one array, or a tuple of them),
+    the stopper driven with the positions the diagnosis replays."""
     fmu = make_slave(unzipdir, model_description)
+    t, v, x = recording["time_s"], recording["v_da_V"], stopper_positions(recording["x_s_m"])
     try:
-        initialize(fmu, vrs, inputs=(recording["v_da_V"][0], recording["x_s_m"][0]), parameters=start_values)
-        t, v, x = recording["time_s"], recording["v_da_V"], recording["x_s_m"]
+        initialize(fmu, vrs, inputs=(v[0], x[0]), parameters=start_values)
         read = np.empty((len(outputs), len(t)))
         vr_v, vr_x, vr_out = [vrs["v_DA"]], [vrs["x_s"]], [vrs[name] for name in outputs]
         for k in range(len(t)):
