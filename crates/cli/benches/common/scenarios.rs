@@ -23,11 +23,11 @@
 
 use std::f64::consts::PI;
 
-use jetpipe_model::integrator::Statistics;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::scenario;
 use jetpipe_model::simulation::Simulation;
+use jetpipe_model::Statistics;
 
 /// Simulated time of every scenario, s.
 pub const DURATION: f64 = 10.0;

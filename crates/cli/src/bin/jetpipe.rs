@@ -354,12 +354,12 @@ fn linearize(force: f64, x_s: f64, json: bool) -> Result<(), String> {
     }
     let model = Actuator::new(Parameters::default())?;
     model.params.check_stopper(x_s)?;
-    let v = jetpipe_cli::linearization::command_for_force(&model, force, x_s)?;
-    let lin = jetpipe_cli::linearization::linearize(&model, v, x_s)?;
+    let v = jetpipe_model::linearization::command_for_force(&model, force, x_s)?;
+    let lin = jetpipe_model::linearization::linearize(&model, v, x_s)?;
     if json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&lin.to_json()).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&linear_model_json(&lin)).map_err(|e| e.to_string())?
         );
         return Ok(());
     }
@@ -434,4 +434,32 @@ fn simulate(step: f64, tolerance: f64, csv: Option<PathBuf>) -> Result<(), Strin
         println!("  wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The report `jetpipe linearize --json` prints.
+fn linear_model_json(lin: &jetpipe_model::LinearModel) -> serde_json::Value {
+    use jetpipe_model::physics::actuator::N_STATES;
+    let matrix = |m: &jetpipe_model::physics::actuator::Jacobian| -> Vec<Vec<f64>> {
+        (0..N_STATES)
+            .map(|r| (0..N_STATES).map(|c| m[(r, c)]).collect())
+            .collect()
+    };
+    let pairs = |v: &[nalgebra::Complex<f64>]| -> Vec<[f64; 2]> { v.iter().map(|z| [z.re, z.im]).collect() };
+    let op = &lin.operating_point;
+    serde_json::json!({
+        "states": ["i", "x_jp", "der(x_jp)", "der(x_jp,2)", "P1", "P2"],
+        "input": "v_DA",
+        "output": "F_act",
+        "A": matrix(&lin.a),
+        "B": lin.b.iter().map(|v| vec![*v]).collect::<Vec<_>>(),
+        "C": [lin.c.iter().copied().collect::<Vec<_>>()],
+        "D": [[lin.d]],
+        "poles": pairs(&lin.poles),
+        "zeros": pairs(&lin.zeros),
+        "bandwidth_Hz": lin.bandwidth_hz(),
+        "operating_point": {
+            "v_DA": op.v_da, "x_s": op.x_s, "F_act": op.f_act, "i": op.current,
+            "x_jp": op.x_jp, "P1": op.p1, "P2": op.p2
+        }
+    })
 }

@@ -9,7 +9,7 @@
 //! | `supply_pressure_drop` | `supply_resistance` (Pa·s/kg) | supply pressure at the jet pipe (§2.6) |
 //! | `heat_transfer` | `heat_transfer_fraction` (1) | polytropic exponent in (2.29) |
 //! | `transport_delay` | `command_delay` (s) | command seen by the current driver |
-//! | `sensor_offset_gain` | `force_sensor_offset` (N), `force_sensor_gain` (1) | the `F_meas` output (see [`super::force_sensor`]) |
+//! | `sensor_offset_gain` | `force_sensor_offset` (N), `force_sensor_gain` (1) | the `F_meas` output (see [`super::sensors`]) |
 
 /// The names of the effects, as reports and parameters use them.
 pub const EFFECT_NAMES: [&str; 7] = [

@@ -47,7 +47,7 @@ pub const LOCAL_ERROR_FRACTION: f64 = 0.1;
 /// How a step is integrated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
-    /// Current driver and jet pipe propagated exactly ([`crate::electromechanics`]); only
+    /// Current driver and jet pipe propagated exactly (the private `electromechanics`); only
     /// the two chamber pressures are integrated, with error control on them.
     Split,
     /// All six states with the SDIRK4 integrator (kept for comparison, and used when the

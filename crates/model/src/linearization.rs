@@ -9,9 +9,9 @@
 
 use nalgebra::{Complex, SMatrix, SVector};
 
-use jetpipe_model::physics::actuator::{index, Actuator, Inputs, Jacobian, State, N_STATES};
-use jetpipe_model::physics::current_driver::CurrentDriver;
-use jetpipe_model::simulation::equilibrium;
+use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, State, N_STATES};
+use crate::physics::current_driver::CurrentDriver;
+use crate::simulation::equilibrium;
 
 /// The operating point of a linearisation.
 #[derive(Clone, Debug, PartialEq)]
@@ -174,33 +174,6 @@ impl LinearModel {
         }
         None
     }
-
-    /// The report `jetpipe linearize --json` prints.
-    pub fn to_json(&self) -> serde_json::Value {
-        let matrix = |m: &Jacobian| -> Vec<Vec<f64>> {
-            (0..N_STATES)
-                .map(|r| (0..N_STATES).map(|c| m[(r, c)]).collect())
-                .collect()
-        };
-        let pairs = |v: &[Complex<f64>]| -> Vec<[f64; 2]> { v.iter().map(|z| [z.re, z.im]).collect() };
-        let op = &self.operating_point;
-        serde_json::json!({
-            "states": ["i", "x_jp", "der(x_jp)", "der(x_jp,2)", "P1", "P2"],
-            "input": "v_DA",
-            "output": "F_act",
-            "A": matrix(&self.a),
-            "B": self.b.iter().map(|v| vec![*v]).collect::<Vec<_>>(),
-            "C": [self.c.iter().copied().collect::<Vec<_>>()],
-            "D": [[self.d]],
-            "poles": pairs(&self.poles),
-            "zeros": pairs(&self.zeros),
-            "bandwidth_Hz": self.bandwidth_hz(),
-            "operating_point": {
-                "v_DA": op.v_da, "x_s": op.x_s, "F_act": op.f_act, "i": op.current,
-                "x_jp": op.x_jp, "P1": op.p1, "P2": op.p2
-            }
-        })
-    }
 }
 
 /// State at an operating point, for callers that need it.
@@ -211,7 +184,7 @@ pub fn operating_state(model: &Actuator, op: &OperatingPoint) -> Result<State, S
 #[cfg(test)]
 mod tests {
     use super::*;
-    use jetpipe_model::physics::parameters::Parameters;
+    use crate::physics::parameters::Parameters;
 
     fn at_45_newtons() -> LinearModel {
         let model = Actuator::new(Parameters::default()).unwrap();
