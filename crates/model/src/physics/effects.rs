@@ -221,6 +221,9 @@ impl BoucWen {
     /// Beyond this many knots a branch is integrated directly (a width far below the
     /// input's travel, where the law is a play to rounding anyway).
     const MAX_KNOTS: f64 = 32768.0;
+    /// At most this many steps of a knot's spacing in a direct integration: a branch reaches
+    /// its asymptote long before unless the law is slower than any fitted one (A n ≲ 0.01).
+    const MAX_DIRECT_STEPS: usize = 1 << 20;
 
     /// dw/dv in units of the half-width (w = z/r, v = x̄/r), moving in `direction`.
     fn slope(&self, w: f64, direction: f64) -> f64 {
@@ -254,6 +257,40 @@ impl BoucWen {
         w + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
     }
 
+    /// w after a travel of more half-widths than the knots reach. The branch rises
+    /// monotonically to its asymptote w = ±1 (in the travel's direction), where the slope
+    /// vanishes and it stays: steps of a knot's spacing until it is there to rounding. A law
+    /// so slow that it is not there after [`Self::MAX_DIRECT_STEPS`] covers the rest in
+    /// [`Self::MAX_KNOTS`] equal steps, each kept short of the asymptote, so the work has a
+    /// bound whatever the travel.
+    fn far_along_branch(&self, w0: f64, travel: f64) -> f64 {
+        let direction = travel.signum();
+        let toward_asymptote = |w: f64| if direction > 0.0 { w.min(1.0) } else { w.max(-1.0) };
+        let spacing = 1.0 / Self::KNOTS_PER_HALF_WIDTH;
+        let mut left = travel.abs();
+        let mut w = w0;
+        for _ in 0..Self::MAX_DIRECT_STEPS {
+            if left <= 0.0 {
+                return w;
+            }
+            let h = spacing.min(left);
+            let next = toward_asymptote(self.runge_kutta(w, h * direction, direction));
+            if next == w {
+                return w;
+            }
+            w = next;
+            left -= h;
+        }
+        if left <= 0.0 {
+            return w;
+        }
+        let h = left / Self::MAX_KNOTS * direction;
+        for _ in 0..Self::MAX_KNOTS as usize {
+            w = toward_asymptote(self.runge_kutta(w, h, direction));
+        }
+        w
+    }
+
     /// The output for an input moved monotonically from the memory's to `input`.
     ///
     /// A branch (the law integrated from the memory in one direction) is a function of the
@@ -273,13 +310,7 @@ impl BoucWen {
         let direction = travel.signum();
         let position = travel.abs() * Self::KNOTS_PER_HALF_WIDTH;
         if position > Self::MAX_KNOTS {
-            let steps = position.ceil();
-            let h = travel / steps;
-            let mut w = w0;
-            for _ in 0..steps as usize {
-                w = self.runge_kutta(w, h, direction);
-            }
-            return input - r * w;
+            return input - r * self.far_along_branch(w0, travel);
         }
         let h = direction / Self::KNOTS_PER_HALF_WIDTH;
         let k = position.floor() as usize;
@@ -654,6 +685,46 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_branch_beyond_the_knots_reach_agrees_with_fine_integration_and_ends_on_its_asymptote() {
+        for (n, gain, share) in [(1.0, 0.5, 0.75), (3.7, 0.99, 0.52), (8.0, 1.2, 0.3)] {
+            let Hysteresis::BoucWen(law) = bouc_wen(n, gain, share) else {
+                unreachable!()
+            };
+            let r = law.half_width;
+            // 150 half-widths: past the 128 the knots reach.
+            for (z0, travel) in [(0.0, 150.0), (-0.9, -150.0), (0.5, -150.0)] {
+                let mut memory = [1e-4; PLAY_OPERATORS];
+                memory[BoucWen::OUTPUT] = 1e-4 - z0 * r;
+                let input = 1e-4 + travel * r;
+                let steps = 1_000_000;
+                let h = travel / steps as f64;
+                let mut w: f64 = z0;
+                for _ in 0..steps {
+                    w = law.runge_kutta(w, h, travel.signum());
+                }
+                let direct = law.output_after(&memory, input);
+                assert!(
+                    (direct - (input - r * w)).abs() < 1e-9 * r,
+                    "n {n}, z0 {z0}, travel {travel}: {direct} vs {}",
+                    input - r * w
+                );
+                // On the asymptote: the output trails the input by one half-width.
+                assert!((direct - (input - travel.signum() * r)).abs() < 1e-9 * r);
+            }
+        }
+        // A law far slower than any fitted one, over a million half-widths: the work is
+        // bounded and the branch still rises monotonically, short of its asymptote.
+        let Hysteresis::BoucWen(slow) = bouc_wen(1e-3, 1e-3, 0.5) else {
+            unreachable!()
+        };
+        let r = slow.half_width;
+        let memory = [1e-4; PLAY_OPERATORS];
+        let w_far = |travel: f64| (1e-4 + travel * r - slow.output_after(&memory, 1e-4 + travel * r)) / r;
+        let (near, far) = (w_far(200.0), w_far(1e6));
+        assert!(0.0 < near && near < far && far <= 1.0, "{near} then {far}");
     }
 
     #[test]
