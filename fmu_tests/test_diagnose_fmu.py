@@ -22,9 +22,9 @@ BIN = ROOT / "target" / "release"
 
 
 def stopper_positions(x):
-    """The report's `stopper_positions`: x_s averaged over samples k-3..k+4 (fewer at the ends)."""
+    """The report's `stopper_positions`: x_s averaged over samples k-3..k+3 (fewer at the ends)."""
     n = len(x)
-    return np.array([x[k] + np.mean(x[max(k - 3, 0):min(k + 5, n)] - x[k]) for k in range(n)])
+    return np.array([x[k] + np.mean(x[max(k - 3, 0):min(k + 4, n)] - x[k]) for k in range(n)])
 
 
 def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, outputs=("F_meas",)):

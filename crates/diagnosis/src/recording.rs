@@ -28,19 +28,17 @@ impl Recording {
     }
 
     /// The recording with the stopper positions the model is driven with: each the mean of
-    /// the recorded positions at samples k − 3 ..= k + 4 (fewer at the ends).
+    /// the recorded positions at samples k − 3 ..= k + 3 (fewer at the ends).
     ///
     /// The model moves the stopper linearly between samples and reads a velocity-dependent
-    /// force (friction) at a sample with the slope of the interval that ends there. On the
-    /// recorded positions that slope is poor for a friction law that changes over a fraction
-    /// of a mm/s: positions are rounded (1 µm on the bench), so an interval's slope comes in
-    /// steps of 1 mm/s and is zero wherever the position stays within a step, around every
-    /// reversal, where the moving stopper's friction is near its stiction; and it is the
-    /// velocity half a sample earlier. With these means the interval ending at sample k has
-    /// the slope (x_{k+4} − x_{k−4}) / (8 Δt): the centred difference at t_k, with the
-    /// rounding averaged over eight samples, and exactly zero while the stopper is still. The
-    /// positions themselves lead by half a sample (a quarter of a µm at 0.5 mm/s) and a start
-    /// or stop of the stopper is spread over four samples either side.
+    /// force (friction) at a sample with the slope of the interval that ends there. Positions
+    /// are rounded (1 µm on the bench), so on the recorded positions an interval's slope comes
+    /// in steps of 1 mm/s and is zero wherever the position stays within a step, around every
+    /// reversal, where the moving stopper's friction is near its stiction. With these means the
+    /// slope is (x_{k+3} − x_{k−4}) / (7 Δt), the rounding averaged over seven samples, and
+    /// exactly zero while the stopper is still. The window is centred, so the positions do not
+    /// lead or lag (at the bench's 1.5 Hz, 10 mm motion a lead of half a sample would move the
+    /// chamber volumes enough to cost 0.04 N); the slope stays the velocity half a sample early.
     ///
     /// The diagnosis replays these positions, so the FMU reproduces its errors when it is
     /// driven with them (`fmu_tests/test_diagnose_fmu.py` does the same averaging).
@@ -49,7 +47,7 @@ impl Recording {
         let n = x.len();
         let x_s = (0..n)
             .map(|k| {
-                let window = &x[k.saturating_sub(3)..(k + 5).min(n)];
+                let window = &x[k.saturating_sub(3)..(k + 4).min(n)];
                 // Deviations from x_k: a still stopper keeps its position to the bit.
                 let deviation = window.iter().map(|&xi| xi - x[k]).sum::<f64>() / window.len() as f64;
                 x[k] + deviation
