@@ -32,5 +32,5 @@ def test_the_check_sees_a_newer_glibc():
     """The same check on the host build (linked against this machine's glibc) finds a newer
     version: the scan is not vacuous."""
     host = REPO / "target" / "release" / "libjetpipe.so"
-    assert host.is_file(), f"{host} not built (scripts/test.sh builds it: cargo build --release --lib -p jetpipe-fmu)"
+    assert host.is_file(), f"{host} not built (scripts/test.sh builds it: cargo build --release --lib -p jetpipe-fmu -p jetpipe-cli)"
     assert max(glibc_versions(host.read_bytes())) > GLIBC_MAX

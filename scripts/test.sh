@@ -21,7 +21,11 @@ RUSTDOCFLAGS="-D warnings" run cargo doc --no-deps --workspace --release
 run bash scripts/build_win64.sh
 JETPIPE_WIN64=1 run bash scripts/package.sh
 # The host build, linked against this machine's glibc: the platform test's counter-example.
-run cargo build --release --lib -p jetpipe-fmu
+# With jetpipe-cli in the same invocation cargo unifies the features as for package.sh's
+# `cargo run --bin jetpipe` (plotters turns on num-traits' `default`), which has just built
+# this library: it is reused. `-p jetpipe-fmu` alone resolved them anew and rebuilt nalgebra,
+# the model and the FMU for the same code (14 s).
+run cargo build --release --lib -p jetpipe-fmu -p jetpipe-cli
 if [ ! -f dist/JetPipeActuator.fmu ]; then
     echo "test.sh: dist/JetPipeActuator.fmu was not written" >&2
     exit 1

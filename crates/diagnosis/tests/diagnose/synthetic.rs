@@ -8,17 +8,15 @@
 //! The full protocol (80 s) runs for every case; set JETPIPE_DIAGNOSE_CASES to a comma
 //! list of case names to run a subset.
 
-use jetpipe_diagnosis::recording::Recording;
 use jetpipe_diagnosis::{diagnose, Diagnosis};
 use jetpipe_model::physics::parameters::Parameters;
-use synthetic_bench::{generate, write_csv, BenchEffects};
+use synthetic_bench::{generate, BenchEffects};
+
+use super::{generated, names};
 
 fn run(name: &str, effects: BenchEffects, seed: u64) -> Diagnosis {
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    write_csv(&generate(&effects, seed, 80.0), &path).unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let rows = generate(&effects, seed, 80.0);
+    let recording = generated(&format!("synthetic-{name}"), &rows, &Parameters::default());
     let started = std::time::Instant::now();
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
     let named: Vec<String> = d
@@ -44,7 +42,6 @@ fn run(name: &str, effects: BenchEffects, seed: u64) -> Diagnosis {
         d.after.heldout_rms,
         started.elapsed().as_secs_f64()
     );
-    let _ = std::fs::remove_dir_all(&dir);
     d
 }
 
@@ -53,10 +50,6 @@ fn selected(name: &str) -> bool {
         Ok(list) => list.split(',').any(|c| c.trim() == name),
         Err(_) => true,
     }
-}
-
-fn names(d: &Diagnosis) -> Vec<&'static str> {
-    d.effects.iter().map(|f| f.name).collect()
 }
 
 #[test]
@@ -254,16 +247,13 @@ fn calibration_re_identifies_the_static_parameters() {
     if !selected("calibrate") {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-calibrate", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    write_csv(&generate(&BenchEffects::default(), 110, 80.0), &path).unwrap();
     let wrong = Parameters {
         c_d: 0.60,
         x_jp_offset: 0.07e-3,
         ..Parameters::default()
     };
-    let recording = Recording::read(&path, &wrong).unwrap();
+    let rows = generate(&BenchEffects::default(), 110, 80.0);
+    let recording = generated("synthetic-calibrate", &rows, &wrong);
     let d = diagnose(&recording, &wrong, true, &mut |line| println!("{line}")).unwrap();
     let value = |name: &str| d.calibrated.iter().find(|c| c.name == name).map(|c| c.value).unwrap();
     println!(
@@ -277,5 +267,4 @@ fn calibration_re_identifies_the_static_parameters() {
         value("x_jp_offset")
     );
     assert!(d.effects.is_empty(), "added {:?}", names(&d));
-    let _ = std::fs::remove_dir_all(&dir);
 }

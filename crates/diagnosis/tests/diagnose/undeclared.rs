@@ -8,10 +8,11 @@
 //! Each mechanism is a test of its own; set JETPIPE_UNDECLARED to a comma list of names to
 //! run a subset.
 
-use jetpipe_diagnosis::recording::Recording;
 use jetpipe_diagnosis::{diagnose, Diagnosis};
 use jetpipe_model::physics::parameters::Parameters;
-use synthetic_bench::{generate, undeclared_mechanism, write_csv};
+use synthetic_bench::{generate, undeclared_mechanism};
+
+use super::{generated, names, value_reference};
 
 fn run(name: &str, seed: u64) -> Option<(Diagnosis, &'static str, &'static str)> {
     if let Ok(list) = std::env::var("JETPIPE_UNDECLARED") {
@@ -20,14 +21,10 @@ fn run(name: &str, seed: u64) -> Option<(Diagnosis, &'static str, &'static str)>
         }
     }
     let mechanism = undeclared_mechanism(name).expect("a mechanism of the table");
-    let dir = std::env::temp_dir().join(format!("jetpipe-undeclared-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    write_csv(&generate(&(mechanism.effects)(), seed, 80.0), &path).unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let rows = generate(&(mechanism.effects)(), seed, 80.0);
+    let recording = generated(&format!("undeclared-{name}"), &rows, &Parameters::default());
     let started = std::time::Instant::now();
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
     println!(
         "{name} (truth {}/{}): {} in {:.1} s; {}",
         mechanism.location,
@@ -49,7 +46,7 @@ fn placed(name: &str, seed: u64) {
     let Some((d, location, family)) = run(name, seed) else {
         return;
     };
-    let named: Vec<&str> = d.effects.iter().map(|e| e.name).collect();
+    let named = names(&d);
     assert!(named.is_empty(), "{name}: named {named:?} for an undeclared effect");
     let mechanism = undeclared_mechanism(name).unwrap();
     let force_reached = d.before.heldout_rms > 1.5 * d.noise_floor;
@@ -66,11 +63,7 @@ fn placed(name: &str, seed: u64) {
         );
         let thesis = Parameters::default();
         for &(parameter, truth) in mechanism.model_parameters {
-            let reference = jetpipe_model::variables::VARIABLES
-                .iter()
-                .find(|v| v.name == parameter)
-                .unwrap()
-                .value_reference;
+            let reference = value_reference(parameter);
             let fitted = d.parameters.get(reference).unwrap();
             let departure = truth - thesis.get(reference).unwrap();
             assert!(
@@ -188,7 +181,7 @@ fn a_force_sensor_with_backlash_is_found_at_the_force_sensor_as_hysteresis_not_j
 
 #[test]
 fn every_mechanism_of_the_table_has_a_test_here() {
-    let source = include_str!("diagnose_undeclared.rs");
+    let source = include_str!("undeclared.rs");
     for m in synthetic_bench::UNDECLARED {
         assert!(
             source.contains(&format!("placed(\"{}\"", m.name)),
@@ -205,16 +198,11 @@ fn an_undeclared_back_pressure_and_named_friction_are_both_found() {
     }
     let mut effects = (undeclared_mechanism("return_back_pressure").unwrap().effects)();
     effects.friction_coulomb = 2.0;
-    let dir = std::env::temp_dir().join(format!("jetpipe-undeclared-{}-both", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    write_csv(&generate(&effects, 21, 80.0), &path).unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let rows = generate(&effects, 21, 80.0);
+    let recording = generated("undeclared-both", &rows, &Parameters::default());
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
     println!("{}", d.summary().join(" | "));
-    let named: Vec<&str> = d.effects.iter().map(|e| e.name).collect();
-    assert_eq!(named, ["piston_friction"]);
+    assert_eq!(names(&d), ["piston_friction"]);
     let found = d.discovered.first().expect("the back pressure discovered");
     assert_eq!(
         (found.location, found.family),

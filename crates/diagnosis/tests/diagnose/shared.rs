@@ -17,6 +17,8 @@ use jetpipe_diagnosis::recording::Recording;
 use jetpipe_diagnosis::{diagnose, Diagnosis};
 use jetpipe_model::physics::parameters::Parameters;
 
+use super::{names, value_reference};
+
 fn shared(name: &str) -> Option<PathBuf> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/bench")
@@ -45,18 +47,6 @@ fn run(name: &str) -> Option<Diagnosis> {
         d.summary().join(" | ")
     );
     Some(d)
-}
-
-fn value_reference(name: &str) -> u32 {
-    jetpipe_model::variables::VARIABLES
-        .iter()
-        .find(|v| v.name == name)
-        .unwrap()
-        .value_reference
-}
-
-fn names(d: &Diagnosis) -> Vec<&'static str> {
-    d.effects.iter().map(|e| e.name).collect()
 }
 
 /// The value of a parameter of the diagnosis's final model.

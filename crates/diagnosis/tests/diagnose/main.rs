@@ -1,0 +1,46 @@
+//! `jetpipe diagnose` end to end, in one test binary:
+//!
+//! * `shared`: the project's shared bench recordings (`../shared/bench/`);
+//! * `synthetic`: the synthetic bench's recordings of the named effects;
+//! * `undeclared`: the synthetic bench's undeclared mechanisms.
+//!
+//! Why one binary and not three: cargo runs test binaries one after another and each
+//! harness runs its tests two at a time, so a binary's last, long test left a core idle
+//! until it ended, three times over. Here the harness takes the next of all the
+//! diagnoses whenever one ends, and both cores stay busy until the last few.
+
+mod shared;
+mod synthetic;
+mod undeclared;
+
+use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::Diagnosis;
+use jetpipe_model::physics::parameters::Parameters;
+
+/// The names of the named effects a diagnosis added.
+fn names(d: &Diagnosis) -> Vec<&'static str> {
+    d.effects.iter().map(|e| e.name).collect()
+}
+
+/// The FMU value reference of a model variable.
+fn value_reference(name: &str) -> u32 {
+    jetpipe_model::variables::VARIABLES
+        .iter()
+        .find(|v| v.name == name)
+        .unwrap()
+        .value_reference
+}
+
+/// Rows of the synthetic bench read back as a recording, through the CSV file the bench
+/// writes (its formatting and quantisation are part of what is tested), with `base` as the
+/// model the recording is read against. `label` names the file's folder, unique in the
+/// binary: the tests run in parallel in one process.
+fn generated(label: &str, rows: &[[f64; 6]], base: &Parameters) -> Recording {
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{label}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("recording.csv");
+    synthetic_bench::write_csv(rows, &path).unwrap();
+    let recording = Recording::read(&path, base).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    recording
+}
