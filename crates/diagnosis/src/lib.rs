@@ -26,6 +26,7 @@ mod named;
 pub mod noise;
 pub mod recording;
 pub mod replay;
+mod rounds;
 pub mod signals;
 pub mod signature;
 
@@ -647,466 +648,265 @@ pub fn diagnose(
     diagnose_with(recording, base, &options, progress)
 }
 
+/// What every stage of a diagnosis reads: the recording, its training blocks and the
+/// channels' noise floors.
+struct Context<'a> {
+    recording: &'a Recording,
+    options: &'a Options,
+    training: Vec<bool>,
+    n: usize,
+    noise: f64,
+    pressure_noise: Option<[f64; 2]>,
+    channel_noise: [f64; CHANNELS],
+    /// The noise of the force against the pressures.
+    mechanical_noise: f64,
+}
+
+impl<'a> Context<'a> {
+    /// Estimate the channels' noise floors (step 1); a force channel rounded coarser than
+    /// its noise gets a line in `input_checks`.
+    fn measure(
+        recording: &'a Recording,
+        options: &'a Options,
+        input_checks: &mut Vec<String>,
+        progress: &mut dyn FnMut(&str),
+    ) -> Self {
+        let training = training_mask(&recording.time);
+        let n = recording.len();
+        let noise = noise::noise_floor(&recording.force);
+        let pressure_noise = match (&recording.p1, &recording.p2) {
+            (Some(a), Some(b)) => Some([noise::noise_floor(a), noise::noise_floor(b)]),
+            _ => None,
+        };
+        if let Some(q) = noise::quantisation_step(&recording.force) {
+            if q > noise {
+                input_checks.push(format!(
+                    "The force channel is quantised in steps of {q:.4} N, coarser than its noise {noise:.4} N: errors below a step cannot be told from rounding."
+                ));
+            }
+        }
+        progress(&format!(
+            "{n} samples, force noise floor {noise:.4} N{}",
+            pressure_noise
+                .map(|p| format!(", pressure noise floors {:.0} and {:.0} Pa", p[0], p[1]))
+                .unwrap_or_default()
+        ));
+        let mut channel_noise = [noise, 0.0, 0.0];
+        if let Some(p) = pressure_noise {
+            channel_noise[1] = p[0];
+            channel_noise[2] = p[1];
+        }
+        Self {
+            recording,
+            options,
+            training,
+            n,
+            noise,
+            pressure_noise,
+            channel_noise,
+            mechanical_noise: noise,
+        }
+    }
+
+    /// The force against the pressures carries the pressures' noise through the piston area.
+    fn with_piston_area(mut self, area: f64) -> Self {
+        let noise = self.noise;
+        self.mechanical_noise = self
+            .pressure_noise
+            .map(|p| (noise * noise + area * area * (p[0] * p[0] + p[1] * p[1])).sqrt())
+            .unwrap_or(noise);
+        self
+    }
+}
+
+/// Diagnose a recording with the given options: the steps of the module's account, in order.
 pub fn diagnose_with(
     recording: &Recording,
     base: &Parameters,
     options: &Options,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
+    // 1. The file's checks and the noise floors.
     let mut input_checks = checks::check_file(recording, base)?;
     let smoothed = recording.with_stopper_smoothed();
-    let recording = &smoothed;
-    let training = training_mask(&recording.time);
-    let n = recording.len();
-    let noise = noise::noise_floor(&recording.force);
-    let pressure_noise = match (&recording.p1, &recording.p2) {
-        (Some(a), Some(b)) => Some([noise::noise_floor(a), noise::noise_floor(b)]),
-        _ => None,
-    };
-    if let Some(q) = noise::quantisation_step(&recording.force) {
-        if q > noise {
-            input_checks.push(format!(
-                "The force channel is quantised in steps of {q:.4} N, coarser than its noise {noise:.4} N: errors below a step cannot be told from rounding."
-            ));
-        }
-    }
-    progress(&format!(
-        "{n} samples, force noise floor {noise:.4} N{}",
-        pressure_noise
-            .map(|p| format!(", pressure noise floors {:.0} and {:.0} Pa", p[0], p[1]))
-            .unwrap_or_default()
-    ));
+    let cx = Context::measure(&smoothed, options, &mut input_checks, progress);
     let before_model = Actuator::new(base.clone())?;
-    let before_fast = replay_fast(&before_model, recording, n)?;
+    let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
     input_checks.extend(checks::check_against_model(
-        recording,
+        cx.recording,
         &before_fast.force,
         Some((&before_fast.p1, &before_fast.p2)),
         base,
     )?);
-    let mut params = base.clone();
-    let mut calibrated = vec![];
-    if options.calibrate {
-        progress("calibration: x_jp_offset, C_d and the leakage (§3.3.1), on the whole and on halves");
-        let (p, report) = calibrate::calibrate(recording, base, &training);
-        params = p;
-        calibrated = report;
-        for c in &calibrated {
-            progress(&format!(
-                "  {} = {:.4e} (thesis {:.4e}){}",
-                c.name,
-                c.value,
-                c.thesis,
-                if c.flags.is_empty() { "" } else { "  FLAGGED" }
-            ));
-        }
-    }
-    let mut channel_noise = [noise, 0.0, 0.0];
-    if let Some(p) = pressure_noise {
-        channel_noise[1] = p[0];
-        channel_noise[2] = p[1];
-    }
-    let area = before_model.piston_area;
-    let mechanical_noise = pressure_noise
-        .map(|p| (noise * noise + area * area * (p[0] * p[0] + p[1] * p[1])).sqrt())
-        .unwrap_or(noise);
-    let mut effects: Vec<AddedEffect> = vec![];
-    let mut discovered: Vec<DiscoveredTerm> = vec![];
-    let mut first_candidates: Vec<Scored> = vec![];
-    let mut localization: Option<Localization> = None;
+    // 2. The static identification, when asked for.
+    let (params, calibrated) = if options.calibrate {
+        calibrate_static(&cx, base, progress)
+    } else {
+        (base.clone(), vec![])
+    };
+    let cx = cx.with_piston_area(before_model.piston_area);
+    // 3–5. Replay, localize, add what earns its place; then refit the additions together.
     let mut replays = 1;
-    // An effect added on the force side of the piston leaves the pressures, and so the
-    // upstream places' scores, as they were.
-    let mut reusable: Option<Localization> = None;
-    for round in 0..=MAX_EFFECTS {
-        let model = Actuator::new(params.clone())?;
-        let current = replay_fast(&model, recording, n)?;
-        replays += 1;
-        let problem = Problem::new(recording, &params, &training, channel_noise);
-        let prediction = [current.force.clone(), current.p1.clone(), current.p2.clone()];
-        let (_, heldout) = problem.errors(&prediction);
-        let count = heldout_count(&training) as f64;
-        let misfit: Vec<f64> = (0..CHANNELS)
-            .filter(|&c| problem.weights[c] > 0.0)
-            .map(|c| (heldout[c] / count).sqrt())
-            .collect();
-        if misfit.iter().all(|m| *m <= EXPLAINED_WITHIN_NOISE) {
-            progress("every channel is within its noise on the held-out blocks");
-            localization = None;
-            break;
-        }
-        let force_residual = difference(&recording.force, &current.force);
-        let line = signature::spectrum(&recording.time, &force_residual);
-        let periodic =
-            (line.peak_over_median > 100.0 && line.low_share < 0.5 && line.peak_hz > 0.2).then_some(line.peak_hz);
-        // Pressures within their noise: nothing upstream of the piston departs by more
-        // than they can show, and only the mechanics and the force sensor are fitted.
-        let pressures_agree = problem.weights[1] > 0.0
-            && problem.weights[2] > 0.0
-            && (1..CHANNELS).all(|c| (heldout[c] / count).sqrt() <= EXPLAINED_WITHIN_NOISE);
-        let candidates: Vec<Candidate> = catalogue(&params, pressure_noise.is_some(), periodic)
-            .into_iter()
-            .filter(|c| !effects.iter().any(|e| Some(e.name) == c.named))
-            .filter(|c| !pressures_agree || matches!(c.location, "mechanics" | "force_sensor"))
-            .collect();
+    let mut found = rounds::run_rounds(&cx, params, &mut replays, progress)?;
+    let joint_refit = refit_jointly(&cx, &mut found, &mut replays, progress)?;
+    // 6. The verdict, from the accurate replays.
+    conclude(
+        &cx,
+        before_model,
+        found,
+        joint_refit,
+        input_checks,
+        calibrated,
+        replays,
+        progress,
+    )
+}
+
+/// Re-identify what the thesis identified from static loops (§3.3.1).
+fn calibrate_static(cx: &Context, base: &Parameters, progress: &mut dyn FnMut(&str)) -> (Parameters, Vec<Calibrated>) {
+    progress("calibration: x_jp_offset, C_d and the leakage (§3.3.1), on the whole and on halves");
+    let (params, calibrated) = calibrate::calibrate(cx.recording, base, &cx.training);
+    for c in &calibrated {
         progress(&format!(
-            "round {}: held-out misfit {} noise floors",
-            round + 1,
-            misfit
-                .iter()
-                .zip(CHANNEL_NAMES)
-                .map(|(m, name)| format!("{name} {m:.1}"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            "  {} = {:.4e} (thesis {:.4e}){}",
+            c.name,
+            c.value,
+            c.thesis,
+            if c.flags.is_empty() { "" } else { "  FLAGGED" }
         ));
-        let (found, used) = match reusable.take() {
-            Some(previous) => {
-                progress("the pressures are as before: the places upstream keep their scores");
-                let mut kept: Vec<Scored> = previous
-                    .candidates
-                    .into_iter()
-                    .filter(|s| !effects.iter().any(|e| Some(e.name) == s.fit.candidate.named))
-                    .collect();
-                (rank(&mut kept), 0)
-            }
-            None => localize(&problem, &current, &candidates, options, progress),
-        };
-        replays += used;
-        if round == 0 {
-            first_candidates = found.candidates.clone();
-        }
-        let place = found.location;
-        let force_before = rms_where(&force_residual, &training, false);
-        let place_share = found.best_at(place).map_or(0.0, |s| s.explained);
-        let mut added = None;
-        // Named effects are the hypotheses tried first: once a term outside them has been
-        // added, a named effect found later may be absorbing what that term's form misses,
-        // and only those whose own signature is tested in the residual (friction, the
-        // sensor's offset and gain, hysteresis) are still tried.
-        let nameable = |s: &&Scored| {
-            s.fit
-                .candidate
-                .named
-                .map_or(false, |name| discovered.is_empty() || named::has_signature_test(name))
-        };
-        if round < MAX_EFFECTS && place != "unknown" {
-            let mut named: Vec<&Scored> = found
-                .candidates
-                .iter()
-                .filter(|s| s.fit.candidate.location == place)
-                .filter(nameable)
-                .collect();
-            named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
-            for s in named {
-                let name = s.fit.candidate.named.expect("filtered on named");
-                let gain = force_before - s.force_heldout_rms;
-                let worse_pressures = (1..CHANNELS)
-                    .any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * heldout[c] + count * 0.01);
-                let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share && s.explained >= NAMED_MIN_SHARE;
-                let gain_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
-                let test = named_signature(name, recording, &model, &current, &training, noise, mechanical_noise);
-                progress(&format!(
-                    "  {name}: explains {:.1} % (its place {:.1} %), force held-out {force_before:.4} -> {:.4} N, signature {}",
-                    100.0 * s.explained,
-                    100.0 * place_share,
-                    s.force_heldout_rms,
-                    if test.present { "present" } else { "absent" }
-                ));
-                if !test.sentence.is_empty() {
-                    progress(&format!("    {}", test.sentence));
-                }
-                if share_ok && gain_ok && !worse_pressures && test.present {
-                    added = Some((s.clone(), test.sentence));
-                    break;
-                }
-            }
-        }
-        // With pressures, the mechanics and the force sensor are judged on the force
-        // against the pressures, where an upstream departure does not reach: a second
-        // effect there is found even while a larger one upstream dominates the misfit.
-        // (With the pressures within their noise the round's candidates were these already.)
-        if added.is_none() && round < MAX_EFFECTS && !pressures_agree {
-            if let Some(through) = force_through_mechanics(&model, recording) {
-                let downstream = Problem::new(recording, &params, &training, [mechanical_noise, 0.0, 0.0]);
-                let (_, misfit) = downstream.errors(&[through.force.clone(), vec![], vec![]]);
-                if (misfit[FORCE] / count).sqrt() > EXPLAINED_WITHIN_NOISE {
-                    let near: Vec<Candidate> = candidates
-                        .iter()
-                        .filter(|c| matches!(c.location, "mechanics" | "force_sensor"))
-                        .cloned()
-                        .collect();
-                    progress(
-                        "the force departs from the pressures too: the mechanics and the force sensor on their own",
-                    );
-                    let (side, used) = localize(&downstream, &through, &near, options, progress);
-                    replays += used;
-                    let side_share = side.best_at(side.location).map_or(0.0, |s| s.explained);
-                    let mut named: Vec<&Scored> = side
-                        .candidates
-                        .iter()
-                        .filter(|s| s.fit.candidate.location == side.location)
-                        .filter(nameable)
-                        .collect();
-                    named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
-                    for s in named {
-                        let name = s.fit.candidate.named.expect("filtered on named");
-                        let mut trial = params.clone();
-                        if apply_named(&mut trial, s).is_err() {
-                            continue;
-                        }
-                        let with = replay_fast(&Actuator::new(trial)?, recording, n)?;
-                        replays += 1;
-                        let after = rms_where(&difference(&recording.force, &with.force), &training, false);
-                        let gain = force_before - after;
-                        let share_ok =
-                            s.explained >= NAMED_SHARE_OF_PLACE * side_share && s.explained >= NAMED_MIN_SHARE;
-                        let gain_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
-                        let test =
-                            named_signature(name, recording, &model, &current, &training, noise, mechanical_noise);
-                        progress(&format!(
-                            "  {name}: explains {:.1} % of the force against the pressures, force held-out {force_before:.4} -> {after:.4} N, signature {}",
-                            100.0 * s.explained,
-                            if test.present { "present" } else { "absent" }
-                        ));
-                        if share_ok && gain_ok && test.present {
-                            let mut s = s.clone();
-                            s.force_heldout_rms = after;
-                            s.fit.prediction[FORCE] = with.force;
-                            added = Some((s, test.sentence));
-                            break;
-                        }
-                    }
-                }
-            }
-        }
-        // No named effect fits: the place's own best candidates that the FMU can carry,
-        // each kept only if the model with it (replayed, not predicted) is better on the
-        // held-out blocks by more than a noise floor and by more than its parameters'
-        // BIC penalty, and no pressure channel gets worse.
-        if added.is_none() && round < MAX_EFFECTS && place != "unknown" {
-            let mut at_place: Vec<&Scored> = found
-                .candidates
-                .iter()
-                .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
-                .filter(|s| s.explained >= LOCATED_SHARE)
-                .collect();
-            at_place.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
-            let before_total: f64 = heldout.iter().sum();
-            let mut kept = None;
-            for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
-                let label = s.fit.candidate.label;
-                let penalty = used_terms(s) * count.ln();
-                let worse_pressures = (1..CHANNELS)
-                    .any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * heldout[c] + count * 0.01);
-                if worse_pressures || before_total - s.fit.heldout_total() < penalty {
-                    progress(&format!(
-                        "  {label}: not better than its parameters' penalty, or worse in a pressure"
-                    ));
-                    continue;
-                }
-                let Some(set) = discover::model_terms(&s.fit.candidate, &s.fit.values, &params, &problem) else {
-                    progress(&format!("  {label}: the FMU has no parameters for it"));
-                    continue;
-                };
-                let mut trial = params.clone();
-                if set
-                    .iter()
-                    .any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
-                    || trial.validate().is_err()
-                {
-                    continue;
-                }
-                let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
-                replays += 1;
-                let residual = difference(&recording.force, &with.force);
-                let after = rms_where(&residual, &training, false);
-                let gain = force_before - after;
-                progress(&format!(
-                    "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
-                ));
-                // A pressure transducer's term leaves the force as it is: it is judged on
-                // the pressures, by the same rule in their noise, and must leave the force
-                // no worse.
-                let pressures = if s.fit.candidate.location == "pressure_sensors" {
-                    let (_, replayed) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
-                    let in_noise = |h: &[f64; CHANNELS]| ((h[1] + h[2]) / count).sqrt();
-                    let (was, now) = (in_noise(&heldout), in_noise(&replayed));
-                    progress(&format!(
-                        "  {label}: in the model, pressures held-out {was:.2} -> {now:.2} noise floors"
-                    ));
-                    let rms_pa = |series: [&[f64]; 2]| {
-                        let measured = [recording.p1.as_deref(), recording.p2.as_deref()];
-                        [0, 1].map(|c| {
-                            measured[c].map_or(0.0, |m| rms_where(&difference(m, series[c]), &training, false))
-                        })
-                    };
-                    let better = was - now >= MIN_RELATIVE_GAIN * was
-                        && was - now >= MIN_GAIN_IN_NOISE
-                        && after <= force_before + 0.05 * noise;
-                    better.then(|| (rms_pa([&current.p1, &current.p2]), rms_pa([&with.p1, &with.p2])))
-                } else {
-                    None
-                };
-                if pressures.is_some()
-                    || (gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise)
-                {
-                    kept = Some((s.fit.candidate.clone(), set, trial, after, pressures));
-                    break;
-                }
-            }
-            if let Some((candidate, set, trial, after, pressures_heldout)) = kept {
-                progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
-                discovered.push(DiscoveredTerm {
-                    location: candidate.location,
-                    family: candidate.family,
-                    candidate: candidate.label,
-                    reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, &params),
-                    parameters: set,
-                    heldout_before: force_before,
-                    heldout_after: after,
-                    share: 1.0 - (after / force_before).powi(2),
-                    pressures_heldout,
-                });
-                params = trial;
-                reusable = None;
-                continue;
-            }
-        }
-        let Some((s, signature_sentence)) = added else {
-            localization = Some(found);
-            break;
-        };
-        let place = s.fit.candidate.location;
-        let downstream = place != found.location;
-        let place_share = if downstream { s.explained } else { place_share };
-        if downstream && pressure_noise.is_some() {
-            reusable = Some(found.clone());
-        }
-        let name = s.fit.candidate.named.expect("a named candidate");
-        let set = apply_named(&mut params, &s)?;
-        let remainder = difference(&recording.force, &s.fit.prediction[FORCE]);
-        let chain = ChainSignals::new(&model, recording, &current);
-        let follows = Signature::of(&recording.time, &remainder, &chain, "N");
-        let top = follows.follows.first();
-        let share = 1.0 - (s.force_heldout_rms / force_before).powi(2);
-        let values: Vec<String> = set.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
-        let evidence = format!(
-            "Of the places in the chain, the {place} explains the most of the held-out misfit{} ({:.1} %), and {name} {:.1} % of it{}. Fitted on the training blocks ({}), it lowers the held-out force error from {force_before:.4} N to {:.4} N (noise floor {noise:.4} N), {:.1} % of its mean square.",
-            if downstream { " of the force against the pressures" } else { "" },
-            100.0 * place_share,
-            100.0 * s.explained,
-            if signature_sentence.is_empty() {
-                String::new()
-            } else {
-                format!("; {signature_sentence}")
-            },
-            values.join(", "),
-            s.force_heldout_rms,
-            100.0 * share
-        );
-        progress(&format!("adding {name}"));
-        effects.push(AddedEffect {
-            name,
-            location: place,
-            parameters: set,
-            evidence,
-            heldout_before: force_before,
-            heldout_after: s.force_heldout_rms,
-            share,
-            remainder_follows: top
-                .map(|f| format!("{} (η² = {:.2})", f.signal, f.eta_squared))
-                .unwrap_or_default(),
-        });
     }
-    // Each effect and term was fitted with those before it held: refit them together.
-    let mut joint = None;
-    if effects.len() + discovered.len() >= 2 {
-        let names: Vec<&'static str> = effects
-            .iter()
-            .flat_map(|e| e.parameters.iter())
-            .chain(discovered.iter().flat_map(|d| d.parameters.iter()))
-            .map(|(name, _)| *name)
-            .filter(|name| parameter_value(&params, name) != 0.0)
-            .collect();
-        progress(&format!("joint refit of the {} parameters added", names.len()));
-        let problem = Problem::new(recording, &params, &training, channel_noise);
-        let terms: Vec<Term> = names
-            .iter()
-            .map(|&name| {
-                let value = parameter_value(&params, name);
-                let (lower, upper) = corrections::declared_bounds(name);
-                Term {
-                    name,
-                    unit: discover::unit_of(name),
-                    mechanism: Mechanism::Parameter(name),
-                    neutral: value,
-                    step: 1e-3 * value.abs(),
-                    lower,
-                    upper,
-                }
-            })
-            .collect();
-        let candidate = Candidate {
-            label: "joint refit",
-            location: "",
-            family: "",
-            named: None,
-            terms,
-            settings: vec![],
-        };
-        let current = replay_fast(&Actuator::new(params.clone())?, recording, n)?;
-        let before_joint = rms_where(&difference(&recording.force, &current.force), &training, false);
-        let step_of = |name: &'static str| candidate.terms.iter().find(|t| t.name == name).map_or(0.0, |t| t.step);
-        let sensitivities = |name: &'static str| problem.sensitivity(name, step_of(name), &current);
-        if let Ok(fit) = problem.fit(&candidate, 3, &current, &sensitivities) {
-            replays += fit.replays + names.len();
-            let mut trial = params.clone();
-            let valid = names
-                .iter()
-                .zip(&fit.values)
-                .all(|(name, value)| set_parameter(&mut trial, name, *value).is_ok())
-                && trial.validate().is_ok();
-            if valid {
-                let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
-                replays += 1;
-                let after_joint = rms_where(&difference(&recording.force, &with.force), &training, false);
-                progress(&format!(
-                    "  held-out force error {before_joint:.4} -> {after_joint:.4} N"
-                ));
-                if after_joint < before_joint {
-                    params = trial;
-                    // A named effect the refit turned off (its amplitude at zero: another
-                    // term took over what it explained) is no longer there.
-                    effects.retain(|e| {
-                        let off = match e.name {
-                            "piston_friction" => params.friction_coulomb == 0.0,
-                            _ => e.parameters.iter().all(|(name, _)| {
-                                parameter_value(&params, name) == parameter_value(&Parameters::default(), name)
-                            }),
-                        };
-                        if off {
-                            progress(&format!("  {} is off after the refit: removed", e.name));
-                        }
-                        !off
-                    });
-                    if params.friction_coulomb == 0.0 {
-                        params.friction_velocity = 0.0;
-                    }
-                    for (name, value) in effects
-                        .iter_mut()
-                        .flat_map(|e| e.parameters.iter_mut())
-                        .chain(discovered.iter_mut().flat_map(|d| d.parameters.iter_mut()))
-                    {
-                        *value = parameter_value(&params, name);
-                    }
-                    joint = Some((before_joint, after_joint));
-                }
+    (params, calibrated)
+}
+
+/// The added parameters as one candidate, starting from their current values.
+fn joint_candidate(params: &Parameters, names: &[&'static str]) -> Candidate {
+    let terms: Vec<Term> = names
+        .iter()
+        .map(|&name| {
+            let value = parameter_value(params, name);
+            let (lower, upper) = corrections::declared_bounds(name);
+            Term {
+                name,
+                unit: discover::unit_of(name),
+                mechanism: Mechanism::Parameter(name),
+                neutral: value,
+                step: 1e-3 * value.abs(),
+                lower,
+                upper,
             }
-        }
+        })
+        .collect();
+    Candidate {
+        label: "joint refit",
+        location: "",
+        family: "",
+        named: None,
+        terms,
+        settings: vec![],
     }
+}
+
+/// Each effect and term was fitted with those before it held: refit them together, and
+/// keep the refit when the held-out force error falls. The error before and after.
+fn refit_jointly(
+    cx: &Context,
+    found: &mut rounds::Findings,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<(f64, f64)>, String> {
+    if found.effects.len() + found.discovered.len() < 2 {
+        return Ok(None);
+    }
+    let (recording, n) = (cx.recording, cx.n);
+    let params = &found.params;
+    let names: Vec<&'static str> = found
+        .effects
+        .iter()
+        .flat_map(|e| e.parameters.iter())
+        .chain(found.discovered.iter().flat_map(|d| d.parameters.iter()))
+        .map(|(name, _)| *name)
+        .filter(|name| parameter_value(params, name) != 0.0)
+        .collect();
+    progress(&format!("joint refit of the {} parameters added", names.len()));
+    let problem = Problem::new(recording, params, &cx.training, cx.channel_noise);
+    let candidate = joint_candidate(params, &names);
+    let current = replay_fast(&Actuator::new(params.clone())?, recording, n)?;
+    let before_joint = rms_where(&difference(&recording.force, &current.force), &cx.training, false);
+    let step_of = |name: &'static str| candidate.terms.iter().find(|t| t.name == name).map_or(0.0, |t| t.step);
+    let sensitivities = |name: &'static str| problem.sensitivity(name, step_of(name), &current);
+    let Ok(fit) = problem.fit(&candidate, 3, &current, &sensitivities) else {
+        return Ok(None);
+    };
+    *replays += fit.replays + names.len();
+    let mut trial = params.clone();
+    let valid = names
+        .iter()
+        .zip(&fit.values)
+        .all(|(name, value)| set_parameter(&mut trial, name, *value).is_ok())
+        && trial.validate().is_ok();
+    if !valid {
+        return Ok(None);
+    }
+    let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
+    *replays += 1;
+    let after_joint = rms_where(&difference(&recording.force, &with.force), &cx.training, false);
+    progress(&format!(
+        "  held-out force error {before_joint:.4} -> {after_joint:.4} N"
+    ));
+    if after_joint >= before_joint {
+        return Ok(None);
+    }
+    found.params = trial;
+    retire_switched_off(found, progress);
+    Ok(Some((before_joint, after_joint)))
+}
+
+/// After the joint refit: a named effect the refit turned off (its amplitude at zero:
+/// another term took over what it explained) is no longer there, and the others report
+/// their refitted values.
+fn retire_switched_off(found: &mut rounds::Findings, progress: &mut dyn FnMut(&str)) {
+    let params = &mut found.params;
+    found.effects.retain(|e| {
+        let off = match e.name {
+            "piston_friction" => params.friction_coulomb == 0.0,
+            _ => e
+                .parameters
+                .iter()
+                .all(|(name, _)| parameter_value(params, name) == parameter_value(&Parameters::default(), name)),
+        };
+        if off {
+            progress(&format!("  {} is off after the refit: removed", e.name));
+        }
+        !off
+    });
+    if params.friction_coulomb == 0.0 {
+        params.friction_velocity = 0.0;
+    }
+    for (name, value) in found
+        .effects
+        .iter_mut()
+        .flat_map(|e| e.parameters.iter_mut())
+        .chain(found.discovered.iter_mut().flat_map(|d| d.parameters.iter_mut()))
+    {
+        *value = parameter_value(params, name);
+    }
+}
+
+/// The final accurate replays, the verdict (step 6) and the tests of the residual.
+fn conclude(
+    cx: &Context,
+    before_model: Actuator,
+    found: rounds::Findings,
+    joint_refit: Option<(f64, f64)>,
+    input_checks: Vec<String>,
+    calibrated: Vec<Calibrated>,
+    replays: usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    let (recording, n, noise, training) = (cx.recording, cx.n, cx.noise, &cx.training);
     // The reported figures come from the accurate, error-controlled replay.
     progress("final replays with the error-controlled integrator");
-    let final_model = Actuator::new(params.clone())?;
+    let final_model = Actuator::new(found.params.clone())?;
     let (before, after) = std::thread::scope(|scope| {
         let b = scope.spawn(|| replay(&before_model, recording, 1e-5, n));
         let a = replay(&final_model, recording, 1e-5, n);
@@ -1114,81 +914,24 @@ pub fn diagnose_with(
     });
     let (before, after) = (before?, after?);
     let after_residual = difference(&recording.force, &after.force);
-    let after_errors = errors(&after, recording, &training);
-    let split = pressure_noise.and_then(|pn| pressure_split(&final_model, recording, &after, noise, pn));
+    let after_errors = errors(&after, recording, training);
+    let split = cx
+        .pressure_noise
+        .and_then(|pn| pressure_split(&final_model, recording, &after, noise, pn));
     let chain = ChainSignals::new(&final_model, recording, &after);
     let remainder = Signature::of(&recording.time, &after_residual, &chain, "N");
-    let explained = after_errors.heldout_rms <= EXPLAINED_WITHIN_NOISE * noise;
-    // The force is the verdict's channel; pressures that depart while the force does not
-    // (a pressure transducer, say) still get their place and signature.
-    let pressures_off = split
-        .as_ref()
-        .map_or(false, |s| s.pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE));
-    let unexplained = (!explained || pressures_off && localization.is_some()).then(|| {
-        let (location, family, alternatives) = match &localization {
-            Some(l) => (l.location, l.family, l.alternatives()),
-            None => ("unknown", "unknown", vec![]),
-        };
-        let ratio = after_errors.heldout_rms / noise.max(1e-12);
-        let place = if location == "unknown" {
-            "no candidate place in the chain explains a good part of it".to_string()
-        } else {
-            let share = localization
-                .as_ref()
-                .and_then(|l| l.best_at(location))
-                .map_or(0.0, |s| s.explained);
-            format!(
-                "the model departs most likely at the {location} ({family}: a correction there explains {:.0} % of the held-out misfit){}",
-                100.0 * share,
-                if alternatives.is_empty() {
-                    String::new()
-                } else {
-                    format!(", though the {} explain nearly as much", alternatives.join(" and the "))
-                }
-            )
-        };
-        let (sentence, signature) = if explained {
-            let s = split.as_ref().expect("pressures_off needs the split");
-            let worse = if s.pressure_ratio[0] >= s.pressure_ratio[1] { 0 } else { 1 };
-            let measured = if worse == 0 { &recording.p1 } else { &recording.p2 };
-            let modelled = if worse == 0 { &after.p1 } else { &after.p2 };
-            let residual = difference(measured.as_ref().expect("pressures"), modelled);
-            let signature = Signature::of(&recording.time, &residual, &chain, "Pa");
-            (
-                format!(
-                    "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's by {:.0} and {:.0} Pa RMS ({:.1}× and {:.1}× their noise); {place}. Chamber {}: {}",
-                    after_errors.heldout_rms,
-                    s.pressure_rms[0],
-                    s.pressure_rms[1],
-                    s.pressure_ratio[0],
-                    s.pressure_ratio[1],
-                    worse + 1,
-                    signature.sentence
-                ),
-                signature,
-            )
-        } else {
-            (
-                format!(
-                    "A held-out force error of {:.4} N ({ratio:.1}× the noise floor) stays; {place}. {}",
-                    after_errors.heldout_rms, remainder.sentence
-                ),
-                remainder.clone(),
-            )
-        };
-        Unexplained {
-            rms: after_errors.heldout_rms,
-            ratio_to_noise: ratio,
-            location,
-            family,
-            alternatives,
-            sentence,
-            signature,
-        }
-    });
+    let unexplained = what_stays_unexplained(
+        cx,
+        &found.localization,
+        &after,
+        &after_errors,
+        split.as_ref(),
+        &chain,
+        &remainder,
+    );
     let heldout_residual: Vec<f64> = after_residual
         .iter()
-        .zip(&training)
+        .zip(training)
         .filter(|(_, &m)| !m)
         .map(|(r, _)| *r)
         .collect();
@@ -1200,23 +943,109 @@ pub fn diagnose_with(
     Ok(Diagnosis {
         samples: n,
         noise_floor: noise,
-        pressure_noise,
+        pressure_noise: cx.pressure_noise,
         input_checks,
-        before: errors(&before, recording, &training),
+        before: errors(&before, recording, training),
         after: after_errors,
         calibrated,
-        effects,
-        discovered,
-        joint_refit: joint,
-        candidates: first_candidates,
-        localization,
+        effects: found.effects,
+        discovered: found.discovered,
+        joint_refit,
+        candidates: found.first_candidates,
+        localization: found.localization,
         pressure_split: split,
         unexplained,
         residual_tests,
-        parameters: params,
+        parameters: found.params,
         before_force: before.force,
         after_force: after.force,
         replays,
+    })
+}
+
+/// Explained when the held-out force error is within its noise; otherwise, or when the
+/// pressures depart while the force does not, the remainder: its place and signature.
+fn what_stays_unexplained(
+    cx: &Context,
+    localization: &Option<Localization>,
+    after: &Replay,
+    after_errors: &Errors,
+    split: Option<&PressureSplit>,
+    chain: &ChainSignals,
+    remainder: &Signature,
+) -> Option<Unexplained> {
+    let noise = cx.noise;
+    let explained = after_errors.heldout_rms <= EXPLAINED_WITHIN_NOISE * noise;
+    // The force is the verdict's channel; pressures that depart while the force does not
+    // (a pressure transducer, say) still get their place and signature.
+    let pressures_off = split.map_or(false, |s| s.pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE));
+    if explained && !(pressures_off && localization.is_some()) {
+        return None;
+    }
+    let (location, family, alternatives) = match localization {
+        Some(l) => (l.location, l.family, l.alternatives()),
+        None => ("unknown", "unknown", vec![]),
+    };
+    let ratio = after_errors.heldout_rms / noise.max(1e-12);
+    let place = if location == "unknown" {
+        "no candidate place in the chain explains a good part of it".to_string()
+    } else {
+        let share = localization
+            .as_ref()
+            .and_then(|l| l.best_at(location))
+            .map_or(0.0, |s| s.explained);
+        format!(
+            "the model departs most likely at the {location} ({family}: a correction there explains {:.0} % of the held-out misfit){}",
+            100.0 * share,
+            if alternatives.is_empty() {
+                String::new()
+            } else {
+                format!(", though the {} explain nearly as much", alternatives.join(" and the "))
+            }
+        )
+    };
+    let (sentence, signature) = if explained {
+        let s = split.expect("pressures_off needs the split");
+        let recording = cx.recording;
+        let worse = if s.pressure_ratio[0] >= s.pressure_ratio[1] {
+            0
+        } else {
+            1
+        };
+        let measured = if worse == 0 { &recording.p1 } else { &recording.p2 };
+        let modelled = if worse == 0 { &after.p1 } else { &after.p2 };
+        let residual = difference(measured.as_ref().expect("pressures"), modelled);
+        let signature = Signature::of(&recording.time, &residual, chain, "Pa");
+        (
+            format!(
+                "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's by {:.0} and {:.0} Pa RMS ({:.1}× and {:.1}× their noise); {place}. Chamber {}: {}",
+                after_errors.heldout_rms,
+                s.pressure_rms[0],
+                s.pressure_rms[1],
+                s.pressure_ratio[0],
+                s.pressure_ratio[1],
+                worse + 1,
+                signature.sentence
+            ),
+            signature,
+        )
+    } else {
+        (
+            format!(
+                "A held-out force error of {:.4} N ({ratio:.1}× the noise floor) stays; {place}. {}",
+                after_errors.heldout_rms, remainder.sentence
+            ),
+            remainder.clone(),
+        )
+    };
+    Some(Unexplained {
+        rms: after_errors.heldout_rms,
+        ratio_to_noise: ratio,
+        location,
+        family,
+        alternatives,
+        sentence,
+        signature,
     })
 }
 

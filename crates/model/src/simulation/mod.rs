@@ -502,170 +502,138 @@ impl Simulation {
     /// Integrate `duration` seconds with the command `v` + `v_rate`·s seen by the current
     /// driver; the stopper moves at `x_s_rate`.
     fn advance(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<(), StepFailure> {
-        let t0 = self.time;
-        let t_end = t0 + duration;
         let outcome = match (self.method, &self.propagator) {
-            (Method::Split, Some(propagator)) => {
-                let trajectory = propagator.trajectory(&self.electromechanical_state(), v, v_rate, &self.plays);
-                let pressures = SVector::<f64, 2>::new(self.state[index::P1], self.state[index::P2]);
-                let start_position = self.state[index::JET_POSITION];
-                let system = ChamberSystem::new(
-                    &self.model,
-                    &trajectory,
-                    duration,
-                    start_position,
-                    self.known_chamber_rates().map(|end| (end.pressures, end.rates)),
-                    self.x_s,
-                    self.x_s_rate,
-                );
-                let scale = self.model.state_scales();
-                let tolerances = Tolerances {
-                    relative: self.local_tolerance(),
-                    absolute: SVector::<f64, 2>::new(scale[index::P1], scale[index::P2]) * self.local_tolerance(),
-                };
-                let combine = |s: f64, p: SVector<f64, 2>| {
-                    let em = trajectory.state(s);
-                    State::from([em.current, em.position, em.velocity, em.acceleration, p[0], p[1]])
-                };
-                let ringing_until = self.ringing_until(&system, &trajectory, duration);
-                let changed = self.input_changed || v_rate != 0.0 || self.x_s_rate != 0.0;
-                if changed {
-                    self.chamber_integrator.next_step =
-                        self.chamber_integrator.next_step.min(2.0 * self.step_after_change);
-                }
-                let method = self.chamber_method;
-                let integrate = |integrator: &mut Sdirk4,
-                                 pair: ExplicitPair,
-                                 from: f64,
-                                 p: SVector<f64, 2>,
-                                 to: f64,
-                                 statistics: &mut Statistics| match method {
-                    ChamberMethod::NonStiffFirst | ChamberMethod::DormandPrinceOnly => {
-                        integrator.integrate_nonstiff_first(pair, &system, from, p, to, &tolerances, statistics)
-                    }
-                    ChamberMethod::Sdirk4 => integrator.integrate(&system, from, p, to, &tolerances, statistics),
-                };
-                let result = if ringing_until > 0.0 {
-                    // While the jet pipe rings enough to matter, Dormand–Prince's steps stay
-                    // below a quarter of its period: a longer step samples the 295 Hz forcing
-                    // too sparsely for its embedded estimate to notice what it misses.
-                    // Verner's estimate holds up to a whole period, so a ringing stretch
-                    // longer than the cap and at most a period takes Verner's steps, as
-                    // long as its error allows: the chirp's 1 ms inputs (0.85 ms and the
-                    // rest under the cap) take one, 8 right-hand sides, not 12; the closed
-                    // loop's 2 ms about two, where the current's transient sets the size.
-                    let (_, period) = trajectory.ringing_decay_and_period();
-                    let quarter = 0.25 * period;
-                    let (pair, cap) = if method == ChamberMethod::NonStiffFirst
-                        && ringing_until > quarter
-                        && ringing_until <= 4.0 * quarter
-                    {
-                        (ExplicitPair::Verner, period)
-                    } else {
-                        (ExplicitPair::DormandPrince, quarter)
-                    };
-                    let unlimited = self.chamber_integrator.max_step;
-                    self.chamber_integrator.max_step = cap.min(unlimited);
-                    let t_split = ringing_until;
-                    let first = integrate(
-                        &mut self.chamber_integrator,
-                        pair,
-                        0.0,
-                        pressures,
-                        t_split,
-                        &mut self.statistics,
-                    );
-                    self.chamber_integrator.max_step = unlimited;
-                    match first {
-                        Ok(p) if ringing_until < duration => integrate(
-                            &mut self.chamber_integrator,
-                            ExplicitPair::DormandPrince,
-                            t_split,
-                            p,
-                            duration,
-                            &mut self.statistics,
-                        ),
-                        other => other,
-                    }
-                } else {
-                    integrate(
-                        &mut self.chamber_integrator,
-                        ExplicitPair::DormandPrince,
-                        0.0,
-                        pressures,
-                        duration,
-                        &mut self.statistics,
-                    )
-                };
-                if changed {
-                    self.step_after_change = self.chamber_integrator.first_step;
-                }
-                if self.model.hysteresis.is_active() {
-                    let reached = match &result {
-                        Ok(_) => duration,
-                        Err(f) => f.time,
-                    };
-                    let plays = trajectory.plays_at(reached);
-                    if plays.iter().all(|p| p.is_finite()) {
-                        self.plays = plays;
-                    }
-                }
-                self.chamber_rates_at_end = None;
-                match result {
-                    Ok(p) => {
-                        let mut end = combine(duration, p);
-                        // The position the chambers' last stage saw (the trajectory's own
-                        // value at the end agrees to rounding): with it the state is the
-                        // last stage's, and its rates are the next step's at its start.
-                        if let Some((x_jp, pressures, rates)) = system.end_rates.get().filter(|(_, q, _)| *q == p) {
-                            end[index::JET_POSITION] = x_jp;
-                            self.chamber_rates_at_end = Some(ChamberRatesAtEnd {
-                                x_jp,
-                                pressures,
-                                x_s: self.x_s + self.x_s_rate * duration,
-                                x_s_rate: self.x_s_rate,
-                                rates,
-                            });
-                        }
-                        Ok(end)
-                    }
-                    Err(f) => Err(IntegrationFailure {
-                        message: f.message,
-                        time: t0 + f.time,
-                        state: combine(f.time, f.state),
-                    }),
-                }
-            }
-            _ => {
-                let system = StepSystem {
-                    model: &self.model,
-                    t0,
-                    v_da: v,
-                    v_da_rate: v_rate,
-                    x_s: self.x_s,
-                    x_s_rate: self.x_s_rate,
-                    plays: self.hysteresis_plays(),
-                };
-                let tolerances = self.tolerances();
-                let result =
-                    self.integrator
-                        .integrate(&system, t0, self.state, t_end, &tolerances, &mut self.statistics);
-                if self.model.hysteresis.is_active() {
-                    // Plays follow the static position monotonically within the step.
-                    let y = match &result {
-                        Ok(y) => *y,
-                        Err(f) => f.state,
-                    };
-                    let x_bar = self.model.static_jet_position(y[index::CURRENT]);
-                    self.model.hysteresis.advance(&mut self.plays, x_bar);
-                }
-                result
-            }
+            (Method::Split, Some(_)) => self.split_step(duration, v, v_rate),
+            _ => self.monolithic_step(duration, v, v_rate),
         };
+        self.settle(outcome, duration)
+    }
+
+    /// The split method's step: the jet pipe's exact trajectory drives the chambers, whose
+    /// two pressures alone are integrated.
+    fn split_step(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<State, IntegrationFailure<N_STATES>> {
+        let t0 = self.time;
+        let propagator = self.propagator.as_ref().expect("the split method has a propagator");
+        let trajectory = propagator.trajectory(&self.electromechanical_state(), v, v_rate, &self.plays);
+        let pressures = SVector::<f64, 2>::new(self.state[index::P1], self.state[index::P2]);
+        let start_position = self.state[index::JET_POSITION];
+        let system = ChamberSystem::new(
+            &self.model,
+            &trajectory,
+            duration,
+            start_position,
+            self.known_chamber_rates().map(|end| (end.pressures, end.rates)),
+            self.x_s,
+            self.x_s_rate,
+        );
+        let scale = self.model.state_scales();
+        let tolerances = Tolerances {
+            relative: self.local_tolerance(),
+            absolute: SVector::<f64, 2>::new(scale[index::P1], scale[index::P2]) * self.local_tolerance(),
+        };
+        let combine = |s: f64, p: SVector<f64, 2>| {
+            let em = trajectory.state(s);
+            State::from([em.current, em.position, em.velocity, em.acceleration, p[0], p[1]])
+        };
+        let ringing_until = self.ringing_until(&system, &trajectory, duration);
+        let changed = self.input_changed || v_rate != 0.0 || self.x_s_rate != 0.0;
+        if changed {
+            self.chamber_integrator.next_step = self.chamber_integrator.next_step.min(2.0 * self.step_after_change);
+        }
+        let result = integrate_chambers(
+            &mut self.chamber_integrator,
+            &mut self.statistics,
+            self.chamber_method,
+            &system,
+            &tolerances,
+            pressures,
+            duration,
+            ringing_until,
+        );
+        if changed {
+            self.step_after_change = self.chamber_integrator.first_step;
+        }
+        if self.model.hysteresis.is_active() {
+            let reached = match &result {
+                Ok(_) => duration,
+                Err(f) => f.time,
+            };
+            let plays = trajectory.plays_at(reached);
+            if plays.iter().all(|p| p.is_finite()) {
+                self.plays = plays;
+            }
+        }
+        self.chamber_rates_at_end = None;
+        match result {
+            Ok(p) => {
+                let mut end = combine(duration, p);
+                // The position the chambers' last stage saw (the trajectory's own value at
+                // the end agrees to rounding): with it the state is the last stage's, and its
+                // rates are the next step's at its start.
+                if let Some((x_jp, pressures, rates)) = system.end_rates.get().filter(|(_, q, _)| *q == p) {
+                    end[index::JET_POSITION] = x_jp;
+                    self.chamber_rates_at_end = Some(ChamberRatesAtEnd {
+                        x_jp,
+                        pressures,
+                        x_s: self.x_s + self.x_s_rate * duration,
+                        x_s_rate: self.x_s_rate,
+                        rates,
+                    });
+                }
+                Ok(end)
+            }
+            Err(f) => Err(IntegrationFailure {
+                message: f.message,
+                time: t0 + f.time,
+                state: combine(f.time, f.state),
+            }),
+        }
+    }
+
+    /// The monolithic method's step: all six states integrated together.
+    fn monolithic_step(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<State, IntegrationFailure<N_STATES>> {
+        let t0 = self.time;
+        let system = StepSystem {
+            model: &self.model,
+            t0,
+            v_da: v,
+            v_da_rate: v_rate,
+            x_s: self.x_s,
+            x_s_rate: self.x_s_rate,
+            plays: self.hysteresis_plays(),
+        };
+        let tolerances = self.tolerances();
+        let result = self.integrator.integrate(
+            &system,
+            t0,
+            self.state,
+            t0 + duration,
+            &tolerances,
+            &mut self.statistics,
+        );
+        if self.model.hysteresis.is_active() {
+            // Plays follow the static position monotonically within the step.
+            let y = match &result {
+                Ok(y) => *y,
+                Err(f) => f.state,
+            };
+            let x_bar = self.model.static_jet_position(y[index::CURRENT]);
+            self.model.hysteresis.advance(&mut self.plays, x_bar);
+        }
+        result
+    }
+
+    /// Take a step's end state, or on a failure its last accepted one with the inputs moved
+    /// on as far.
+    fn settle(
+        &mut self,
+        outcome: Result<State, IntegrationFailure<N_STATES>>,
+        duration: f64,
+    ) -> Result<(), StepFailure> {
         match outcome {
             Ok(y) => {
                 self.state = y;
-                self.time = t_end;
+                self.time += duration;
                 self.x_s += self.x_s_rate * duration;
                 Ok(())
             }
@@ -711,6 +679,72 @@ impl Simulation {
 
     fn hysteresis_plays(&self) -> Option<[f64; PLAY_OPERATORS]> {
         self.model.hysteresis.is_active().then_some(self.plays)
+    }
+}
+
+/// Integrate the chambers over a step of `duration`. While the jet pipe rings (until
+/// `ringing_until`), the explicit pairs' steps are capped by its period.
+fn integrate_chambers(
+    integrator: &mut Sdirk4,
+    statistics: &mut Statistics,
+    method: ChamberMethod,
+    system: &ChamberSystem,
+    tolerances: &Tolerances<2>,
+    pressures: SVector<f64, 2>,
+    duration: f64,
+    ringing_until: f64,
+) -> Result<SVector<f64, 2>, IntegrationFailure<2>> {
+    let integrate = |integrator: &mut Sdirk4,
+                     pair: ExplicitPair,
+                     from: f64,
+                     p: SVector<f64, 2>,
+                     to: f64,
+                     statistics: &mut Statistics| match method {
+        ChamberMethod::NonStiffFirst | ChamberMethod::DormandPrinceOnly => {
+            integrator.integrate_nonstiff_first(pair, system, from, p, to, tolerances, statistics)
+        }
+        ChamberMethod::Sdirk4 => integrator.integrate(system, from, p, to, tolerances, statistics),
+    };
+    if ringing_until > 0.0 {
+        // While the jet pipe rings enough to matter, Dormand–Prince's steps stay below a
+        // quarter of its period: a longer step samples the 295 Hz forcing too sparsely for its
+        // embedded estimate to notice what it misses. Verner's estimate holds up to a whole
+        // period, so a ringing stretch longer than the cap and at most a period takes Verner's
+        // steps, as long as its error allows: the chirp's 1 ms inputs (0.85 ms and the rest
+        // under the cap) take one, 8 right-hand sides, not 12; the closed loop's 2 ms about
+        // two, where the current's transient sets the size.
+        let (_, period) = system.trajectory.ringing_decay_and_period();
+        let quarter = 0.25 * period;
+        let (pair, cap) =
+            if method == ChamberMethod::NonStiffFirst && ringing_until > quarter && ringing_until <= 4.0 * quarter {
+                (ExplicitPair::Verner, period)
+            } else {
+                (ExplicitPair::DormandPrince, quarter)
+            };
+        let unlimited = integrator.max_step;
+        integrator.max_step = cap.min(unlimited);
+        let first = integrate(integrator, pair, 0.0, pressures, ringing_until, statistics);
+        integrator.max_step = unlimited;
+        match first {
+            Ok(p) if ringing_until < duration => integrate(
+                integrator,
+                ExplicitPair::DormandPrince,
+                ringing_until,
+                p,
+                duration,
+                statistics,
+            ),
+            other => other,
+        }
+    } else {
+        integrate(
+            integrator,
+            ExplicitPair::DormandPrince,
+            0.0,
+            pressures,
+            duration,
+            statistics,
+        )
     }
 }
 

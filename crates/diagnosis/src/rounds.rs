@@ -1,0 +1,493 @@
+//! Steps 3–5 of the crate's account, repeated: replay the current model, localize the
+//! departure, and add the named effect that earns its name there, or else a discovered
+//! term that the replay confirms.
+
+use super::*;
+
+/// What the rounds found: the model's parameters with every effect and term added.
+pub(crate) struct Findings {
+    pub params: Parameters,
+    pub effects: Vec<AddedEffect>,
+    pub discovered: Vec<DiscoveredTerm>,
+    /// The first round's scored candidates, for the report.
+    pub first_candidates: Vec<Scored>,
+    /// Where the departure left unexplained sits (none when every channel is within its noise).
+    pub localization: Option<Localization>,
+}
+
+/// One round's replay of the current model and how far it is from the recording.
+struct Round {
+    model: Actuator,
+    current: Replay,
+    heldout: [f64; CHANNELS],
+    /// Held-out samples.
+    count: f64,
+    force_before: f64,
+    pressures_agree: bool,
+    candidates: Vec<Candidate>,
+}
+
+/// What a round adds to the model.
+enum Addition {
+    /// A named effect with its signature's sentence.
+    Named(Scored, String),
+    /// A discovered term with the parameters that carry it.
+    Discovered(DiscoveredTerm, Box<Parameters>),
+}
+
+pub(crate) fn run_rounds(
+    cx: &Context,
+    params: Parameters,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Findings, String> {
+    let mut f = Findings {
+        params,
+        effects: vec![],
+        discovered: vec![],
+        first_candidates: vec![],
+        localization: None,
+    };
+    // An effect added on the force side of the piston leaves the pressures, and so the
+    // upstream places' scores, as they were.
+    let mut reusable: Option<Localization> = None;
+    for round in 0..=MAX_EFFECTS {
+        let problem = Problem::new(cx.recording, &f.params, &cx.training, cx.channel_noise);
+        let Some(r) = replay_round(cx, &problem, &f, round, replays, progress)? else {
+            progress("every channel is within its noise on the held-out blocks");
+            f.localization = None;
+            break;
+        };
+        let found = match reusable.take() {
+            Some(previous) => {
+                progress("the pressures are as before: the places upstream keep their scores");
+                let mut kept: Vec<Scored> = previous
+                    .candidates
+                    .into_iter()
+                    .filter(|s| !f.effects.iter().any(|e| Some(e.name) == s.fit.candidate.named))
+                    .collect();
+                rank(&mut kept)
+            }
+            None => {
+                let (found, used) = localize(&problem, &r.current, &r.candidates, cx.options, progress);
+                *replays += used;
+                found
+            }
+        };
+        if round == 0 {
+            f.first_candidates = found.candidates.clone();
+        }
+        let added = if round < MAX_EFFECTS {
+            find_addition(cx, &r, &problem, &found, &f, replays, progress)?
+        } else {
+            None
+        };
+        match added {
+            Some(Addition::Discovered(term, trial)) => {
+                f.discovered.push(term);
+                f.params = *trial;
+                reusable = None;
+            }
+            Some(Addition::Named(s, sentence)) => {
+                if s.fit.candidate.location != found.location && cx.pressure_noise.is_some() {
+                    reusable = Some(found.clone());
+                }
+                let effect = add_effect(cx, &mut f.params, &r, &found, s, sentence, progress)?;
+                f.effects.push(effect);
+            }
+            None => {
+                f.localization = Some(found);
+                break;
+            }
+        }
+    }
+    Ok(f)
+}
+
+/// Replay the current model; `None` when every channel is within its noise held out.
+fn replay_round(
+    cx: &Context,
+    problem: &Problem,
+    f: &Findings,
+    round: usize,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<Round>, String> {
+    let recording = cx.recording;
+    let model = Actuator::new(f.params.clone())?;
+    let current = replay_fast(&model, recording, cx.n)?;
+    *replays += 1;
+    let prediction = [current.force.clone(), current.p1.clone(), current.p2.clone()];
+    let (_, heldout) = problem.errors(&prediction);
+    let count = heldout_count(&cx.training) as f64;
+    let misfit: Vec<f64> = (0..CHANNELS)
+        .filter(|&c| problem.weights[c] > 0.0)
+        .map(|c| (heldout[c] / count).sqrt())
+        .collect();
+    if misfit.iter().all(|m| *m <= EXPLAINED_WITHIN_NOISE) {
+        return Ok(None);
+    }
+    let force_residual = difference(&recording.force, &current.force);
+    let line = signature::spectrum(&recording.time, &force_residual);
+    let periodic =
+        (line.peak_over_median > 100.0 && line.low_share < 0.5 && line.peak_hz > 0.2).then_some(line.peak_hz);
+    // Pressures within their noise: nothing upstream of the piston departs by more
+    // than they can show, and only the mechanics and the force sensor are fitted.
+    let pressures_agree = problem.weights[1] > 0.0
+        && problem.weights[2] > 0.0
+        && (1..CHANNELS).all(|c| (heldout[c] / count).sqrt() <= EXPLAINED_WITHIN_NOISE);
+    let candidates: Vec<Candidate> = catalogue(&f.params, cx.pressure_noise.is_some(), periodic)
+        .into_iter()
+        .filter(|c| !f.effects.iter().any(|e| Some(e.name) == c.named))
+        .filter(|c| !pressures_agree || matches!(c.location, "mechanics" | "force_sensor"))
+        .collect();
+    progress(&format!(
+        "round {}: held-out misfit {} noise floors",
+        round + 1,
+        misfit
+            .iter()
+            .zip(CHANNEL_NAMES)
+            .map(|(m, name)| format!("{name} {m:.1}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    let force_before = rms_where(&force_residual, &cx.training, false);
+    Ok(Some(Round {
+        model,
+        current,
+        heldout,
+        count,
+        force_before,
+        pressures_agree,
+        candidates,
+    }))
+}
+
+/// Named effects are the hypotheses tried first: once a term outside them has been added,
+/// a named effect found later may be absorbing what that term's form misses, and only those
+/// whose own signature is tested in the residual (friction, the sensor's offset and gain,
+/// hysteresis) are still tried.
+fn nameable(s: &Scored, discovered: &[DiscoveredTerm]) -> bool {
+    s.fit
+        .candidate
+        .named
+        .map_or(false, |name| discovered.is_empty() || named::has_signature_test(name))
+}
+
+/// The round's addition, in the order of preference: a named effect at the located place,
+/// one downstream of the pressures, a discovered term at the located place.
+fn find_addition(
+    cx: &Context,
+    r: &Round,
+    problem: &Problem,
+    found: &Localization,
+    f: &Findings,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<Addition>, String> {
+    let place = found.location;
+    if place != "unknown" {
+        if let Some((s, sentence)) = named_at_place(cx, r, problem, found, &f.discovered, progress) {
+            return Ok(Some(Addition::Named(s, sentence)));
+        }
+    }
+    if !r.pressures_agree {
+        if let Some((s, sentence)) = named_downstream(cx, r, &f.params, &f.discovered, replays, progress)? {
+            return Ok(Some(Addition::Named(s, sentence)));
+        }
+    }
+    if place != "unknown" {
+        if let Some((term, trial)) = discover_term(cx, r, problem, found, &f.params, replays, progress)? {
+            return Ok(Some(Addition::Discovered(term, Box::new(trial))));
+        }
+    }
+    Ok(None)
+}
+
+/// The best named effect at the located place that earns its name (step 5), judged on the
+/// fitted prediction.
+fn named_at_place(
+    cx: &Context,
+    r: &Round,
+    problem: &Problem,
+    found: &Localization,
+    discovered: &[DiscoveredTerm],
+    progress: &mut dyn FnMut(&str),
+) -> Option<(Scored, String)> {
+    let (place, count, force_before, noise) = (found.location, r.count, r.force_before, cx.noise);
+    let place_share = found.best_at(place).map_or(0.0, |s| s.explained);
+    let mut named: Vec<&Scored> = found
+        .candidates
+        .iter()
+        .filter(|s| s.fit.candidate.location == place)
+        .filter(|s| nameable(s, discovered))
+        .collect();
+    named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
+    for s in named {
+        let name = s.fit.candidate.named.expect("filtered on named");
+        let gain = force_before - s.force_heldout_rms;
+        let worse_pressures =
+            (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
+        let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share && s.explained >= NAMED_MIN_SHARE;
+        let gain_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
+        let test = named_signature(
+            name,
+            cx.recording,
+            &r.model,
+            &r.current,
+            &cx.training,
+            noise,
+            cx.mechanical_noise,
+        );
+        progress(&format!(
+            "  {name}: explains {:.1} % (its place {:.1} %), force held-out {force_before:.4} -> {:.4} N, signature {}",
+            100.0 * s.explained,
+            100.0 * place_share,
+            s.force_heldout_rms,
+            if test.present { "present" } else { "absent" }
+        ));
+        if !test.sentence.is_empty() {
+            progress(&format!("    {}", test.sentence));
+        }
+        if share_ok && gain_ok && !worse_pressures && test.present {
+            return Some((s.clone(), test.sentence));
+        }
+    }
+    None
+}
+
+/// With pressures, the mechanics and the force sensor are judged on the force against the
+/// pressures, where an upstream departure does not reach: a second effect there is found
+/// even while a larger one upstream dominates the misfit. (With the pressures within their
+/// noise the round's candidates were these already.) Judged on the replay.
+fn named_downstream(
+    cx: &Context,
+    r: &Round,
+    params: &Parameters,
+    discovered: &[DiscoveredTerm],
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<(Scored, String)>, String> {
+    let (recording, count, force_before, noise) = (cx.recording, r.count, r.force_before, cx.noise);
+    let Some(through) = force_through_mechanics(&r.model, recording) else {
+        return Ok(None);
+    };
+    let downstream = Problem::new(recording, params, &cx.training, [cx.mechanical_noise, 0.0, 0.0]);
+    let (_, misfit) = downstream.errors(&[through.force.clone(), vec![], vec![]]);
+    if (misfit[FORCE] / count).sqrt() <= EXPLAINED_WITHIN_NOISE {
+        return Ok(None);
+    }
+    let near: Vec<Candidate> = r
+        .candidates
+        .iter()
+        .filter(|c| matches!(c.location, "mechanics" | "force_sensor"))
+        .cloned()
+        .collect();
+    progress("the force departs from the pressures too: the mechanics and the force sensor on their own");
+    let (side, used) = localize(&downstream, &through, &near, cx.options, progress);
+    *replays += used;
+    let side_share = side.best_at(side.location).map_or(0.0, |s| s.explained);
+    let mut named: Vec<&Scored> = side
+        .candidates
+        .iter()
+        .filter(|s| s.fit.candidate.location == side.location)
+        .filter(|s| nameable(s, discovered))
+        .collect();
+    named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
+    for s in named {
+        let name = s.fit.candidate.named.expect("filtered on named");
+        let mut trial = params.clone();
+        if apply_named(&mut trial, s).is_err() {
+            continue;
+        }
+        let with = replay_fast(&Actuator::new(trial)?, recording, cx.n)?;
+        *replays += 1;
+        let after = rms_where(&difference(&recording.force, &with.force), &cx.training, false);
+        let gain = force_before - after;
+        let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * side_share && s.explained >= NAMED_MIN_SHARE;
+        let gain_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
+        let test = named_signature(
+            name,
+            recording,
+            &r.model,
+            &r.current,
+            &cx.training,
+            noise,
+            cx.mechanical_noise,
+        );
+        progress(&format!(
+            "  {name}: explains {:.1} % of the force against the pressures, force held-out {force_before:.4} -> {after:.4} N, signature {}",
+            100.0 * s.explained,
+            if test.present { "present" } else { "absent" }
+        ));
+        if share_ok && gain_ok && test.present {
+            let mut s = s.clone();
+            s.force_heldout_rms = after;
+            s.fit.prediction[FORCE] = with.force;
+            return Ok(Some((s, test.sentence)));
+        }
+    }
+    Ok(None)
+}
+
+/// No named effect fits: the place's own best candidates that the FMU can carry, each kept
+/// only if the model with it (replayed, not predicted) is better on the held-out blocks by
+/// more than a noise floor and by more than its parameters' BIC penalty, and no pressure
+/// channel gets worse.
+fn discover_term(
+    cx: &Context,
+    r: &Round,
+    problem: &Problem,
+    found: &Localization,
+    params: &Parameters,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<(DiscoveredTerm, Parameters)>, String> {
+    let (recording, count, force_before, noise) = (cx.recording, r.count, r.force_before, cx.noise);
+    let mut at_place: Vec<&Scored> = found
+        .candidates
+        .iter()
+        .filter(|s| s.fit.candidate.location == found.location && s.fit.candidate.named.is_none())
+        .filter(|s| s.explained >= LOCATED_SHARE)
+        .collect();
+    at_place.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
+    let before_total: f64 = r.heldout.iter().sum();
+    for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
+        let label = s.fit.candidate.label;
+        let penalty = used_terms(s) * count.ln();
+        let worse_pressures =
+            (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
+        if worse_pressures || before_total - s.fit.heldout_total() < penalty {
+            progress(&format!(
+                "  {label}: not better than its parameters' penalty, or worse in a pressure"
+            ));
+            continue;
+        }
+        let Some(set) = discover::model_terms(&s.fit.candidate, &s.fit.values, params, problem) else {
+            progress(&format!("  {label}: the FMU has no parameters for it"));
+            continue;
+        };
+        let mut trial = params.clone();
+        if set
+            .iter()
+            .any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
+            || trial.validate().is_err()
+        {
+            continue;
+        }
+        let with = replay_fast(&Actuator::new(trial.clone())?, recording, cx.n)?;
+        *replays += 1;
+        let residual = difference(&recording.force, &with.force);
+        let after = rms_where(&residual, &cx.training, false);
+        let gain = force_before - after;
+        progress(&format!(
+            "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
+        ));
+        let pressures = if s.fit.candidate.location == "pressure_sensors" {
+            pressures_judgement(cx, r, problem, &with, after, progress, label)
+        } else {
+            None
+        };
+        if pressures.is_some() || (gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise) {
+            let candidate = &s.fit.candidate;
+            progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
+            let term = DiscoveredTerm {
+                location: candidate.location,
+                family: candidate.family,
+                candidate: candidate.label,
+                reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+                parameters: set,
+                heldout_before: force_before,
+                heldout_after: after,
+                share: 1.0 - (after / force_before).powi(2),
+                pressures_heldout: pressures,
+            };
+            return Ok(Some((term, trial)));
+        }
+    }
+    Ok(None)
+}
+
+/// A pressure transducer's term leaves the force as it is: it is judged on the pressures,
+/// by the same rule in their noise, and must leave the force no worse. When it passes, the
+/// held-out RMS of each pressure before and after, Pa.
+fn pressures_judgement(
+    cx: &Context,
+    r: &Round,
+    problem: &Problem,
+    with: &Replay,
+    after: f64,
+    progress: &mut dyn FnMut(&str),
+    label: &str,
+) -> Option<([f64; 2], [f64; 2])> {
+    let recording = cx.recording;
+    let (_, replayed) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
+    let in_noise = |h: &[f64; CHANNELS]| ((h[1] + h[2]) / r.count).sqrt();
+    let (was, now) = (in_noise(&r.heldout), in_noise(&replayed));
+    progress(&format!(
+        "  {label}: in the model, pressures held-out {was:.2} -> {now:.2} noise floors"
+    ));
+    let rms_pa = |series: [&[f64]; 2]| {
+        let measured = [recording.p1.as_deref(), recording.p2.as_deref()];
+        [0, 1].map(|c| measured[c].map_or(0.0, |m| rms_where(&difference(m, series[c]), &cx.training, false)))
+    };
+    let better = was - now >= MIN_RELATIVE_GAIN * was
+        && was - now >= MIN_GAIN_IN_NOISE
+        && after <= r.force_before + 0.05 * cx.noise;
+    better.then(|| (rms_pa([&r.current.p1, &r.current.p2]), rms_pa([&with.p1, &with.p2])))
+}
+
+/// Add the named effect to the model and write down its evidence.
+fn add_effect(
+    cx: &Context,
+    params: &mut Parameters,
+    r: &Round,
+    found: &Localization,
+    s: Scored,
+    signature_sentence: String,
+    progress: &mut dyn FnMut(&str),
+) -> Result<AddedEffect, String> {
+    let (force_before, noise) = (r.force_before, cx.noise);
+    let place = s.fit.candidate.location;
+    let downstream = place != found.location;
+    let place_share = if downstream {
+        s.explained
+    } else {
+        found.best_at(found.location).map_or(0.0, |s| s.explained)
+    };
+    let name = s.fit.candidate.named.expect("a named candidate");
+    let set = apply_named(params, &s)?;
+    let remainder = difference(&cx.recording.force, &s.fit.prediction[FORCE]);
+    let chain = ChainSignals::new(&r.model, cx.recording, &r.current);
+    let follows = Signature::of(&cx.recording.time, &remainder, &chain, "N");
+    let top = follows.follows.first();
+    let share = 1.0 - (s.force_heldout_rms / force_before).powi(2);
+    let values: Vec<String> = set.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
+    let evidence = format!(
+        "Of the places in the chain, the {place} explains the most of the held-out misfit{} ({:.1} %), and {name} {:.1} % of it{}. Fitted on the training blocks ({}), it lowers the held-out force error from {force_before:.4} N to {:.4} N (noise floor {noise:.4} N), {:.1} % of its mean square.",
+        if downstream { " of the force against the pressures" } else { "" },
+        100.0 * place_share,
+        100.0 * s.explained,
+        if signature_sentence.is_empty() {
+            String::new()
+        } else {
+            format!("; {signature_sentence}")
+        },
+        values.join(", "),
+        s.force_heldout_rms,
+        100.0 * share
+    );
+    progress(&format!("adding {name}"));
+    Ok(AddedEffect {
+        name,
+        location: place,
+        parameters: set,
+        evidence,
+        heldout_before: force_before,
+        heldout_after: s.force_heldout_rms,
+        share,
+        remainder_follows: top
+            .map(|f| format!("{} (η² = {:.2})", f.signal, f.eta_squared))
+            .unwrap_or_default(),
+    })
+}
