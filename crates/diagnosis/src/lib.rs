@@ -332,6 +332,25 @@ fn penalised(s: &Scored, heldout_samples: f64) -> f64 {
     s.fit.heldout_total() + used_terms(s) * heldout_samples.ln()
 }
 
+/// What each term of a discovered candidate must earn on the held-out blocks, in noise
+/// floors squared: BIC's ln(samples), and at least a hundredth of a noise floor squared per
+/// held-out sample. The second binds on long recordings, where ln n lets a term in for a
+/// trend of a few hundredths of the noise (a pressure transducer's 8 kPa offset was otherwise
+/// taken as an offset and a drift on both channels, for 11 Pa over 80 s against 150 Pa of
+/// noise).
+fn discovery_penalty_per_term(heldout_samples: f64) -> f64 {
+    heldout_samples
+        .ln()
+        .max(MIN_MEAN_SQUARE_GAIN_PER_TERM * heldout_samples)
+}
+
+/// See [`discovery_penalty_per_term`].
+const MIN_MEAN_SQUARE_GAIN_PER_TERM: f64 = 0.01;
+
+fn discovery_penalised(s: &Scored, heldout_samples: f64) -> f64 {
+    s.fit.heldout_total() + used_terms(s) * discovery_penalty_per_term(heldout_samples)
+}
+
 /// Runs `f` on every item over `jobs` threads, results in the items' order.
 fn parallel_map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let jobs = jobs.clamp(1, items.len().max(1));

@@ -350,11 +350,11 @@ fn discover_term(
         .filter(|s| s.fit.candidate.location == found.location && s.fit.candidate.named.is_none())
         .filter(|s| s.explained >= LOCATED_SHARE)
         .collect();
-    at_place.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
+    at_place.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
     let before_total: f64 = r.heldout.iter().sum();
     for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
         let label = s.fit.candidate.label;
-        let penalty = used_terms(s) * count.ln();
+        let penalty = used_terms(s) * discovery_penalty_per_term(count);
         let worse_pressures =
             (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
         if worse_pressures || before_total - s.fit.heldout_total() < penalty {
