@@ -1,4 +1,4 @@
-//! Bench recordings (MODEL.md, "Measured data"): a CSV file with a header row and the
+//! Bench recordings (docs/model.md, "CSV formats"): a CSV file with a header row and the
 //! columns `time_s, v_da_V, x_s_m, force_N`, optionally `p1_Pa, p2_Pa`, in SI units.
 //! Every problem is reported with its row (1-based, the header is row 1) and column.
 

@@ -1,5 +1,5 @@
 //! Replaying a recording's inputs through the model: the command held between samples,
-//! the stopper moving linearly between samples (MODEL.md, "Measured data").
+//! the stopper moving linearly between samples (docs/model.md, "CSV formats").
 
 use crate::recording::Recording;
 use jetpipe_model::physics::actuator::{Actuator, Outputs};

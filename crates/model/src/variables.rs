@@ -49,7 +49,7 @@ pub mod vr {
     pub const P1_START: u32 = 201;
     pub const P2_START: u32 = 202;
 
-    // Effects the thesis model lacks (MODEL.md), all off at their start values.
+    // Effects the thesis model lacks (docs/model.md), all off at their start values.
     pub const HYSTERESIS_WIDTH: u32 = 300;
     pub const HYSTERESIS_DEADBAND: u32 = 301;
     pub const HYSTERESIS_EXPONENT: u32 = 302;

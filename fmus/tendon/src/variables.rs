@@ -42,7 +42,7 @@ pub const UNITS: &[UnitDefinition] = &[
     units::S,
 ];
 
-/// The actuator's stopper range with the thesis geometry (MODEL.md: 0.026 < x_s < 0.096).
+/// The actuator's stopper range with the thesis geometry (docs/model.md: 0.026 < x_s < 0.096).
 const STROKE: (Option<f64>, Option<f64>) = (Some(0.026), Some(0.096));
 
 pub const VARIABLES: &[Variable] = &[

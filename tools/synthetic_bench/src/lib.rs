@@ -1,6 +1,6 @@
 //! Independent synthetic bench: the test oracle for the diagnosis of bench recordings.
 //!
-//! This module writes recordings in the format of `MODEL.md` ("Measured data") following the
+//! This module writes recordings in the format of docs/model.md ("CSV formats") following the
 //! protocol of `bench/README.md`, from its own implementation of the thesis model (Henri 1994,
 //! §2.2–2.7) plus optional physical effects the thesis model lacks. It deliberately shares no
 //! code with the model under test (`physics`, `simulation`, `integrator`, `electromechanics`,
@@ -503,7 +503,7 @@ pub fn undeclared_mechanism(name: &str) -> Option<&'static UndeclaredMechanism> 
     UNDECLARED.iter().find(|m| m.name == name)
 }
 
-/// Constants of the thesis model with the defaults of `MODEL.md` (SI units).
+/// Constants of the thesis model with the defaults of docs/model.md (SI units).
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchParams {
     pub p_supply: f64,

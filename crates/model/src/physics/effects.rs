@@ -1,4 +1,4 @@
-//! Effects the thesis model lacks (MODEL.md, "Effects the thesis model lacks"). Each is
+//! Effects the thesis model lacks (docs/model.md, "Effects and correction terms"). Each is
 //! off at its parameter's default, and then the model is the thesis model exactly.
 //!
 //! | name | parameter(s) | where it acts |

@@ -50,7 +50,7 @@ pub trait StaticCurve {
     }
 }
 
-/// f3 as MODEL.md fixes it: x̄ = x_jp_sat tanh(F_jp / F_jp_sat). The thesis's f3 is the
+/// f3 as docs/model.md fixes it: x̄ = x_jp_sat tanh(F_jp / F_jp_sat). The thesis's f3 is the
 /// midpoint line of Fig. 3.5, which the text does not give. Its argument is
 /// x = F_jp / F_jp_sat, and tanh's nearest singularities are the poles at x = ±iπ/2.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -60,7 +60,7 @@ pub struct TanhSaturation {
 }
 
 /// The static curve of (2.5) the model uses: the FMU, the assembled model's right-hand side
-/// and Jacobian, and the propagator all take it from here. It is MODEL.md's tanh, blended
+/// and Jacobian, and the propagator all take it from here. It is the tanh of docs/model.md, blended
 /// with the algebraic sigmoid u/√(1 + u²) in the share `f3_algebraic_share` (0 by
 /// default): x̄ = x_jp_sat [(1 − β) tanh u + β u/√(1 + u²)], u = F_jp / F_jp_sat. Both have
 /// the slope x_jp_sat/F_jp_sat at 0 and saturate at x_jp_sat; the algebraic one has the

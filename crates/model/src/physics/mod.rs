@@ -1,12 +1,12 @@
 //! The actuator's physics, one module per physical part, in plain Rust (no FFI types).
-//! Equation numbers are those of P.D. Henri's 1994 thesis; `MODEL.md` corrects its slips.
+//! Equation numbers are those of P.D. Henri's 1994 thesis; docs/model.md ("Choices the thesis leaves open") corrects its slips.
 //! Each equation is stated once, here: the exact propagator (`crate::electromechanics`)
 //! takes the current driver, f3 and the jet pipe's linear dynamics from `current_driver`
 //! and `jet_pipe` rather than deriving them again.
 //!
 //! | part | module | equations |
 //! |---|---|---|
-//! | parameters and their defaults | [`parameters`] | Table 3.1, MODEL.md |
+//! | parameters and their defaults | [`parameters`] | Table 3.1, docs/model.md |
 //! | current driver | [`current_driver`] | (2.1)–(2.3) |
 //! | jet pipe | [`jet_pipe`] | (2.4)–(2.7) |
 //! | orifice areas (supply/return area of each port) | [`orifice_geometry`] | (2.8)–(2.17) |

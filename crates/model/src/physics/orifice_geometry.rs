@@ -1,6 +1,6 @@
 //! Orifice areas from the receiver-plate geometry, (2.8)–(2.17), §2.5.
 //!
-//! Geometry (MODEL.md): the two control ports are circles of radius R = D_jp/2 centred at
+//! Geometry (docs/model.md, "Orifice areas"): the two control ports are circles of radius R = D_jp/2 centred at
 //! +D_jp (port 1, charging side) and −D_jp (port 2, venting side); the jet exit is a circle
 //! of radius R centred at the absolute tip position x; the tip flange is a disc of radius
 //! 3R centred at x.
@@ -345,7 +345,7 @@ mod tests {
         assert!((a.supply_1 - port_area(D)).abs() < 1e-18);
         assert!((a.return_2 - port_area(D)).abs() < 1e-18);
         assert_eq!(a.return_1, 0.0);
-        // Symmetry A_s2(x) = A_s1(−x), A_r2(x) = A_r1(−x) (MODEL.md's correction of (2.10)–(2.11)).
+        // Symmetry A_s2(x) = A_s1(−x), A_r2(x) = A_r1(−x) (docs/model.md's correction of (2.10)–(2.11)).
         for x in [-1.7 * D, -0.3 * D, 0.2 * D, 1.1 * D, 2.5 * D] {
             assert_eq!(supply_area_port2(D, x), supply_area_port1(D, -x));
             assert_eq!(return_area_port2(D, x), return_area_port1(D, -x));

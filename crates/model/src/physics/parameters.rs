@@ -1,4 +1,4 @@
-//! The model's parameters, with the defaults of Table 3.1 and MODEL.md (taken from the
+//! The model's parameters, with the defaults of Table 3.1 and docs/model.md (taken from the
 //! FMU's variable table, so the two cannot disagree).
 
 use super::chambers::CylinderGeometry;
