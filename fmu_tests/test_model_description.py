@@ -15,6 +15,8 @@ INTERFACE = {
     "i": ("output", "A", 13, None),
     "x_jp": ("output", "m", 14, None),
     "F_meas": ("output", "N", 15, None),
+    "P1_meas": ("output", "Pa", 16, None),
+    "P2_meas": ("output", "Pa", 17, None),
 }
 
 # MODEL.md defaults and Table 3.1 of the thesis, with their units.

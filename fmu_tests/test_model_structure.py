@@ -109,7 +109,8 @@ def test_actuator_structure_and_bounds():
     direct = {u.variable.name: sorted(d.name for d in u.dependencies) for u in md.outputs}
     # Only the stopper acts within a step (it moves at once, conserving the air); v_DA acts
     # through the current's dynamics.
-    assert direct == {"F_act": ["x_s"], "F_meas": ["x_s"], "P1": ["x_s"], "P2": ["x_s"], "i": [], "x_jp": []}
+    assert direct == {"F_act": ["x_s"], "F_meas": ["x_s"], "P1": ["x_s"], "P2": ["x_s"], "P1_meas": ["x_s"],
+                      "P2_meas": ["x_s"], "i": [], "x_jp": []}
     x_s = by_name["x_s"]
     assert float(x_s.min) == pytest.approx(0.026) and float(x_s.max) == pytest.approx(0.096)
     assert float(by_name["C_d"].min) == 0.0 and float(by_name["C_d"].max) == 1.0
