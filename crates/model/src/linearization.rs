@@ -9,7 +9,7 @@
 
 use nalgebra::{Complex, SMatrix, SVector};
 
-use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, State, N_STATES};
+use crate::physics::actuator::{index, Actuator, Inputs, Jacobian, N_STATES};
 use crate::physics::current_driver::CurrentDriver;
 use crate::simulation::equilibrium;
 
@@ -174,11 +174,6 @@ impl LinearModel {
         }
         None
     }
-}
-
-/// State at an operating point, for callers that need it.
-pub fn operating_state(model: &Actuator, op: &OperatingPoint) -> Result<State, String> {
-    equilibrium(model, op.v_da, op.x_s)
 }
 
 #[cfg(test)]

@@ -108,18 +108,18 @@ impl CommandStage {
     }
 }
 
-/// The commands the current driver sees at each sample of a recording.
-pub fn seen_commands(p: &Parameters, time: &[f64], v_da: &[f64]) -> Vec<f64> {
-    if !is_active(p) || time.is_empty() {
-        return v_da.to_vec();
-    }
-    let mut stage = CommandStage::at_rest(p, time[0], v_da[0]);
-    time.iter().zip(v_da).map(|(&t, &v)| stage.next(p, t, v)).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The commands the current driver sees at each sample of a recording.
+    fn seen_commands(p: &Parameters, time: &[f64], v_da: &[f64]) -> Vec<f64> {
+        if !is_active(p) || time.is_empty() {
+            return v_da.to_vec();
+        }
+        let mut stage = CommandStage::at_rest(p, time[0], v_da[0]);
+        time.iter().zip(v_da).map(|(&t, &v)| stage.next(p, t, v)).collect()
+    }
 
     #[test]
     fn with_every_term_off_the_driver_sees_the_command_itself() {

@@ -169,16 +169,6 @@ impl SensorLaw {
     }
 }
 
-/// The force sensor's static reading of the force `force` at `time`.
-pub fn static_reading(p: &Parameters, force: f64, time: f64) -> f64 {
-    SensorLaw::of(p, Channel::Force).static_reading(force, time)
-}
-
-/// Whether the force sensor filters its reading (and so has a memory).
-pub fn filters(p: &Parameters) -> bool {
-    SensorLaw::of(p, Channel::Force).filters()
-}
-
 /// A transducer's memory: past static readings (for the delay) and the lag's and the
 /// play's outputs at the last communication point.
 #[derive(Clone, Debug, PartialEq)]
@@ -428,7 +418,7 @@ mod tests {
             force_sensor_quadratic: 4e-4,
             ..Parameters::default()
         };
-        assert!((static_reading(&p, 50.0, 3.0) - (50.0 + 4e-4 * 2500.0)).abs() < 1e-12);
+        assert!((force(&p).static_reading(50.0, 3.0) - (50.0 + 4e-4 * 2500.0)).abs() < 1e-12);
     }
 
     #[test]

@@ -17,7 +17,6 @@ use crate::integrator::rosenbrock::Ros2;
 use crate::integrator::OdeSystem;
 use crate::physics::actuator::{index, Actuator, Outputs, State};
 use crate::physics::parameters::Parameters;
-use crate::physics::sensors::{Channel, SensorLaw};
 use crate::physics::time_varying;
 
 /// The chamber Jacobian is refreshed every this many ROS2 steps.
@@ -121,11 +120,7 @@ impl FixedStep {
         sim.statistics.rhs_evaluations += 3 * substeps + 2 * new_jacobians;
         sim.statistics.jacobians += new_jacobians;
         let mut y = sim.model.outputs_at(&sim.state, x_s, rate, time);
-        for ((memory, reading), channel) in sim.transducers.iter_mut().zip(y.readings_mut()).zip(Channel::ALL) {
-            if let Some(memory) = memory {
-                *reading = memory.record(&SensorLaw::of(&sim.model.params, channel), time, *reading);
-            }
-        }
+        sim.record_transducers(&mut y);
         self.outputs = y;
         Ok(())
     }

@@ -418,17 +418,22 @@ impl Simulation {
         self.stopper_velocity = (self.x_s - self.x_s_at_last_step) / step;
         self.x_s_at_last_step = self.x_s;
         if self.transducers.iter().any(Option::is_some) {
-            let readings = self
+            let mut y = self
                 .model
-                .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time)
-                .readings();
-            for ((memory, reading), channel) in self.transducers.iter_mut().zip(readings).zip(Channel::ALL) {
-                if let Some(memory) = memory {
-                    memory.record(&SensorLaw::of(&self.model.params, channel), self.time, reading);
-                }
-            }
+                .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time);
+            self.record_transducers(&mut y);
         }
         Ok(())
+    }
+
+    /// Record the transducers' static readings in `y` (at the simulation's time) in the
+    /// memories of those that filter, and put their filtered readings in `y`.
+    fn record_transducers(&mut self, y: &mut Outputs) {
+        for ((memory, reading), channel) in self.transducers.iter_mut().zip(y.readings_mut()).zip(Channel::ALL) {
+            if let Some(memory) = memory {
+                *reading = memory.record(&SensorLaw::of(&self.model.params, channel), self.time, *reading);
+            }
+        }
     }
 
     /// The command the current driver sees over the next `step`, through the command stage
