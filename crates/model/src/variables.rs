@@ -113,6 +113,13 @@ pub mod vr {
     pub const P2_SENSOR_DRIFT: u32 = 512;
     pub const P2_SENSOR_LAG: u32 = 513;
     pub const P2_SENSOR_DELAY: u32 = 514;
+    pub const SUPPLY_RESTRICTION_AREA: u32 = 520;
+    pub const SUPPLY_PLENUM_VOLUME: u32 = 521;
+    pub const RETURN_PLENUM_VOLUME: u32 = 522;
+    pub const PORT_RESTRICTION_AREA_1: u32 = 523;
+    pub const PORT_RESTRICTION_AREA_2: u32 = 524;
+    pub const PORT_LINE_VOLUME_1: u32 = 525;
+    pub const PORT_LINE_VOLUME_2: u32 = 526;
 }
 
 /// The D/A converter's range: a command outside it is refused.
@@ -772,6 +779,34 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: as the command delay"),
+    parameter("supply_restriction_area", vr::SUPPLY_RESTRICTION_AREA, "m2", 0.0, "supply restriction: the jet pipe draws its supply through an orifice of this discharge coefficient times area, (2.18), instead of from P_s directly (0 = off; not with supply_resistance)")
+        .at_least(0.0).at_most(1e-4)
+        .cite("(2.18), §2.6")
+        .because(LEAK_AREA),
+    parameter("supply_plenum_volume", vr::SUPPLY_PLENUM_VOLUME, "m3", 0.0, "supply plenum: a gas volume between the supply restriction and the jet pipe, whose pressure follows (2.29) (0 = the restriction alone; needs supply_resistance or supply_restriction_area)")
+        .at_least(0.0).at_most(1e-3)
+        .cite("(2.29)")
+        .because(DEAD_VOLUME),
+    parameter("return_plenum_volume", vr::RETURN_PLENUM_VOLUME, "m3", 0.0, "return plenum: a gas volume between the return orifices and the return restriction, whose pressure follows (2.29) (0 = the restriction alone; needs return_resistance or return_vent_area)")
+        .at_least(0.0).at_most(1e-3)
+        .cite("(2.29)")
+        .because(DEAD_VOLUME),
+    parameter("port_restriction_area_1", vr::PORT_RESTRICTION_AREA_1, "m2", 0.0, "port restriction: receiver port 1 reaches chamber 1 through an orifice of this discharge coefficient times area, (2.18) (0 = off; not with port_resistance_1)")
+        .at_least(0.0).at_most(1e-4)
+        .cite("(2.18), (2.24)")
+        .because(LEAK_AREA),
+    parameter("port_restriction_area_2", vr::PORT_RESTRICTION_AREA_2, "m2", 0.0, "port restriction: receiver port 2 reaches chamber 2 through an orifice of this discharge coefficient times area, (2.18) (0 = off; not with port_resistance_2)")
+        .at_least(0.0).at_most(1e-4)
+        .cite("(2.18), (2.25)")
+        .because(LEAK_AREA),
+    parameter("port_line_volume_1", vr::PORT_LINE_VOLUME_1, "m3", 0.0, "port line: a gas volume between receiver port 1 and its restriction, whose pressure follows (2.29) (0 = the restriction alone; needs port_resistance_1 or port_restriction_area_1)")
+        .at_least(0.0).at_most(1e-3)
+        .cite("(2.29)")
+        .because(DEAD_VOLUME),
+    parameter("port_line_volume_2", vr::PORT_LINE_VOLUME_2, "m3", 0.0, "port line: a gas volume between receiver port 2 and its restriction, whose pressure follows (2.29) (0 = the restriction alone; needs port_resistance_2 or port_restriction_area_2)")
+        .at_least(0.0).at_most(1e-3)
+        .cite("(2.29)")
+        .because(DEAD_VOLUME),
 ];
 
 const N_VARIABLES: usize = TABLE.len();

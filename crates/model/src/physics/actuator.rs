@@ -11,6 +11,7 @@ use super::jet_pipe::StaticCurve;
 use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
+use super::restrictions::{self, node, Restrictions, PRESSURES_WITH_VOLUMES};
 use super::sensors::{Channel, SensorLaw};
 use super::{current_driver, jet_pipe, piston};
 
@@ -65,6 +66,21 @@ impl MassFlows {
     }
 }
 
+/// The flows with restrictions between the valve and the air ([`Actuator::network_flows`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NetworkFlows {
+    /// The flows through the orifices of the valve (at the pressures behind the
+    /// restrictions), the leakage and the vents.
+    pub flows: MassFlows,
+    /// The mass inflow of each chamber through its port: the port's net flow, or the
+    /// restriction's behind a line volume.
+    pub into_chambers: [f64; 2],
+    /// The pressures behind the restrictions, in the order of [`node`].
+    pub node_pressures: [f64; node::COUNT],
+    /// The net mass inflow of each volume (0 unless `nodes` were given).
+    pub node_inflows: [f64; node::COUNT],
+}
+
 /// The model's outputs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Outputs {
@@ -104,6 +120,8 @@ pub struct Actuator {
     /// C_d times the area factor of each orifice, [supply 1, return 1, supply 2, return 2]:
     /// C_d for all four in the thesis model, other factors under the valve asymmetry terms.
     pub discharge: [f64; 4],
+    /// Restrictions between the valve and the air, and the volumes behind them.
+    pub restrictions: Restrictions,
 }
 
 impl Actuator {
@@ -120,7 +138,9 @@ impl Actuator {
             params.c_d * params.supply_area_scale_2,
             params.c_d * params.return_area_scale_2,
         ];
+        let restrictions = Restrictions::from_parameters(&params);
         Ok(Self {
+            restrictions,
             params,
             flow,
             cylinder,
@@ -160,70 +180,188 @@ impl Actuator {
     }
 
     /// [`Self::mass_flows`] for orifice areas already known (they depend on x_jp alone,
-    /// and the integrators evaluate many pressures at one jet pipe position).
+    /// and the integrators evaluate many pressures at one jet pipe position). With
+    /// restrictions, the pressures behind them are quasi-static (see [`Self::network_flows`]).
     pub fn mass_flows_through(&self, a: &OrificeAreas, p1: f64, p2: f64) -> MassFlows {
+        if self.restrictions.any() {
+            return self.network_flows(a, p1, p2, None).flows;
+        }
         let p = &self.params;
         let k = &self.flow;
         let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
-        // The orifices of each port see the chamber's pressure, or, through a port
-        // restriction, a pressure between it and the flow's source. That pressure is found
-        // with the nominal supply and return pressures: a port restriction together with a
-        // supply or return line resistance is approximated, not solved jointly.
-        let port =
-            |chamber: f64, resistance: f64, cd_supply: f64, supply_area: f64, cd_return: f64, return_area: f64| {
-                effects::port_pressure(chamber, resistance, p.p_s, p.p_r, |q| {
-                    mass_flow(k, cd_supply * supply_area, p.p_s, q) - mass_flow(k, cd_return * return_area, q, p.p_r)
-                })
-            };
-        let q1 = port(p1, p.port_resistance_1, cd_s1, a.supply_1, cd_r1, a.return_1);
-        let q2 = port(p2, p.port_resistance_2, cd_s2, a.supply_2, cd_r2, a.return_2);
-        let (p1, p2, chamber_1, chamber_2) = (q1, q2, p1, p2);
-        let supply = |p_supply: f64| {
-            (
-                mass_flow(k, cd_s1 * a.supply_1, p_supply, p1),
-                mass_flow(k, cd_s2 * a.supply_2, p_supply, p2),
-            )
-        };
-        let p_supply = effects::supply_pressure_at_jet(p.p_s, p.supply_resistance, p1.min(p2), |ps| {
-            let (s1, s2) = supply(ps);
-            s1 + s2
-        });
-        let (supply_1, supply_2) = supply(p_supply);
-        let returns = |p_return: f64| {
-            (
-                mass_flow(k, cd_r1 * a.return_1, p1, p_return),
-                mass_flow(k, cd_r2 * a.return_2, p2, p_return),
-            )
-        };
-        let p_return = if p.return_vent_area > 0.0 {
-            effects::return_pressure_at_vent_orifice(p.p_r, p1.max(p2), |pr| {
-                let (r1, r2) = returns(pr);
-                (r1 + r2, mass_flow(k, p.return_vent_area, pr, p.p_r))
-            })
-        } else {
-            effects::return_pressure_at_vent(p.p_r, p.return_resistance, p1.max(p2), |pr| {
-                let (r1, r2) = returns(pr);
-                r1 + r2
-            })
-        };
-        let (return_1, return_2) = returns(p_return);
-        let (vent_1, vent_2) = if p.chamber_vent_1 == 0.0 && p.chamber_vent_2 == 0.0 {
-            (0.0, 0.0)
-        } else {
-            (
-                mass_flow(k, p.chamber_vent_1, chamber_1, p.p_r),
-                mass_flow(k, p.chamber_vent_2, chamber_2, p.p_r),
-            )
-        };
+        let (vent_1, vent_2) = self.chamber_vents(p1, p2);
         MassFlows {
-            supply_1,
-            return_1,
-            supply_2,
-            return_2,
-            leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, chamber_1, chamber_2),
+            supply_1: mass_flow(k, cd_s1 * a.supply_1, p.p_s, p1),
+            return_1: mass_flow(k, cd_r1 * a.return_1, p1, p.p_r),
+            supply_2: mass_flow(k, cd_s2 * a.supply_2, p.p_s, p2),
+            return_2: mass_flow(k, cd_r2 * a.return_2, p2, p.p_r),
+            leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
             vent_1,
             vent_2,
         }
+    }
+
+    /// The `chamber_vent_*` leaks of each chamber to the return pressure.
+    fn chamber_vents(&self, p1: f64, p2: f64) -> (f64, f64) {
+        let p = &self.params;
+        if p.chamber_vent_1 == 0.0 && p.chamber_vent_2 == 0.0 {
+            (0.0, 0.0)
+        } else {
+            (
+                mass_flow(&self.flow, p.chamber_vent_1, p1, p.p_r),
+                mass_flow(&self.flow, p.chamber_vent_2, p2, p.p_r),
+            )
+        }
+    }
+
+    /// The flows with restrictions between the valve and the air ([`super::restrictions`]).
+    /// The pressure behind a restriction with a volume is `nodes`' entry when `nodes` is
+    /// given; otherwise, and without a volume, it is quasi-static. Those are found one place
+    /// at a time: the ports' with the supply and return pressures known or nominal, then the
+    /// supply's and the return's with the ports' (a port restriction together with a
+    /// quasi-static supply or return restriction is approximated, not solved jointly).
+    pub fn network_flows(
+        &self,
+        a: &OrificeAreas,
+        p1: f64,
+        p2: f64,
+        nodes: Option<&[f64; node::COUNT]>,
+    ) -> NetworkFlows {
+        let p = &self.params;
+        let k = &self.flow;
+        let places = &self.restrictions.places;
+        let stated = |i: usize| nodes.filter(|_| places[i].has_volume()).map(|n| n[i]);
+        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
+        let supply_known = stated(node::SUPPLY).unwrap_or(p.p_s);
+        let return_known = stated(node::RETURN).unwrap_or(p.p_r);
+        let port = |i: usize, chamber: f64, supply_area: f64, return_area: f64| {
+            if let Some(q) = stated(i) {
+                return q;
+            }
+            let restriction = &places[i];
+            let net_inflow = |q: f64| {
+                (
+                    mass_flow(k, supply_area, supply_known, q),
+                    mass_flow(k, return_area, q, return_known),
+                )
+            };
+            if restriction.cd_area > 0.0 {
+                let (lo, hi) = (
+                    chamber.min(supply_known).min(return_known),
+                    chamber.max(supply_known).max(return_known),
+                );
+                restrictions::balanced_pressure(lo, hi, |q| {
+                    let (supplied, returned) = net_inflow(q);
+                    // Flows the port takes in, against flows it gives out, each positive.
+                    let onward = restriction.flow(k, q, chamber);
+                    (supplied + (-onward).max(0.0), returned + onward.max(0.0))
+                })
+            } else {
+                effects::port_pressure(chamber, restriction.resistance, supply_known, return_known, |q| {
+                    let (supplied, returned) = net_inflow(q);
+                    supplied - returned
+                })
+            }
+        };
+        let q1 = port(node::LINE_1, p1, cd_s1 * a.supply_1, cd_r1 * a.return_1);
+        let q2 = port(node::LINE_2, p2, cd_s2 * a.supply_2, cd_r2 * a.return_2);
+        let supply = |p_supply: f64| {
+            (
+                mass_flow(k, cd_s1 * a.supply_1, p_supply, q1),
+                mass_flow(k, cd_s2 * a.supply_2, p_supply, q2),
+            )
+        };
+        let supply_place = &places[node::SUPPLY];
+        let p_supply = match stated(node::SUPPLY) {
+            Some(p_supply) => p_supply,
+            None if supply_place.cd_area > 0.0 => restrictions::balanced_pressure(q1.min(q2).min(p.p_s), p.p_s, |ps| {
+                let (s1, s2) = supply(ps);
+                (supply_place.flow(k, p.p_s, ps), s1 + s2)
+            }),
+            None => effects::supply_pressure_at_jet(p.p_s, supply_place.resistance, q1.min(q2), |ps| {
+                let (s1, s2) = supply(ps);
+                s1 + s2
+            }),
+        };
+        let (supply_1, supply_2) = supply(p_supply);
+        let returns = |p_return: f64| {
+            (
+                mass_flow(k, cd_r1 * a.return_1, q1, p_return),
+                mass_flow(k, cd_r2 * a.return_2, q2, p_return),
+            )
+        };
+        let return_place = &places[node::RETURN];
+        let p_return = match stated(node::RETURN) {
+            Some(p_return) => p_return,
+            None if return_place.cd_area > 0.0 => {
+                // At P_r nothing leaves and at the higher port pressure nothing enters.
+                restrictions::balanced_pressure(p.p_r, q1.max(q2).max(p.p_r), |pr| {
+                    let (r1, r2) = returns(pr);
+                    (r1 + r2, return_place.flow(k, pr, p.p_r))
+                })
+            }
+            None => effects::return_pressure_at_vent(p.p_r, return_place.resistance, q1.max(q2), |pr| {
+                let (r1, r2) = returns(pr);
+                r1 + r2
+            }),
+        };
+        let (return_1, return_2) = returns(p_return);
+        let (vent_1, vent_2) = self.chamber_vents(p1, p2);
+        let into_chamber = |i: usize, q: f64, chamber: f64, through_port: f64| match stated(i) {
+            Some(_) => places[i].flow(k, q, chamber),
+            None => through_port,
+        };
+        let into_1 = into_chamber(node::LINE_1, q1, p1, supply_1 - return_1);
+        let into_2 = into_chamber(node::LINE_2, q2, p2, supply_2 - return_2);
+        let mut node_inflows = [0.0; node::COUNT];
+        if nodes.is_some() {
+            node_inflows = [
+                supply_place.flow(k, p.p_s, p_supply) - supply_1 - supply_2,
+                return_1 + return_2 - return_place.flow(k, p_return, p.p_r),
+                supply_1 - return_1 - into_1,
+                supply_2 - return_2 - into_2,
+            ];
+        }
+        NetworkFlows {
+            flows: MassFlows {
+                supply_1,
+                return_1,
+                supply_2,
+                return_2,
+                leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+                vent_1,
+                vent_2,
+            },
+            into_chambers: [into_1, into_2],
+            node_pressures: [p_supply, p_return, q1, q2],
+            node_inflows,
+        }
+    }
+
+    /// The rates of P1, P2 and the gas volumes' pressures ([`super::restrictions::node`]) for
+    /// the pressures `p` in that order: (2.29) for the chambers, and for each volume the same
+    /// law at a fixed volume. A place without a volume has the rate 0.
+    pub fn pressure_rates_with_volumes(
+        &self,
+        areas: &OrificeAreas,
+        p: &[f64; PRESSURES_WITH_VOLUMES],
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> [f64; PRESSURES_WITH_VOLUMES] {
+        let nodes = [p[2], p[3], p[4], p[5]];
+        let network = self.network_flows(areas, p[0], p[1], Some(&nodes));
+        let f = &network.flows;
+        let net_1 = network.into_chambers[0] - f.leakage - f.vent_1;
+        let net_2 = network.into_chambers[1] + f.leakage - f.vent_2;
+        let (dp1, dp2) = self.chamber_rates(net_1, net_2, p[0], p[1], x_s, x_s_rate);
+        let mut rates = [dp1, dp2, 0.0, 0.0, 0.0, 0.0];
+        let rt = self.params.r_gas * self.params.temperature;
+        for (i, place) in self.restrictions.places.iter().enumerate() {
+            if place.has_volume() {
+                rates[2 + i] = self.polytropic_exponent * rt * network.node_inflows[i] / place.volume;
+            }
+        }
+        rates
     }
 
     /// dP1/dt and dP2/dt, (2.29).
@@ -240,32 +378,21 @@ impl Actuator {
         x_s: f64,
         x_s_rate: f64,
     ) -> (f64, f64) {
-        let p = &self.params;
         let flows = self.mass_flows_through(areas, p1, p2);
+        self.chamber_rates(flows.net_1(), flows.net_2(), p1, p2, x_s, x_s_rate)
+    }
+
+    /// (2.29) for both chambers with their net mass inflows.
+    fn chamber_rates(&self, net_1: f64, net_2: f64, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
+        let p = &self.params;
         if p.stopper_compliance != 0.0 {
-            return self.pressure_rates_on_a_compliant_stopper(&flows, p1, p2, x_s, x_s_rate);
+            return self.pressure_rates_on_a_compliant_stopper(net_1, net_2, p1, p2, x_s, x_s_rate);
         }
         let (v1, v2) = self.cylinder.volumes(x_s);
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
         (
-            pressure_rate(
-                self.polytropic_exponent,
-                p.r_gas,
-                p.temperature,
-                v1,
-                dv1,
-                flows.net_1(),
-                p1,
-            ),
-            pressure_rate(
-                self.polytropic_exponent,
-                p.r_gas,
-                p.temperature,
-                v2,
-                dv2,
-                flows.net_2(),
-                p2,
-            ),
+            pressure_rate(self.polytropic_exponent, p.r_gas, p.temperature, v1, dv1, net_1, p1),
+            pressure_rate(self.polytropic_exponent, p.r_gas, p.temperature, v2, dv2, net_2, p2),
         )
     }
 
@@ -275,7 +402,8 @@ impl Actuator {
     /// b_i = n P_i A_p / V_i; solved for D in closed form.
     fn pressure_rates_on_a_compliant_stopper(
         &self,
-        flows: &MassFlows,
+        net_1: f64,
+        net_2: f64,
         p1: f64,
         p2: f64,
         x_s: f64,
@@ -286,8 +414,8 @@ impl Actuator {
         let stretch = p.stopper_compliance * self.piston_area;
         let (v1, v2) = self.cylinder.volumes(x_s + stretch * (p1 - p2));
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
-        let d1 = pressure_rate(n, p.r_gas, p.temperature, v1, dv1, flows.net_1(), p1);
-        let d2 = pressure_rate(n, p.r_gas, p.temperature, v2, dv2, flows.net_2(), p2);
+        let d1 = pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1);
+        let d2 = pressure_rate(n, p.r_gas, p.temperature, v2, dv2, net_2, p2);
         let (b1, b2) = (n * p1 * self.piston_area / v1, n * p2 * self.piston_area / v2);
         let difference = (d1 - d2) / (1.0 + (b1 + b2) * stretch);
         (d1 - b1 * stretch * difference, d2 + b2 * stretch * difference)

@@ -437,22 +437,6 @@ fn return_pressure_through_line(p_r: f64, resistance: f64, highest: f64, return_
     increasing_root(p_r, highest.max(p_r), |p| p - p_r - resistance * return_flow(p))
 }
 
-/// Pressure of a return plenum that empties to `p_r` through an orifice: the root of
-/// ṁ_in(p) = ṁ_out(p), where `flows(p)` gives (ṁ_in, the return flow into the plenum,
-/// which falls as p rises; ṁ_out, the vent's flow (2.18), which rises). The plenum's
-/// volume is not modelled: it fills in far less than the chambers do. At P_r nothing
-/// leaves and at `highest` nothing enters, so the root lies in [P_r, highest].
-#[inline(never)]
-pub fn return_pressure_at_vent_orifice(p_r: f64, highest: f64, flows: impl Fn(f64) -> (f64, f64)) -> f64 {
-    // The flows' imbalance relative to their sum, in the pressures' scale, so that the
-    // root finder's tolerances (relative to the pressures) mean something for flows.
-    let scale = highest.max(p_r);
-    increasing_root(p_r, scale, |p| {
-        let (inflow, outflow) = flows(p);
-        scale * (outflow - inflow) / (outflow + inflow + f64::MIN_POSITIVE)
-    })
-}
-
 /// Pressure that the orifices of a port see when a restriction of `resistance` (Pa·s/kg)
 /// lies between them and the chamber: the root of q = P_chamber + R ṁ(q), with ṁ(q) the
 /// net flow into the port (supply in, return out), which falls as q rises. The root lies
@@ -480,7 +464,7 @@ fn port_pressure_through_restriction(
 /// The root in [a, b] of an increasing `residual` (the end nearest the sign change when
 /// the bracket holds none): the Illinois variant of regula falsi, which never leaves the
 /// bracket however steep the residual is.
-fn increasing_root(a: f64, b: f64, residual: impl Fn(f64) -> f64) -> f64 {
+pub(crate) fn increasing_root(a: f64, b: f64, residual: impl Fn(f64) -> f64) -> f64 {
     let scale = a.abs().max(b.abs());
     let (mut a, mut fa) = (a, residual(a));
     let (mut b, mut fb) = (b, residual(b));

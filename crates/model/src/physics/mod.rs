@@ -14,6 +14,7 @@
 //! | chambers | [`chambers`] | (2.24)–(2.32) |
 //! | piston force and spring | [`piston`] | (2.36)–(2.38) |
 //! | effects the thesis model lacks (off by default) | [`effects`] | docs/model.md |
+//! | restrictions and gas volumes between the valve and the air (off by default) | [`restrictions`] | (2.18), (2.29) |
 //! | the command as the current driver sees it (off by default) | [`command_stage`] | (2.1) |
 //! | what the force and pressure transducers read | [`sensors`] | docs/model.md |
 //! | constants that vary in time (off by default) | [`time_varying`] | docs/model.md |
@@ -29,5 +30,6 @@ pub mod orifice_flow;
 pub mod orifice_geometry;
 pub mod parameters;
 pub mod piston;
+pub mod restrictions;
 pub mod sensors;
 pub mod time_varying;

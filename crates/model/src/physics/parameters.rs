@@ -97,6 +97,14 @@ pub struct Parameters {
     pub p2_sensor_drift: f64,
     pub p2_sensor_lag: f64,
     pub p2_sensor_delay: f64,
+    /// Restrictions as orifices and the gas volumes behind them (0 = off).
+    pub supply_restriction_area: f64,
+    pub supply_plenum_volume: f64,
+    pub return_plenum_volume: f64,
+    pub port_restriction_area_1: f64,
+    pub port_restriction_area_2: f64,
+    pub port_line_volume_1: f64,
+    pub port_line_volume_2: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -199,6 +207,13 @@ impl Default for Parameters {
             p2_sensor_drift: 0.0,
             p2_sensor_lag: 0.0,
             p2_sensor_delay: 0.0,
+            supply_restriction_area: 0.0,
+            supply_plenum_volume: 0.0,
+            return_plenum_volume: 0.0,
+            port_restriction_area_1: 0.0,
+            port_restriction_area_2: 0.0,
+            port_line_volume_1: 0.0,
+            port_line_volume_2: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -388,6 +403,13 @@ impl Parameters {
             vr::P2_SENSOR_DRIFT => &mut self.p2_sensor_drift,
             vr::P2_SENSOR_LAG => &mut self.p2_sensor_lag,
             vr::P2_SENSOR_DELAY => &mut self.p2_sensor_delay,
+            vr::SUPPLY_RESTRICTION_AREA => &mut self.supply_restriction_area,
+            vr::SUPPLY_PLENUM_VOLUME => &mut self.supply_plenum_volume,
+            vr::RETURN_PLENUM_VOLUME => &mut self.return_plenum_volume,
+            vr::PORT_RESTRICTION_AREA_1 => &mut self.port_restriction_area_1,
+            vr::PORT_RESTRICTION_AREA_2 => &mut self.port_restriction_area_2,
+            vr::PORT_LINE_VOLUME_1 => &mut self.port_line_volume_1,
+            vr::PORT_LINE_VOLUME_2 => &mut self.port_line_volume_2,
             _ => return None,
         })
     }
@@ -456,12 +478,7 @@ impl Parameters {
                 self.hysteresis_deadband, self.hysteresis_exponent
             ));
         }
-        if self.return_resistance > 0.0 && self.return_vent_area > 0.0 {
-            return Err(format!(
-                "return_resistance = {} Pa.s/kg and return_vent_area = {} m2 are both set: they are two laws of the same return restriction, set one",
-                self.return_resistance, self.return_vent_area
-            ));
-        }
+        super::restrictions::check(self)?;
         if self.l_cyl <= self.l_p {
             return Err(format!(
                 "L_cyl = {} m is invalid: must exceed L_p = {} m",

@@ -1,4 +1,5 @@
-//! The split method's integrated part: the two chamber pressures, driven by the jet pipe's
+//! The split method's integrated part: the two chamber pressures (and the pressures of the
+//! gas volumes behind restrictions when there are any, [`crate::physics::restrictions`]), driven by the jet pipe's
 //! exactly known trajectory. Most of what is here keeps the integrator from paying twice for
 //! the same thing (the orifice areas at a stage time, the rates at a step's start and end)
 //! and stops its steps at the tangencies of the orifice geometry, where the flows have kinks.
@@ -9,15 +10,16 @@ use crate::electromechanics::{Trajectory, MAX_NODES};
 use crate::integrator::{finite_difference_jacobian, OdeSystem};
 use crate::physics::actuator::Actuator;
 use crate::physics::orifice_geometry::OrificeAreas;
+use crate::physics::restrictions::PRESSURES_WITH_VOLUMES;
 
 /// The jet pipe position, pressures and pressure rates at the end of a step.
-pub(super) type EndRates = (f64, SVector<f64, 2>, SVector<f64, 2>);
+pub(super) type EndRates<const N: usize> = (f64, SVector<f64, N>, SVector<f64, N>);
 
 /// The chambers over one step, driven by the exactly known jet pipe trajectory. Its time
 /// is counted from the step's start, as the trajectory's is: a step size the integrator
 /// repeats (the cap, the rest of an equal communication step) is then the same to the last
 /// bit each time, which [`Trajectory::node_positions`] relies on.
-pub(super) struct ChamberSystem<'a> {
+pub(super) struct ChamberSystem<'a, const N: usize> {
     pub(super) model: &'a Actuator,
     pub(super) trajectory: &'a Trajectory<'a>,
     pub(super) x_s: f64,
@@ -35,10 +37,10 @@ pub(super) struct ChamberSystem<'a> {
     pub(super) stage_areas: std::cell::RefCell<StageAreas>,
     /// The pressures and rates at the step's start (t = 0), asked for twice: by the ringing
     /// test and by the integrator's first stage.
-    pub(super) start_rates: std::cell::Cell<Option<(SVector<f64, 2>, SVector<f64, 2>)>>,
+    pub(super) start_rates: std::cell::Cell<Option<(SVector<f64, N>, SVector<f64, N>)>>,
     /// The jet pipe position, pressures and rates of the last evaluation at t = duration:
     /// the integrator's last stage, whose rates are the next step's rates at its start.
-    pub(super) end_rates: std::cell::Cell<Option<EndRates>>,
+    pub(super) end_rates: std::cell::Cell<Option<EndRates<N>>>,
     /// The last time asked about in [`OdeSystem::breakpoint`] and its area stretch: the next
     /// question starts there.
     pub(super) stretch_at: std::cell::Cell<Option<(f64, i32)>>,
@@ -49,7 +51,7 @@ pub(super) struct ChamberSystem<'a> {
     pub(super) duration: f64,
 }
 
-impl<'a> ChamberSystem<'a> {
+impl<'a, const N: usize> ChamberSystem<'a, N> {
     /// The chambers over [0, duration], from the jet pipe position `start_position`; the
     /// pressure rates at the start are `start_rates` when they are already known.
     pub(super) fn new(
@@ -57,7 +59,7 @@ impl<'a> ChamberSystem<'a> {
         trajectory: &'a Trajectory<'a>,
         duration: f64,
         start_position: f64,
-        start_rates: Option<(SVector<f64, 2>, SVector<f64, 2>)>,
+        start_rates: Option<(SVector<f64, N>, SVector<f64, N>)>,
         x_s: f64,
         x_s_rate: f64,
     ) -> Self {
@@ -160,7 +162,7 @@ impl<'a> ChamberSystem<'a> {
     /// The rates at t = 0, kept (see `start_rates`); out of line, so the stages' path stays
     /// small enough to be inlined into the integrator.
     #[inline(never)]
-    pub(super) fn rates_at_start(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+    pub(super) fn rates_at_start(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
         match self.start_rates.get() {
             Some((pressures, rates)) if pressures == *p => rates,
             _ => {
@@ -172,17 +174,27 @@ impl<'a> ChamberSystem<'a> {
     }
 
     /// The rates at t = duration, recorded with the position and pressures (see `end_rates`).
-    pub(super) fn rates_at_end(&self, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+    pub(super) fn rates_at_end(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
         let (position, areas) = self.position_and_areas(self.duration);
         let rates = self.rates(&areas, self.duration, p);
         self.end_rates.set(Some((position, *p, rates)));
         rates
     }
 
-    pub(super) fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+    pub(super) fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         let x_s = self.x_s + self.x_s_rate * t;
-        let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
-        SVector::<f64, 2>::new(a, b)
+        if N == 2 {
+            let (a, b) = self.model.pressure_rates_through(areas, p[0], p[1], x_s, self.x_s_rate);
+            return SVector::<f64, N>::from_fn(|i, _| if i == 0 { a } else { b });
+        }
+        let mut pressures = [0.0; PRESSURES_WITH_VOLUMES];
+        for (slot, value) in pressures.iter_mut().zip(p.iter()) {
+            *slot = *value;
+        }
+        let rates = self
+            .model
+            .pressure_rates_with_volumes(areas, &pressures, x_s, self.x_s_rate);
+        SVector::<f64, N>::from_fn(|i, _| rates[i])
     }
 }
 
@@ -202,9 +214,9 @@ impl StageAreas {
     }
 }
 
-impl OdeSystem<2> for ChamberSystem<'_> {
+impl<const N: usize> OdeSystem<N> for ChamberSystem<'_, N> {
     #[inline]
-    fn rhs(&self, t: f64, p: &SVector<f64, 2>) -> SVector<f64, 2> {
+    fn rhs(&self, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         if t == 0.0 {
             return self.rates_at_start(p);
         }
@@ -261,7 +273,7 @@ impl OdeSystem<2> for ChamberSystem<'_> {
         self.stretch_at.set(Some((t1, stretch_a)));
         None
     }
-    fn jacobian(&self, t: f64, p: &SVector<f64, 2>, f_p: &SVector<f64, 2>) -> nalgebra::SMatrix<f64, 2, 2> {
+    fn jacobian(&self, t: f64, p: &SVector<f64, N>, f_p: &SVector<f64, N>) -> nalgebra::SMatrix<f64, N, N> {
         let areas = self.areas(t);
         finite_difference_jacobian(|q| self.rates(&areas, t, q), p, f_p)
     }
@@ -282,7 +294,7 @@ mod tests {
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
         // The chambers' time starts at the step's start, as the trajectory's does.
-        let system = ChamberSystem::new(
+        let system = ChamberSystem::<2>::new(
             &model,
             &trajectory,
             0.002,
@@ -328,7 +340,7 @@ mod tests {
         let propagator = sim.propagator.as_ref().unwrap();
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
-        let system = ChamberSystem::new(
+        let system = ChamberSystem::<2>::new(
             &model,
             &trajectory,
             0.01,

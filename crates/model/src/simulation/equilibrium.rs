@@ -2,13 +2,14 @@
 //! chamber pressures at which both net mass flows vanish (§3.3.1), found by a
 //! pseudo-transient run polished by Newton's method, which converges from any start.
 
-use nalgebra::SVector;
+use nalgebra::{DMatrix, DVector, SVector};
 
 use super::monolithic::StepSystem;
 use crate::integrator::{Sdirk4, Statistics, Tolerances};
 use crate::physics::actuator::{index, Actuator, State};
 use crate::physics::command_stage;
 use crate::physics::current_driver;
+use crate::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use crate::physics::time_varying;
 
 /// The current at its static value and the jet pipe at rest at f3 of it; the pressures
@@ -116,6 +117,101 @@ pub fn equilibrium(model: &Actuator, v_da: f64, x_s: f64) -> Result<State, Strin
         ));
     }
     Ok(y)
+}
+
+/// The chamber pressures of `state` and the volumes' pressures at which every net flow of the
+/// network with its volumes vanishes ([`Actuator::pressure_rates_with_volumes`]), at the
+/// constants' values at `time`. [`equilibrium`] balances the chambers with the pressures
+/// behind the restrictions found one place at a time; that is close, and Newton's method on
+/// all the pressures together takes it the rest of the way.
+pub fn balance_with_volumes(
+    model: &Actuator,
+    state: &State,
+    x_s: f64,
+    time: f64,
+) -> Result<(State, [f64; node::COUNT]), String> {
+    let held;
+    let model = if time_varying::varies(&model.params) {
+        let mut at = model.clone();
+        time_varying::set_at(&mut at.params, &model.params, time)?;
+        held = at;
+        &held
+    } else {
+        model
+    };
+    let areas = model.areas(state[index::JET_POSITION]);
+    let quasi_static = model
+        .network_flows(&areas, state[index::P1], state[index::P2], None)
+        .node_pressures;
+    let active: Vec<usize> = (0..PRESSURES_WITH_VOLUMES)
+        .filter(|&i| i < 2 || model.restrictions.places[i - 2].has_volume())
+        .collect();
+    let mut all = [0.0; PRESSURES_WITH_VOLUMES];
+    all[0] = state[index::P1];
+    all[1] = state[index::P2];
+    all[2..].copy_from_slice(&quasi_static);
+    let residual = |all: &[f64; PRESSURES_WITH_VOLUMES]| {
+        let rates = model.pressure_rates_with_volumes(&areas, all, x_s, 0.0);
+        DVector::from_iterator(active.len(), active.iter().map(|&i| rates[i]))
+    };
+    let scale = model.params.p_s.max(model.params.p_r);
+    let mut r = residual(&all);
+    for _ in 0..50 {
+        if r.amax() == 0.0 {
+            break;
+        }
+        let mut jac = DMatrix::<f64>::zeros(active.len(), active.len());
+        for (c, &i) in active.iter().enumerate() {
+            let mut moved = all;
+            let h = 1e-7 * moved[i].abs().max(1e3);
+            moved[i] += h;
+            jac.set_column(c, &((residual(&moved) - &r) / h));
+        }
+        let delta = match jac.lu().solve(&(-&r)) {
+            Some(delta) => delta,
+            None => break,
+        };
+        // Halve the step until the imbalance falls: the start is close, but the orifice
+        // law's root makes the rates steep where a restriction's pressures meet.
+        let mut fraction = 1.0;
+        let mut improved = None;
+        for _ in 0..30 {
+            let mut trial = all;
+            for (k, &i) in active.iter().enumerate() {
+                trial[i] += fraction * delta[k];
+            }
+            let r_trial = residual(&trial);
+            if r_trial.amax() < r.amax() {
+                improved = Some((trial, r_trial));
+                break;
+            }
+            fraction *= 0.5;
+        }
+        match improved {
+            Some((trial, r_trial)) => {
+                let moved = (fraction * delta.amax()).abs();
+                all = trial;
+                r = r_trial;
+                if moved < 1e-12 * scale {
+                    break;
+                }
+            }
+            None => break,
+        }
+    }
+    let balanced = r.amax() <= 1e-3 * scale;
+    if !balanced {
+        return Err(format!(
+            "could not balance the gas volumes behind the restrictions with the chambers at x_s = {x_s} m: pressures still change by {} Pa/s",
+            r.amax()
+        ));
+    }
+    let mut balanced = *state;
+    balanced[index::P1] = all[0];
+    balanced[index::P2] = all[1];
+    let mut nodes = [0.0; node::COUNT];
+    nodes.copy_from_slice(&all[2..]);
+    Ok((balanced, nodes))
 }
 
 #[cfg(test)]

@@ -18,11 +18,11 @@ mod fixed_step;
 mod monolithic;
 mod snapshot;
 
-pub use equilibrium::{equilibrium, equilibrium_at, equilibrium_of_electromechanics};
+pub use equilibrium::{balance_with_volumes, equilibrium, equilibrium_at, equilibrium_of_electromechanics};
 pub use fixed_step::FixedStep;
 pub use snapshot::{SimulationSnapshot, SNAPSHOT_LAYOUT};
 
-use nalgebra::SVector;
+use nalgebra::{Const, DimMin, SVector};
 
 use self::chambers::ChamberSystem;
 use self::monolithic::StepSystem;
@@ -32,6 +32,7 @@ use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
 use crate::physics::time_varying;
 
@@ -120,6 +121,9 @@ pub struct Simulation {
     /// (see [`crate::physics::sensors`]).
     transducers: [Option<SensorMemory>; 3],
     propagator: Option<ElectromechanicalPropagator>,
+    /// The pressures of the gas volumes behind restrictions, in the order of
+    /// [`crate::physics::restrictions::node`] (followed only for the places with a volume).
+    nodes: [f64; node::COUNT],
     /// The chambers' pressure rates at the end of the last split step, with what they are a
     /// function of: when the next step starts from the same jet pipe position, pressures and
     /// stopper motion, they are its rates at the start and are not evaluated again.
@@ -156,7 +160,16 @@ impl Simulation {
         check_finite("v_DA", v_da, "V")?;
         model.params.check_stopper(x_s)?;
         let state = equilibrium_at(&model, v_da, x_s, time)?;
-        Ok(Self::from_state(model, state, v_da, x_s, time, relative_tolerance))
+        if !model.restrictions.has_volumes() {
+            return Ok(Self::from_state(model, state, v_da, x_s, time, relative_tolerance));
+        }
+        let (state, nodes) = balance_with_volumes(&model, &state, x_s, time)?;
+        let mut simulation = Self::from_state(model, state, v_da, x_s, time, relative_tolerance);
+        if simulation.propagator.is_none() {
+            return Err(volumes_need_the_split_method(&simulation.model));
+        }
+        simulation.nodes = nodes;
+        Ok(simulation)
     }
 
     /// A simulation from a given state.
@@ -173,7 +186,20 @@ impl Simulation {
         // What the driver has seen since long before (the delay line's past): the command
         // through the stage, as every later entry of the line is.
         let seen_before = command_stage.current(&model.params);
+        let nodes = if model.restrictions.any() {
+            model
+                .network_flows(
+                    &model.areas(state[index::JET_POSITION]),
+                    state[index::P1],
+                    state[index::P2],
+                    None,
+                )
+                .node_pressures
+        } else {
+            [0.0; node::COUNT]
+        };
         Self {
+            nodes,
             model,
             time,
             state,
@@ -216,6 +242,13 @@ impl Simulation {
     /// The six states (see [`index`]).
     pub fn state(&self) -> &State {
         &self.state
+    }
+
+    /// The pressures behind the restrictions, Pa, in the order of
+    /// [`crate::physics::restrictions::node`]: a state where the place has a volume; otherwise
+    /// the quasi-static value at the start, and not followed.
+    pub fn node_pressures(&self) -> [f64; node::COUNT] {
+        self.nodes
     }
 
     /// The command v_DA, V: as set, or where its ramp ended (the driver may see another
@@ -322,7 +355,7 @@ impl Simulation {
     /// without asking, if it is no longer than a ringing period and the default method
     /// integrates it). The pressure rates at the start come from `system`, which
     /// keeps them for the integrator's first stage.
-    fn ringing_until(&self, system: &ChamberSystem, trajectory: &Trajectory, step: f64) -> f64 {
+    fn ringing_until<const N: usize>(&self, system: &ChamberSystem<N>, trajectory: &Trajectory, step: f64) -> f64 {
         let after_current_transient = step.min(5.0 / self.model.params.omega_cd);
         let amplitude = trajectory
             .ringing_amplitude(0.0)
@@ -345,10 +378,10 @@ impl Simulation {
         let h = 1e-7;
         // The system's rates at the start are at the trajectory's x(0), which is x_jp to
         // rounding (an ulp, some 1e-13 of h).
-        let start = system.rhs(0.0, &SVector::<f64, 2>::new(p1, p2));
-        let (a0, b0) = (start[0], start[1]);
-        let (a1, b1) = self.model.pressure_rates(x_jp + h, p1, p2, self.x_s, self.x_s_rate);
-        let sensitivity = ((a1 - a0) / h).abs().max(((b1 - b0) / h).abs());
+        let pressures = self.pressures::<N>();
+        let start = system.rhs(0.0, &pressures);
+        let moved = system.rates(&self.model.areas(x_jp + h), 0.0, &pressures);
+        let sensitivity = ((moved - start) / h).amax();
         // Pressure ripple ≈ ∂Ṗ/∂x · amplitude / ω_d.
         let ripple = sensitivity * amplitude * period / (2.0 * std::f64::consts::PI);
         let allowed = 0.01 * self.local_tolerance() * (self.model.state_scales()[index::P1] + p1.abs().max(p2.abs()));
@@ -509,6 +542,9 @@ impl Simulation {
     fn advance(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<(), StepFailure> {
         let outcome = match (self.method, &self.propagator) {
             (Method::Split, Some(_)) => self.split_step(duration, v, v_rate),
+            _ if self.model.restrictions.has_volumes() => {
+                return Err(StepFailure::InvalidRequest(volumes_need_the_split_method(&self.model)))
+            }
             _ => self.monolithic_step(duration, v, v_rate),
         };
         self.settle(outcome, duration)
@@ -517,26 +553,59 @@ impl Simulation {
     /// The split method's step: the jet pipe's exact trajectory drives the chambers, whose
     /// two pressures alone are integrated.
     fn split_step(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<State, IntegrationFailure<N_STATES>> {
+        if self.model.restrictions.has_volumes() {
+            self.split_step_over::<PRESSURES_WITH_VOLUMES>(duration, v, v_rate)
+        } else {
+            self.split_step_over::<2>(duration, v, v_rate)
+        }
+    }
+
+    /// The pressures the split method integrates: P1 and P2, then the volumes' (N = 6).
+    fn pressures<const N: usize>(&self) -> SVector<f64, N> {
+        SVector::<f64, N>::from_fn(|i, _| match i {
+            0 => self.state[index::P1],
+            1 => self.state[index::P2],
+            _ => self.nodes[i - 2],
+        })
+    }
+
+    /// [`Self::split_step`] with N integrated pressures.
+    fn split_step_over<const N: usize>(
+        &mut self,
+        duration: f64,
+        v: f64,
+        v_rate: f64,
+    ) -> Result<State, IntegrationFailure<N_STATES>>
+    where
+        Const<N>: DimMin<Const<N>, Output = Const<N>>,
+    {
         let t0 = self.time;
         let propagator = self.propagator.as_ref().expect("the split method has a propagator");
         let trajectory = propagator.trajectory(&self.electromechanical_state(), v, v_rate, &self.plays);
-        let pressures = SVector::<f64, 2>::new(self.state[index::P1], self.state[index::P2]);
+        let pressures = self.pressures::<N>();
         let start_position = self.state[index::JET_POSITION];
-        let system = ChamberSystem::new(
+        // The rates kept from the last step are the chambers' alone.
+        let known_rates = self.known_chamber_rates().filter(|_| N == 2).map(|end| {
+            (
+                SVector::<f64, N>::from_fn(|i, _| end.pressures[i]),
+                SVector::<f64, N>::from_fn(|i, _| end.rates[i]),
+            )
+        });
+        let system = ChamberSystem::<N>::new(
             &self.model,
             &trajectory,
             duration,
             start_position,
-            self.known_chamber_rates().map(|end| (end.pressures, end.rates)),
+            known_rates,
             self.x_s,
             self.x_s_rate,
         );
         let scale = self.model.state_scales();
         let tolerances = Tolerances {
             relative: self.local_tolerance(),
-            absolute: SVector::<f64, 2>::new(scale[index::P1], scale[index::P2]) * self.local_tolerance(),
+            absolute: SVector::<f64, N>::repeat(scale[index::P1] * self.local_tolerance()),
         };
-        let combine = |s: f64, p: SVector<f64, 2>| {
+        let combine = |s: f64, p: SVector<f64, N>| {
             let em = trajectory.state(s);
             State::from([em.current, em.position, em.velocity, em.acceleration, p[0], p[1]])
         };
@@ -577,15 +646,26 @@ impl Simulation {
                 // rates are the next step's at its start.
                 if let Some((x_jp, pressures, rates)) = system.end_rates.get().filter(|(_, q, _)| *q == p) {
                     end[index::JET_POSITION] = x_jp;
-                    self.chamber_rates_at_end = Some(ChamberRatesAtEnd {
-                        x_jp,
-                        pressures,
-                        x_s: self.x_s + self.x_s_rate * duration,
-                        x_s_rate: self.x_s_rate,
-                        rates,
-                    });
+                    if N == 2 {
+                        self.chamber_rates_at_end = Some(ChamberRatesAtEnd {
+                            x_jp,
+                            pressures: SVector::<f64, 2>::new(pressures[0], pressures[1]),
+                            x_s: self.x_s + self.x_s_rate * duration,
+                            x_s_rate: self.x_s_rate,
+                            rates: SVector::<f64, 2>::new(rates[0], rates[1]),
+                        });
+                    }
                 }
+                keep_nodes(&mut self.nodes, &p);
                 Ok(end)
+            }
+            Err(f) if f.state.iter().all(|v| v.is_finite()) => {
+                keep_nodes(&mut self.nodes, &f.state);
+                Err(IntegrationFailure {
+                    message: f.message,
+                    time: t0 + f.time,
+                    state: combine(f.time, f.state),
+                })
             }
             Err(f) => Err(IntegrationFailure {
                 message: f.message,
@@ -689,20 +769,24 @@ impl Simulation {
 
 /// Integrate the chambers over a step of `duration`. While the jet pipe rings (until
 /// `ringing_until`), the explicit pairs' steps are capped by its period.
-fn integrate_chambers(
+#[allow(clippy::too_many_arguments)]
+fn integrate_chambers<const N: usize>(
     integrator: &mut Sdirk4,
     statistics: &mut Statistics,
     method: ChamberMethod,
-    system: &ChamberSystem,
-    tolerances: &Tolerances<2>,
-    pressures: SVector<f64, 2>,
+    system: &ChamberSystem<N>,
+    tolerances: &Tolerances<N>,
+    pressures: SVector<f64, N>,
     duration: f64,
     ringing_until: f64,
-) -> Result<SVector<f64, 2>, IntegrationFailure<2>> {
+) -> Result<SVector<f64, N>, IntegrationFailure<N>>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
     let integrate = |integrator: &mut Sdirk4,
                      pair: ExplicitPair,
                      from: f64,
-                     p: SVector<f64, 2>,
+                     p: SVector<f64, N>,
                      to: f64,
                      statistics: &mut Statistics| match method {
         ChamberMethod::NonStiffFirst | ChamberMethod::DormandPrinceOnly => {
@@ -751,6 +835,22 @@ fn integrate_chambers(
             statistics,
         )
     }
+}
+
+/// Keep the volumes' pressures of an integrated pressure vector (entries 2.. of N = 6).
+fn keep_nodes<const N: usize>(nodes: &mut [f64; node::COUNT], p: &SVector<f64, N>) {
+    for i in 2..N {
+        nodes[i - 2] = p[i];
+    }
+}
+
+/// Why a model with gas volumes cannot take a monolithic step.
+fn volumes_need_the_split_method(model: &Actuator) -> String {
+    let p = &model.params;
+    format!(
+        "the gas volumes behind restrictions (supply_plenum_volume = {} m3, return_plenum_volume = {} m3, port_line_volume_1 = {} m3, port_line_volume_2 = {} m3) are integrated by the split method only, which needs a jet pipe with two distinct eigenvalues (zeta_2 = {} must be < 1)",
+        p.supply_plenum_volume, p.return_plenum_volume, p.port_line_volume_1, p.port_line_volume_2, p.zeta_2
+    )
 }
 
 fn check_finite(name: &str, value: f64, unit: &str) -> Result<(), String> {
@@ -1118,6 +1218,167 @@ mod tests {
             .unwrap()
             .outputs();
         assert_eq!(y.f_meas, y.f_act);
+    }
+
+    /// 0.3 s of command steps at 1 kHz, the forces and the volumes' pressures at each sample.
+    fn stepped_run(model: &Actuator) -> (Vec<f64>, Vec<[f64; node::COUNT]>) {
+        let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
+        let (mut forces, mut nodes) = (vec![], vec![]);
+        for k in 0..300 {
+            sim.set_command(if (k / 50) % 2 == 0 { 4.0 } else { 1.0 }).unwrap();
+            sim.step(1e-3).unwrap();
+            forces.push(sim.outputs().f_act);
+            nodes.push(sim.node_pressures());
+        }
+        (forces, nodes)
+    }
+
+    fn worst_difference(a: &[f64], b: &[f64]) -> f64 {
+        a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    }
+
+    /// A volume behind a restriction, shrunk to a thousandth of a cubic millimetre, fills in
+    /// microseconds: the run must follow the quasi-static restriction's, which takes no volume
+    /// and finds the pressure behind it as a root at every evaluation.
+    #[test]
+    fn a_vanishing_volume_behind_a_restriction_gives_the_restriction_alone() {
+        type Setter = fn(&mut Parameters, f64);
+        let cases: [(&str, Setter); 3] = [
+            ("port line behind an orifice", |p, v| {
+                p.port_restriction_area_1 = 0.2e-6;
+                p.port_line_volume_1 = v;
+            }),
+            ("supply plenum behind a resistance", |p, v| {
+                p.supply_resistance = 3e8;
+                p.supply_plenum_volume = v;
+            }),
+            ("return plenum behind a vent orifice", |p, v| {
+                p.return_vent_area = 0.35e-6;
+                p.return_plenum_volume = v;
+            }),
+        ];
+        let (thesis, _) = stepped_run(&thesis_model());
+        for (name, set) in cases {
+            let (quasi_static, _) = stepped_run(&with(|p| set(p, 0.0)));
+            let (tiny, _) = stepped_run(&with(|p| set(p, 1e-12)));
+            let (sizeable, _) = stepped_run(&with(|p| set(p, 3e-6)));
+            let effect = worst_difference(&quasi_static, &thesis);
+            assert!(
+                effect > 0.3,
+                "{name}: the restriction moves the force by {effect} N only"
+            );
+            let gap = worst_difference(&tiny, &quasi_static);
+            assert!(
+                gap < 1e-3 * effect,
+                "{name}: {gap} N from the quasi-static run (effect {effect} N)"
+            );
+            let volume_effect = worst_difference(&sizeable, &quasi_static);
+            assert!(
+                volume_effect > 0.05,
+                "{name}: 3 cm3 moves the force by {volume_effect} N only"
+            );
+        }
+    }
+
+    #[test]
+    fn with_volumes_the_equilibrium_balances_every_flow_and_stays_put() {
+        let model = with(|p| {
+            p.supply_restriction_area = 0.25e-6;
+            p.supply_plenum_volume = 2e-6;
+            p.return_resistance = 1e8;
+            p.return_plenum_volume = 1e-6;
+            p.port_restriction_area_2 = 0.3e-6;
+            p.port_line_volume_2 = 3e-6;
+        });
+        for v in [-3.0, 1.0, 2.5, 8.0] {
+            let mut sim = Simulation::at_equilibrium(model.clone(), v, 0.06, 0.0, 1e-8).unwrap();
+            let mut pressures = [0.0; PRESSURES_WITH_VOLUMES];
+            pressures[0] = sim.state[index::P1];
+            pressures[1] = sim.state[index::P2];
+            pressures[2..].copy_from_slice(&sim.node_pressures());
+            let rates =
+                model.pressure_rates_with_volumes(&model.areas(sim.state[index::JET_POSITION]), &pressures, 0.06, 0.0);
+            // A pascal per second at most: far below a millisecond's change of 1 Pa.
+            assert!(rates.iter().all(|r| r.abs() < 1.0), "v = {v}: {rates:?}");
+            let p = &model.params;
+            let nodes = sim.node_pressures();
+            assert!(
+                nodes[node::SUPPLY] < p.p_s && nodes[node::SUPPLY] > p.p_r,
+                "v = {v}: {nodes:?}"
+            );
+            assert!(
+                nodes[node::RETURN] > p.p_r && nodes[node::RETURN] < p.p_s,
+                "v = {v}: {nodes:?}"
+            );
+            let before = sim.outputs();
+            sim.step(0.5).unwrap();
+            let after = sim.outputs();
+            assert!(
+                (after.f_act - before.f_act).abs() < 1e-6,
+                "v = {v}: {before:?} -> {after:?}"
+            );
+            assert!(worst_difference(&sim.node_pressures(), &nodes) < 1e-3, "v = {v}");
+        }
+    }
+
+    /// The volumes change how the pressures get there, not where they settle: the static force
+    /// is the quasi-static restriction's, and a command step reaches it later.
+    #[test]
+    fn a_line_volume_keeps_the_static_force_and_slows_the_step() {
+        let alone = with(|p| p.port_restriction_area_1 = 0.2e-6);
+        let with_line = with(|p| {
+            p.port_restriction_area_1 = 0.2e-6;
+            p.port_line_volume_1 = 3e-6;
+        });
+        let settled = |model: &Actuator| {
+            Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-8)
+                .unwrap()
+                .outputs()
+                .f_act
+        };
+        assert!((settled(&alone) - settled(&with_line)).abs() < 1e-6);
+        let response = |model: &Actuator| {
+            let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
+            let start = sim.outputs().f_act;
+            sim.set_command(2.5).unwrap();
+            sim.step(0.01).unwrap();
+            sim.outputs().f_act - start
+        };
+        assert!(
+            response(&with_line) < 0.9 * response(&alone),
+            "{} vs {}",
+            response(&with_line),
+            response(&alone)
+        );
+    }
+
+    #[test]
+    fn the_monolithic_method_refuses_volumes_by_name() {
+        let model = with(|p| {
+            p.supply_resistance = 3e8;
+            p.supply_plenum_volume = 2e-6;
+        });
+        let mut sim = Simulation::at_equilibrium(model, 2.5, 0.054, 0.0, 1e-6).unwrap();
+        sim.set_method(Method::Monolithic);
+        match sim.step(1e-3) {
+            Err(StepFailure::InvalidRequest(e)) => {
+                assert!(
+                    e.contains("supply_plenum_volume = 0.000002") && e.contains("split"),
+                    "{e}"
+                )
+            }
+            other => panic!("{other:?}"),
+        }
+        let without_modal_form = with(|p| {
+            p.zeta_2 = 1.5;
+            p.port_resistance_2 = 1e8;
+            p.port_line_volume_2 = 1e-6;
+        });
+        let e = Simulation::at_equilibrium(without_modal_form, 2.5, 0.054, 0.0, 1e-6).unwrap_err();
+        assert!(
+            e.contains("port_line_volume_2 = 0.000001") && e.contains("zeta_2 = 1.5"),
+            "{e}"
+        );
     }
 
     #[test]

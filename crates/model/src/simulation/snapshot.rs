@@ -18,6 +18,7 @@ use crate::integrator::{Sdirk4, Statistics};
 use crate::physics::actuator::{Actuator, State, N_STATES};
 use crate::physics::command_stage::CommandStage;
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::restrictions::node;
 use crate::physics::sensors::SensorMemory;
 
 /// A simulation's memory between two steps: see the module's documentation.
@@ -25,6 +26,7 @@ use crate::physics::sensors::SensorMemory;
 pub struct SimulationSnapshot {
     time: f64,
     state: [f64; N_STATES],
+    nodes: [f64; node::COUNT],
     v_da: f64,
     x_s: f64,
     v_da_rate: f64,
@@ -47,11 +49,11 @@ pub struct SimulationSnapshot {
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-pub const SNAPSHOT_LAYOUT: f64 = 2.0;
+pub const SNAPSHOT_LAYOUT: f64 = 3.0;
 
-/// Numbers before the two counted lists: the layout, 18 scalars, the state, the plays, the
-/// command stage (3) and the six work counters as two halves each.
-const FIXED_VALUES: usize = 1 + 18 + N_STATES + PLAY_OPERATORS + 3 + 2 * STATISTICS;
+/// Numbers before the two counted lists: the layout, 18 scalars, the state, the volumes'
+/// pressures, the plays, the command stage (3) and the six work counters as two halves each.
+const FIXED_VALUES: usize = 1 + 18 + N_STATES + node::COUNT + PLAY_OPERATORS + 3 + 2 * STATISTICS;
 const STATISTICS: usize = 6;
 
 impl Simulation {
@@ -62,6 +64,7 @@ impl Simulation {
         SimulationSnapshot {
             time: self.time,
             state,
+            nodes: self.nodes,
             v_da: self.v_da,
             x_s: self.x_s,
             v_da_rate: self.v_da_rate,
@@ -96,6 +99,7 @@ impl Simulation {
             sim.method = s.method;
         }
         sim.chamber_method = s.chamber_method;
+        sim.nodes = s.nodes;
         sim.v_da_rate = s.v_da_rate;
         sim.x_s_rate = s.x_s_rate;
         sim.integrator = s.integrator;
@@ -125,7 +129,8 @@ impl SimulationSnapshot {
     /// method (0 split, 1 monolithic), chamber method (0 non-stiff first, 1 Dormand–Prince
     /// only, 2 SDIRK4), the two integrators' next, largest and first step sizes, input changed
     /// (0 or 1), the step after a change, stopper velocity, x_s at the last step; the state;
-    /// the plays; the command stage (time, held, lagged); the work counters (steps, rejected,
+    /// the pressures of the gas volumes behind restrictions (supply, return, line 1, line 2); the
+    /// plays; the command stage (time, held, lagged); the work counters (steps, rejected,
     /// right-hand sides, Jacobians, Newton failures, stiff hand-overs), each as its low then
     /// its high 32 bits, since an `f64` holds integers exactly only up to 2^53; then the
     /// number of past commands and their (time, v_DA, rate); then for each transducer (force,
@@ -160,6 +165,7 @@ impl SimulationSnapshot {
             self.x_s_at_last_step,
         ]);
         v.extend_from_slice(&self.state);
+        v.extend_from_slice(&self.nodes);
         v.extend_from_slice(&self.plays);
         v.extend_from_slice(&self.command_stage.to_values());
         for count in statistics_counts(&self.statistics) {
@@ -208,6 +214,8 @@ impl SimulationSnapshot {
             scalars.try_into().expect("18 values");
         let mut state = [0.0; N_STATES];
         state.copy_from_slice(next(N_STATES));
+        let mut nodes = [0.0; node::COUNT];
+        nodes.copy_from_slice(next(node::COUNT));
         let mut plays = [0.0; PLAY_OPERATORS];
         plays.copy_from_slice(next(PLAY_OPERATORS));
         let stage: [f64; 3] = next(3).try_into().expect("3 values");
@@ -271,7 +279,7 @@ impl SimulationSnapshot {
             stopper_velocity,
             x_s_at_last_step,
         ];
-        let finite = numbers.iter().chain(&state).chain(&stage).chain(sensor).all(|v| v.is_finite())
+        let finite = numbers.iter().chain(&state).chain(&nodes).chain(&stage).chain(sensor).all(|v| v.is_finite())
             && command_history.iter().all(|c| c.v_da.is_finite() && c.rate.is_finite())
             // The step caps may be unlimited; the oldest past command is from −∞.
             && !max_step.is_nan()
@@ -288,6 +296,7 @@ impl SimulationSnapshot {
         Ok(Self {
             time,
             state,
+            nodes,
             v_da,
             x_s,
             v_da_rate,
@@ -396,9 +405,13 @@ mod tests {
     }
 
     /// The rest of it: the command stage (a lag), the force and chamber 2 transducers' delays, a
-    /// varying supply.
+    /// varying supply feeding a plenum, a port line's volume.
     fn with_staged_memory() -> Actuator {
         model(|p| {
+            p.supply_resistance = 2e8;
+            p.supply_plenum_volume = 2e-6;
+            p.port_restriction_area_1 = 0.2e-6;
+            p.port_line_volume_1 = 3e-6;
             p.command_lag = 0.002;
             p.force_sensor_delay = 0.002;
             p.p2_sensor_delay = 0.003;
