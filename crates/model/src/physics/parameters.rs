@@ -312,6 +312,13 @@ impl Parameters {
         vr::P2_SENSOR_DRIFT,
         vr::P2_SENSOR_LAG,
         vr::P2_SENSOR_DELAY,
+        vr::SUPPLY_RESTRICTION_AREA,
+        vr::SUPPLY_PLENUM_VOLUME,
+        vr::RETURN_PLENUM_VOLUME,
+        vr::PORT_RESTRICTION_AREA_1,
+        vr::PORT_RESTRICTION_AREA_2,
+        vr::PORT_LINE_VOLUME_1,
+        vr::PORT_LINE_VOLUME_2,
     ];
 
     fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
@@ -555,6 +562,28 @@ mod tests {
         );
         p.hysteresis_exponent = 0.0;
         assert!(p.validate().is_ok());
+    }
+
+    /// The list that defaults, copies and the FMU state go through must hold every parameter
+    /// of the variable table, or a new one is silently left at its start value there.
+    #[test]
+    fn every_parameter_of_the_table_is_a_listed_field() {
+        let parameters: Vec<u32> = crate::variables::TABLE
+            .iter()
+            .map(|row| row.variable)
+            .filter(|v| v.causality == crate::variable::Causality::Parameter)
+            .map(|v| v.value_reference)
+            // How a run starts, not a constant of the model.
+            .filter(|vr| ![vr::START_AT_EQUILIBRIUM, vr::P1_START, vr::P2_START].contains(vr))
+            .collect();
+        let mut listed = Parameters::VALUE_REFERENCES.to_vec();
+        listed.sort_unstable();
+        let mut expected = parameters.clone();
+        expected.sort_unstable();
+        assert_eq!(listed, expected);
+        for vr in parameters {
+            assert!(Parameters::default().field_mut(vr).is_some(), "{}", variable_name(vr));
+        }
     }
 
     #[test]
