@@ -68,12 +68,14 @@ def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description,
     assert abs(rms - reported) <= 0.05 * reported
 
 
-# A term in the command stage (a rate limit between communication points) and one in the
-# force sensor (a lag of its reading): both have a memory the FMU keeps between steps.
+# A term in the command stage (a rate limit between communication points), one in the
+# force sensor (a lag of its reading) and a port line's volume behind an orifice (a pressure
+# state of its own): each has a memory the FMU keeps between steps.
 @pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
                     reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
 @pytest.mark.parametrize("mechanism,parameter", [("current_slew_limit", "current_slew_limit"),
-                                                 ("force_sensor_lag", "force_sensor_lag")])
+                                                 ("force_sensor_lag", "force_sensor_lag"),
+                                                 ("port_1_restriction", "port_line_volume_1")])
 def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path, mechanism, parameter):
     recording_path = tmp_path / f"{mechanism}.csv"

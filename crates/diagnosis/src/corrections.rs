@@ -244,6 +244,26 @@ fn term_off(name: &'static str, unit: &'static str, step: f64, upper: f64) -> Te
     }
 }
 
+/// A restriction as an orifice (C_d·A, searched over 0.01–10 mm² on a logarithmic scale: off
+/// at 0 and at an infinite area) and the gas volume behind it. The area is searched with a
+/// volume that fills within a tenth of a millisecond (0.1 cm³: the restriction nearly alone,
+/// at the cost of the fast replay's fixed steps rather than a root at every evaluation), then
+/// both are refined together ([`Mechanism::Searched`] followed by parameters).
+fn volume_behind(area: &'static str, volume: &'static str) -> Vec<Term> {
+    vec![
+        Term {
+            name: area,
+            unit: "m2",
+            mechanism: Mechanism::Searched(area),
+            neutral: 0.0,
+            step: 0.0,
+            lower: 1e-8,
+            upper: 1e-5,
+        },
+        started(volume, "m3", 1e-7, 2e-7, 0.0, 1e-4),
+    ]
+}
+
 /// Where the Bouc–Wen law's fit starts: exponent, gain and β share (a rounded bend, the
 /// output still at a reversal, symmetric).
 const BOUC_WEN_START: [f64; 3] = [2.0, 1.0, 0.5];
@@ -514,6 +534,20 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             ],
         ),
         c(
+            "port 1 orifice with a line volume",
+            "valve",
+            "restriction",
+            None,
+            volume_behind("port_restriction_area_1", "port_line_volume_1"),
+        ),
+        c(
+            "port 2 orifice with a line volume",
+            "valve",
+            "restriction",
+            None,
+            volume_behind("port_restriction_area_2", "port_line_volume_2"),
+        ),
+        c(
             "supply pressure",
             "supply",
             "parameter_offset",
@@ -526,6 +560,13 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "restriction",
             Some("supply_pressure_drop"),
             vec![term_off("supply_resistance", "Pa.s/kg", 1e8, 1e11)],
+        ),
+        c(
+            "supply orifice with a plenum",
+            "supply",
+            "restriction",
+            Some("supply_pressure_drop"),
+            volume_behind("supply_restriction_area", "supply_plenum_volume"),
         ),
         c(
             "supply pressure drift",
@@ -565,6 +606,13 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
                 lower: 1e-8,
                 upper: 1e-5,
             }],
+        ),
+        c(
+            "return vent orifice with a plenum",
+            "return",
+            "restriction",
+            None,
+            volume_behind("return_vent_area", "return_plenum_volume"),
         ),
         c(
             "dead volumes",
@@ -1086,6 +1134,9 @@ impl Problem<'_> {
             return self.fit_shape(candidate, base_replay);
         }
         if terms.iter().any(|t| t.mechanism.is_searched()) {
+            if terms.len() > 1 {
+                return self.fit_search_then_refine(candidate, iterations, base_replay);
+            }
             return self.fit_search(candidate, base_replay);
         }
         // Sensitivities of the modulated parameters (at the base point: first order).
@@ -1107,8 +1158,12 @@ impl Problem<'_> {
             // Columns: nonlinear terms by finite differences (shared ones at the start).
             let mut columns: Vec<Sensitivity> = Vec::with_capacity(terms.len());
             for (j, term) in terms.iter().enumerate() {
-                let column = match term.mechanism {
+                let known = match term.mechanism {
                     Mechanism::Parameter(name) if iteration == 0 && candidate.settings.is_empty() => shared(name),
+                    _ => None,
+                };
+                let column = match term.mechanism {
+                    _ if known.is_some() => known,
                     Mechanism::Parameter(_) | Mechanism::CommandLag | Mechanism::InputCubic => {
                         let mut moved = point.values.clone();
                         let step = if moved[j] + term.step <= term.upper {
@@ -1339,6 +1394,58 @@ impl Problem<'_> {
         Ok(Fit {
             candidate: candidate.clone(),
             values,
+            ..fit
+        })
+    }
+
+    /// A searched term followed by parameters that only act once it is on (an orifice and the
+    /// volume behind it): the search with the parameters at their starts, then Gauss–Newton on
+    /// all of them from there, the searched term now a parameter.
+    fn fit_search_then_refine(
+        &self,
+        candidate: &Candidate,
+        iterations: usize,
+        base_replay: &Replay,
+    ) -> Result<Fit, String> {
+        let (first, rest) = candidate.terms.split_first().ok_or("a candidate without terms")?;
+        let mut settings = candidate.settings.clone();
+        settings.extend(
+            rest.iter()
+                .filter_map(|t| t.mechanism.model_parameter().map(|name| (name, t.neutral))),
+        );
+        let searched = Candidate {
+            terms: vec![first.clone()],
+            settings,
+            ..candidate.clone()
+        };
+        let found = self.fit_search(&searched, base_replay)?;
+        let neutral: Vec<f64> = candidate.terms.iter().map(|t| t.neutral).collect();
+        if found.values[0] == first.neutral {
+            // Nothing the search could find: the candidate stays off.
+            return Ok(Fit {
+                candidate: candidate.clone(),
+                values: neutral,
+                ..found
+            });
+        }
+        let name = first
+            .mechanism
+            .model_parameter()
+            .ok_or("a searched term without a parameter")?;
+        let mut refined = candidate.clone();
+        refined.terms[0] = Term {
+            mechanism: Mechanism::Parameter(name),
+            neutral: found.values[0],
+            step: 0.02 * found.values[0],
+            ..first.clone()
+        };
+        let start: Vec<f64> = refined.terms.iter().map(|t| t.neutral).collect();
+        let start_replay = self.replay(&refined, &start)?;
+        let none = |_: &'static str| None;
+        let fit = self.fit(&refined, iterations, &start_replay, &none)?;
+        Ok(Fit {
+            candidate: candidate.clone(),
+            replays: fit.replays + found.replays + 1,
             ..fit
         })
     }

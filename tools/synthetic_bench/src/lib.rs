@@ -494,7 +494,7 @@ pub const UNDECLARED: &[UndeclaredMechanism] = &[
         family: "restriction",
         truth: "receiver port 1 reaches chamber 1 through a 3 cm³ line and an orifice of C_d·A = 0.2 mm²",
         effects: std_port_1_restriction,
-        model_parameters: &[],
+        model_parameters: &[("port_restriction_area_1", 0.2e-6), ("port_line_volume_1", 3e-6)],
     },
 ];
 

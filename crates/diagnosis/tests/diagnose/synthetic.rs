@@ -100,7 +100,9 @@ fn single(name: &str, expected: &str, effects: BenchEffects, seed: u64, near_noi
 // down to the noise. Where the forms differ, part of the error stays: a Stribeck curve with
 // its own speed scales and a viscous term the named law lacks, read at the velocity of the
 // averaged stopper positions' last interval, half a sample early (measured 1.76 noise floors;
-// the bound for named effects is 2), and a supply plenum vs an algebraic drop (4.5).
+// the bound for named effects is 2). The supply plenum is the model's supply orifice
+// with a plenum, but the generator's orifice is sized from its resistance and its plenum may be
+// enlarged, so it is held to the bound for named effects, 2.
 
 #[test]
 fn sensor_offset_and_gain() {
@@ -197,7 +199,7 @@ fn supply_pressure_drop_through_a_plenum() {
             ..Default::default()
         },
         107,
-        Some(6.0),
+        Some(2.0),
     );
 }
 
