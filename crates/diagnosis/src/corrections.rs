@@ -264,6 +264,12 @@ fn volume_behind(area: &'static str, volume: &'static str) -> Vec<Term> {
     ]
 }
 
+/// Golden-section steps of a searched term: its bracket shrinks to 0.618^16 = 5e-4 of its
+/// range (a thousandth of a decade over three), or, for the first pass's ranking, to
+/// 0.618^10 = 8e-3 (6 % in value over three decades).
+const GOLDEN_STEPS: usize = 16;
+const COARSE_GOLDEN_STEPS: usize = 10;
+
 /// Where the Bouc–Wen law's fit starts: exponent, gain and β share (a rounded bend, the
 /// output still at a reversal, symmetric).
 const BOUC_WEN_START: [f64; 3] = [2.0, 1.0, 0.5];
@@ -915,6 +921,9 @@ pub struct Problem<'a> {
     /// The middle and the span of the recording's time, for the ramp regressor.
     pub t_mid: f64,
     pub t_span: f64,
+    /// Threads for the finite-difference replays of one Gauss–Newton step (1 while the
+    /// candidates themselves are spread over the threads).
+    pub jobs: std::sync::atomic::AtomicUsize,
 }
 
 impl<'a> Problem<'a> {
@@ -943,7 +952,13 @@ impl<'a> Problem<'a> {
             mean_position: recording.x_s.iter().sum::<f64>() / n as f64,
             t_mid: 0.5 * (t0 + t1),
             t_span: (t1 - t0).max(1e-9),
+            jobs: std::sync::atomic::AtomicUsize::new(1),
         }
+    }
+
+    /// Spread each Gauss–Newton step's finite-difference replays over `jobs` threads.
+    pub fn set_jobs(&self, jobs: usize) {
+        self.jobs.store(jobs.max(1), std::sync::atomic::Ordering::Relaxed);
     }
 
     /// Model outputs with the nonlinear terms at `values` (linear terms are added by
@@ -1137,7 +1152,7 @@ impl Problem<'_> {
             if terms.len() > 1 {
                 return self.fit_search_then_refine(candidate, iterations, base_replay);
             }
-            return self.fit_search(candidate, base_replay);
+            return self.fit_search(candidate, base_replay, GOLDEN_STEPS);
         }
         // Sensitivities of the modulated parameters (at the base point: first order).
         let modulated: Vec<Option<Sensitivity>> = terms
@@ -1155,35 +1170,59 @@ impl Problem<'_> {
         let mut prediction = self.predict(terms, &point, &modulated);
         let (mut train, _) = self.errors(&prediction);
         for iteration in 0..iterations.max(1) {
-            // Columns: nonlinear terms by finite differences (shared ones at the start).
-            let mut columns: Vec<Sensitivity> = Vec::with_capacity(terms.len());
-            for (j, term) in terms.iter().enumerate() {
-                let known = match term.mechanism {
+            // Columns: nonlinear terms by finite differences (shared ones at the start), their
+            // replays spread over the threads.
+            let mut known: Vec<Option<Sensitivity>> = terms
+                .iter()
+                .map(|term| match term.mechanism {
                     Mechanism::Parameter(name) if iteration == 0 && candidate.settings.is_empty() => shared(name),
                     _ => None,
-                };
+                })
+                .collect();
+            let differenced: Vec<(usize, f64)> = terms
+                .iter()
+                .enumerate()
+                .filter(|(j, term)| {
+                    known[*j].is_none()
+                        && matches!(
+                            term.mechanism,
+                            Mechanism::Parameter(_) | Mechanism::CommandLag | Mechanism::InputCubic
+                        )
+                })
+                .map(|(j, term)| {
+                    let step = if point.values[j] + term.step <= term.upper {
+                        term.step
+                    } else {
+                        -term.step
+                    };
+                    (j, step)
+                })
+                .collect();
+            let jobs = self.jobs.load(std::sync::atomic::Ordering::Relaxed);
+            let moved_replays = crate::parallel_map(&differenced, jobs, |&(j, step)| {
+                let mut moved = point.values.clone();
+                moved[j] += step;
+                self.replay(candidate, &moved).ok().map(|r| {
+                    let d =
+                        |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| (x - y) / step).collect() };
+                    [
+                        d(&r.force, &point.replay.force),
+                        d(&r.p1, &point.replay.p1),
+                        d(&r.p2, &point.replay.p2),
+                    ]
+                })
+            });
+            replays += differenced.len();
+            let mut moved_replays = differenced
+                .iter()
+                .map(|&(j, _)| j)
+                .zip(moved_replays)
+                .collect::<Vec<_>>();
+            let mut columns: Vec<Sensitivity> = Vec::with_capacity(terms.len());
+            for (j, term) in terms.iter().enumerate() {
                 let column = match term.mechanism {
-                    _ if known.is_some() => known,
-                    Mechanism::Parameter(_) | Mechanism::CommandLag | Mechanism::InputCubic => {
-                        let mut moved = point.values.clone();
-                        let step = if moved[j] + term.step <= term.upper {
-                            term.step
-                        } else {
-                            -term.step
-                        };
-                        moved[j] += step;
-                        replays += 1;
-                        self.replay(candidate, &moved).ok().map(|r| {
-                            let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
-                                a.iter().zip(b).map(|(x, y)| (x - y) / step).collect()
-                            };
-                            [
-                                d(&r.force, &point.replay.force),
-                                d(&r.p1, &point.replay.p1),
-                                d(&r.p2, &point.replay.p2),
-                            ]
-                        })
-                    }
+                    _ if known[j].is_some() => known[j].take(),
+                    _ if moved_replays.first().map_or(false, |(k, _)| *k == j) => moved_replays.remove(0).1,
                     Mechanism::Output { .. } | Mechanism::Modulated { .. } => {
                         let mut unit = point.values.clone();
                         unit.iter_mut().zip(terms).for_each(|(v, t)| {
@@ -1400,7 +1439,9 @@ impl Problem<'_> {
 
     /// A searched term followed by parameters that only act once it is on (an orifice and the
     /// volume behind it): the search with the parameters at their starts, then Gauss–Newton on
-    /// all of them from there, the searched term now a parameter.
+    /// all of them from there, the searched term now a parameter. A first pass (one
+    /// iteration: the ranking of every candidate) stops after a coarser search; the leaders'
+    /// refinement does it all.
     fn fit_search_then_refine(
         &self,
         candidate: &Candidate,
@@ -1418,8 +1459,22 @@ impl Problem<'_> {
             settings,
             ..candidate.clone()
         };
-        let found = self.fit_search(&searched, base_replay)?;
+        let first_pass = iterations <= 1;
+        let found = self.fit_search(
+            &searched,
+            base_replay,
+            if first_pass { COARSE_GOLDEN_STEPS } else { GOLDEN_STEPS },
+        )?;
         let neutral: Vec<f64> = candidate.terms.iter().map(|t| t.neutral).collect();
+        if first_pass && found.values[0] != first.neutral {
+            let mut values = neutral;
+            values[0] = found.values[0];
+            return Ok(Fit {
+                candidate: candidate.clone(),
+                values,
+                ..found
+            });
+        }
         if found.values[0] == first.neutral {
             // Nothing the search could find: the candidate stays off.
             return Ok(Fit {
@@ -1450,7 +1505,7 @@ impl Problem<'_> {
         })
     }
 
-    fn fit_search(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
+    fn fit_search(&self, candidate: &Candidate, base_replay: &Replay, golden_steps: usize) -> Result<Fit, String> {
         let p = self.base;
         let term = &candidate.terms[0];
         let commands = self.recording.v_da.iter();
@@ -1498,7 +1553,7 @@ impl Problem<'_> {
         let mut c = b - phi * (b - a);
         let mut d = a + phi * (b - a);
         let (mut fc, mut fd) = (evaluate(to_value(c)).0, evaluate(to_value(d)).0);
-        for _ in 0..16 {
+        for _ in 0..golden_steps {
             if fc < fd {
                 b = d;
                 d = c;

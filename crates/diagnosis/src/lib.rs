@@ -472,9 +472,13 @@ fn localize(
         .map(|s| s.fit.candidate.clone())
         .collect();
     progress(&format!("refining the {} leading candidates", leaders.len()));
+    // Fewer leaders than threads, and one of them may take most of the time (a smooth
+    // hysteresis law): its finite differences share the threads too.
+    problem.set_jobs(jobs);
     let refined: Vec<Option<Fit>> = parallel_map_shown("refining", bars, &leaders, jobs, |c| {
         problem.fit(c, REFINE_ITERATIONS, base_replay, &shared).ok()
     });
+    problem.set_jobs(1);
     for fit in refined.into_iter().flatten() {
         replays += fit.replays;
         let better = score(fit);
@@ -848,6 +852,7 @@ fn refit_jointly(
         .collect();
     progress(&format!("joint refit of the {} parameters added", names.len()));
     let problem = Problem::new(recording, params, &cx.training, cx.channel_noise);
+    problem.set_jobs(cx.options.jobs);
     let candidate = joint_candidate(params, &names);
     let current = replay_fast(&Actuator::new(params.clone())?, recording, n)?;
     let before_joint = rms_where(&difference(&recording.force, &current.force), &cx.training, false);

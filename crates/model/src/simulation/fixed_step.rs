@@ -1,6 +1,7 @@
 //! Stepping by one sample interval with no error control, for replaying a recording many
 //! times over (the diagnosis fits its corrections this way): the current driver and jet pipe
-//! propagated exactly as in the split method, the two chamber pressures by one ROS2 step
+//! propagated exactly as in the split method, the two chamber pressures (with the pressures of
+//! the gas volumes behind restrictions, when there are any) by one ROS2 step
 //! ([`crate::integrator::rosenbrock`]) per interval (per piece of it where the delayed
 //! command switches). The sample period (1 ms on the bench) is far below the chambers' time
 //! constants; the error-controlled [`Simulation::step`] checks the final figures.
