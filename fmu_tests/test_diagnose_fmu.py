@@ -73,14 +73,14 @@ def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description,
 # state of its own): each has a memory the FMU keeps between steps.
 @pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
                     reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
-@pytest.mark.parametrize("mechanism,parameter", [("current_slew_limit", "current_slew_limit"),
-                                                 ("force_sensor_lag", "force_sensor_lag"),
-                                                 ("port_1_restriction", "port_line_volume_1")])
+@pytest.mark.parametrize("mechanism,parameter,duration", [("current_slew_limit", "current_slew_limit", 80),
+                                                          ("force_sensor_lag", "force_sensor_lag", 80),
+                                                          ("port_1_restriction", "port_line_volume_1", 40)])
 def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
-        unzipdir, model_description, vrs, tmp_path, mechanism, parameter):
+        unzipdir, model_description, vrs, tmp_path, mechanism, parameter, duration):
     recording_path = tmp_path / f"{mechanism}.csv"
     subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "41",
-                    "--undeclared", mechanism], check=True, capture_output=True)
+                    "--duration", str(duration), "--undeclared", mechanism], check=True, capture_output=True)
     report_path = tmp_path / "report.json"
     subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
                    check=True, capture_output=True)

@@ -244,24 +244,29 @@ fn term_off(name: &'static str, unit: &'static str, step: f64, upper: f64) -> Te
     }
 }
 
-/// A restriction as an orifice (C_d·A, searched over 0.01–10 mm² on a logarithmic scale: off
-/// at 0 and at an infinite area) and the gas volume behind it. The area is searched with a
+/// A restriction as an orifice ([`orifice_area`]) and the gas volume behind it. The orifice
+/// alone is the volume's limit at zero, where its refinement may take it: a quasi-static
+/// orifice needs a root at every evaluation, and a replay with it takes two to three times
+/// as long, so it is not a candidate of its own. The area is searched with a
 /// volume that fills within a tenth of a millisecond (0.1 cm³: the restriction nearly alone,
 /// at the cost of the fast replay's fixed steps rather than a root at every evaluation), then
 /// both are refined together ([`Mechanism::Searched`] followed by parameters).
 fn volume_behind(area: &'static str, volume: &'static str) -> Vec<Term> {
-    vec![
-        Term {
-            name: area,
-            unit: "m2",
-            mechanism: Mechanism::Searched(area),
-            neutral: 0.0,
-            step: 0.0,
-            lower: 1e-8,
-            upper: 1e-5,
-        },
-        started(volume, "m3", 1e-7, 2e-7, 0.0, 1e-4),
-    ]
+    vec![orifice_area(area), started(volume, "m3", 1e-7, 2e-7, 0.0, 1e-4)]
+}
+
+/// An orifice's C_d·A (m²), searched over 0.01–10 mm² on a logarithmic scale: it is off at
+/// zero area and at an infinite one.
+fn orifice_area(name: &'static str) -> Term {
+    Term {
+        name,
+        unit: "m2",
+        mechanism: Mechanism::Searched(name),
+        neutral: 0.0,
+        step: 0.0,
+        lower: 1e-8,
+        upper: 1e-5,
+    }
 }
 
 /// Golden-section steps of a searched term: its bracket shrinks to 0.618^16 = 5e-4 of its
@@ -597,21 +602,6 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             "restriction",
             None,
             vec![term_off("return_resistance", "Pa.s/kg", 1e8, 1e11)],
-        ),
-        c(
-            "return vent orifice",
-            "return",
-            "restriction",
-            None,
-            vec![Term {
-                name: "return_vent_area",
-                unit: "m2",
-                mechanism: Mechanism::Searched("return_vent_area"),
-                neutral: 0.0,
-                step: 0.0,
-                lower: 1e-8,
-                upper: 1e-5,
-            }],
         ),
         c(
             "return vent orifice with a plenum",
@@ -1476,10 +1466,17 @@ impl Problem<'_> {
             });
         }
         if found.values[0] == first.neutral {
-            // Nothing the search could find: the candidate stays off.
+            // Nothing the search could find: the candidate stays off, and so do the parameters
+            // that act only behind it.
+            let mut values = neutral;
+            for (value, term) in values.iter_mut().zip(&candidate.terms).skip(1) {
+                if let Some(name) = term.mechanism.model_parameter() {
+                    *value = parameter_value(self.base, name);
+                }
+            }
             return Ok(Fit {
                 candidate: candidate.clone(),
-                values: neutral,
+                values,
                 ..found
             });
         }

@@ -6,7 +6,7 @@
 //! | `jet_pipe_hysteresis` | `hysteresis_width`, `hysteresis_deadband` (m), `hysteresis_exponent`, `hysteresis_gain`, `hysteresis_beta_share` (1) | on f3's output, before the jet pipe dynamics (§3.2.1–3.2.2): a Prandtl–Ishlinskii operator, or with an exponent a smooth Bouc–Wen law (see [`Hysteresis`]) |
 //! | `piston_friction` | `friction_coulomb` (N), `friction_velocity` (m/s), `friction_stribeck` (N), `friction_stribeck_velocity` (m/s) | rod force while the stopper moves, (2.33)–(2.35) |
 //! | `dead_volume` | `dead_volume_1`, `dead_volume_2` (m³) | added to (2.30)–(2.31) |
-//! | `supply_pressure_drop` | `supply_resistance` (Pa·s/kg) | supply pressure at the jet pipe (§2.6) |
+//! | `supply_pressure_drop` | `supply_resistance` (Pa·s/kg), or `supply_restriction_area` (m²) with `supply_plenum_volume` (m³) | supply pressure at the jet pipe (§2.6; see [`super::restrictions`]) |
 //! | `heat_transfer` | `heat_transfer_fraction` (1) | polytropic exponent in (2.29) |
 //! | `transport_delay` | `command_delay` (s) | command seen by the current driver |
 //! | `sensor_offset_gain` | `force_sensor_offset` (N), `force_sensor_gain` (1) | the `F_meas` output (see [`super::sensors`]) |

@@ -245,10 +245,19 @@ impl Simulation {
     }
 
     /// The pressures behind the restrictions, Pa, in the order of
-    /// [`crate::physics::restrictions::node`]: a state where the place has a volume; otherwise
-    /// the quasi-static value at the start, and not followed.
+    /// [`crate::physics::restrictions::node`]: the state where the place has a volume, the
+    /// quasi-static pressure where it has a restriction alone, and where it has none the
+    /// pressure the valve sees there (P_s, P_r, the chamber's).
     pub fn node_pressures(&self) -> [f64; node::COUNT] {
-        self.nodes
+        let x_jp = self.state[index::JET_POSITION];
+        self.model
+            .network_flows(
+                &self.model.areas(x_jp),
+                self.state[index::P1],
+                self.state[index::P2],
+                Some(&self.nodes),
+            )
+            .node_pressures
     }
 
     /// The command v_DA, V: as set, or where its ramp ended (the driver may see another
