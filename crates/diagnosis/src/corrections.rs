@@ -271,7 +271,8 @@ fn orifice_area(name: &'static str) -> Term {
 
 /// Golden-section steps of a searched term: its bracket shrinks to 0.618^16 = 5e-4 of its
 /// range (a thousandth of a decade over three), or, for the first pass's ranking, to
-/// 0.618^10 = 8e-3 (6 % in value over three decades).
+/// 0.618^10 = 8e-3 (6 % in value over three decades; a limit's range is linear, 0.8 % of
+/// it). The leaders' refinement and a discovered term's trial search to the finer bracket.
 const GOLDEN_STEPS: usize = 16;
 const COARSE_GOLDEN_STEPS: usize = 10;
 
@@ -1142,7 +1143,13 @@ impl Problem<'_> {
             if terms.len() > 1 {
                 return self.fit_search_then_refine(candidate, iterations, base_replay);
             }
-            return self.fit_search(candidate, base_replay, GOLDEN_STEPS);
+            // The first pass only ranks the candidates: a coarser search does for that.
+            let steps = if iterations <= 1 {
+                COARSE_GOLDEN_STEPS
+            } else {
+                GOLDEN_STEPS
+            };
+            return self.fit_search(candidate, base_replay, steps);
         }
         // Sensitivities of the modulated parameters (at the base point: first order).
         let modulated: Vec<Option<Sensitivity>> = terms
@@ -1430,8 +1437,10 @@ impl Problem<'_> {
     /// A searched term followed by parameters that only act once it is on (an orifice and the
     /// volume behind it): the search with the parameters at their starts, then Gauss–Newton on
     /// all of them from there, the searched term now a parameter. A first pass (one
-    /// iteration: the ranking of every candidate) stops after a coarser search; the leaders'
-    /// refinement does it all.
+    /// iteration: the ranking of every candidate) searches coarser. It still takes its one
+    /// Gauss–Newton step: the volume can matter more than the orifice (a wide orifice in front
+    /// of a line acts as a volume added to the chamber), and without the step such a candidate
+    /// would rank below the ones that mimic it and never be refined.
     fn fit_search_then_refine(
         &self,
         candidate: &Candidate,
@@ -1456,15 +1465,6 @@ impl Problem<'_> {
             if first_pass { COARSE_GOLDEN_STEPS } else { GOLDEN_STEPS },
         )?;
         let neutral: Vec<f64> = candidate.terms.iter().map(|t| t.neutral).collect();
-        if first_pass && found.values[0] != first.neutral {
-            let mut values = neutral;
-            values[0] = found.values[0];
-            return Ok(Fit {
-                candidate: candidate.clone(),
-                values,
-                ..found
-            });
-        }
         if found.values[0] == first.neutral {
             // Nothing the search could find: the candidate stays off, and so do the parameters
             // that act only behind it.

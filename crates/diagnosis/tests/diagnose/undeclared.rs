@@ -214,3 +214,37 @@ fn an_undeclared_back_pressure_and_named_friction_are_both_found() {
     assert!((p_r - 141_325.0).abs() <= 0.2 * 40e3, "P_r = {p_r}");
     assert!(d.after.heldout_rms < 0.1 * d.before.heldout_rms);
 }
+
+/// The port restriction at more than twice its standard area, with named friction on top:
+/// the orifice and its line found at their own size beside the named effect, not at the
+/// standard mechanism's values.
+#[test]
+fn a_wider_port_restriction_with_named_friction_is_found_at_its_own_size() {
+    if std::env::var("JETPIPE_UNDECLARED").is_ok() {
+        return;
+    }
+    let mut effects = (undeclared_mechanism("port_1_restriction").unwrap().effects)();
+    effects.undeclared.port_1_restriction = 0.45e-6;
+    effects.friction_coulomb = 2.0;
+    let rows = generate(&effects, 22, 80.0);
+    let recording = generated("undeclared-wider-port", &rows, &Parameters::default());
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    println!("{}", d.summary().join(" | "));
+    assert_eq!(names(&d), ["piston_friction"]);
+    let found = d.discovered.first().expect("the port restriction discovered");
+    assert_eq!(
+        (found.location, found.family),
+        ("valve", "restriction"),
+        "{}",
+        found.reading
+    );
+    let (area, volume) = (d.parameters.port_restriction_area_1, d.parameters.port_line_volume_1);
+    assert!(
+        (area - 0.45e-6).abs() <= 0.2 * 0.45e-6,
+        "port_restriction_area_1 = {area}"
+    );
+    assert!((volume - 3e-6).abs() <= 0.2 * 3e-6, "port_line_volume_1 = {volume}");
+    // The friction's own remainder (the named law lacks the bench's viscous term) is what
+    // stays: within the 2 noise floors for named effects.
+    assert!(d.after.heldout_rms < 2.0 * d.noise_floor, "{} N", d.after.heldout_rms);
+}
