@@ -770,8 +770,8 @@ pub fn diagnose_with(
     let cx = cx.with_piston_area(before_model.piston_area);
     // 3–5. Replay, localize, add what earns its place; then refit the additions together.
     let mut replays = 1;
-    let mut found = rounds::run_rounds(&cx, params, &mut replays, progress)?;
-    let joint_refit = refit_jointly(&cx, &mut found, &mut replays, progress)?;
+    let found = rounds::run_rounds(&cx, params, &mut replays, progress)?;
+    let joint_refit = found.joint_refit;
     // 6. The verdict, from the accurate replays.
     conclude(
         &cx,
@@ -831,7 +831,7 @@ fn joint_candidate(params: &Parameters, names: &[&'static str]) -> Candidate {
 
 /// Each effect and term was fitted with those before it held: refit them together, and
 /// keep the refit when the held-out force error falls. The error before and after.
-fn refit_jointly(
+pub(crate) fn refit_jointly(
     cx: &Context,
     found: &mut rounds::Findings,
     replays: &mut usize,

@@ -13,6 +13,8 @@ pub(crate) struct Findings {
     pub first_candidates: Vec<Scored>,
     /// Where the departure left unexplained sits (none when every channel is within its noise).
     pub localization: Option<Localization>,
+    /// The held-out force error before and after the last joint refit that was kept.
+    pub joint_refit: Option<(f64, f64)>,
 }
 
 /// One round's replay of the current model and how far it is from the recording.
@@ -47,6 +49,7 @@ pub(crate) fn run_rounds(
         discovered: vec![],
         first_candidates: vec![],
         localization: None,
+        joint_refit: None,
     };
     // An effect added on the force side of the piston leaves the pressures, and so the
     // upstream places' scores, as they were.
@@ -99,6 +102,15 @@ pub(crate) fn run_rounds(
                 f.localization = Some(found);
                 break;
             }
+        }
+        // Each addition was fitted with those before it held. Refitting them together now,
+        // not only at the end, lets the next round start from where they explain most: a
+        // discovered restriction fitted while friction was still missing leaves the pressures
+        // a few noise floors off, and the next round would fit every upstream candidate again
+        // for that.
+        if let Some(refit) = crate::refit_jointly(cx, &mut f, replays, progress)? {
+            f.joint_refit = Some(refit);
+            reusable = None;
         }
     }
     Ok(f)
