@@ -1168,7 +1168,7 @@ impl Problem<'_> {
         let (mut train, _) = self.errors(&prediction);
         for iteration in 0..iterations.max(1) {
             // Columns: nonlinear terms by finite differences (shared ones at the start), their
-            // replays spread over the threads.
+            // replays spread over the threads; `known` ends up holding both kinds.
             let mut known: Vec<Option<Sensitivity>> = terms
                 .iter()
                 .map(|term| match term.mechanism {
@@ -1210,16 +1210,13 @@ impl Problem<'_> {
                 })
             });
             replays += differenced.len();
-            let mut moved_replays = differenced
-                .iter()
-                .map(|&(j, _)| j)
-                .zip(moved_replays)
-                .collect::<Vec<_>>();
+            for (&(j, _), column) in differenced.iter().zip(moved_replays) {
+                known[j] = column;
+            }
             let mut columns: Vec<Sensitivity> = Vec::with_capacity(terms.len());
             for (j, term) in terms.iter().enumerate() {
                 let column = match term.mechanism {
                     _ if known[j].is_some() => known[j].take(),
-                    _ if moved_replays.first().map_or(false, |(k, _)| *k == j) => moved_replays.remove(0).1,
                     Mechanism::Output { .. } | Mechanism::Modulated { .. } => {
                         let mut unit = point.values.clone();
                         unit.iter_mut().zip(terms).for_each(|(v, t)| {
