@@ -49,18 +49,27 @@ def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values
         release(fmu)
 
 
-@pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
-                    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
-def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description, vrs, tmp_path):
-    recording_path = tmp_path / "friction.csv"
-    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "31",
-                    "--friction-coulomb", "2.5"], check=True, capture_output=True)
+needs_binaries = pytest.mark.skipif(
+    not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
+    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
+
+
+def generated_and_diagnosed(tmp_path, name, *benchgen_args):
+    """A recording from the independent generator and `jetpipe diagnose`'s report on it."""
+    recording_path = tmp_path / f"{name}.csv"
+    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), *benchgen_args],
+                   check=True, capture_output=True)
     report_path = tmp_path / "report.json"
     subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
                    check=True, capture_output=True)
-    report = json.loads(report_path.read_text())
-    assert [e["name"] for e in report["effects"]][:1] == ["piston_friction"], report["effects"]
     recording = np.genfromtxt(recording_path, delimiter=",", names=True)
+    return recording, json.loads(report_path.read_text())
+
+
+@needs_binaries
+def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description, vrs, tmp_path):
+    recording, report = generated_and_diagnosed(tmp_path, "friction", "--seed", "31", "--friction-coulomb", "2.5")
+    assert [e["name"] for e in report["effects"]][:1] == ["piston_friction"], report["effects"]
     force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
@@ -71,24 +80,17 @@ def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description,
 # A term in the command stage (a rate limit between communication points), one in the
 # force sensor (a lag of its reading) and a port line's volume behind an orifice (a pressure
 # state of its own): each has a memory the FMU keeps between steps.
-@pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
-                    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
+@needs_binaries
 @pytest.mark.parametrize("mechanism,parameter,duration", [("current_slew_limit", "current_slew_limit", 80),
                                                           ("force_sensor_lag", "force_sensor_lag", 80),
                                                           ("port_1_restriction", "port_line_volume_1", 40)])
 def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path, mechanism, parameter, duration):
-    recording_path = tmp_path / f"{mechanism}.csv"
-    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "41",
-                    "--duration", str(duration), "--undeclared", mechanism], check=True, capture_output=True)
-    report_path = tmp_path / "report.json"
-    subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
-                   check=True, capture_output=True)
-    report = json.loads(report_path.read_text())
+    recording, report = generated_and_diagnosed(tmp_path, mechanism, "--seed", "41", "--duration", str(duration),
+                                                "--undeclared", mechanism)
     assert report["effects"] == [], report["effects"]
     assert parameter in report["discovered"][0]["parameters"], report["discovered"]
     assert parameter in report["fmu_start_values"], report["fmu_start_values"]
-    recording = np.genfromtxt(recording_path, delimiter=",", names=True)
     force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
@@ -101,23 +103,16 @@ def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
 # The Bouc–Wen law of jet_pipe_hysteresis, with the loop's starting state: its memory is the
 # FMU state's hysteresis array, and the step's closed form (a parabola per step) must give
 # through the FMU what the diagnosis's fast replay gave.
-@pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
-                    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
+@needs_binaries
 def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path):
-    recording_path = tmp_path / "hysteresis.csv"
     # The protocol's first 40 s hold both branches and the minor loops that tell the laws apart.
-    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "105", "--duration", "40",
-                    "--hysteresis-width", "0.16e-3"], check=True, capture_output=True)
-    report_path = tmp_path / "report.json"
-    subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
-                   check=True, capture_output=True)
-    report = json.loads(report_path.read_text())
+    recording, report = generated_and_diagnosed(tmp_path, "hysteresis", "--seed", "105", "--duration", "40",
+                                                "--hysteresis-width", "0.16e-3")
     assert [e["name"] for e in report["effects"]] == ["jet_pipe_hysteresis"], report["effects"]
     start_values = report["fmu_start_values"]
     assert start_values.get("hysteresis_exponent", 0) > 0, start_values
     assert start_values.get("hysteresis_start", 0) < -0.5, start_values
-    recording = np.genfromtxt(recording_path, delimiter=",", names=True)
     force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values)
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
@@ -127,23 +122,16 @@ def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
 
 # A pressure transducer's terms act on P1_meas and P2_meas alone: the report's pressure errors
 # after must come back through the FMU's transducer outputs, a delay's memory included.
-@pytest.mark.skipif(not (BIN / "benchgen").exists() or not (BIN / "jetpipe").exists(),
-                    reason="needs target/release/benchgen and jetpipe (cargo test --release builds them)")
+@needs_binaries
 @pytest.mark.parametrize("mechanism,parameter", [("p1_sensor_offset", "p1_sensor_offset"),
                                                  ("p2_sensor_delay", "p2_sensor_delay")])
 def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors_after(
         unzipdir, model_description, vrs, tmp_path, mechanism, parameter):
-    recording_path = tmp_path / f"{mechanism}.csv"
-    subprocess.run([str(BIN / "benchgen"), "--out", str(recording_path), "--seed", "43", "--duration", "40",
-                    "--undeclared", mechanism], check=True, capture_output=True)
-    report_path = tmp_path / "report.json"
-    subprocess.run([str(BIN / "jetpipe"), "diagnose", str(recording_path), "--report", str(report_path)],
-                   check=True, capture_output=True)
-    report = json.loads(report_path.read_text())
+    recording, report = generated_and_diagnosed(tmp_path, mechanism, "--seed", "43", "--duration", "40",
+                                                "--undeclared", mechanism)
     assert report["effects"] == [], report["effects"]
     assert parameter in report["discovered"][0]["parameters"], report["discovered"]
     assert report["discovered"][0]["location"] == "pressure_sensors", report["discovered"]
-    recording = np.genfromtxt(recording_path, delimiter=",", names=True)
     p1, p2 = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"],
                                 outputs=("P1_meas", "P2_meas"))
     through_fmu = [float(np.sqrt(np.mean((recording[c] - p) ** 2))) for c, p in (("p1_Pa", p1), ("p2_Pa", p2))]
