@@ -3,7 +3,7 @@
 # rustc and its Windows standard library (rustc 1.63; this machine's rustup toolchain has no
 # Windows target and none can be downloaded) and MinGW-w64 as the linker. The FMU's three
 # crates are compiled here as cargo would: crates/fmi2 and crates/model as rlibs, then
-# crates/fmu as the cdylib; the model's two dependencies, nalgebra (0.32, with its own
+# the root package (src/) as the cdylib; the model's two dependencies, nalgebra (0.32, with its own
 # dependencies, at versions that build on 1.63) and smallvec, are fetched from crates.io by
 # cargo at the versions of tools/win64/Cargo.lock and compiled here with rustc 1.63 one by one. Installs the Debian packages it needs when they are missing (as root),
 # and wine64, on which fmu_tests/test_win64.py runs the DLL.
@@ -75,8 +75,8 @@ CARGO_PKG_VERSION="$VERSION" CARGO_PKG_NAME=jetpipe-fmi2 "$RUSTC" --crate-name f
     -o "$DEPS/libfmi2.rlib" crates/fmi2/src/lib.rs
 CARGO_PKG_VERSION="$VERSION" CARGO_PKG_NAME=jetpipe-model "$RUSTC" --crate-name jetpipe_model --crate-type rlib \
     "${OWN[@]}" -o "$DEPS/libjetpipe_model.rlib" crates/model/src/lib.rs $(x nalgebra) $(x smallvec)
-echo "==> $OUT/JetPipeActuator.dll (crates/fmu)"
+echo "==> $OUT/JetPipeActuator.dll (src/)"
 CARGO_PKG_VERSION="$VERSION" CARGO_PKG_NAME=jetpipe-fmu "$RUSTC" --crate-name JetPipeActuator --crate-type cdylib \
     "${OWN[@]}" -C linker=x86_64-w64-mingw32-gcc -C strip=symbols \
-    -o "$OUT/JetPipeActuator.dll" crates/fmu/src/lib.rs $(x fmi2) $(x jetpipe_model)
+    -o "$OUT/JetPipeActuator.dll" src/lib.rs $(x fmi2) $(x jetpipe_model)
 echo "==> wrote $OUT/JetPipeActuator.dll"

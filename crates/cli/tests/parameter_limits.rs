@@ -4,7 +4,7 @@
 //! initialisation ends.
 
 // The FMU's test helpers (a logging callback and instances through the exported symbols).
-#[path = "../../fmu/tests/common/mod.rs"]
+#[path = "../../../tests/common/mod.rs"]
 mod common;
 
 use common::*;

@@ -2,14 +2,14 @@
 //! layer for any [`crate::model::CoSimModel`], for the crates that put a model on the layer
 //! (`fmus/` in the workspace).
 //!
-//! The actuator's `crates/fmu/src/fmu_exports.rs` stays literal because cbindgen reads it to
+//! The actuator's `src/fmu_exports.rs` stays literal because cbindgen reads it to
 //! write the C header whose compilation against the standard `fmi2Functions.h` proves the
 //! signatures. This macro must therefore emit exactly the same signatures:
 //! `tests::macro_signatures_are_the_literal_exports` compares the two texts (only as text:
 //! this crate does not depend on the actuator's), so an edit to one without the other fails.
 //!
 //! Invoke it once per cdylib; a second invocation, or the actuator's own symbols in the same
-//! library or test (any crate that links `crates/fmu`), would give duplicate `fmi2*`
+//! library or test (any crate that links the FMU crate), would give duplicate `fmi2*`
 //! definitions.
 
 /// Emit the 34 `#[no_mangle] extern "C" fn fmi2*` functions of FMI 2.0 Co-Simulation as
@@ -426,7 +426,7 @@ mod tests {
     #[test]
     fn macro_signatures_are_the_literal_exports() {
         let literal = exported_items(
-            include_str!("../../fmu/src/fmu_exports.rs"),
+            include_str!("../../../src/fmu_exports.rs"),
             "use crate::ExportedModel;",
             "\u{0}",
         );
@@ -434,15 +434,15 @@ mod tests {
         assert_eq!(
             literal.len(),
             34,
-            "crates/fmu/src/fmu_exports.rs should export the 34 FMI 2.0 Co-Simulation functions"
+            "src/fmu_exports.rs should export the 34 FMI 2.0 Co-Simulation functions"
         );
         assert_eq!(
             literal.len(),
             generated.len(),
-            "the macro and crates/fmu/src/fmu_exports.rs export different counts"
+            "the macro and src/fmu_exports.rs export different counts"
         );
         for (a, b) in literal.iter().zip(&generated) {
-            assert_eq!(a, b, "the macro's item differs from crates/fmu/src/fmu_exports.rs");
+            assert_eq!(a, b, "the macro's item differs from src/fmu_exports.rs");
         }
     }
 }

@@ -5,7 +5,7 @@
 //! * Implement [`model::CoSimModel`] (variable table in a [`model::ModelInfo`]).
 //! * Export the `fmi2*` C symbols as forwarders to [`api`] instantiated for the type: with
 //!   [`fmi2_cosimulation_exports!`] in the model's cdylib crate (the actuator's crate,
-//!   `crates/fmu`, writes the same forwarders out literally for cbindgen).
+//!   the root package of the repository, writes the same forwarders out literally for cbindgen).
 //! * Write `modelDescription.xml` with
 //!   [`model_description::model_description_xml`]`(M::info())` (panics on a broken
 //!   table; [`model_description::try_model_description_xml`] returns the problems).

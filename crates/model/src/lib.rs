@@ -27,7 +27,7 @@
 //!   and the fixed-step replay of a recording the diagnosis fits with;
 //! * [`linearization`]: the linear model of §4.2.2;
 //! * [`variables`]: the table of the actuator's variables (name, value reference, unit, start,
-//!   limits, thesis reference), from which the FMU's model description comes (`crates/fmu`);
+//!   limits, thesis reference), from which the FMU's model description comes (the root package, `src/`);
 //! * [`scenario`]: the standard scenario's inputs.
 //!
 //! Private: the exact propagation of the current driver and jet pipe over a step

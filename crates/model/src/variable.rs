@@ -1,6 +1,6 @@
 //! What one variable of the table ([`crate::variables`]) is: name, value reference, type,
 //! causality, variability, unit, start, limits, description. Plain data: the FMU crate
-//! (`crates/fmu`) turns each into the FMI layer's variable for the model description, the
+//! (the root package, `src/variables.rs`) turns each into the FMI layer's variable for the model description, the
 //! getters and the setters; the model itself, the command-line tool and the diagnosis read
 //! them as they are. The names follow FMI 2.0's, whose concepts these are.
 

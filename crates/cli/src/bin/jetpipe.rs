@@ -199,17 +199,17 @@ fn run(cli: Cli) -> Result<(), String> {
     }
 }
 
-/// `cargo run --bin jetpipe` builds the FMU crate (crates/fmu) as a dependency only, and does
+/// `cargo run --bin jetpipe` builds the FMU crate (the root package) as a dependency only, and does
 /// not put its cdylib next to this executable; the FMU needs it, so build it (a no-op when it
 /// is up to date) with the same profile as this executable.
 fn build_shared_library() -> Result<PathBuf, String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot locate this executable: {e}"))?;
     let library = exe.with_file_name("libjetpipe.so");
-    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/../fmu/Cargo.toml");
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/../../Cargo.toml");
     if std::path::Path::new(manifest).is_file() {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
         let mut command = std::process::Command::new(&cargo);
-        command.args(["build", "--lib", "--manifest-path", manifest]);
+        command.args(["build", "--lib", "-p", "jetpipe-fmu", "--manifest-path", manifest]);
         if !cfg!(debug_assertions) {
             command.arg("--release");
         }

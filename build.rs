@@ -30,7 +30,7 @@ const STANDARD_TYPES: &[&str] = &[
 
 fn main() {
     println!("cargo:rerun-if-changed=src/fmu_exports.rs");
-    println!("cargo:rerun-if-changed=../fmi2/src/types.rs");
+    println!("cargo:rerun-if-changed=crates/fmi2/src/types.rs");
     println!("cargo:rerun-if-changed=build.rs");
     let crate_dir = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
