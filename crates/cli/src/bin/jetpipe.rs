@@ -53,23 +53,33 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Compare a bench recording with the model, find the effects it lacks, report before/after.
+    /// Compare bench recordings with the model, find the effects they lack, report before/after.
+    ///
+    /// One recording: `diagnose REC.csv --report r.json`. Many: `diagnose A.csv B.csv DIR --out OUT`
+    /// writes OUT/NAME.json and OUT/NAME.html per recording, OUT/summary.csv and OUT/index.html.
     Diagnose {
-        /// The recording (CSV: time_s, v_da_V, x_s_m, force_N[, p1_Pa, p2_Pa]).
-        recording: PathBuf,
-        /// Where to write the JSON report (written only if the diagnosis succeeds).
+        /// The recordings (CSV: time_s, v_da_V, x_s_m, force_N[, p1_Pa, p2_Pa]); with --out, also
+        /// directories, which stand for the .csv files in them and their subdirectories.
+        #[arg(required = true, num_args = 1..)]
+        recordings: Vec<PathBuf>,
+        /// Where to write the JSON report of the one recording (written only if the diagnosis
+        /// succeeds).
+        #[arg(long, required_unless_present = "out", conflicts_with = "out")]
+        report: Option<PathBuf>,
+        /// Directory for each recording's JSON report and HTML page, summary.csv and index.html.
         #[arg(long)]
-        report: PathBuf,
+        out: Option<PathBuf>,
         /// JSON object of FMU parameter values to start from instead of the thesis's.
         #[arg(long)]
         params: Option<PathBuf>,
         /// Re-identify jet pipe offset, C_d and leakage (§3.3.1) first.
         #[arg(long)]
         calibrate: bool,
-        /// Directory for SVG plots of the residuals and force/current loops.
-        #[arg(long)]
+        /// Directory for the SVG figures of the one recording (with --out they are in the pages).
+        #[arg(long, conflicts_with = "out")]
         plots: Option<PathBuf>,
-        /// Worker threads for the candidate fits (default: every core this process may use).
+        /// Cores to use (default: every core this process may use): with --out, recordings are
+        /// diagnosed side by side on them; with one recording, its candidate fits.
         #[arg(long)]
         jobs: Option<usize>,
     },
@@ -182,20 +192,32 @@ fn run(cli: Cli) -> Result<(), String> {
         }
         Command::Linearize { force, x_s, json } => linearize(force, x_s, json),
         Command::Diagnose {
-            recording,
+            recordings,
             report,
+            out,
             params,
             calibrate,
             plots,
             jobs,
-        } => diagnose(
-            &recording,
-            &report,
-            params.as_deref(),
-            calibrate,
-            plots.as_deref(),
-            jobs,
-        ),
+        } => match (out, report) {
+            (Some(out), _) => diagnose_batch(recordings, out, params.as_deref(), calibrate, jobs),
+            (None, Some(report)) => {
+                let [recording] = recordings.as_slice() else {
+                    return Err(format!(
+                        "--report takes one recording, got {}: give several with --out DIR",
+                        recordings.len()
+                    ));
+                };
+                if recording.is_dir() {
+                    return Err(format!(
+                        "{} is a directory: diagnose its recordings with --out DIR",
+                        recording.display()
+                    ));
+                }
+                diagnose(recording, &report, params.as_deref(), calibrate, plots.as_deref(), jobs)
+            }
+            (None, None) => Err("give --report FILE (one recording) or --out DIR".to_string()),
+        },
     }
 }
 
@@ -324,14 +346,17 @@ fn diagnose(
     let name = recording_path.display().to_string();
     let json = diagnosis.to_json(&name);
     if let Some(dir) = plots {
-        jetpipe_cli::plots::write_diagnosis_plots(dir, &recording, &diagnosis)?;
+        let inputs = jetpipe_cli::plots::FigureInputs {
+            recording: &recording,
+            diagnosis: &diagnosis,
+            base: &base,
+        };
+        jetpipe_cli::plots::write_diagnosis_plots(dir, &inputs)?;
         eprintln!("plots written to {}", dir.display());
     }
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
-    // Write beside the target and rename: an existing report is never left half-written.
-    let temporary = report.with_extension("json.partial");
-    std::fs::write(&temporary, text).map_err(|e| format!("cannot write {}: {e}", temporary.display()))?;
-    std::fs::rename(&temporary, report).map_err(|e| format!("cannot write {}: {e}", report.display()))?;
+    // An existing report is never left half-written.
+    jetpipe_cli::batch::write_atomically(report, &text)?;
     println!(
         "{name}: {} samples, noise floor {:.4} N",
         diagnosis.samples, diagnosis.noise_floor
@@ -346,6 +371,50 @@ fn diagnose(
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+fn diagnose_batch(
+    inputs: Vec<PathBuf>,
+    out: PathBuf,
+    params: Option<&std::path::Path>,
+    calibrate: bool,
+    jobs: Option<usize>,
+) -> Result<(), String> {
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get()));
+    let options = jetpipe_cli::batch::BatchOptions {
+        inputs,
+        out,
+        base: read_parameters(params)?,
+        calibrate,
+        jobs,
+    };
+    let started = Instant::now();
+    let rows = jetpipe_cli::batch::run(&options, &|line: &str| eprintln!("{line}"))?;
+    let failed: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.verdict == "error")
+        .map(|r| r.name.as_str())
+        .collect();
+    println!(
+        "{} recordings in {:.1} s with {jobs} jobs: {} explained, {} with a remainder, {} failed",
+        rows.len(),
+        started.elapsed().as_secs_f64(),
+        rows.iter().filter(|r| r.verdict == "explained").count(),
+        rows.iter().filter(|r| r.verdict == "unexplained_remainder").count(),
+        failed.len()
+    );
+    println!("  pages: {}", options.out.join("index.html").display());
+    println!("  table: {}", options.out.join("summary.csv").display());
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} of {} recordings could not be diagnosed ({}); their errors are in summary.csv",
+            failed.len(),
+            rows.len(),
+            failed.join(", ")
+        ))
+    }
 }
 
 fn linearize(force: f64, x_s: f64, json: bool) -> Result<(), String> {
