@@ -166,7 +166,9 @@ pub fn summary_csv(rows: &[SummaryRow]) -> Result<String, String> {
             ])
             .map_err(fail)?;
     }
-    let bytes = writer.into_inner().map_err(|e| format!("cannot write summary.csv: {e}"))?;
+    let bytes = writer
+        .into_inner()
+        .map_err(|e| format!("cannot write summary.csv: {e}"))?;
     String::from_utf8(bytes).map_err(|e| format!("cannot write summary.csv: {e}"))
 }
 
@@ -194,10 +196,9 @@ pub fn run(options: &BatchOptions, log: &(dyn Fn(&str) + Sync)) -> Result<Vec<Su
                 let Some(item) = items.get(k) else { break };
                 let began = Instant::now();
                 // A panic in one diagnosis is that recording's error, not the batch's end.
-                let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    diagnose_one(item, options, inner_jobs)
-                }))
-                .unwrap_or_else(|_| Err("the diagnosis panicked".to_string()));
+                let outcome =
+                    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| diagnose_one(item, options, inner_jobs)))
+                        .unwrap_or_else(|_| Err("the diagnosis panicked".to_string()));
                 let row = match outcome {
                     Ok(row) => {
                         log(&format!(

@@ -32,7 +32,7 @@ th{background:#f3f3f3}td.n{text-align:right;font-variant-numeric:tabular-nums}
 .verdict{display:inline-block;padding:.2em .7em;border-radius:.3em;font-weight:bold;color:#fff}
 .explained{background:#2b7a2b}.unexplained_remainder{background:#b3541e}.error{background:#a11}
 pre{background:#f6f6f6;padding:.7em;overflow-x:auto}figure{margin:1.2em 0}figure svg{max-width:100%;height:auto}
-figcaption{font-size:.9em;color:#444}";
+figcaption{font-size:.9em;color:#444}body.wide{max-width:1400px}#summary td{font-size:.9em}";
 
 fn number(v: &Value) -> Option<f64> {
     v.as_f64()
@@ -98,7 +98,9 @@ fn errors_section(report: &Value) -> String {
         number(&report["noise_floor_Pa"]["p1"]),
         number(&report["noise_floor_Pa"]["p2"]),
     ) {
-        html.push_str(&format!(" Noise floors of the pressures: P1 {p1:.0} Pa, P2 {p2:.0} Pa."));
+        html.push_str(&format!(
+            " Noise floors of the pressures: P1 {p1:.0} Pa, P2 {p2:.0} Pa."
+        ));
     }
     html.push_str("</p>");
     let pressures = |v: &Value| -> Option<String> {
@@ -339,7 +341,10 @@ pub fn page(name: &str, report: &Value, figures: &[Figure], report_file: &str, i
     html.push_str(&format!(
         "<h2>The report</h2><p>Every number of this page is in <a href=\"{r}\">{r}</a>; the fields are described \
          in the project's docs/diagnosis.md.{}</p></body></html>\n",
-        index.map_or_else(String::new, |i| format!(" <a href=\"{}\">All recordings</a>.", escape(i))),
+        index.map_or_else(String::new, |i| format!(
+            " <a href=\"{}\">All recordings</a>.",
+            escape(i)
+        )),
         r = escape(report_file),
     ));
     html
@@ -373,7 +378,11 @@ impl SummaryRow {
     pub fn from_report(name: &str, report: &Value, page: &str, report_file: &str) -> Self {
         let mut added: Vec<String> = report["effects"]
             .as_array()
-            .map(|a| a.iter().filter_map(|e| e["name"].as_str().map(str::to_string)).collect())
+            .map(|a| {
+                a.iter()
+                    .filter_map(|e| e["name"].as_str().map(str::to_string))
+                    .collect()
+            })
             .unwrap_or_default();
         if let Some(terms) = report["discovered"].as_array() {
             for d in terms {
@@ -431,7 +440,7 @@ pub fn index(rows: &[SummaryRow], elapsed_s: f64, jobs: usize) -> String {
     let cell = |x: Option<f64>| x.map_or_else(|| "—".into(), |v| format!("{v:.4}"));
     let mut html = format!(
         "<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>Diagnoses of {n} recordings</title>\
-         <meta name=viewport content=\"width=device-width, initial-scale=1\"><style>{STYLE}</style></head><body>\
+         <meta name=viewport content=\"width=device-width, initial-scale=1\"><style>{STYLE}</style></head><body class=wide>\
          <h1>Diagnoses of {n} recordings</h1><p>{explained} explained, {remainder} with a remainder, {failed} \
          failed; {elapsed_s:.1} s wall with {jobs} jobs. The same table is in <a href=\"summary.csv\">summary.csv</a>.</p>\
          <table id=summary><tr><th>recording</th><th>verdict</th><th>noise floor (N)</th><th>held-out before (N)</th>\
@@ -485,7 +494,10 @@ mod tests {
                             "parameters": {"k_cd": 0.036, "i_offset": 0.0}}],
         });
         let row = SummaryRow::from_report("u_kcd_gain", &report, "u_kcd_gain.html", "u_kcd_gain.json");
-        assert_eq!(row.added, "piston_friction; current_driver/parameter_offset: i_offset k_cd");
+        assert_eq!(
+            row.added,
+            "piston_friction; current_driver/parameter_offset: i_offset k_cd"
+        );
         assert_eq!(row.heldout_after_n, Some(0.05));
         assert!(row.remainder_location.is_empty());
     }

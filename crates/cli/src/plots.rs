@@ -21,11 +21,11 @@ use jetpipe_diagnosis::signals::ChainSignals;
 use jetpipe_diagnosis::signature::conditional_means;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::command_stage;
 use jetpipe_model::physics::current_driver::static_current;
 use jetpipe_model::physics::jet_pipe::{tip_force, StaticCurve, F3};
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
-use jetpipe_model::physics::command_stage;
 
 /// One figure: a file name without extension, a title, a caption saying what to look at.
 #[derive(Clone, Debug)]
@@ -41,7 +41,7 @@ const ENVELOPE_COLUMNS: usize = 700;
 /// Points of a curve in a plane (every k-th sample, in time order).
 const MAX_CURVE: usize = 2000;
 /// Points of a scatter (before those that fall on the same pixels are dropped).
-const MAX_SCATTER: usize = 1500;
+const MAX_SCATTER: usize = 1000;
 /// The replay tolerance of the figures' pressures (the diagnosis's final replays use the same).
 const REPLAY_TOLERANCE: f64 = 1e-5;
 
@@ -208,14 +208,14 @@ fn panel(area: &Area, caption: &str, x_label: &str, y_label: &str, series: &[&Se
     for s in series {
         if let Some(radius) = s.dots {
             let style = s.colour.mix(s.opacity).filled();
-            // One dot per cell of two pixels: more would be drawn over each other.
+            // One dot per cell of three pixels: more would be drawn over each other.
             let mut seen = std::collections::HashSet::new();
             let distinct: Vec<(f64, f64)> = s
                 .points
                 .iter()
                 .filter(|&&p| {
                     let (x, y) = chart.backend_coord(&p);
-                    seen.insert((x / 2, y / 2))
+                    seen.insert((x / 3, y / 3))
                 })
                 .copied()
                 .collect();
@@ -254,7 +254,8 @@ fn svg(
         draw(body.split_evenly((rows, 1)))?;
         root.present().map_err(fail)?;
     }
-    Ok(text)
+    // plotters spells out SVG's defaults on every dot: a third of a scatter's bytes.
+    Ok(text.replace(" stroke=\"none\" stroke-width=\"1\"/>", "/>"))
 }
 
 /// Units and scale of the chain's signals (the diagnosis names them; the figures print SI
@@ -318,8 +319,16 @@ pub fn diagnosis_figures(inputs: &FigureInputs) -> Result<Vec<Figure>, String> {
 
 fn force_over_time(recording: &Recording, diagnosis: &Diagnosis) -> Result<Figure, String> {
     let t = &recording.time;
-    let before = Series::line(envelope(t, &diagnosis.before_force, ENVELOPE_COLUMNS), BEFORE, "model before");
-    let after = Series::line(envelope(t, &diagnosis.after_force, ENVELOPE_COLUMNS), AFTER, "model after");
+    let before = Series::line(
+        envelope(t, &diagnosis.before_force, ENVELOPE_COLUMNS),
+        BEFORE,
+        "model before",
+    );
+    let after = Series::line(
+        envelope(t, &diagnosis.after_force, ENVELOPE_COLUMNS),
+        AFTER,
+        "model after",
+    );
     let measured = Series::measured(envelope(t, &recording.force, ENVELOPE_COLUMNS), "measured (on top)");
     let order = [&before, &after, &measured];
     let svg = svg(420, &order, 1, |areas| {
@@ -378,7 +387,9 @@ fn residual_over_time(recording: &Recording, diagnosis: &Diagnosis) -> Result<Fi
 /// The binned means of `residual` over ten quantile bins of `signal`, as a line.
 fn binned_means(signal: &[f64], residual: &[f64], scale: f64) -> Vec<(f64, f64)> {
     let (_, bins) = conditional_means(residual, signal);
-    bins.into_iter().map(|(centre, mean, _)| (centre * scale, mean)).collect()
+    bins.into_iter()
+        .map(|(centre, mean, _)| (centre * scale, mean))
+        .collect()
 }
 
 fn residual_against_signal(
@@ -414,7 +425,12 @@ fn residual_against_signal(
         format!("binned means before (η² = {eta:.2})"),
     );
     let eta_after = conditional_means(&after_residual, values).0;
-    let dots_after = Series::dots(every_kth(&scaled, &after_residual, MAX_SCATTER), AFTER, 0.35, "samples after");
+    let dots_after = Series::dots(
+        every_kth(&scaled, &after_residual, MAX_SCATTER),
+        AFTER,
+        0.35,
+        "samples after",
+    );
     let means_after = Series::means(
         binned_means(values, &after_residual, scale),
         AFTER,
@@ -432,7 +448,13 @@ fn residual_against_signal(
                 "residual (N)",
                 &[&dots_before, &means_before],
             )?;
-            panel(&areas[1], "residual after", &axis, "residual (N)", &[&dots_after, &means_after])
+            panel(
+                &areas[1],
+                "residual after",
+                &axis,
+                "residual (N)",
+                &[&dots_after, &means_after],
+            )
         },
     )?;
     Ok(Figure {
@@ -459,7 +481,13 @@ fn force_against_command(recording: &Recording, diagnosis: &Diagnosis) -> Result
     let measured = Series::measured(every_kth(v, &recording.force, MAX_CURVE), "measured (on top)").broken_at(step);
     let order = [&before, &after, &measured];
     let svg = svg(560, &order, 1, |areas| {
-        panel(&areas[0], "force against command", "command v_DA (V)", "force (N)", &order)
+        panel(
+            &areas[0],
+            "force against command",
+            "command v_DA (V)",
+            "force (N)",
+            &order,
+        )
     })?;
     Ok(Figure {
         name: "force_against_command",
@@ -533,7 +561,11 @@ fn static_curves(recording: &Recording, diagnosis: &Diagnosis, base: &Parameters
     if sensor_term {
         figures.push(force_sensor_curve(recording, diagnosis, base, after)?);
     }
-    if diagnosis.discovered.iter().any(|d| bends_command_path(d.location, d.family)) {
+    if diagnosis
+        .discovered
+        .iter()
+        .any(|d| bends_command_path(d.location, d.family))
+    {
         figures.push(command_path_curve(recording, base, after)?);
     }
     Ok(figures)
@@ -545,7 +577,10 @@ fn force_sensor_curve(
     base: &Parameters,
     after: &Parameters,
 ) -> Result<Figure, String> {
-    let (law_before, law_after) = (SensorLaw::of(base, Channel::Force), SensorLaw::of(after, Channel::Force));
+    let (law_before, law_after) = (
+        SensorLaw::of(base, Channel::Force),
+        SensorLaw::of(after, Channel::Force),
+    );
     let (f0, f1) = range(diagnosis.before_force.iter().copied());
     let curve: Vec<(f64, f64)> = (0..=200)
         .map(|k| {
@@ -655,7 +690,10 @@ mod tests {
     #[test]
     fn the_envelope_keeps_every_column_extreme_in_time_order() {
         let t: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-3).collect();
-        let y: Vec<f64> = t.iter().map(|t| (37.0 * t).sin() + if *t == 5.0 { 9.0 } else { 0.0 }).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|t| (37.0 * t).sin() + if *t == 5.0 { 9.0 } else { 0.0 })
+            .collect();
         let e = envelope(&t, &y, 100);
         assert!(e.len() <= 200);
         assert!(e.windows(2).all(|w| w[0].0 <= w[1].0));

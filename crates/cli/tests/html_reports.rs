@@ -1,0 +1,242 @@
+//! `jetpipe diagnose DIR --out OUT`, its pages rendered in a real browser.
+//!
+//! The recordings come from the synthetic bench (the independent simulator): one with a force
+//! sensor offset and gain, one with the jet pipe's static curve bent (a mechanism outside the
+//! named effects), and one file whose force is in kN, which must be refused without stopping
+//! the others. Each page is rendered by headless Chromium (Debian's `chromium`, which
+//! `scripts/install_chromium.sh` installs; `JETPIPE_CHROMIUM` may name another binary): the
+//! rendered DOM must show the report's verdict and every figure, and a screenshot must show
+//! the figures' series painted in their colours.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use synthetic_bench::{generate, undeclared_mechanism, BenchEffects};
+
+/// Seconds of the bench protocol each recording holds (segments A and B: the major loop and
+/// the nested reversals).
+const DURATION: f64 = 24.0;
+
+fn chromium() -> PathBuf {
+    if let Some(path) = std::env::var_os("JETPIPE_CHROMIUM") {
+        return PathBuf::from(path);
+    }
+    let found = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|dir| dir.join("chromium"))
+            .find(|candidate| candidate.is_file())
+    });
+    found.unwrap_or_else(|| {
+        panic!(
+            "these tests render the diagnosis pages in Chromium, and no `chromium` is on PATH: \
+             run `bash scripts/install_chromium.sh` (Debian's package), or set JETPIPE_CHROMIUM"
+        )
+    })
+}
+
+/// Chromium run headless on `page`, with no network service it would start on its own, in a
+/// profile of its own; `mode` is `--dump-dom` or `--screenshot=FILE`.
+fn render(page: &Path, profile: &Path, mode: &str) -> String {
+    let output = Command::new(chromium())
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--window-size=1000,7000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(mode)
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .expect("chromium runs");
+    assert!(
+        output.status.success(),
+        "chromium failed on {}: {}",
+        page.display(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// Pixels of a PNG (RGBA or RGB, 8 bits) whose colour is within 40 of `colour` in every channel.
+fn pixels_near(png_path: &Path, colour: [u8; 3]) -> usize {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png_path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buffer).unwrap();
+    let channels = info.color_type.samples();
+    assert_eq!(info.bit_depth, png::BitDepth::Eight);
+    buffer[..info.buffer_size()]
+        .chunks(channels)
+        .filter(|p| (0..3).all(|c| (p[c] as i32 - colour[c] as i32).abs() <= 40))
+        .count()
+}
+
+fn write_recording(dir: &Path, name: &str, effects: &BenchEffects, seed: u64) {
+    synthetic_bench::write_csv(&generate(effects, seed, DURATION), dir.join(name)).unwrap();
+}
+
+#[test]
+fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verdicts_and_figures() {
+    let root = std::env::temp_dir().join(format!("jetpipe-html-reports-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let (recordings, out) = (root.join("recordings"), root.join("out"));
+    std::fs::create_dir_all(recordings.join("hand")).unwrap();
+    let sensor = BenchEffects {
+        force_sensor_offset: 1.5,
+        force_sensor_gain: 1.04,
+        ..BenchEffects::default()
+    };
+    write_recording(&recordings, "sensor.csv", &sensor, 1);
+    let curve = (undeclared_mechanism("jet_pipe_curve").unwrap().effects)();
+    write_recording(&recordings.join("hand"), "curve.csv", &curve, 2);
+    // The sensor recording with its force written in kN: refused, the others go on.
+    let text = std::fs::read_to_string(recordings.join("sensor.csv")).unwrap();
+    let kilonewtons: String = text
+        .lines()
+        .enumerate()
+        .map(|(k, line)| {
+            if k == 0 {
+                return format!("{line}\n");
+            }
+            let mut fields: Vec<String> = line.split(',').map(str::to_string).collect();
+            fields[3] = format!("{:.7}", fields[3].parse::<f64>().unwrap() / 1000.0);
+            fields.join(",") + "\n"
+        })
+        .collect();
+    std::fs::write(recordings.join("kilonewtons.csv"), kilonewtons).unwrap();
+
+    let run = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .args(["diagnose", recordings.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .args(["--jobs", "2"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "a refused recording makes the batch fail");
+    assert!(
+        stderr.contains("1 of 3 recordings could not be diagnosed (kilonewtons)"),
+        "{stderr}"
+    );
+
+    let mut summary = csv::Reader::from_path(out.join("summary.csv")).unwrap();
+    let headers = summary.headers().unwrap().clone();
+    let column = |name: &str| headers.iter().position(|h| h == name).unwrap();
+    let rows: Vec<csv::StringRecord> = summary.records().map(Result::unwrap).collect();
+    let names: Vec<&str> = rows.iter().map(|r| &r[column("recording")]).collect();
+    assert_eq!(names, ["hand-curve", "kilonewtons", "sensor"]);
+    assert_eq!(&rows[1][column("verdict")], "error");
+    assert!(rows[1][column("error")].contains("force_N"), "{:?}", rows[1]);
+
+    let profile = root.join("chromium-profile");
+    for row in [&rows[0], &rows[2]] {
+        let name = &row[column("recording")];
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join(&row[column("report")])).unwrap()).unwrap();
+        assert_eq!(report["verdict"].as_str().unwrap(), &row[column("verdict")]);
+        let page = out.join(&row[column("page")]);
+        let html = std::fs::read_to_string(&page).unwrap();
+        for loader in [
+            "<script",
+            "<link",
+            "<img",
+            "<iframe",
+            "@import",
+            "url(",
+            "src=",
+            "href=\"http",
+        ] {
+            assert!(!html.contains(loader), "{name}: the page loads something ({loader})");
+        }
+
+        let dom = render(&page, &profile, "--dump-dom");
+        let words = match report["verdict"].as_str().unwrap() {
+            "explained" => "explained</span>",
+            _ => "not explained: a remainder stays</span>",
+        };
+        assert!(
+            dom.contains(words),
+            "{name}: the rendered page does not show its verdict"
+        );
+        let first_summary = report["summary"][0].as_str().unwrap().replace('&', "&amp;");
+        assert!(dom.contains(&first_summary[..40]), "{name}: no verdict sentence");
+        // Figures: force, residual in time, residual against a signal, loops, pressures, and
+        // the static curve of the term added at the force sensor or on the command path.
+        let added_static_curve = report["effects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|e| e["location"] == "force_sensor")
+            || report["discovered"].as_array().unwrap().iter().any(|d| {
+                d["family"] == "nonlinearity" && matches!(d["location"].as_str(), Some("force_sensor" | "jet_pipe"))
+            });
+        let figures = dom.matches("<figure").count();
+        assert_eq!(dom.matches("<svg").count(), figures, "{name}: a figure without its SVG");
+        assert_eq!(
+            figures,
+            5 + usize::from(added_static_curve),
+            "{name}: {figures} figures"
+        );
+        for figure in [
+            "figure-force_over_time",
+            "figure-residual_over_time",
+            "figure-residual_against_signal",
+            "figure-force_against_command",
+            "figure-pressures_over_time",
+        ] {
+            assert!(dom.contains(figure), "{name}: no {figure}");
+        }
+
+        let screenshot = root.join(format!("{name}.png"));
+        render(&page, &profile, &format!("--screenshot={}", screenshot.display()));
+        // The series' colours, as painted: the model before (red), after (blue).
+        let red = pixels_near(&screenshot, [214, 39, 40]);
+        let blue = pixels_near(&screenshot, [31, 119, 180]);
+        assert!(red > 5000 && blue > 5000, "{name}: red {red}, blue {blue} pixels");
+    }
+    // Each recording the test made was given its term: the sensor's named, the curve's found.
+    let sensor: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sensor.json")).unwrap()).unwrap();
+    assert_eq!(
+        sensor["effects"][0]["name"], "sensor_offset_gain",
+        "{}",
+        sensor["summary"]
+    );
+    let curve: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("hand-curve.json")).unwrap()).unwrap();
+    assert_eq!(curve["discovered"][0]["location"], "jet_pipe", "{}", curve["summary"]);
+
+    let index = render(&out.join("index.html"), &profile, "--dump-dom");
+    for page in ["hand-curve.html", "sensor.html"] {
+        assert!(
+            index.contains(&format!("href=\"{page}\"")),
+            "the index does not link {page}"
+        );
+    }
+    let explained = rows.iter().filter(|r| &r[column("verdict")] == "explained").count();
+    assert!(
+        index.contains(&format!("{explained} explained")) && index.contains("1 failed"),
+        "{index}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn one_recording_with_report_and_out_together_is_refused_by_name() {
+    let output = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .args(["diagnose", "a.csv", "--report", "r.json", "--out", "dir"])
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("--report") && stderr.contains("--out"), "{stderr}");
+    let two = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .args(["diagnose", "a.csv", "b.csv", "--report", "r.json"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&two.stderr).contains("--report takes one recording, got 2"));
+}
