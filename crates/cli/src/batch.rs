@@ -234,9 +234,59 @@ pub fn run(options: &BatchOptions, log: &(dyn Fn(&str) + Sync)) -> Result<Vec<Su
         .zip(&items)
         .map(|(row, item)| row.unwrap_or_else(|| SummaryRow::failed(&item.name, "not diagnosed")))
         .collect();
-    write_atomically(&options.out.join("summary.csv"), &summary_csv(&rows)?)?;
-    let index = html_report::index(&rows, started.elapsed().as_secs_f64(), options.jobs);
-    write_atomically(&options.out.join("index.html"), &index)?;
+    let timing = format!(
+        "{:.1} s wall with {} jobs",
+        started.elapsed().as_secs_f64(),
+        options.jobs
+    );
+    write_summary_and_index(&options.out, &rows, &timing)?;
+    Ok(rows)
+}
+
+/// `DIR/summary.csv` and `DIR/index.html` of these rows; `timing` says how long they took.
+fn write_summary_and_index(dir: &Path, rows: &[SummaryRow], timing: &str) -> Result<(), String> {
+    write_atomically(&dir.join("summary.csv"), &summary_csv(rows)?)?;
+    write_atomically(&dir.join("index.html"), &html_report::index(rows, timing))
+}
+
+/// The file a recording's error is written to when it was diagnosed elsewhere (the Dask
+/// example writes it, [`index_directory`] reads it).
+pub const ERROR_SUFFIX: &str = ".error.txt";
+
+/// `summary.csv` and `index.html` of the reports already in `dir`: every `NAME.json` that is a
+/// diagnosis report (with `NAME.html` beside it, linked when present) and every
+/// `NAME.error.txt` (a recording that could not be diagnosed, the file holding why). For
+/// reports written elsewhere, e.g. by the workers of `examples/dask_diagnose.py`.
+pub fn index_directory(dir: &Path, timing: &str) -> Result<Vec<SummaryRow>, String> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| format!("cannot read the directory {}: {e}", dir.display()))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .collect();
+    paths.sort();
+    let mut rows = vec![];
+    for path in paths {
+        let file_name = path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        if let Some(name) = file_name.strip_suffix(ERROR_SUFFIX) {
+            let error = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            rows.push(SummaryRow::failed(name, error.trim()));
+        } else if let Some(name) = file_name.strip_suffix(".json") {
+            let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            let report: serde_json::Value =
+                serde_json::from_str(&text).map_err(|e| format!("{}: not valid JSON: {e}", path.display()))?;
+            if report.get("verdict").is_none() || report.get("heldout").is_none() {
+                continue;
+            }
+            let page = format!("{name}.html");
+            let page = if dir.join(&page).is_file() { page } else { String::new() };
+            rows.push(SummaryRow::from_report(name, &report, &page, &file_name));
+        }
+    }
+    if rows.is_empty() {
+        return Err(format!("{}: no diagnosis report (NAME.json) in it", dir.display()));
+    }
+    write_summary_and_index(dir, &rows, timing)?;
     Ok(rows)
 }
 

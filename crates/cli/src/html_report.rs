@@ -435,20 +435,26 @@ impl SummaryRow {
     }
 }
 
-/// The index page of a batch: a table of the rows, linking each page.
-pub fn index(rows: &[SummaryRow], elapsed_s: f64, jobs: usize) -> String {
+/// The index page of a batch: a table of the rows, linking each page; `timing` says how long
+/// the batch took (empty when unknown).
+pub fn index(rows: &[SummaryRow], timing: &str) -> String {
     let cell = |x: Option<f64>| x.map_or_else(|| "—".into(), |v| format!("{v:.4}"));
     let mut html = format!(
         "<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>Diagnoses of {n} recordings</title>\
          <meta name=viewport content=\"width=device-width, initial-scale=1\"><style>{STYLE}</style></head><body class=wide>\
          <h1>Diagnoses of {n} recordings</h1><p>{explained} explained, {remainder} with a remainder, {failed} \
-         failed; {elapsed_s:.1} s wall with {jobs} jobs. The same table is in <a href=\"summary.csv\">summary.csv</a>.</p>\
+         failed{timing}. The same table is in <a href=\"summary.csv\">summary.csv</a>.</p>\
          <table id=summary><tr><th>recording</th><th>verdict</th><th>noise floor (N)</th><th>held-out before (N)</th>\
          <th>held-out after (N)</th><th>whole before (N)</th><th>whole after (N)</th><th>added</th><th>remainder at</th></tr>",
         n = rows.len(),
         explained = rows.iter().filter(|r| r.verdict == "explained").count(),
         remainder = rows.iter().filter(|r| r.verdict == "unexplained_remainder").count(),
         failed = rows.iter().filter(|r| r.verdict == "error").count(),
+        timing = if timing.is_empty() {
+            String::new()
+        } else {
+            format!("; {}", escape(timing))
+        },
     );
     for r in rows {
         let name = if r.page.is_empty() {

@@ -83,6 +83,15 @@ enum Command {
         #[arg(long)]
         jobs: Option<usize>,
     },
+    /// Write DIR/summary.csv and DIR/index.html from the diagnosis reports in DIR (NAME.json,
+    /// with NAME.html beside it; NAME.error.txt for a recording that could not be diagnosed),
+    /// e.g. reports written on a cluster by examples/dask_diagnose.py.
+    DiagnosisIndex {
+        dir: PathBuf,
+        /// How long the diagnoses took, for the index page (e.g. "212 s on 4 workers").
+        #[arg(long, default_value = "")]
+        timing: String,
+    },
     /// Run the standard scenario in-process and print a summary.
     Simulate {
         /// Communication step in seconds.
@@ -164,6 +173,16 @@ fn run(cli: Cli) -> Result<(), String> {
             Ok(())
         }
         Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
+        Command::DiagnosisIndex { dir, timing } => {
+            let rows = jetpipe_cli::batch::index_directory(&dir, &timing)?;
+            println!(
+                "{} recordings: {} and {}",
+                rows.len(),
+                dir.join("summary.csv").display(),
+                dir.join("index.html").display()
+            );
+            Ok(())
+        }
         Command::Sweep {
             params,
             threads,
