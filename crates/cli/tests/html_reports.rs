@@ -1,9 +1,9 @@
 //! `jetpipe diagnose DIR --out OUT`, its pages rendered in a real browser.
 //!
 //! The recordings come from the synthetic bench (the independent simulator): one with a force
-//! sensor offset and gain, one with the jet pipe's static curve bent (a mechanism outside the
-//! named effects), and one file whose force is in kN, which must be refused without stopping
-//! the others. Each page is rendered by headless Chromium (Debian's `chromium`, which
+//! sensor offset and gain, the same without its pressure channels, one with the jet pipe's
+//! static curve bent (a mechanism outside the named effects), and one file whose force is in
+//! kN, which must be refused without stopping the others. Each page is rendered by headless Chromium (Debian's `chromium`, which
 //! `scripts/install_chromium.sh` installs; `JETPIPE_CHROMIUM` may name another binary): the
 //! rendered DOM must show the report's verdict and every figure, and a screenshot must show
 //! the figures' series painted in their colours.
@@ -110,6 +110,12 @@ fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verd
         })
         .collect();
     std::fs::write(recordings.join("kilonewtons.csv"), kilonewtons).unwrap();
+    // The sensor recording without its pressure channels: a page without the pressures' figure.
+    let force_only: String = text
+        .lines()
+        .map(|line| line.split(',').take(4).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    std::fs::write(recordings.join("hand").join("force_only.csv"), force_only).unwrap();
 
     let run = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
         .args(["diagnose", recordings.to_str().unwrap(), "--out", out.to_str().unwrap()])
@@ -119,7 +125,7 @@ fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verd
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success(), "a refused recording makes the batch fail");
     assert!(
-        stderr.contains("1 of 3 recordings could not be diagnosed (kilonewtons)"),
+        stderr.contains("1 of 4 recordings could not be diagnosed (kilonewtons)"),
         "{stderr}"
     );
 
@@ -128,12 +134,12 @@ fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verd
     let column = |name: &str| headers.iter().position(|h| h == name).unwrap();
     let rows: Vec<csv::StringRecord> = summary.records().map(Result::unwrap).collect();
     let names: Vec<&str> = rows.iter().map(|r| &r[column("recording")]).collect();
-    assert_eq!(names, ["hand-curve", "kilonewtons", "sensor"]);
-    assert_eq!(&rows[1][column("verdict")], "error");
-    assert!(rows[1][column("error")].contains("force_N"), "{:?}", rows[1]);
+    assert_eq!(names, ["hand-curve", "hand-force_only", "kilonewtons", "sensor"]);
+    assert_eq!(&rows[2][column("verdict")], "error");
+    assert!(rows[2][column("error")].contains("force_N"), "{:?}", rows[2]);
 
     let profile = root.join("chromium-profile");
-    for row in [&rows[0], &rows[2]] {
+    for row in [&rows[0], &rows[1], &rows[3]] {
         let name = &row[column("recording")];
         let report: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join(&row[column("report")])).unwrap()).unwrap();
@@ -164,8 +170,10 @@ fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verd
         );
         let first_summary = report["summary"][0].as_str().unwrap().replace('&', "&amp;");
         assert!(dom.contains(&first_summary[..40]), "{name}: no verdict sentence");
-        // Figures: force, residual in time, residual against a signal, loops, pressures, and
-        // the static curve of the term added at the force sensor or on the command path.
+        // Figures: force, residual in time, residual against a signal, loops, the pressures when
+        // the recording has them, and the static curve of the term added at the force sensor or
+        // on the command path.
+        let has_pressures = report["pressure_split"]["available"] == true;
         let added_static_curve = report["effects"]
             .as_array()
             .unwrap()
@@ -178,7 +186,7 @@ fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verd
         assert_eq!(dom.matches("<svg").count(), figures, "{name}: a figure without its SVG");
         assert_eq!(
             figures,
-            5 + usize::from(added_static_curve),
+            4 + usize::from(has_pressures) + usize::from(added_static_curve),
             "{name}: {figures} figures"
         );
         for figure in [
@@ -186,10 +194,10 @@ fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verd
             "figure-residual_over_time",
             "figure-residual_against_signal",
             "figure-force_against_command",
-            "figure-pressures_over_time",
         ] {
             assert!(dom.contains(figure), "{name}: no {figure}");
         }
+        assert_eq!(dom.contains("figure-pressures_over_time"), has_pressures, "{name}");
 
         let screenshot = root.join(format!("{name}.png"));
         render(&page, &profile, &format!("--screenshot={}", screenshot.display()));
@@ -211,7 +219,11 @@ fn a_directory_of_recordings_becomes_pages_that_chromium_renders_with_their_verd
     assert_eq!(curve["discovered"][0]["location"], "jet_pipe", "{}", curve["summary"]);
 
     let index = render(&out.join("index.html"), &profile, "--dump-dom");
-    for page in ["hand-curve.html", "sensor.html"] {
+    assert_eq!(sensor["pressure_split"]["available"], true);
+    let force_only: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("hand-force_only.json")).unwrap()).unwrap();
+    assert_eq!(force_only["pressure_split"]["available"], false);
+    for page in ["hand-curve.html", "hand-force_only.html", "sensor.html"] {
         assert!(
             index.contains(&format!("href=\"{page}\"")),
             "the index does not link {page}"
