@@ -75,6 +75,13 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
+/// The smallest and largest finite value (a drawn curve spans the data, no more).
+fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)))
+}
+
 /// The minimum and maximum of `y` in each of `columns` equal slices of the samples, in time
 /// order: a trace drawn through them covers the same pixels as the full trace.
 pub fn envelope(t: &[f64], y: &[f64], columns: usize) -> Vec<(f64, f64)> {
@@ -581,7 +588,7 @@ fn force_sensor_curve(
         SensorLaw::of(base, Channel::Force),
         SensorLaw::of(after, Channel::Force),
     );
-    let (f0, f1) = range(diagnosis.before_force.iter().copied());
+    let (f0, f1) = span(diagnosis.before_force.iter().copied());
     let curve: Vec<(f64, f64)> = (0..=200)
         .map(|k| {
             let f = f0 + (f1 - f0) * k as f64 / 200.0;
@@ -627,7 +634,7 @@ fn command_path_curve(recording: &Recording, base: &Parameters, after: &Paramete
         let current = static_current(p.k_cd, p.i_offset, command);
         F3::from_parameters(p).value(tip_force(p.k_m, current)) * 1e3
     };
-    let (v0, v1) = range(recording.v_da.iter().copied());
+    let (v0, v1) = span(recording.v_da.iter().copied());
     let curve = |p: &Parameters| -> Vec<(f64, f64)> {
         (0..=300)
             .map(|k| {
