@@ -114,14 +114,16 @@ fn diagnose_one(item: &Item, options: &BatchOptions, jobs: usize) -> Result<Summ
     };
     let diagnosis = jetpipe_diagnosis::diagnose_with(&recording, &options.base, &diagnosis_options, &mut |_| {})?;
     let report = diagnosis.to_json(&item.name);
+    let (report_file, page_file) = (format!("{}.json", item.name), format!("{}.html", item.name));
+    let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())? + "\n";
+    // The report first: should the figures fail, the diagnosis is not lost with them.
+    write_atomically(&options.out.join(&report_file), &text)?;
     let figures = diagnosis_figures(&FigureInputs {
         recording: &recording,
         diagnosis: &diagnosis,
         base: &options.base,
-    })?;
-    let (report_file, page_file) = (format!("{}.json", item.name), format!("{}.html", item.name));
-    let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())? + "\n";
-    write_atomically(&options.out.join(&report_file), &text)?;
+    })
+    .map_err(|e| format!("{e} (the report {report_file} was written)"))?;
     let page = html_report::page(&item.name, &report, &figures, &report_file, Some("index.html"));
     write_atomically(&options.out.join(&page_file), &page)?;
     Ok(SummaryRow::from_report(&item.name, &report, &page_file, &report_file))
