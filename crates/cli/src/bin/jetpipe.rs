@@ -57,6 +57,7 @@ enum Command {
     ///
     /// One recording: `diagnose REC.csv --report r.json`. Many: `diagnose A.csv B.csv DIR --out OUT`
     /// writes OUT/NAME.json and OUT/NAME.html per recording, OUT/summary.csv and OUT/index.html.
+    #[command(group = clap::ArgGroup::new("destination").required(true).args(["report", "out"]))]
     Diagnose {
         /// The recordings (CSV: time_s, v_da_V, x_s_m, force_N[, p1_Pa, p2_Pa]); with --out, also
         /// directories, which stand for the .csv files in them and their subdirectories.
@@ -64,7 +65,7 @@ enum Command {
         recordings: Vec<PathBuf>,
         /// Where to write the JSON report of the one recording (written only if the diagnosis
         /// succeeds).
-        #[arg(long, required_unless_present = "out", conflicts_with = "out")]
+        #[arg(long, conflicts_with = "out")]
         report: Option<PathBuf>,
         /// Directory for each recording's JSON report and HTML page, summary.csv and index.html.
         #[arg(long)]
