@@ -12,6 +12,8 @@ run() {
     echo "<== $(( SECONDS - started )) s: $*"
 }
 
+# Debian's Chromium, in which a test renders the diagnosis's HTML pages.
+run bash scripts/install_chromium.sh
 run cargo test --release
 # Lints: clippy with warnings as errors, on every crate and target (the component is
 # installed when the toolchain lacks it).
