@@ -145,3 +145,23 @@ def test_with_the_preset_the_standard_scenario_differs_from_the_reference(unzipd
     with_preset = standard_run(unzipdir, model_description, vrs, lambda fmu: fmu.setReal(vr, list(preset.values())))
     want = np.array(reference_rows())
     assert np.max(np.abs(with_preset[:, 0] - want[:, 0])) > 1.0
+
+
+def test_fmpy_takes_the_preset_file_as_start_values(fmu_path, unzipdir, model_description, vrs, preset):
+    """The README's use: fmpy.simulate_fmu(..., start_values=json.load(...)) runs the same model
+    as an instance whose parameters this master sets itself."""
+    import json
+
+    import fmpy
+
+    with open(V.PRESET_PATH) as f:
+        start_values = json.load(f)
+    u = np.array([(0.0, 2.5, 0.054), (1.0, 2.5, 0.054)], dtype=[("time", float), ("v_DA", float), ("x_s", float)])
+    r = fmpy.simulate_fmu(str(fmu_path), stop_time=1.0, input=u, output_interval=0.01, start_values=start_values,
+                          output=["F_act"])
+    own = standard_run(unzipdir, model_description, vrs, lambda fmu: fmu.setReal([vrs[n] for n in preset],
+                                                                                   list(preset.values())))
+    # Both start at the equilibrium of v_DA = 2.5 V, x_s = 54 mm with the preset's parameters.
+    assert r["F_act"][0] == pytest.approx(own[0, 0], abs=1e-9)
+    thesis = standard_run(unzipdir, model_description, vrs, lambda fmu: None)
+    assert abs(r["F_act"][0] - thesis[0, 0]) > 0.5
