@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import validation as V  # noqa: E402
-from validation_effects import DEAD_VOLUME_PROBE, measured_effects  # noqa: E402
+from validation_effects import measured_effects  # noqa: E402
 from scenarios import spring_force  # noqa: E402
 
 DOCS = V.ROOT / "docs"
@@ -292,7 +292,7 @@ def main():
     worst_p = min(min(abs(r8["runs"][(f, "P")]["err_hi"]), abs(r8["runs"][(f, "P")]["err_lo"])) for f in (2.0, 5.0, 20.0))
     worst_ff = max(max(abs(r8["runs"][(f, "P+FF")]["err_hi"]), abs(r8["runs"][(f, "P+FF")]["err_lo"])) for f in (2.0, 5.0, 20.0))
     text["s8_worst_ff"] = worst_ff
-    rows.append(("8", "Figs. 4.7–4.9", "offset with P + f⁻¹ (4.2)", "removed", f"|error| ≤ {worst_ff:.3f} N (P alone ≥ {worst_p:.2f} N)",
+    rows.append(("8", "Figs. 4.7–4.9", "offset with P + f⁻¹ (4.2)", "removed", f"\\|error\\| ≤ {worst_ff:.3f} N (P alone ≥ {worst_p:.2f} N)",
                  "agrees", "square 40–50 N; 25–65 N is slew-limited at 20 Hz (current clipped at 0.4 A)"))
 
     # ---------------- 9
@@ -555,17 +555,20 @@ equations rather than a thesis figure.
 ![measured effects]({fx['f10']})
 
 The thesis model misses the figures the thesis measured on the actuator itself: the 1 N
-closed-loop bandwidth (section 7), the trend of the open-loop bandwidth with the mean (section
-5) and the hysteresis loops (section 3). The preset turns on three effects, with the values
-[docs/model.md](model.md#the-thesis-measured-preset) derives ({', '.join(f'`{k}` = {v:g}' for k, v in fx['preset'].items())}):
+closed-loop bandwidth and the insensitivity to the stopper position (section 7), the trend of the
+open-loop bandwidth with the mean (section 5) and the hysteresis loops (section 3). The preset
+turns on four effects, with the values [docs/model.md](model.md#the-thesis-measured-preset)
+derives ({', '.join(f'`{k}` = {v:g}' for k, v in fx['preset'].items())}):
 
 - **the jet pipe's hysteresis as the seal §3.2.1 suspects** (Bouc–Wen, width 0.16 mm as
   measured, sliding share 0.7): motions of the static tip position smaller than
   width/share = 0.23 mm peak to peak pass at 0.3 of their size, larger ones open the 0.16 mm loop;
-- **the three flow constants of Table 3.1 times 1.2** (C_d = 0.835 and both leakage products):
-  the static curve does not change (every flow scales alike), the chambers fill 1.2 times faster;
-- **a leak from chamber 2 to atmosphere** of C_d·A = 0.03 mm² (a third of the leakage past the
-  piston).
+- **the three flow constants of Table 3.1 times 1.4** (C_d = 0.974 and both leakage products):
+  the static curve does not change (every flow scales alike), the chambers fill 1.4 times faster;
+- **a dead volume of 3.5 cm³ on chamber 1's side** (port and passage), which makes chamber 1's
+  volume depend less on the stopper position;
+- **a leak from chamber 2 to atmosphere** of C_d·A = 0.03 mm² (about a quarter of the leakage past
+  the piston).
 
 **Reproduced**, measured by the same Python P controller at 500 Hz as section 7:
 
@@ -577,6 +580,15 @@ closed-loop bandwidth (section 7), the trend of the open-loop bandwidth with the
   the loop gain is 0.3 of the thesis model's; a 5 N input drives it through the loop. At 1 Hz the
   gain is {fx['cl'][(1.0, 0.054)]['low_dB']:.1f} dB (1 N) and {fx['cl'][(5.0, 0.054)]['low_dB']:.1f} dB (5 N), against
   {s7['cl'][(1.0, 0.054)]['low_dB']:.1f} dB for the thesis model;
+- 40 mm against 54 mm: {fx['cl'][(1.0, 0.040)]['bw_rel_Hz']:.0f} and {fx['cl'][(5.0, 0.040)]['bw_rel_Hz']:.0f} Hz at 1 and 5 N,
+  {pct(fx['cl'][(1.0, 0.040)]['bw_rel_Hz'], fx['cl'][(1.0, 0.054)]['bw_rel_Hz'])} and
+  {pct(fx['cl'][(5.0, 0.040)]['bw_rel_Hz'], fx['cl'][(5.0, 0.054)]['bw_rel_Hz'])} on 54 mm (thesis model
+  {pct(s7['cl'][(1.0, 0.040)]['bw_rel_Hz'], s7['cl'][(1.0, 0.054)]['bw_rel_Hz'])} and
+  {pct(s7['cl'][(5.0, 0.040)]['bw_rel_Hz'], s7['cl'][(5.0, 0.054)]['bw_rel_Hz'])}). With the same 3.5 cm³ split evenly
+  over both chambers the bandwidths are {fx['probe'][(1.0, 0.054)]:.0f} / {fx['probe'][(5.0, 0.054)]:.0f} Hz at 54 mm and
+  {fx['probe'][(1.0, 0.040)]:.0f} / {fx['probe'][(5.0, 0.040)]:.0f} Hz at 40 mm (1 N / 5 N). This fits the loop gain's
+  two parts, one per chamber: at 40 mm chamber 1's part grows and chamber 2's shrinks (chamber 2 is
+  larger), and a volume on chamber 1's side alone lets the two nearly cancel;
 - open loop at 54 mm: {min(fx['bws_m'] + fx['bws_a']):.2f}–{max(fx['bws_m'] + fx['bws_a']):.2f} Hz, rising with the mean
   ({fx['bws_m'][0]:.2f} → {fx['bws_m'][-1]:.2f} Hz) as Fig. 3.15 shows; the vent is what
   turns the trend (the hysteresis, rate-independent, cannot move an open-loop bandwidth; see
@@ -585,21 +597,13 @@ closed-loop bandwidth (section 7), the trend of the open-loop bandwidth with the
   the actuator's force loop is {fx['s3']['loops']['i_at_45N_A'] * 1e3:.0f} mA wide at 45 N (thesis model:
   {x['s3']['loops']['i_at_45N_A'] * 1e3:.0f} mA of lag).
 
+The price: C_d = 0.974 is close to the ideal orifice's 1 (a well-rounded nozzle's), and 3.5 cm³
+is 0.6 of chamber 1's volume at midstroke, where §2.6 calls the lines short and their capacitance
+negligible. The 5 N bandwidth is the figure that sets both: each cubic centimetre on chamber 1
+lowers it, each step of the flow factor raises it, and C_d cannot exceed 1 (the FMU refuses it).
+
 **Not reproduced:**
 
-- **Little difference between 40 and 54 mm** (Fig. 4.1b): with the preset, 40 mm gives
-  {fx['cl'][(1.0, 0.040)]['bw_rel_Hz']:.0f} Hz at 1 N and {fx['cl'][(5.0, 0.040)]['bw_rel_Hz']:.0f} Hz at 5 N. Halving chamber 1
-  doubles its rate; at 1 N the higher loop gain then lets the error exceed the seal's elastic
-  range and the loop jumps to its large-signal behaviour (resonance peak
-  {fx['cl'][(1.0, 0.040)]['peak_dB'] - fx['cl'][(1.0, 0.040)]['low_dB']:.1f} dB). The physical remedy, port and line
-  volumes that make the chamber volumes depend less on x_s, slows both positions: with
-  {DEAD_VOLUME_PROBE * 1e6:.0f} cm³ on each side and the flow constants at their ceiling (C_d = 1, the most
-  an orifice passes) the bandwidths are {fx['probe'][(1.0, 0.054)]:.0f} / {fx['probe'][(5.0, 0.054)]:.0f} Hz at 54 mm and
-  {fx['probe'][(1.0, 0.040)]:.0f} / {fx['probe'][(5.0, 0.040)]:.0f} Hz at 40 mm (1 N / 5 N): still
-  {pct(fx['probe'][(1.0, 0.040)], fx['probe'][(1.0, 0.054)])} and {pct(fx['probe'][(5.0, 0.040)], fx['probe'][(5.0, 0.054)])} apart, and the 5 N bandwidth
-  {"already below" if fx['probe'][(5.0, 0.054)] < 64 else "down to"} 80 Hz − 20 % = 64 Hz. Flattening the dependence to 25 % at 5 N needs more volume still,
-  which only a discharge coefficient above 1 could make up for; §2.6 also calls the lines short.
-  So no physical combination of these effects gives 80 Hz at 5 N and the insensitivity together.
 - **Jet-pipe step, 5 % settling 0.07 s** (Fig. 3.11): {fx['s2']['settle5_s']:.4f} s. A 20 mA step moves
   the pipe within the seal's elastic range, so the ring-down is the thesis's ω2, ζ2 (fitted here
   again: {fx['s2']['omega_2']:.1f} rad/s, {fx['s2']['zeta_2']:.5f}); 0.07 s needs ζ2 ≈ 0.017, not the 0.019
