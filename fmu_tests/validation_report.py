@@ -128,7 +128,7 @@ def main():
         ("3", "§3.3.1", "floor", "spring force", "spring force exactly (3.89, 2.65, 1.24 N)", "0", ""),
         ("3", "§4.2.1", "slope k near 45 N", "≈ 550 N/A", f"{r['k_static_45N']:.0f} N/A", pct(r["k_static_45N"], 550), ""),
         ("3", "Figs. 3.4, 3.7, 3.13", "jet-pipe loop, halves apart", "≈ 0.16 mm (8 % of the 1 mm range)",
-         f"{r['loops']['x_jp_m'] * 1e3:.3f} mm; force loop {r['loops']['i_at_45N_A'] * 1e3:.0f} mA apart at 45 N", "none",
+         f"{abs(r['loops']['x_jp_m']) * 1e3:.3f} mm; force loop {r['loops']['i_at_45N_A'] * 1e3:.0f} mA apart at 45 N", "none",
          "no hysteresis in the thesis model; the force loop's width is lag"),
     ]
 
