@@ -53,6 +53,15 @@ THESIS = {
     "cl_1N_Hz": 25.0,
 }
 
+PRESET_PATH = ROOT / "presets" / "thesis_measured.json"
+
+
+def load_preset(path=PRESET_PATH) -> dict:
+    """The FMU start values of a preset file (a JSON object of parameter names and numbers)."""
+    with open(path) as f:
+        return {name: float(value) for name, value in json.load(f).items()}
+
+
 K_CD = 0.04  # A/V, default current driver gain
 V_MAX = 10.0  # D/A range
 F_SAMPLE = 500.0  # Hz, the thesis's controller rate (§4.1)
@@ -65,9 +74,13 @@ T_SAMPLE = 1.0 / F_SAMPLE
 
 
 class FmuContext:
-    """The FMU extracted once; `instance(...)` makes initialised instances."""
+    """The FMU extracted once; `instance(...)` makes initialised instances.
 
-    def __init__(self, path=None):
+    `preset` (a dict of FMU start values, e.g. presets/thesis_measured.json) is set in every
+    instance before the scenario's own parameters, and `param`/`defaults` read it: every
+    scenario then runs on the actuator with those values."""
+
+    def __init__(self, path=None, preset=None):
         env = os.environ.get("JETPIPE_FMU")
         self.path = Path(path or env or default_fmu_path()).resolve()
         if not self.path.is_file():
@@ -81,13 +94,19 @@ class FmuContext:
             for v in self.model_description.modelVariables
             if v.causality == "parameter" and v.type == "Real"
         }
+        self.preset = dict(preset or {})
+        unknown = sorted(set(self.preset) - set(self.defaults))
+        if unknown:
+            raise ValueError(f"preset names no real parameter of the FMU: {unknown}")
+        self.defaults.update({k: float(v) for k, v in self.preset.items()})
         self.live = []
 
     def instance(self, v_DA=0.0, x_s=0.054, parameters=None, booleans=None, tolerance=None) -> "Plant":
         fmu = make_slave(self.unzipdir, self.model_description)
         plant = Plant(self, fmu)
         self.live.append(plant)
-        initialize(fmu, self.vrs, inputs=(v_DA, x_s), parameters=parameters, booleans=booleans, tolerance=tolerance)
+        merged = dict(self.preset, **(parameters or {}))
+        initialize(fmu, self.vrs, inputs=(v_DA, x_s), parameters=merged, booleans=booleans, tolerance=tolerance)
         plant.v_DA, plant.x_s = float(v_DA), float(x_s)
         return plant
 
@@ -320,6 +339,9 @@ def scenario_2(ctx: FmuContext, fast=True):
         is_.append(i)
     ts, xs = np.array(ts), np.array(xs)
     x_final = d["x_jp_sat"] * math.tanh(d["k_m"] * d["k_cd"] * v_step / d["F_jp_sat"])
+    if ctx.preset:
+        # An effect between f3 and the dynamics (the hysteresis) moves the final value: the run's own.
+        x_final = float(np.mean(xs[ts >= ts[-1] - 0.01]))
     rise, settle, overshoot = step_metrics(ts, xs, 0.0, x_final)
     t100 = float(ts[np.argmax(xs >= x_final)])  # first crossing of the final value (0-100 % rise)
     # The same step through the linear current driver + third-order jet pipe (thesis parameters).
@@ -380,7 +402,7 @@ def ramp_loop(ctx, x_s, t_ramp, h=0.01, v_lo=-10.0, v_hi=10.0):
     for leg, sgn, v0 in (("up", 1.0, v_lo), ("down", -1.0, v_hi)):
         for k in range(n):
             p.step(h, v_DA=v0 + sgn * rate * (k + 0.5) * h)  # mid-step hold
-            out[leg].append(p.get("i", "F_act"))
+            out[leg].append(p.get("i", "F_act", "x_jp"))
     p.close()
     return {leg: np.array(v) for leg, v in out.items()}
 
@@ -407,7 +429,24 @@ def scenario_3(ctx: FmuContext, fast=True):
     # Static slope dF/di about 45 N (the k of §4.2.1).
     s = res["static"][0.054]
     res["k_static_45N"] = float(np.interp(45.0, s["F"][40:], np.gradient(s["F"], s["i"])[40:]))
+    res["loops"] = loop_separations(res["ramp"][0.054])
     return res
+
+
+def loop_separations(ramp):
+    """Separations of the falling and rising branches of a slow ramp (columns i, F_act, x_jp):
+    the jet pipe's at i = 0 (m), and the current between the branches at 45 N (A)."""
+    up, down = ramp["up"], ramp["down"]
+    x_up = float(np.interp(0.0, up[:, 0], up[:, 2]))
+    x_down = float(np.interp(0.0, down[::-1, 0], down[::-1, 2]))
+
+    def current_at(branch, F):
+        k = int(np.nonzero(branch[:, 1] > branch[:, 1].min() + 1e-6)[0][0])  # above the spring floor
+        Fs, i_s = branch[k:, 1], branch[k:, 0]
+        order = np.argsort(Fs)
+        return float(np.interp(F, Fs[order], i_s[order]))
+
+    return {"x_jp_m": x_down - x_up, "i_at_45N_A": current_at(up, 45.0) - current_at(down[::-1], 45.0)}
 
 
 # --------------------------------------------------------------------------------------------
@@ -655,6 +694,17 @@ def linear_closed_loop(lin, freqs, k_p=K_P, k_cd=K_CD, ts=T_SAMPLE):
 
 
 CL_CASES = ((1.0, 0.054), (5.0, 0.054), (1.0, 0.040), (5.0, 0.040))
+CL_FREQS_FAST = np.array([1, 5, 10, 20, 30, 40, 50, 60, 70, 80, 100, 125, 160, 200.0])
+
+
+def closed_loop_response(ctx, amp, x_s, freqs):
+    """Sine dwells of the P loop at each frequency about 45 N; the -3 dB point relative to the
+    lowest frequency's magnitude (bw_rel_Hz) and relative to 1 (bw_abs_Hz)."""
+    H, off = zip(*[closed_loop_point(ctx, f, amp, x_s=x_s) for f in freqs])
+    H = np.array(H)
+    mag = db(H)
+    return {"H": H, "offset": np.array(off), "bw_rel_Hz": crossing_3db(freqs, mag, mag[0]),
+            "bw_abs_Hz": crossing_3db(freqs, mag, 0.0), "peak_dB": float(mag.max()), "low_dB": float(mag[0])}
 
 
 def scenario_7(ctx: FmuContext, fast=True):
@@ -677,16 +727,9 @@ def scenario_7(ctx: FmuContext, fast=True):
     F_ss = brentq(lambda F: K_P * (45.0 - F) - inv(F), 30.0, 45.0)
     res["offset_predicted_45N"] = F_ss - 45.0
     # Closed-loop frequency response.
-    freqs = np.array([1, 5, 10, 20, 30, 40, 50, 60, 70, 80, 100, 125, 160, 200.0] if fast else
-                     np.unique(np.concatenate([np.geomspace(1, 220, 30), [25, 55, 80]])))
+    freqs = (CL_FREQS_FAST if fast else np.unique(np.concatenate([np.geomspace(1, 220, 30), [25, 55, 80]])))
     res["freqs"] = freqs
-    res["cl"] = {}
-    for amp, xs in CL_CASES:
-        H, off = zip(*[closed_loop_point(ctx, f, amp, x_s=xs) for f in freqs])
-        H = np.array(H)
-        mag = db(H)
-        res["cl"][(amp, xs)] = {"H": H, "offset": np.array(off), "bw_rel_Hz": crossing_3db(freqs, mag, mag[0]),
-                                "bw_abs_Hz": crossing_3db(freqs, mag, 0.0), "peak_dB": float(mag.max())}
+    res["cl"] = {(amp, xs): closed_loop_response(ctx, amp, xs, freqs) for amp, xs in CL_CASES}
     # Linear estimates: §4.2.1 first-order formula and the full linearisation at 500 Hz.
     lin = linearize(45.0, 0.054)
     fa = fluid_analysis(ctx, lin, 0.054)

@@ -198,3 +198,33 @@ fn bad_names_and_values_are_refused_before_any_run() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_thesis_measured_preset_is_a_base_the_sweep_accepts_and_it_changes_the_force() {
+    let preset = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/thesis_measured.json");
+    let dir = scratch("preset");
+    let final_force = |base: Option<&Path>, name: &str| -> f64 {
+        let out = dir.join(name);
+        let mut args = vec!["--param", "k_spring=88.14", "--no-serial"];
+        if let Some(base) = base {
+            args.extend(["--base-params", base.to_str().unwrap()]);
+        }
+        let o = sweep_cli(&args, &out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let csv = std::fs::read_to_string(&out).unwrap();
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(*row.last().unwrap(), "ok");
+        let i = header.iter().position(|h| *h == "final_F_act_N").unwrap();
+        row[i].parse().unwrap()
+    };
+    let thesis = final_force(None, "thesis.csv");
+    let measured = final_force(Some(&preset), "measured.csv");
+    // The hysteresis and the vent move the force of the standard scenario by newtons, not bits.
+    assert!(
+        (measured - thesis).abs() > 0.5,
+        "thesis {thesis} N, with the preset {measured} N"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
