@@ -7,7 +7,7 @@
 //! What a reader must be able to trust: the measured series is drawn last and semi-transparent,
 //! so the model's curves cannot hide it; legends sit in a strip above the plot, off the data;
 //! every axis names its unit; dense series are decimated (a min/max envelope per pixel column
-//! for traces in time, every k-th sample for curves in a plane, at most [`MAX_SCATTER`] points
+//! for traces in time, every k-th sample for curves in a plane, at most `MAX_SCATTER` points
 //! for a scatter), so a figure of an 80 000-sample recording stays under about 100 kB.
 
 use std::path::Path;
