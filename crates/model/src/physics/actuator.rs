@@ -8,7 +8,7 @@ use nalgebra::{SMatrix, SVector};
 use super::chambers::{pressure_rate, CylinderGeometry};
 use super::effects::{self, Hysteresis, PLAY_OPERATORS};
 use super::jet_pipe::StaticCurve;
-use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
+use super::orifice_flow::{self, leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
 use super::restrictions::{self, node, Restrictions, PRESSURES_WITH_VOLUMES};
@@ -122,6 +122,22 @@ pub struct Actuator {
     pub discharge: [f64; 4],
     /// Restrictions between the valve and the air, and the volumes behind them.
     pub restrictions: Restrictions,
+    /// Which terms of the pressure rates are live, decided here once for all evaluations.
+    rate_terms: RateTerms,
+}
+
+/// Which terms of the chambers' pressure rates a model has, decided once when it is built, so
+/// that the thesis model's evaluations do not test, term by term, for effects that are off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RateTerms {
+    /// (2.18)–(2.29) alone: the four orifices of the valve at P_s and P_r, the leakage past the
+    /// piston, a rigid stopper; no restriction, no chamber vent. Factors that are plain
+    /// constants (C_d's area scales, dead volumes, the polytropic exponent of heat transfer)
+    /// keep it.
+    Thesis,
+    /// The thesis's terms and any of: restrictions between the valve and the air, chamber
+    /// vents, a compliant stopper.
+    Extended,
 }
 
 impl Actuator {
@@ -139,7 +155,17 @@ impl Actuator {
             params.c_d * params.return_area_scale_2,
         ];
         let restrictions = Restrictions::from_parameters(&params);
+        let rate_terms = if restrictions.any()
+            || params.chamber_vent_1 != 0.0
+            || params.chamber_vent_2 != 0.0
+            || params.stopper_compliance != 0.0
+        {
+            RateTerms::Extended
+        } else {
+            RateTerms::Thesis
+        };
         Ok(Self {
+            rate_terms,
             restrictions,
             params,
             flow,
@@ -378,8 +404,52 @@ impl Actuator {
         x_s: f64,
         x_s_rate: f64,
     ) -> (f64, f64) {
+        match self.rate_terms {
+            RateTerms::Thesis => self.thesis_pressure_rates(areas, p1, p2, x_s, x_s_rate),
+            RateTerms::Extended => self.extended_pressure_rates(areas, p1, p2, x_s, x_s_rate),
+        }
+    }
+
+    /// [`Self::pressure_rates_through`] with every term tested for: right for any model.
+    pub fn extended_pressure_rates(&self, areas: &OrificeAreas, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
         let flows = self.mass_flows_through(areas, p1, p2);
         self.chamber_rates(flows.net_1(), flows.net_2(), p1, p2, x_s, x_s_rate)
+    }
+
+    /// Which terms of the pressure rates this model has.
+    pub fn rate_terms(&self) -> RateTerms {
+        self.rate_terms
+    }
+
+    /// [`Self::pressure_rates_through`] of a model whose [`RateTerms`] are the thesis's: the
+    /// flows (2.18)–(2.25) into (2.29), with no test for the terms that are off. The same
+    /// operations in the same order as the general path's, so the same bits (a vent of zero
+    /// is a subtraction of +0, which changes no value).
+    #[inline(always)]
+    pub fn thesis_pressure_rates(&self, a: &OrificeAreas, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
+        let p = &self.params;
+        let k = &self.flow;
+        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
+        let supply_1 = orifice_flow::mass_flow_inline(k, cd_s1 * a.supply_1, p.p_s, p1);
+        let return_1 = orifice_flow::mass_flow_inline(k, cd_r1 * a.return_1, p1, p.p_r);
+        let supply_2 = orifice_flow::mass_flow_inline(k, cd_s2 * a.supply_2, p.p_s, p2);
+        let return_2 = orifice_flow::mass_flow_inline(k, cd_r2 * a.return_2, p2, p.p_r);
+        let leakage = orifice_flow::mass_flow_inline(
+            k,
+            orifice_flow::leakage_cd_area(p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+            p1,
+            p2,
+        );
+        // (2.24), (2.25)
+        let net_1 = supply_1 - return_1 - leakage;
+        let net_2 = supply_2 - return_2 + leakage;
+        let (v1, v2) = self.cylinder.volumes(x_s);
+        let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
+        let n = self.polytropic_exponent;
+        (
+            pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1),
+            pressure_rate(n, p.r_gas, p.temperature, v2, dv2, net_2, p2),
+        )
     }
 
     /// (2.29) for both chambers with their net mass inflows.

@@ -5,12 +5,12 @@
 
 use nalgebra::{Const, DimMin, SVector};
 
-use super::chambers::ChamberSystem;
+use super::chambers::{ChamberSystem, ExtendedLaw, PressureLaw, ThesisLaw, VolumesLaw};
 use super::monolithic::StepSystem;
 use super::{ChamberMethod, ChamberRatesAtEnd, Method, Simulation, StepFailure};
 use crate::electromechanics::{ElectromechanicalState, Trajectory};
 use crate::integrator::{ExplicitPair, IntegrationFailure, OdeSystem, Sdirk4, Statistics, Tolerances};
-use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
+use crate::physics::actuator::{index, Actuator, Outputs, RateTerms, State, N_STATES};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use crate::physics::sensors::{Channel, SensorLaw};
@@ -22,7 +22,7 @@ impl Simulation {
     /// without asking, if it is no longer than a ringing period and the default method
     /// integrates it). The pressure rates at the start come from `system`, which
     /// keeps them for the integrator's first stage.
-    fn ringing_until<const N: usize>(&self, system: &ChamberSystem<N>, trajectory: &Trajectory, step: f64) -> f64 {
+    fn ringing_until<const N: usize, L: PressureLaw<N>>(&self, system: &ChamberSystem<N, L>, trajectory: &Trajectory, step: f64) -> f64 {
         let after_current_transient = step.min(5.0 / self.model.params.omega_cd);
         let amplitude = trajectory
             .ringing_amplitude(0.0)
@@ -153,9 +153,11 @@ impl Simulation {
     /// two pressures alone are integrated.
     fn split_step(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<State, IntegrationFailure<N_STATES>> {
         if self.model.restrictions.has_volumes() {
-            self.split_step_over::<PRESSURES_WITH_VOLUMES>(duration, v, v_rate)
-        } else {
-            self.split_step_over::<2>(duration, v, v_rate)
+            return self.split_step_over::<PRESSURES_WITH_VOLUMES, VolumesLaw>(duration, v, v_rate);
+        }
+        match self.model.rate_terms() {
+            RateTerms::Thesis => self.split_step_over::<2, ThesisLaw>(duration, v, v_rate),
+            RateTerms::Extended => self.split_step_over::<2, ExtendedLaw>(duration, v, v_rate),
         }
     }
 
@@ -169,7 +171,7 @@ impl Simulation {
     }
 
     /// [`Self::split_step`] with N integrated pressures.
-    fn split_step_over<const N: usize>(
+    fn split_step_over<const N: usize, L: PressureLaw<N>>(
         &mut self,
         duration: f64,
         v: f64,
@@ -190,7 +192,7 @@ impl Simulation {
                 SVector::<f64, N>::from_fn(|i, _| end.rates[i]),
             )
         });
-        let system = ChamberSystem::<N>::new(
+        let system = ChamberSystem::<N, L>::new(
             &self.model,
             &trajectory,
             duration,
@@ -369,11 +371,11 @@ impl Simulation {
 /// Integrate the chambers over a step of `duration`. While the jet pipe rings (until
 /// `ringing_until`), the explicit pairs' steps are capped by its period.
 #[allow(clippy::too_many_arguments)]
-fn integrate_chambers<const N: usize>(
+fn integrate_chambers<const N: usize, L: PressureLaw<N>>(
     integrator: &mut Sdirk4,
     statistics: &mut Statistics,
     method: ChamberMethod,
-    system: &ChamberSystem<N>,
+    system: &ChamberSystem<N, L>,
     tolerances: &Tolerances<N>,
     pressures: SVector<f64, N>,
     duration: f64,
