@@ -59,7 +59,9 @@ impl PressureLaw<PRESSURES_WITH_VOLUMES> for VolumesLaw {
         for (slot, value) in pressures.iter_mut().zip(p.iter()) {
             *slot = *value;
         }
-        SVector::<f64, PRESSURES_WITH_VOLUMES>::from(model.pressure_rates_with_volumes(areas, &pressures, x_s, x_s_rate))
+        SVector::<f64, PRESSURES_WITH_VOLUMES>::from(
+            model.pressure_rates_with_volumes(areas, &pressures, x_s, x_s_rate),
+        )
     }
 }
 

@@ -22,7 +22,12 @@ impl Simulation {
     /// without asking, if it is no longer than a ringing period and the default method
     /// integrates it). The pressure rates at the start come from `system`, which
     /// keeps them for the integrator's first stage.
-    fn ringing_until<const N: usize, L: PressureLaw<N>>(&self, system: &ChamberSystem<N, L>, trajectory: &Trajectory, step: f64) -> f64 {
+    fn ringing_until<const N: usize, L: PressureLaw<N>>(
+        &self,
+        system: &ChamberSystem<N, L>,
+        trajectory: &Trajectory,
+        step: f64,
+    ) -> f64 {
         let after_current_transient = step.min(5.0 / self.model.params.omega_cd);
         let amplitude = trajectory
             .ringing_amplitude(0.0)
