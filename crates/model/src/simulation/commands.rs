@@ -18,6 +18,9 @@ impl Simulation {
     /// and the delay line, as [`Self::command_segments`] pieces; shared by the
     /// error-controlled and the fixed steps.
     pub(super) fn seen_command_segments(&mut self, step: f64) -> smallvec::SmallVec<[(f64, f64, f64); 2]> {
+        if !self.plan.command_path {
+            return smallvec::smallvec![(step, self.v_da, self.v_da_rate)];
+        }
         // The command stage holds what the driver sees over the step (a command ramp
         // reaches it at the next communication point).
         let applied = self.v_da;

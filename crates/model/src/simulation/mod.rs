@@ -36,10 +36,11 @@ use crate::electromechanics::ElectromechanicalPropagator;
 use crate::integrator::{Sdirk4, Statistics, Tolerances};
 use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
-use crate::physics::command_stage::CommandStage;
+use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::restrictions::node;
 use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
+use crate::physics::time_varying;
 
 /// The default relative tolerance (also the model description's default experiment).
 pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-6;
@@ -133,6 +134,37 @@ pub struct Simulation {
     /// function of: when the next step starts from the same jet pipe position, pressures and
     /// stopper motion, they are its rates at the start and are not evaluated again.
     chamber_rates_at_end: Option<ChamberRatesAtEnd>,
+    /// Which of a step's optional stages the model has, decided once from its parameters.
+    plan: StepPlan,
+}
+
+/// The optional stages of a step, decided once when a simulation is built from its model (its
+/// parameters do not change after: the constants that vary in time are set and reset
+/// around each step, and do not change which stages are live), so that the thesis model's
+/// step does not test for each effect that is off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct StepPlan {
+    /// Constants vary in time ([`crate::physics::time_varying`]).
+    varying_constants: bool,
+    /// The command reaches the driver through the command stage or the transport delay.
+    command_path: bool,
+    /// A transducer filters its reading (and so has a memory, which records the reading after
+    /// each step).
+    filtering_transducers: bool,
+    /// The hysteresis operator has a memory to follow.
+    hysteresis: bool,
+}
+
+impl StepPlan {
+    fn of(model: &Actuator, transducers: &[Option<SensorMemory>; 3]) -> Self {
+        let p = &model.params;
+        StepPlan {
+            varying_constants: time_varying::varies(p),
+            command_path: command_stage::is_active(p) || p.command_delay != 0.0,
+            filtering_transducers: transducers.iter().any(Option::is_some),
+            hysteresis: model.hysteresis.is_active(),
+        }
+    }
 }
 
 /// See [`Simulation::chamber_rates_at_end`].
@@ -183,6 +215,7 @@ impl Simulation {
         // What the driver has seen since long before (the delay line's past): the command
         // through the stage, as every later entry of the line is.
         let seen_before = command_stage.current(&model.params);
+        let plan = StepPlan::of(&model, &transducers);
         let nodes = if model.restrictions.any() {
             model
                 .network_flows(
@@ -228,6 +261,7 @@ impl Simulation {
             transducers,
             propagator,
             chamber_rates_at_end: None,
+            plan,
         }
     }
 
@@ -303,6 +337,9 @@ impl Simulation {
         let mut y = self
             .model
             .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time);
+        if !self.plan.filtering_transducers {
+            return y;
+        }
         for ((memory, reading), channel) in self.transducers.iter().zip(y.readings_mut()).zip(Channel::ALL) {
             if let Some(memory) = memory {
                 *reading = memory.output(&SensorLaw::of(&self.model.params, channel), self.time, *reading);

@@ -73,7 +73,7 @@ impl Simulation {
 
     /// Advance by `step` seconds.
     pub fn step(&mut self, step: f64) -> Result<(), StepFailure> {
-        if !time_varying::varies(&self.model.params) {
+        if !self.plan.varying_constants {
             return self.step_with_constants_held(step);
         }
         // The varying constants at mid-step, held over the step; the chambers' rates kept
@@ -122,7 +122,7 @@ impl Simulation {
         self.input_changed = false;
         self.stopper_velocity = (self.x_s - self.x_s_at_last_step) / step;
         self.x_s_at_last_step = self.x_s;
-        if self.transducers.iter().any(Option::is_some) {
+        if self.plan.filtering_transducers {
             let mut y = self
                 .model
                 .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time);
@@ -233,7 +233,7 @@ impl Simulation {
         if changed {
             self.step_after_change = self.chamber_integrator.first_step;
         }
-        if self.model.hysteresis.is_active() {
+        if self.plan.hysteresis {
             let reached = match &result {
                 Ok(_) => duration,
                 Err(f) => f.time,
@@ -302,7 +302,7 @@ impl Simulation {
             &tolerances,
             &mut self.statistics,
         );
-        if self.model.hysteresis.is_active() {
+        if self.plan.hysteresis {
             // Plays follow the static position monotonically within the step.
             let y = match &result {
                 Ok(y) => *y,
