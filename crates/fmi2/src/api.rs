@@ -75,8 +75,7 @@ unsafe fn guarded<M: CoSimModel>(
             return inst.error(illegal_call_message(f, inst.state));
         }
         // call tracing only for models that declare the "logCalls" category
-        let declared = M::info().log_categories.iter().any(|(n, _)| *n == CAT_CALLS);
-        if declared && inst.should_log(fmi2OK, CAT_CALLS) {
+        if inst.logs_calls() {
             inst.log(fmi2OK, CAT_CALLS, f.name());
         }
         body(inst)
