@@ -17,8 +17,9 @@
 #      and reports the CPU time of the fastest of R timed runs (default 3);
 #   3. prints each pair, the median CPU time of each build and the median of the pairs'
 #      ratios (current / COMMIT), with the load average before and after;
-#   4. with --callgrind, counts the instructions executed inside fmi2DoStep for one cold run of
-#      each build (valgrind --tool=callgrind): a figure that does not drift with the machine.
+#   4. with --callgrind, counts the instructions executed inside fmi2DoStep, fmi2GetReal and
+#      fmi2SetReal (the calls of each step) for one cold run of each build (valgrind
+#      --tool=callgrind): figures that do not drift with the machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$(pwd)"
@@ -130,13 +131,21 @@ echo "load average before $load_before, after $(load)"
 
 if ((callgrind)); then
     command -v valgrind >/dev/null || { echo "--callgrind needs valgrind" >&2; exit 1; }
-    echo "==> instructions inside fmi2DoStep, one cold run (callgrind)"
+    echo "==> instructions of one cold run (callgrind), inside the calls of each step"
     count() {
-        valgrind --tool=callgrind --callgrind-out-file="$work/callgrind.out" --toggle-collect=fmi2DoStep \
+        valgrind --tool=callgrind --callgrind-out-file="$work/callgrind.out" --toggle-collect="$3" \
             "$driver" --cold "$1" "$2" 2>&1 >/dev/null | sed -n 's/.*Collected : *//p'
     }
-    old_ir="$(count "$old_lib" "$old_guid")"
-    current_ir="$(count "$current_lib" "$current_guid")"
-    awk -v a="$old_ir" -v b="$current_ir" -v s="$short" \
-        'BEGIN { printf "%s %.1f M, current %.1f M; ratio %.3f\n", s, a / 1e6, b / 1e6, b / a }'
+    total_old=0
+    total_current=0
+    for call in fmi2DoStep fmi2GetReal fmi2SetReal; do
+        old_ir="$(count "$old_lib" "$old_guid" "$call")"
+        current_ir="$(count "$current_lib" "$current_guid" "$call")"
+        total_old=$((total_old + old_ir))
+        total_current=$((total_current + current_ir))
+        awk -v a="$old_ir" -v b="$current_ir" -v s="$short" -v f="$call" \
+            'BEGIN { printf "%-12s %s %6.2f M, current %6.2f M; ratio %.3f\n", f, s, a / 1e6, b / 1e6, b / a }'
+    done
+    awk -v a="$total_old" -v b="$total_current" -v s="$short" \
+        'BEGIN { printf "%-12s %s %6.2f M, current %6.2f M; ratio %.3f\n", "all three", s, a / 1e6, b / 1e6, b / a }'
 fi

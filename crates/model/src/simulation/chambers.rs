@@ -151,6 +151,7 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
     }
 
     /// The jet pipe position at `t` and the orifice areas there.
+    #[inline(always)]
     pub(super) fn position_and_areas(&self, t: f64) -> (f64, OrificeAreas) {
         if let Some(known) = self.stage_areas.borrow().at(t) {
             return known;
@@ -226,6 +227,7 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
     }
 
     /// The rates at t = duration, recorded with the position and pressures (see `end_rates`).
+    #[inline(always)]
     pub(super) fn rates_at_end(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
         let (position, areas) = self.position_and_areas(self.duration);
         let rates = self.rates(&areas, self.duration, p);
