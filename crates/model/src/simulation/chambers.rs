@@ -257,6 +257,10 @@ impl StageAreas {
 }
 
 impl<const N: usize, L: PressureLaw<N>> OdeSystem<N> for ChamberSystem<'_, N, L> {
+    // Inlined into the integrator's stages with what it calls on their path (the law, the
+    // rates at the end, the stage areas' lookup): out of line, the right-hand side with f2
+    // cost 2.5 % more instructions per step, the rates at the end and the lookup another
+    // 1.7 % (callgrind, the standard scenario's inputs at 1 kHz).
     #[inline(always)]
     fn rhs(&self, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         if t == 0.0 {
