@@ -260,16 +260,23 @@ impl CoSimModel for ActuatorFmu {
                         &computed
                     }
                 };
-                let y = simulation.outputs();
+                // The states among the outputs are read as they are: an importer asks for the
+                // outputs one value reference at a time, and the others cost a force each.
+                let state = simulation.state();
                 Ok(match value_reference {
-                    vr::F_ACT => y.f_act,
-                    vr::F_MEAS => y.f_meas,
-                    vr::P1 => y.p1,
-                    vr::P2 => y.p2,
-                    vr::P1_MEAS => y.p1_meas,
-                    vr::P2_MEAS => y.p2_meas,
-                    vr::I => y.current,
-                    _ => y.x_jp,
+                    vr::P1 => state[index::P1],
+                    vr::P2 => state[index::P2],
+                    vr::I => state[index::CURRENT],
+                    vr::X_JP => state[index::JET_POSITION],
+                    _ => {
+                        let y = simulation.outputs();
+                        match value_reference {
+                            vr::F_ACT => y.f_act,
+                            vr::F_MEAS => y.f_meas,
+                            vr::P1_MEAS => y.p1_meas,
+                            _ => y.p2_meas,
+                        }
+                    }
                 })
             }
             vr::P1_START => Ok(self.p1_start),

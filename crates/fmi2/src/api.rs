@@ -75,8 +75,7 @@ unsafe fn guarded<M: CoSimModel>(
             return inst.error(illegal_call_message(f, inst.state));
         }
         // call tracing only for models that declare the "logCalls" category
-        let declared = M::info().log_categories.iter().any(|(n, _)| *n == CAT_CALLS);
-        if declared && inst.should_log(fmi2OK, CAT_CALLS) {
+        if inst.logs_calls() {
             inst.log(fmi2OK, CAT_CALLS, f.name());
         }
         body(inst)
@@ -158,6 +157,7 @@ fn variability_name(v: Variability) -> &'static str {
 }
 
 /// The variable with value reference `vr` and type `ty`, or a message naming the VR.
+#[inline]
 pub fn lookup<M: CoSimModel>(fname: &str, vr: u32, ty: VarType) -> Result<&'static Variable, String> {
     let vars = M::info().variables;
     if let Some(v) = vars.iter().find(|v| v.value_reference == vr && v.var_type == ty) {
@@ -175,6 +175,7 @@ pub fn lookup<M: CoSimModel>(fname: &str, vr: u32, ty: VarType) -> Result<&'stat
 }
 
 /// Whether `v` may be read in `state`: in `instantiated` only parameters and inputs.
+#[inline]
 pub fn check_get(fname: &str, v: &Variable, state: State) -> Result<(), String> {
     if state == State::Instantiated && !matches!(v.causality, Causality::Parameter | Causality::Input) {
         return Err(format!(
@@ -191,6 +192,7 @@ pub fn check_get(fname: &str, v: &Variable, state: State) -> Result<(), String> 
 /// Whether `v` may be set in `state`: no outputs or locals; fixed parameters only in
 /// `instantiated` and `initializationMode`; tunable parameters and inputs also in
 /// `stepComplete`.
+#[inline]
 pub fn check_set(fname: &str, v: &Variable, state: State) -> Result<(), String> {
     let early = matches!(state, State::Instantiated | State::InitializationMode);
     let ok = match (v.causality, v.variability) {

@@ -81,6 +81,9 @@ pub struct Instance<M: CoSimModel> {
     pub logging_on: bool,
     /// One flag per entry of `M::info().log_categories`.
     pub categories_enabled: Vec<bool>,
+    /// Where the model declares the "logCalls" category in `M::info().log_categories`, found
+    /// once: every call asks whether to trace itself.
+    calls_category: Option<usize>,
     pub state: State,
     /// `last_successful_time` of the last `fmi2DoStep` that returned fmi2Discard (the
     /// model's `time()` is what `fmi2GetRealStatus` reports).
@@ -104,6 +107,7 @@ impl<M: CoSimModel> Instance<M> {
             component_environment: callbacks.map_or(std::ptr::null_mut(), |c| c.componentEnvironment),
             logging_on,
             categories_enabled: vec![logging_on; n],
+            calls_category: M::info().log_categories.iter().position(|(name, _)| *name == CAT_CALLS),
             state: State::Instantiated,
             last_successful_time: None,
             last_error: None,
@@ -140,6 +144,12 @@ impl<M: CoSimModel> Instance<M> {
     /// Whether a message with this status and category passes the filter: fmi2Discard,
     /// fmi2Error and fmi2Fatal always pass; others need logging on for their category
     /// (a category the model does not declare follows the global `logging_on`).
+    /// Whether calls are traced: the model declares "logCalls" and it is enabled (what
+    /// `should_log(fmi2OK, CAT_CALLS)` says for a declared category).
+    pub fn logs_calls(&self) -> bool {
+        self.calls_category.map_or(false, |i| self.categories_enabled[i])
+    }
+
     pub fn should_log(&self, status: fmi2Status, category: &str) -> bool {
         if status >= fmi2Discard {
             return true;

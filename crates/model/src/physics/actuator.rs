@@ -8,7 +8,7 @@ use nalgebra::{SMatrix, SVector};
 use super::chambers::{pressure_rate, CylinderGeometry};
 use super::effects::{self, Hysteresis, PLAY_OPERATORS};
 use super::jet_pipe::StaticCurve;
-use super::orifice_flow::{leakage_flow, mass_flow, FlowConstants};
+use super::orifice_flow::{self, leakage_flow, mass_flow, FlowConstants};
 use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulated_orifice_areas, OrificeAreas};
 use super::parameters::Parameters;
 use super::restrictions::{self, node, Restrictions, PRESSURES_WITH_VOLUMES};
@@ -122,6 +122,25 @@ pub struct Actuator {
     pub discharge: [f64; 4],
     /// Restrictions between the valve and the air, and the volumes behind them.
     pub restrictions: Restrictions,
+    /// Which terms of the pressure rates are live, decided here once for all evaluations.
+    rate_terms: RateTerms,
+    /// Whether the outputs are the thesis's alone: no friction or extra piston force, every
+    /// transducer reading its quantity itself.
+    thesis_outputs: bool,
+}
+
+/// Which terms of the chambers' pressure rates a model has, decided once when it is built, so
+/// that the thesis model's evaluations do not test, term by term, for effects that are off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RateTerms {
+    /// (2.18)–(2.29) alone: the four orifices of the valve at P_s and P_r, the leakage past the
+    /// piston, a rigid stopper; no restriction, no chamber vent. Factors that are plain
+    /// constants (C_d's area scales, dead volumes, the polytropic exponent of heat transfer)
+    /// keep it.
+    Thesis,
+    /// The thesis's terms and any of: restrictions between the valve and the air, chamber
+    /// vents, a compliant stopper.
+    Extended,
 }
 
 impl Actuator {
@@ -139,7 +158,25 @@ impl Actuator {
             params.c_d * params.return_area_scale_2,
         ];
         let restrictions = Restrictions::from_parameters(&params);
+        let rate_terms = if restrictions.any()
+            || params.chamber_vent_1 != 0.0
+            || params.chamber_vent_2 != 0.0
+            || params.stopper_compliance != 0.0
+        {
+            RateTerms::Extended
+        } else {
+            RateTerms::Thesis
+        };
+        let thesis_outputs = params.friction_coulomb == 0.0
+            && params.friction_stribeck == 0.0
+            && params.viscous_friction == 0.0
+            && params.position_force_rate == 0.0
+            && Channel::ALL
+                .iter()
+                .all(|&channel| SensorLaw::of(&params, channel).is_identity());
         Ok(Self {
+            thesis_outputs,
+            rate_terms,
             restrictions,
             params,
             flow,
@@ -378,8 +415,59 @@ impl Actuator {
         x_s: f64,
         x_s_rate: f64,
     ) -> (f64, f64) {
+        match self.rate_terms {
+            RateTerms::Thesis => self.thesis_pressure_rates(areas, p1, p2, x_s, x_s_rate),
+            RateTerms::Extended => self.extended_pressure_rates(areas, p1, p2, x_s, x_s_rate),
+        }
+    }
+
+    /// [`Self::pressure_rates_through`] with every term tested for: right for any model.
+    pub fn extended_pressure_rates(
+        &self,
+        areas: &OrificeAreas,
+        p1: f64,
+        p2: f64,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> (f64, f64) {
         let flows = self.mass_flows_through(areas, p1, p2);
         self.chamber_rates(flows.net_1(), flows.net_2(), p1, p2, x_s, x_s_rate)
+    }
+
+    /// Which terms of the pressure rates this model has.
+    pub fn rate_terms(&self) -> RateTerms {
+        self.rate_terms
+    }
+
+    /// [`Self::pressure_rates_through`] of a model whose [`RateTerms`] are the thesis's: the
+    /// flows (2.18)–(2.25) into (2.29), with no test for the terms that are off. The same
+    /// operations in the same order as the general path's, so the same bits (a vent of zero
+    /// is a subtraction of +0, which changes no value).
+    #[inline(always)]
+    pub fn thesis_pressure_rates(&self, a: &OrificeAreas, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
+        let p = &self.params;
+        let k = &self.flow;
+        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
+        let supply_1 = orifice_flow::mass_flow_inline(k, cd_s1 * a.supply_1, p.p_s, p1);
+        let return_1 = orifice_flow::mass_flow_inline(k, cd_r1 * a.return_1, p1, p.p_r);
+        let supply_2 = orifice_flow::mass_flow_inline(k, cd_s2 * a.supply_2, p.p_s, p2);
+        let return_2 = orifice_flow::mass_flow_inline(k, cd_r2 * a.return_2, p2, p.p_r);
+        let leakage = orifice_flow::mass_flow_inline(
+            k,
+            orifice_flow::leakage_cd_area(p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+            p1,
+            p2,
+        );
+        // (2.24), (2.25)
+        let net_1 = supply_1 - return_1 - leakage;
+        let net_2 = supply_2 - return_2 + leakage;
+        let (v1, v2) = self.cylinder.volumes(x_s);
+        let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
+        let n = self.polytropic_exponent;
+        (
+            pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1),
+            pressure_rate(n, p.r_gas, p.temperature, v2, dv2, net_2, p2),
+        )
     }
 
     /// (2.29) for both chambers with their net mass inflows.
@@ -521,6 +609,26 @@ impl Actuator {
     /// filters are the caller's: see [`super::sensors::SensorMemory`]).
     pub fn outputs_at(&self, y: &State, x_s: f64, stopper_velocity: f64, time: f64) -> Outputs {
         use index::*;
+        if self.thesis_outputs {
+            // (2.36)–(2.38) with no friction term (a friction of ±0 subtracted from a
+            // pressure force, which is never −0, changes no bit); each reading is its
+            // quantity, as the general law's offset 0 plus gain 1 times it: 0 + x, which is x
+            // but for −0.
+            let f_act = piston::actuator_force(
+                piston::pressure_force(self.piston_area, y[P1], y[P2]),
+                self.spring_force(x_s),
+            );
+            return Outputs {
+                f_act,
+                f_meas: 0.0 + f_act,
+                p1_meas: 0.0 + y[P1],
+                p2_meas: 0.0 + y[P2],
+                p1: y[P1],
+                p2: y[P2],
+                current: y[CURRENT],
+                x_jp: y[JET_POSITION],
+            };
+        }
         let p = &self.params;
         let pressure_force = piston::pressure_force(self.piston_area, y[P1], y[P2])
             - effects::friction_force(
@@ -606,5 +714,116 @@ mod tests {
         let model = Actuator::new(p).unwrap();
         let f = model.mass_flows(3e-4, 4e5, 2e5);
         assert_eq!((f.net_1(), f.net_2()), (0.0, 0.0));
+    }
+
+    /// Jet pipe positions across and beyond the ports, and pressures from below P_r to
+    /// above P_s, both orders of P1 and P2, equal pressures, choked and unchoked flows.
+    fn rate_samples() -> Vec<(f64, f64, f64, f64, f64)> {
+        let mut samples = vec![];
+        for x_jp in [-0.4e-3, -0.11e-3, -2e-5, 0.0, 1e-6, 0.05e-3, 0.2e-3, 0.6e-3] {
+            for (p1, p2) in [
+                (5.8e5, 2.8e5),
+                (2.8e5, 5.8e5),
+                (3.3e5, 3.3e5),
+                (1.2e5, 6.9e5),
+                (1.0e5, 1.01e5),
+            ] {
+                for (x_s, x_s_rate) in [(0.054, 0.0), (0.047, -0.02), (0.066, 0.03)] {
+                    samples.push((x_jp, p1, p2, x_s, x_s_rate));
+                }
+            }
+        }
+        samples
+    }
+
+    #[test]
+    fn the_thesis_rates_are_the_general_paths_to_the_last_bit() {
+        let with_factors = Parameters {
+            supply_area_scale_1: 1.07,
+            return_area_scale_2: 0.93,
+            dead_volume_1: 2e-6,
+            heat_transfer_fraction: 0.4,
+            ..Parameters::default()
+        };
+        for params in [Parameters::default(), with_factors] {
+            let model = Actuator::new(params).unwrap();
+            assert_eq!(model.rate_terms(), RateTerms::Thesis);
+            for (x_jp, p1, p2, x_s, x_s_rate) in rate_samples() {
+                let areas = model.areas(x_jp);
+                let thesis = model.thesis_pressure_rates(&areas, p1, p2, x_s, x_s_rate);
+                let general = model.extended_pressure_rates(&areas, p1, p2, x_s, x_s_rate);
+                assert_eq!(
+                    (thesis.0.to_bits(), thesis.1.to_bits()),
+                    (general.0.to_bits(), general.1.to_bits()),
+                    "x_jp {x_jp}, P1 {p1}, P2 {p2}, x_s {x_s}, rate {x_s_rate}"
+                );
+                assert_eq!(model.pressure_rates_through(&areas, p1, p2, x_s, x_s_rate), thesis);
+            }
+        }
+    }
+
+    #[test]
+    fn a_vent_a_restriction_or_a_compliant_stopper_takes_the_general_rates() {
+        type Setter = fn(&mut Parameters);
+        let terms: [(&str, Setter); 4] = [
+            ("chamber_vent_2", |p| p.chamber_vent_2 = 2e-9),
+            ("supply_resistance", |p| p.supply_resistance = 3e8),
+            ("port_restriction_area_1", |p| p.port_restriction_area_1 = 0.2e-6),
+            ("stopper_compliance", |p| p.stopper_compliance = 1e-5),
+        ];
+        let thesis = Actuator::new(Parameters::default()).unwrap();
+        for (name, set) in terms {
+            let mut params = Parameters::default();
+            set(&mut params);
+            let model = Actuator::new(params).unwrap();
+            assert_eq!(model.rate_terms(), RateTerms::Extended, "{name}");
+            // The term acts: the rates differ from the thesis model's somewhere.
+            let differs = rate_samples().into_iter().any(|(x_jp, p1, p2, x_s, x_s_rate)| {
+                model.pressure_rates(x_jp, p1, p2, x_s, x_s_rate) != thesis.pressure_rates(x_jp, p1, p2, x_s, x_s_rate)
+            });
+            assert!(differs, "{name} changes no rate");
+        }
+    }
+
+    #[test]
+    fn the_thesis_outputs_are_the_general_paths_to_the_last_bit() {
+        let model = Actuator::new(Parameters::default()).unwrap();
+        assert!(model.thesis_outputs);
+        let mut general = model.clone();
+        general.thesis_outputs = false;
+        for (x_jp, p1, p2, x_s, stopper_velocity) in rate_samples() {
+            let mut y = State::zeros();
+            y[index::CURRENT] = 0.13;
+            y[index::JET_POSITION] = x_jp;
+            y[index::P1] = p1;
+            y[index::P2] = p2;
+            for time in [0.0, 3.7] {
+                let (a, b) = (
+                    model.outputs_at(&y, x_s, stopper_velocity, time),
+                    general.outputs_at(&y, x_s, stopper_velocity, time),
+                );
+                let bits = |o: &Outputs| {
+                    [o.f_act, o.f_meas, o.p1_meas, o.p2_meas, o.p1, o.p2, o.current, o.x_jp].map(f64::to_bits)
+                };
+                assert_eq!(bits(&a), bits(&b), "{y:?} at x_s {x_s}");
+            }
+        }
+        // Any friction or transducer term leaves the thesis outputs.
+        for params in [
+            Parameters {
+                friction_coulomb: 1.5,
+                ..Parameters::default()
+            },
+            Parameters {
+                p2_sensor_offset: 300.0,
+                ..Parameters::default()
+            },
+            Parameters {
+                force_sensor_lag: 1e-3,
+                ..Parameters::default()
+            },
+        ] {
+            assert!(!Actuator::new(params).unwrap().thesis_outputs);
+        }
     }
 }

@@ -44,7 +44,7 @@ impl FlowConstants {
     }
 
     /// f2 of (2.22), regularised in the band next to r = 1.
-    #[inline]
+    #[inline(always)]
     pub fn f2(&self, ratio: f64) -> f64 {
         // Outside the band (1 − r ≥ band), tested without a division.
         if 1.0 - ratio >= REGULARISATION_RATIO_BAND {
@@ -170,6 +170,13 @@ impl UnchokedFactor {
 /// the pressure difference is reversed; choked below the critical ratio.
 #[inline]
 pub fn mass_flow(k: &FlowConstants, cd_area: f64, p_from: f64, p_to: f64) -> f64 {
+    mass_flow_inline(k, cd_area, p_from, p_to)
+}
+
+/// [`mass_flow`] inlined wherever it is called: for the thesis model's right-hand side, which
+/// evaluates it five times (where the compiler would otherwise keep one out-of-line copy).
+#[inline(always)]
+pub fn mass_flow_inline(k: &FlowConstants, cd_area: f64, p_from: f64, p_to: f64) -> f64 {
     let (p_up, p_down, sign) = if p_from >= p_to {
         (p_from, p_to, 1.0)
     } else {

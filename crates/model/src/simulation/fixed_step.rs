@@ -12,7 +12,8 @@
 
 use nalgebra::{Const, DimMin, SMatrix, SVector};
 
-use super::{keep_nodes, Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
+use super::stepping::keep_nodes;
+use super::{Simulation, StepFailure, DEFAULT_RELATIVE_TOLERANCE};
 use crate::electromechanics::Trajectory;
 use crate::integrator::rosenbrock::Ros2;
 use crate::integrator::{OdeSystem, Statistics};

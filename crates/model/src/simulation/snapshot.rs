@@ -13,7 +13,7 @@
 //! [`SimulationSnapshot::to_values`] flattens a snapshot into numbers for a byte codec that
 //! knows only `f64` arrays; [`SimulationSnapshot::from_values`] checks their shape.
 
-use super::{ChamberMethod, CommandChange, Method, Simulation};
+use super::{ChamberMethod, CommandChange, Method, Simulation, StepPlan};
 use crate::integrator::{Sdirk4, Statistics};
 use crate::physics::actuator::{Actuator, State, N_STATES};
 use crate::physics::command_stage::CommandStage;
@@ -113,6 +113,7 @@ impl Simulation {
         sim.x_s_at_last_step = s.x_s_at_last_step;
         sim.command_stage = s.command_stage;
         sim.transducers = s.transducers.clone();
+        sim.plan = StepPlan::of(&sim.model, &sim.transducers);
         Ok(sim)
     }
 }

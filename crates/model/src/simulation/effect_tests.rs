@@ -1,0 +1,237 @@
+//! Runs of a [`Simulation`] with the effects on: each changes what it should, and the gas
+//! volumes behind restrictions behave as their quasi-static limits say.
+
+use super::tests::{thesis_model, with};
+use super::*;
+use crate::physics::parameters::Parameters;
+use crate::physics::restrictions::PRESSURES_WITH_VOLUMES;
+
+/// Force after holding `v` for `hold` seconds, having come from `from`.
+fn settled_force(model: &Actuator, from: f64, v: f64, hold: f64) -> f64 {
+    let mut sim = Simulation::at_equilibrium(model.clone(), from, 0.054, 0.0, 1e-6).unwrap();
+    // a slow ramp so hysteresis sees a monotone sweep
+    for k in 1..=100 {
+        sim.set_command(from + (v - from) * k as f64 / 100.0).unwrap();
+        sim.step(0.01).unwrap();
+    }
+    sim.step(hold).unwrap();
+    sim.outputs().f_act
+}
+
+#[test]
+fn effects_are_off_by_default_and_each_changes_what_it_should() {
+    let thesis = thesis_model();
+    // jet_pipe_hysteresis: at the same command the force is higher coming down than
+    // going up (the tip lags the command by the play widths).
+    let hysteretic = with(|p| p.hysteresis_width = 0.16e-3);
+    let up = settled_force(&hysteretic, -4.0, 0.5, 2.0);
+    let down = settled_force(&hysteretic, 6.0, 0.5, 2.0);
+    let plain_up = settled_force(&thesis, -4.0, 0.5, 2.0);
+    let plain_down = settled_force(&thesis, 6.0, 0.5, 2.0);
+    // (the plain model is still settling from opposite sides: allow a tenth of the loop)
+    assert!(
+        (plain_up - plain_down).abs() < 0.1 * (down - up),
+        "hysteresis without the effect: {plain_up} {plain_down}"
+    );
+    assert!(down - up > 1.0, "hysteresis loop: up {up} N, down {down} N");
+    // supply_pressure_drop lowers the saturated force; dead_volume does not change statics.
+    let full = settled_force(&thesis, 0.0, 10.0, 2.0);
+    let dropped = settled_force(&with(|p| p.supply_resistance = 3e8), 0.0, 10.0, 2.0);
+    assert!(dropped < full - 1.0, "supply drop: {dropped} vs {full}");
+    let dead = with(|p| {
+        p.dead_volume_1 = 3e-6;
+        p.dead_volume_2 = 3e-6;
+    });
+    assert!((settled_force(&dead, 0.0, 2.5, 3.0) - settled_force(&thesis, 0.0, 2.5, 3.0)).abs() < 1e-3);
+    // dead_volume and heat_transfer slow the pressure response to a command step.
+    let response = |model: &Actuator| {
+        let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-6).unwrap();
+        let start = sim.outputs().f_act;
+        sim.set_command(2.5).unwrap();
+        sim.step(0.05).unwrap();
+        sim.outputs().f_act - start
+    };
+    let base = response(&thesis);
+    assert!(
+        response(&dead) < 0.9 * base,
+        "dead volume: {} vs {base}",
+        response(&dead)
+    );
+    let isothermal = with(|p| p.heat_transfer_fraction = 1.0);
+    assert!(
+        response(&isothermal) < 0.9 * base,
+        "heat transfer: {} vs {base}",
+        response(&isothermal)
+    );
+    // transport_delay: nothing happens until the delay has passed.
+    let delayed = with(|p| p.command_delay = 0.02);
+    let mut sim = Simulation::at_equilibrium(delayed, 1.0, 0.054, 0.0, 1e-6).unwrap();
+    let i0 = sim.outputs().current;
+    sim.set_command(2.5).unwrap();
+    for _ in 0..19 {
+        sim.step(0.001).unwrap();
+    }
+    assert!(
+        (sim.outputs().current - i0).abs() < 1e-12,
+        "current moved before the delay"
+    );
+    sim.step(0.005).unwrap();
+    assert!(
+        sim.outputs().current > i0 + 0.05,
+        "current did not follow after the delay"
+    );
+    // piston_friction: the rod force drops by F_c while the stopper extends.
+    let friction = with(|p| p.friction_coulomb = 1.5);
+    let run = |model: Actuator| {
+        let mut sim = Simulation::at_equilibrium(model, 2.5, 0.054, 0.0, 1e-6).unwrap();
+        sim.set_stopper_rate(0.01).unwrap();
+        sim.step(0.01).unwrap();
+        sim.outputs().f_act
+    };
+    assert!((run(thesis.clone()) - run(friction) - 1.5).abs() < 1e-9);
+    // sensor_offset_gain
+    let sensor = with(|p| {
+        p.force_sensor_offset = 0.7;
+        p.force_sensor_gain = 1.02;
+    });
+    let y = Simulation::at_equilibrium(sensor, 2.5, 0.054, 0.0, 1e-6)
+        .unwrap()
+        .outputs();
+    assert!((y.f_meas - (0.7 + 1.02 * y.f_act)).abs() < 1e-12);
+    let y = Simulation::at_equilibrium(thesis, 2.5, 0.054, 0.0, 1e-6)
+        .unwrap()
+        .outputs();
+    assert_eq!(y.f_meas, y.f_act);
+}
+
+/// 0.3 s of command steps at 1 kHz, the forces and the volumes' pressures at each sample.
+fn stepped_run(model: &Actuator) -> (Vec<f64>, Vec<[f64; node::COUNT]>) {
+    let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
+    let (mut forces, mut nodes) = (vec![], vec![]);
+    for k in 0..300 {
+        sim.set_command(if (k / 50) % 2 == 0 { 4.0 } else { 1.0 }).unwrap();
+        sim.step(1e-3).unwrap();
+        forces.push(sim.outputs().f_act);
+        nodes.push(sim.node_pressures());
+    }
+    (forces, nodes)
+}
+
+fn worst_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+/// A volume behind a restriction, shrunk to a thousandth of a cubic millimetre, fills in
+/// microseconds: the run must follow the quasi-static restriction's, which takes no volume
+/// and finds the pressure behind it as a root at every evaluation.
+#[test]
+fn a_vanishing_volume_behind_a_restriction_gives_the_restriction_alone() {
+    type Setter = fn(&mut Parameters, f64);
+    let cases: [(&str, Setter); 3] = [
+        ("port line behind an orifice", |p, v| {
+            p.port_restriction_area_1 = 0.2e-6;
+            p.port_line_volume_1 = v;
+        }),
+        ("supply plenum behind a resistance", |p, v| {
+            p.supply_resistance = 3e8;
+            p.supply_plenum_volume = v;
+        }),
+        ("return plenum behind a vent orifice", |p, v| {
+            p.return_vent_area = 0.35e-6;
+            p.return_plenum_volume = v;
+        }),
+    ];
+    let (thesis, _) = stepped_run(&thesis_model());
+    for (name, set) in cases {
+        let (quasi_static, _) = stepped_run(&with(|p| set(p, 0.0)));
+        let (tiny, _) = stepped_run(&with(|p| set(p, 1e-12)));
+        let (sizeable, _) = stepped_run(&with(|p| set(p, 3e-6)));
+        let effect = worst_difference(&quasi_static, &thesis);
+        assert!(
+            effect > 0.3,
+            "{name}: the restriction moves the force by {effect} N only"
+        );
+        let gap = worst_difference(&tiny, &quasi_static);
+        assert!(
+            gap < 1e-3 * effect,
+            "{name}: {gap} N from the quasi-static run (effect {effect} N)"
+        );
+        let volume_effect = worst_difference(&sizeable, &quasi_static);
+        assert!(
+            volume_effect > 0.05,
+            "{name}: 3 cm3 moves the force by {volume_effect} N only"
+        );
+    }
+}
+
+#[test]
+fn with_volumes_the_equilibrium_balances_every_flow_and_stays_put() {
+    let model = with(|p| {
+        p.supply_restriction_area = 0.25e-6;
+        p.supply_plenum_volume = 2e-6;
+        p.return_resistance = 1e8;
+        p.return_plenum_volume = 1e-6;
+        p.port_restriction_area_2 = 0.3e-6;
+        p.port_line_volume_2 = 3e-6;
+    });
+    for v in [-3.0, 1.0, 2.5, 8.0] {
+        let mut sim = Simulation::at_equilibrium(model.clone(), v, 0.06, 0.0, 1e-8).unwrap();
+        let mut pressures = [0.0; PRESSURES_WITH_VOLUMES];
+        pressures[0] = sim.state[index::P1];
+        pressures[1] = sim.state[index::P2];
+        pressures[2..].copy_from_slice(&sim.node_pressures());
+        let rates =
+            model.pressure_rates_with_volumes(&model.areas(sim.state[index::JET_POSITION]), &pressures, 0.06, 0.0);
+        // A pascal per second at most: far below a millisecond's change of 1 Pa.
+        assert!(rates.iter().all(|r| r.abs() < 1.0), "v = {v}: {rates:?}");
+        let p = &model.params;
+        let nodes = sim.node_pressures();
+        assert!(
+            nodes[node::SUPPLY] < p.p_s && nodes[node::SUPPLY] > p.p_r,
+            "v = {v}: {nodes:?}"
+        );
+        assert!(
+            nodes[node::RETURN] > p.p_r && nodes[node::RETURN] < p.p_s,
+            "v = {v}: {nodes:?}"
+        );
+        let before = sim.outputs();
+        sim.step(0.5).unwrap();
+        let after = sim.outputs();
+        assert!(
+            (after.f_act - before.f_act).abs() < 1e-6,
+            "v = {v}: {before:?} -> {after:?}"
+        );
+        assert!(worst_difference(&sim.node_pressures(), &nodes) < 1e-3, "v = {v}");
+    }
+}
+
+/// The volumes change how the pressures get there, not where they settle: the static force
+/// is the quasi-static restriction's, and a command step reaches it later.
+#[test]
+fn a_line_volume_keeps_the_static_force_and_slows_the_step() {
+    let alone = with(|p| p.port_restriction_area_1 = 0.2e-6);
+    let with_line = with(|p| {
+        p.port_restriction_area_1 = 0.2e-6;
+        p.port_line_volume_1 = 3e-6;
+    });
+    let settled = |model: &Actuator| {
+        Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-8)
+            .unwrap()
+            .outputs()
+            .f_act
+    };
+    assert!((settled(&alone) - settled(&with_line)).abs() < 1e-6);
+    let response = |model: &Actuator| {
+        let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
+        let start = sim.outputs().f_act;
+        sim.set_command(2.5).unwrap();
+        sim.step(0.01).unwrap();
+        sim.outputs().f_act - start
+    };
+    assert!(
+        response(&with_line) < 0.9 * response(&alone),
+        "{} vs {}",
+        response(&with_line),
+        response(&alone)
+    );
+}

@@ -1,0 +1,215 @@
+/*
+ * Times one build of the actuator FMU's shared library from a plain C importer, for
+ * scripts/bench_vs_commit.sh, which runs two builds through it side by side.
+ *
+ * usage: cosimulation_timer [--repeat N] [--cold] [--csv FILE] LIBRARY GUID
+ *
+ * It loads LIBRARY (a libjetpipe.so) and runs a 10 s co-simulation at 1 kHz: fmi2DoStep of
+ * 1 ms, the inputs v_DA and x_s of the standard scenario (src/scenario.rs: sampled every
+ * 10 ms and held, as fmu_tests/c/scenario_driver.c sets them), default parameters and
+ * tolerance, F_act, P1, P2, i and x_jp read after every step. A run starts with
+ * fmi2Instantiate and ends with fmi2FreeInstance. One untimed run warms the library (page
+ * faults, first-use tables) before N timed ones (--repeat, default 1); --cold skips it, for an
+ * instruction count of exactly one run under callgrind.
+ *
+ * Prints key=value lines: cpu_ms (the process's CPU time, CLOCK_PROCESS_CPUTIME_ID, of the
+ * fastest timed run), wall_ms (its wall time), and digest (64-bit FNV-1a of the bits of the
+ * five outputs at every step: two builds agree bit for bit if and only if, barring a
+ * collision, their digests are equal). --csv FILE also writes t and the five outputs after
+ * every step of the last run with 17 significant digits, for a comparison that says by how
+ * much two builds differ.
+ * Exit status 0 on success, 1 on any failure, 2 on bad usage.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <dlfcn.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "fmi2Functions.h"
+
+static const fmi2ValueReference INPUTS[2] = {1u, 2u};                  /* v_DA, x_s */
+static const fmi2ValueReference OUTPUTS[5] = {10u, 11u, 12u, 13u, 14u}; /* F_act, P1, P2, i, x_jp */
+
+#define SAMPLE 0.01
+#define SAMPLES 1000
+#define STEP 1e-3
+#define STEPS_PER_SAMPLE 10
+
+/* The standard scenario, with the floating-point expressions of scenario_driver.c. */
+static void inputs(int k, fmi2Real u[2]) {
+    const double pi = 3.14159265358979323846;
+    double t = SAMPLE * k;
+    u[0] = 2.5 + 3.0 * sin(2.0 * pi * 0.3 * t) + 0.5 * sin(2.0 * pi * 6.0 * t);
+    u[1] = 0.054 + 0.01 * sin(2.0 * pi * 0.1 * t);
+}
+
+static void logger(fmi2ComponentEnvironment env, fmi2String instanceName, fmi2Status status,
+                   fmi2String category, fmi2String message, ...) {
+    va_list args;
+    (void)env;
+    (void)category;
+    if (status < fmi2Warning) return; /* only problems: printing would be part of the timing */
+    fprintf(stderr, "[%d] %s: ", (int)status, instanceName ? instanceName : "");
+    va_start(args, message);
+    vfprintf(stderr, message, args);
+    va_end(args);
+    fprintf(stderr, "\n");
+}
+
+static fmi2InstantiateTYPE *p_Instantiate;
+static fmi2FreeInstanceTYPE *p_FreeInstance;
+static fmi2SetupExperimentTYPE *p_SetupExperiment;
+static fmi2EnterInitializationModeTYPE *p_EnterInitializationMode;
+static fmi2ExitInitializationModeTYPE *p_ExitInitializationMode;
+static fmi2TerminateTYPE *p_Terminate;
+static fmi2SetRealTYPE *p_SetReal;
+static fmi2GetRealTYPE *p_GetReal;
+static fmi2DoStepTYPE *p_DoStep;
+static fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+
+#define CHECK(call)                                                            \
+    do {                                                                       \
+        fmi2Status s_ = (call);                                                \
+        if (s_ != fmi2OK) {                                                    \
+            fprintf(stderr, "%s returned %d\n", #call, (int)s_);              \
+            exit(1);                                                           \
+        }                                                                      \
+    } while (0)
+
+static double seconds(clockid_t clock) {
+    struct timespec ts;
+    clock_gettime(clock, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static uint64_t fnv1a(uint64_t hash, double value) {
+    uint64_t bits;
+    memcpy(&bits, &value, sizeof bits);
+    for (int i = 0; i < 8; i++) {
+        hash ^= (bits >> (8 * i)) & 0xffu;
+        hash *= 0x100000001b3ull;
+    }
+    return hash;
+}
+
+/* One run of the scenario; the digest of its outputs, and each step's outputs to `csv` if set. */
+static uint64_t run(const char *guid, FILE *csv) {
+    fmi2Component c = p_Instantiate("timer", fmi2CoSimulation, guid, "", &callbacks, fmi2False, fmi2False);
+    fmi2Real u[2], y[5];
+    uint64_t digest = 0xcbf29ce484222325ull;
+    if (!c) {
+        fprintf(stderr, "fmi2Instantiate returned NULL (is %s the library's GUID?)\n", guid);
+        exit(1);
+    }
+    inputs(0, u);
+    CHECK(p_SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0));
+    CHECK(p_EnterInitializationMode(c));
+    CHECK(p_SetReal(c, INPUTS, 2, u));
+    CHECK(p_ExitInitializationMode(c));
+    for (int k = 0; k < SAMPLES; k++) {
+        inputs(k, u);
+        CHECK(p_SetReal(c, INPUTS, 2, u));
+        for (int j = 0; j < STEPS_PER_SAMPLE; j++) {
+            int n = k * STEPS_PER_SAMPLE + j;
+            CHECK(p_DoStep(c, n * STEP, STEP, fmi2True));
+            CHECK(p_GetReal(c, OUTPUTS, 5, y));
+            for (int m = 0; m < 5; m++) digest = fnv1a(digest, y[m]);
+            if (csv)
+                fprintf(csv, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", (n + 1) * STEP, y[0], y[1], y[2],
+                        y[3], y[4]);
+        }
+    }
+    CHECK(p_Terminate(c));
+    p_FreeInstance(c);
+    return digest;
+}
+
+#define RESOLVE(var, name)                                                     \
+    do {                                                                       \
+        var = (name##TYPE *)dlsym(lib, #name);                                 \
+        if (!var) {                                                            \
+            fprintf(stderr, "%s: cannot resolve %s\n", library, #name);        \
+            return 1;                                                          \
+        }                                                                      \
+    } while (0)
+
+static int usage(const char *program) {
+    fprintf(stderr, "usage: %s [--repeat N] [--cold] [--csv FILE] LIBRARY GUID\n", program);
+    return 2;
+}
+
+int main(int argc, char **argv) {
+    int repeat = 1, cold = 0, arg = 1;
+    const char *csv_path = NULL;
+    while (arg < argc && strncmp(argv[arg], "--", 2) == 0) {
+        if (strcmp(argv[arg], "--cold") == 0) {
+            cold = 1;
+            arg += 1;
+        } else if (strcmp(argv[arg], "--repeat") == 0 && arg + 1 < argc) {
+            char *end;
+            long n = strtol(argv[arg + 1], &end, 10);
+            if (*end != '\0' || n < 1 || n > 1000) {
+                fprintf(stderr, "--repeat %s: expected an integer from 1 to 1000\n", argv[arg + 1]);
+                return 2;
+            }
+            repeat = (int)n;
+            arg += 2;
+        } else if (strcmp(argv[arg], "--csv") == 0 && arg + 1 < argc) {
+            csv_path = argv[arg + 1];
+            arg += 2;
+        } else {
+            return usage(argv[0]);
+        }
+    }
+    if (argc - arg != 2) return usage(argv[0]);
+    const char *library = argv[arg], *guid = argv[arg + 1];
+    void *lib = dlopen(library, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        fprintf(stderr, "cannot load %s: %s\n", library, dlerror());
+        return 1;
+    }
+    RESOLVE(p_Instantiate, fmi2Instantiate);
+    RESOLVE(p_FreeInstance, fmi2FreeInstance);
+    RESOLVE(p_SetupExperiment, fmi2SetupExperiment);
+    RESOLVE(p_EnterInitializationMode, fmi2EnterInitializationMode);
+    RESOLVE(p_ExitInitializationMode, fmi2ExitInitializationMode);
+    RESOLVE(p_Terminate, fmi2Terminate);
+    RESOLVE(p_SetReal, fmi2SetReal);
+    RESOLVE(p_GetReal, fmi2GetReal);
+    RESOLVE(p_DoStep, fmi2DoStep);
+
+    FILE *csv = NULL;
+    if (csv_path) {
+        csv = fopen(csv_path, "w");
+        if (!csv) {
+            fprintf(stderr, "cannot write %s\n", csv_path);
+            return 1;
+        }
+        fprintf(csv, "t,F_act,P1,P2,i,x_jp\n");
+    }
+    uint64_t first = cold ? 0 : run(guid, NULL), digest = 0;
+    double best_cpu = INFINITY, best_wall = INFINITY;
+    for (int r = 0; r < repeat; r++) {
+        double cpu0 = seconds(CLOCK_PROCESS_CPUTIME_ID), wall0 = seconds(CLOCK_MONOTONIC);
+        digest = run(guid, r == repeat - 1 ? csv : NULL);
+        double cpu = seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0, wall = seconds(CLOCK_MONOTONIC) - wall0;
+        if (cpu < best_cpu) {
+            best_cpu = cpu;
+            best_wall = wall;
+        }
+        if (!cold && digest != first) {
+            fprintf(stderr, "two runs of the same scenario differ: digests %016llx and %016llx\n",
+                    (unsigned long long)first, (unsigned long long)digest);
+            return 1;
+        }
+    }
+    if (csv) fclose(csv);
+    printf("cpu_ms=%.4f\nwall_ms=%.4f\ndigest=%016llx\n", 1e3 * best_cpu, 1e3 * best_wall,
+           (unsigned long long)digest);
+    return 0;
+}
