@@ -3,7 +3,6 @@
 
 use super::*;
 
-
 /// Length of the bench protocol (s).
 pub const PROTOCOL_DURATION: f64 = 80.0;
 /// Stopper position outside segment E (m).

@@ -9,21 +9,26 @@
 //!
 //!
 //! The effects and their forms are in [`mechanisms`]; the plant in `plant.rs`; the bench
-//! protocol and quantisation in [`bench_protocol`].
+//! protocol and quantisation in [`bench_protocol`]; other protocols (staircases, multisines,
+//! PRBS, sines, ramps, force tracking; stopper motion; 250 Hz–2 kHz) in [`protocols`].
 
 use std::f64::consts::PI;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
+pub mod bench_protocol;
 pub mod mechanisms;
 mod plant;
-pub mod bench_protocol;
+pub mod protocols;
 
+pub use bench_protocol::{protocol_command, protocol_stopper, quantise_da, PROTOCOL_DURATION, STOPPER_HOME};
+use bench_protocol::{quantise_force, quantise_pressure, quantise_stopper};
 pub use mechanisms::*;
 pub use plant::BenchParams;
 use plant::*;
-pub use bench_protocol::{protocol_command, protocol_stopper, quantise_da, PROTOCOL_DURATION, STOPPER_HOME};
-use bench_protocol::{quantise_force, quantise_pressure, quantise_stopper};
+pub use protocols::{
+    command_signal, generate_protocol, stopper_signal, CommandProtocol, ProtocolRecording, ProtocolSpec, StopperMotion,
+};
 
 // ---------------------------------------------------------------------------------------------
 // Noise: splitmix64-seeded xorshift64* with Box–Muller
@@ -129,7 +134,14 @@ where
     C: Fn(f64) -> f64,
     S: Fn(f64) -> (f64, f64),
 {
-    run(params, effects, CommandSource::Open(&command), &stopper, n_samples, opts)
+    run(
+        params,
+        effects,
+        CommandSource::Open(&command),
+        &stopper,
+        n_samples,
+        opts,
+    )
 }
 
 /// Run a recording of `n_samples` rows at the options' sampling period, its command from
@@ -155,7 +167,9 @@ pub fn run(
         "sample_period = {sample} s is not a whole number of the {H} s integration steps"
     );
     let mut cmds: Vec<f64> = match &mut command {
-        CommandSource::Open(f) => (0..n_samples.max(1)).map(|k| quantise_da(f(k as f64 * sample))).collect(),
+        CommandSource::Open(f) => (0..n_samples.max(1))
+            .map(|k| quantise_da(f(k as f64 * sample)))
+            .collect(),
         CommandSource::Closed(controller) => vec![quantise_da(controller(0.0, None))],
     };
     let delay = effects.command_delay.max(0.0);

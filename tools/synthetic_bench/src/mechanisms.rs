@@ -106,7 +106,6 @@
 //!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 
-
 /// Effects beyond the thesis model. `Default` switches every effect off.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchEffects {

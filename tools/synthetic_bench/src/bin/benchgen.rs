@@ -1,5 +1,6 @@
-//! `benchgen`: write a synthetic bench recording (protocol of `bench/README.md`) from the
-//! independent simulator of the `synthetic_bench` library, with chosen effects beyond the thesis model.
+//! `benchgen`: write a synthetic bench recording (the protocol of `bench/README.md`, or another
+//! with `--protocol`) from the independent simulator of the `synthetic_bench` library, with
+//! chosen effects beyond the thesis model.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -7,7 +8,8 @@ use std::time::Instant;
 
 use clap::Parser;
 use synthetic_bench::{
-    generate, undeclared_mechanism, write_csv, BenchEffects, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
+    generate, generate_protocol, undeclared_mechanism, write_csv, BenchEffects, CommandProtocol, ProtocolSpec,
+    StopperMotion, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
 };
 
 #[derive(Parser)]
@@ -22,9 +24,30 @@ struct Cli {
     /// Seed of the sensor noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Length of the recording, s (at most 80: the protocol is truncated).
+    /// Length of the recording, s: with the bench protocol at most 80 (it is truncated), with
+    /// --protocol 20–120.
     #[arg(long, default_value_t = PROTOCOL_DURATION)]
     duration: f64,
+    /// Another protocol than the bench's: staircase, multisine, prbs, sine, ramps or
+    /// force_tracking (a PI controller on the logged force).
+    #[arg(long)]
+    protocol: Option<String>,
+    /// With --protocol: the stopper's motion, `fixed:X` (m), `sine:CENTRE:AMPLITUDE:HZ` (m, m,
+    /// Hz) or `moves:SPEED` (m/s, between random positions).
+    #[arg(long, default_value = "fixed:0.054")]
+    stopper: String,
+    /// With --protocol: sampling rate, Hz (250–2000, a whole number of 20 µs steps a sample).
+    #[arg(long, default_value_t = 1000.0)]
+    sample_rate: f64,
+    /// With --protocol: RMS noise of the force sensor, N.
+    #[arg(long, default_value_t = 0.05)]
+    force_noise: f64,
+    /// With --protocol: RMS noise of each pressure transducer, Pa.
+    #[arg(long, default_value_t = 150.0)]
+    pressure_noise: f64,
+    /// With --protocol: write no pressure columns.
+    #[arg(long)]
+    no_pressures: bool,
     /// jet_pipe_hysteresis: full branch separation of the static jet pipe position, m (e.g. 0.16e-3).
     #[arg(long, default_value_t = 0.0)]
     hysteresis_width: f64,
@@ -224,6 +247,35 @@ fn main() -> ExitCode {
         eprintln!("benchgen: effect parameters must be finite and non-negative (heat transfer ≤ 1)");
         return ExitCode::from(2);
     }
+    if let Some(name) = cli.protocol.as_deref() {
+        let spec = match protocol_spec(&cli, name) {
+            Ok(spec) => spec,
+            Err(e) => {
+                eprintln!("benchgen: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        let start = Instant::now();
+        let recording = match generate_protocol(&spec, &effects) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("benchgen: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        if let Err(e) = recording.write_csv(&cli.out) {
+            eprintln!("benchgen: cannot write {}: {e}", cli.out.display());
+            return ExitCode::FAILURE;
+        }
+        eprintln!(
+            "benchgen: {} rows of {} to {} in {:.2} s ({effects:?})",
+            recording.rows.len(),
+            spec.label(),
+            cli.out.display(),
+            start.elapsed().as_secs_f64()
+        );
+        return ExitCode::SUCCESS;
+    }
     let start = Instant::now();
     let rows = generate(&effects, cli.seed, cli.duration);
     let elapsed = start.elapsed().as_secs_f64();
@@ -237,4 +289,44 @@ fn main() -> ExitCode {
         cli.out.display()
     );
     ExitCode::SUCCESS
+}
+
+/// The protocol of `--protocol` and the options that go with it.
+fn protocol_spec(cli: &Cli, name: &str) -> Result<ProtocolSpec, String> {
+    let number = |field: &str, text: &str| -> Result<f64, String> {
+        text.parse::<f64>()
+            .map_err(|_| format!("--stopper: {field} = {text:?} is not a number"))
+    };
+    let parts: Vec<&str> = cli.stopper.split(':').collect();
+    let stopper = match parts.as_slice() {
+        ["fixed", x] => StopperMotion::Fixed {
+            position: number("position", x)?,
+        },
+        ["sine", c, a, f] => StopperMotion::Sine {
+            centre: number("centre", c)?,
+            amplitude: number("amplitude", a)?,
+            frequency: number("frequency", f)?,
+        },
+        ["moves", v] => StopperMotion::Moves {
+            speed: number("speed", v)?,
+        },
+        _ => {
+            return Err(format!(
+                "--stopper {:?} is not fixed:X, sine:CENTRE:AMPLITUDE:HZ or moves:SPEED",
+                cli.stopper
+            ))
+        }
+    };
+    let spec = ProtocolSpec {
+        command: CommandProtocol::from_name(name)?,
+        stopper,
+        sample_rate: cli.sample_rate,
+        duration: cli.duration,
+        force_noise: cli.force_noise,
+        pressure_noise: cli.pressure_noise,
+        pressures: !cli.no_pressures,
+        seed: cli.seed,
+    };
+    spec.check()?;
+    Ok(spec)
 }
