@@ -22,6 +22,7 @@ pub mod calibrate;
 pub mod checks;
 pub mod corrections;
 mod discover;
+pub mod lines;
 mod localize;
 mod named;
 pub mod noise;
@@ -493,9 +494,12 @@ impl<'a> Context<'a> {
     ) -> Self {
         let training = training_mask(&recording.time);
         let n = recording.len();
-        let noise = noise::noise_floor(&recording.force);
+        // A sharp line (a pick-up) is a departure to find, not noise.
+        let sample_rate = (n - 1) as f64 / (recording.time[n - 1] - recording.time[0]).max(1e-12);
+        let floor = |x: &[f64]| noise::noise_floor(&lines::without_lines(x, sample_rate, 3));
+        let noise = floor(&recording.force);
         let pressure_noise = match (&recording.p1, &recording.p2) {
-            (Some(a), Some(b)) => Some([noise::noise_floor(a), noise::noise_floor(b)]),
+            (Some(a), Some(b)) => Some([floor(a), floor(b)]),
             _ => None,
         };
         if let Some(q) = noise::quantisation_step(&recording.force) {

@@ -27,7 +27,8 @@ pub use mechanisms::*;
 pub use plant::BenchParams;
 use plant::*;
 pub use protocols::{
-    command_signal, generate_protocol, stopper_signal, CommandProtocol, ProtocolRecording, ProtocolSpec, StopperMotion,
+    command_signal, generate_protocol, generate_protocol_with, stopper_signal, CommandProtocol, ProtocolRecording,
+    ProtocolSpec, StopperMotion,
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -282,6 +283,12 @@ pub fn run(
             f_true = yp;
         }
         let mut f = effects.force_sensor_gain * f_true + effects.force_sensor_offset;
+        if und.force_sensor_saturation > 0.0 {
+            f = f.clamp(-und.force_sensor_saturation, und.force_sensor_saturation);
+        }
+        if und.force_sensor_pickup_amplitude != 0.0 {
+            f += und.force_sensor_pickup_amplitude * (2.0 * PI * und.force_sensor_pickup_frequency * t + 1.0).sin();
+        }
         let (mut p1, mut p2) = (y[S_P1], y[S_P2]);
         if und.pressure_sensor_offset_1 != 0.0 {
             p1 += und.pressure_sensor_offset_1;

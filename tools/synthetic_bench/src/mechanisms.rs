@@ -181,6 +181,17 @@ pub struct UndeclaredEffects {
     /// `valve`/`restriction`: C_d·A (m²) of an orifice between receiver port 1 and chamber 1,
     /// with a line volume on the receiver side; 0 = none.
     pub port_1_restriction: f64,
+    /// `force_sensor`/`periodic`: amplitude (N) of a pick-up on the force reading,
+    /// a sin(2π f t + 1 rad) (mains hum on the bridge amplifier); 0 = none.
+    pub force_sensor_pickup_amplitude: f64,
+    /// Its frequency f (Hz).
+    pub force_sensor_pickup_frequency: f64,
+    /// `command`/`nonlinearity`: half width (V) of a dead zone in the D/A output the current
+    /// driver sees: 0 within ±d, v ∓ d outside; 0 = none.
+    pub command_dead_zone: f64,
+    /// `force_sensor`/`limit`: the force reading saturates at ± this (N), after gain and
+    /// offset, before noise and quantisation; 0 = none.
+    pub force_sensor_saturation: f64,
 }
 
 impl Default for BenchEffects {

@@ -264,6 +264,12 @@ impl Model {
     /// Command as the current driver sees it (after the undeclared D/A limit).
     #[inline]
     pub(crate) fn driver_input(&self, v: f64) -> f64 {
+        let d = self.e.undeclared.command_dead_zone;
+        let v = if d > 0.0 {
+            v.signum() * (v.abs() - d).max(0.0)
+        } else {
+            v
+        };
         if self.cmd_limit {
             let l = self.e.undeclared.command_limit;
             v.clamp(-l, l)

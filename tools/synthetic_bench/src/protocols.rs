@@ -365,6 +365,15 @@ pub fn stopper_signal(motion: StopperMotion, seed: u64, duration: f64) -> Box<dy
 
 /// A recording of `effects` under the protocol `spec` (checked first).
 pub fn generate_protocol(spec: &ProtocolSpec, effects: &BenchEffects) -> Result<ProtocolRecording, String> {
+    generate_protocol_with(&BenchParams::default(), spec, effects)
+}
+
+/// [`generate_protocol`] for a plant whose thesis constants are `params` (a supply set low).
+pub fn generate_protocol_with(
+    params: &BenchParams,
+    spec: &ProtocolSpec,
+    effects: &BenchEffects,
+) -> Result<ProtocolRecording, String> {
     spec.check()?;
     let stopper = stopper_signal(spec.stopper, spec.seed, spec.duration);
     let opts = RunOptions {
@@ -375,7 +384,6 @@ pub fn generate_protocol(spec: &ProtocolSpec, effects: &BenchEffects) -> Result<
         ..RunOptions::default()
     };
     let n = (spec.duration * spec.sample_rate).round() as usize;
-    let params = BenchParams::default();
     if spec.command == CommandProtocol::ForceTracking {
         let levels = random_levels(&mut choices(spec.seed, 3), spec.duration, (5.0, 80.0), (1.0, 4.0));
         let reference: Vec<f64> = (0..n).map(|k| level_at(&levels, k as f64 / spec.sample_rate)).collect();
@@ -395,7 +403,7 @@ pub fn generate_protocol(spec: &ProtocolSpec, effects: &BenchEffects) -> Result<
             (integral + kp * error).clamp(-10.0, 10.0)
         };
         let rows = run(
-            &params,
+            params,
             effects,
             CommandSource::Closed(&mut controller),
             &*stopper,
@@ -409,7 +417,7 @@ pub fn generate_protocol(spec: &ProtocolSpec, effects: &BenchEffects) -> Result<
         });
     }
     let command = command_signal(spec.command, spec.seed, spec.duration)?;
-    let rows = run(&params, effects, CommandSource::Open(&*command), &*stopper, n, &opts);
+    let rows = run(params, effects, CommandSource::Open(&*command), &*stopper, n, &opts);
     Ok(ProtocolRecording {
         rows,
         pressures: spec.pressures,

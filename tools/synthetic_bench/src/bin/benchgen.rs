@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use clap::Parser;
 use synthetic_bench::{
-    generate, generate_protocol, undeclared_mechanism, write_csv, BenchEffects, CommandProtocol, ProtocolSpec,
-    StopperMotion, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
+    generate, generate_protocol_with, undeclared_mechanism, write_csv, BenchEffects, BenchParams, CommandProtocol,
+    ProtocolSpec, StopperMotion, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
 };
 
 #[derive(Parser)]
@@ -136,6 +136,21 @@ struct Cli {
     /// port_1_restriction: C_d·A of an orifice between receiver port 1 and chamber 1, m² (e.g. 2e-7).
     #[arg(long)]
     port_1_restriction: Option<f64>,
+    /// A pick-up on the force reading, a sin(2π f t + 1 rad): its amplitude, N (e.g. 0.1).
+    #[arg(long)]
+    force_sensor_pickup_amplitude: Option<f64>,
+    /// Its frequency, Hz (e.g. 50).
+    #[arg(long)]
+    force_sensor_pickup_frequency: Option<f64>,
+    /// A dead zone in the D/A output the current driver sees: its half width, V (e.g. 0.4).
+    #[arg(long)]
+    command_dead_zone: Option<f64>,
+    /// The force reading saturates at ± this, N (e.g. 85).
+    #[arg(long)]
+    force_sensor_saturation: Option<f64>,
+    /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
+    #[arg(long)]
+    supply_pressure: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -180,6 +195,16 @@ fn main() -> ExitCode {
     set(&mut und.jet_pipe_curve_blend, cli.jet_pipe_curve_blend);
     set(&mut und.return_area_reduction, cli.return_area_reduction);
     set(&mut und.port_1_restriction, cli.port_1_restriction);
+    set(
+        &mut und.force_sensor_pickup_amplitude,
+        cli.force_sensor_pickup_amplitude,
+    );
+    set(
+        &mut und.force_sensor_pickup_frequency,
+        cli.force_sensor_pickup_frequency,
+    );
+    set(&mut und.command_dead_zone, cli.command_dead_zone);
+    set(&mut und.force_sensor_saturation, cli.force_sensor_saturation);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -194,6 +219,9 @@ fn main() -> ExitCode {
         und.jet_pipe_curve_blend,
         und.return_area_reduction,
         und.port_1_restriction,
+        und.force_sensor_pickup_frequency,
+        und.command_dead_zone,
+        und.force_sensor_saturation,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -203,6 +231,7 @@ fn main() -> ExitCode {
             und.supply_ripple_amplitude,
             und.return_back_pressure,
             und.receiver_offset,
+            und.force_sensor_pickup_amplitude,
         ]
         .iter()
         .all(|x| x.is_finite());
@@ -256,7 +285,18 @@ fn main() -> ExitCode {
             }
         };
         let start = Instant::now();
-        let recording = match generate_protocol(&spec, &effects) {
+        let mut params = BenchParams::default();
+        if let Some(p) = cli.supply_pressure {
+            if !(p > params.p_return && p.is_finite()) {
+                eprintln!(
+                    "benchgen: --supply-pressure = {p} Pa must exceed the return pressure {} Pa",
+                    params.p_return
+                );
+                return ExitCode::from(2);
+            }
+            params.p_supply = p;
+        }
+        let recording = match generate_protocol_with(&params, &spec, &effects) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("benchgen: {e}");

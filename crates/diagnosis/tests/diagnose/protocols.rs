@@ -1,0 +1,130 @@
+//! `jetpipe diagnose` on recordings made under other protocols than the bench's
+//! (`synthetic_bench::protocols`): each general discovery piece on at least two protocols,
+//! and at two sampling rates where the rate matters. The truths are the synthetic bench's,
+//! written by its own integrator.
+
+use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_model::physics::parameters::Parameters;
+use synthetic_bench::{
+    generate_protocol, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
+};
+
+use super::{names, value_reference};
+
+/// The recording of `effects` under `spec`, through the CSV file the generator writes.
+fn recorded(label: &str, spec: &ProtocolSpec, effects: &BenchEffects) -> Recording {
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{label}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("recording.csv");
+    generate_protocol(spec, effects).unwrap().write_csv(&path).unwrap();
+    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    recording
+}
+
+fn diagnosed(label: &str, spec: &ProtocolSpec, effects: &BenchEffects) -> Diagnosis {
+    let recording = recorded(label, spec, effects);
+    let started = std::time::Instant::now();
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    println!(
+        "{label} ({}): {} in {:.1} s; {}",
+        spec.label(),
+        d.verdict(),
+        started.elapsed().as_secs_f64(),
+        d.summary().join(" | ")
+    );
+    d
+}
+
+fn pickup(amplitude: f64, frequency: f64) -> BenchEffects {
+    BenchEffects {
+        undeclared: UndeclaredEffects {
+            force_sensor_pickup_amplitude: amplitude,
+            force_sensor_pickup_frequency: frequency,
+            ..UndeclaredEffects::default()
+        },
+        ..BenchEffects::default()
+    }
+}
+
+/// A pick-up of `amplitude` N at `frequency` Hz on the force, a sin(2π f t + 1): discovered
+/// at the force sensor as periodic, its frequency within 0.05 % and its amplitude within
+/// 10 %, the force explained, nothing named.
+fn pickup_found(label: &str, spec: &ProtocolSpec, amplitude: f64, frequency: f64) {
+    let d = diagnosed(label, spec, &pickup(amplitude, frequency));
+    assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
+    let found = d
+        .discovered
+        .first()
+        .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
+    assert_eq!(
+        (found.location, found.family),
+        ("force_sensor", "periodic"),
+        "{}",
+        found.reading
+    );
+    let get = |name: &str| d.parameters.get(value_reference(name)).unwrap();
+    let fitted_hz = get("force_sensor_ripple_frequency");
+    assert!(
+        (fitted_hz - frequency).abs() < 5e-4 * frequency,
+        "{label}: {fitted_hz} Hz"
+    );
+    // a sin(ωt + 1) = a cos 1 sin ωt + a sin 1 cos ωt
+    let (sine, cosine) = (get("force_sensor_ripple_sine"), get("force_sensor_ripple_cosine"));
+    let fitted_amplitude = sine.hypot(cosine);
+    assert!(
+        (fitted_amplitude - amplitude).abs() < 0.1 * amplitude,
+        "{label}: amplitude {fitted_amplitude}"
+    );
+    assert!(
+        (cosine.atan2(sine) - 1.0).abs() < 0.1,
+        "{label}: phase {}",
+        cosine.atan2(sine)
+    );
+    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
+}
+
+#[test]
+fn a_fifty_hertz_pickup_under_a_multisine_at_one_kilohertz_without_pressures_is_discovered() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Multisine,
+        sample_rate: 1000.0,
+        duration: 40.0,
+        pressures: false,
+        seed: 3,
+        ..ProtocolSpec::default()
+    };
+    pickup_found("pickup-multisine", &spec, 0.2, 50.0);
+}
+
+#[test]
+fn a_fifty_hertz_pickup_under_a_prbs_at_two_kilohertz_with_a_shaken_stopper_is_discovered() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Prbs,
+        stopper: StopperMotion::Sine {
+            centre: 0.054,
+            amplitude: 0.004,
+            frequency: 2.5,
+        },
+        sample_rate: 2000.0,
+        duration: 30.0,
+        force_noise: 0.03,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    pickup_found("pickup-prbs", &spec, 0.2, 50.0);
+}
+
+#[test]
+fn a_sixty_hertz_pickup_under_a_staircase_at_250_hertz_is_discovered() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Staircase,
+        sample_rate: 250.0,
+        duration: 60.0,
+        force_noise: 0.08,
+        seed: 8,
+        ..ProtocolSpec::default()
+    };
+    pickup_found("pickup-staircase", &spec, 0.3, 60.0);
+}
