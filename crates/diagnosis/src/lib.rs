@@ -18,6 +18,7 @@
 //! The recordings themselves are [`recording`]; [`replay`](mod@replay) runs their inputs
 //! through the model (crate `jetpipe-model`).
 
+mod alternatives;
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;

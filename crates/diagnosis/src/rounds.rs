@@ -85,6 +85,24 @@ pub(crate) fn run_rounds(
         } else {
             None
         };
+        // A named effect is a hypothesis, not a lock: a simpler term at its place that does
+        // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
+        // not a line resistance).
+        let added = match added {
+            Some(Addition::Named(s, sentence)) => {
+                let check = alternatives::Check {
+                    cx,
+                    problem: &problem,
+                    count: r.count,
+                    force_before: r.force_before,
+                };
+                match alternatives::simpler_than_named(&check, &found, &f.params, &s, replays, progress)? {
+                    Some((term, trial)) => Some(Addition::Discovered(term, Box::new(trial))),
+                    None => Some(Addition::Named(s, sentence)),
+                }
+            }
+            other => other,
+        };
         match added {
             Some(Addition::Discovered(term, trial)) => {
                 f.discovered.push(term);

@@ -128,3 +128,64 @@ fn a_sixty_hertz_pickup_under_a_staircase_at_250_hertz_is_discovered() {
     };
     pickup_found("pickup-staircase", &spec, 0.3, 60.0);
 }
+
+/// The supply 30 kPa below the thesis's: the plain supply pressure discovered (within
+/// 2 kPa of the truth), not the named line resistance, and the force explained.
+fn supply_set_low_found(label: &str, spec: &ProtocolSpec) {
+    let truth = synthetic_bench::BenchParams::default().p_supply - 30e3;
+    let params = synthetic_bench::BenchParams {
+        p_supply: truth,
+        ..synthetic_bench::BenchParams::default()
+    };
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{label}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("recording.csv");
+    synthetic_bench::generate_protocol_with(&params, spec, &BenchEffects::default())
+        .unwrap()
+        .write_csv(&path)
+        .unwrap();
+    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    println!(
+        "{label} ({}): {}; {}",
+        spec.label(),
+        d.verdict(),
+        d.summary().join(" | ")
+    );
+    assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
+    let found = d.discovered.first().expect("a discovered term");
+    assert_eq!(
+        (found.location, found.family),
+        ("supply", "parameter_offset"),
+        "{}",
+        found.reading
+    );
+    let p_s = d.parameters.get(value_reference("P_s")).unwrap();
+    assert!((p_s - truth).abs() < 2e3, "{label}: P_s = {p_s}, truth {truth}");
+    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
+}
+
+#[test]
+fn a_supply_set_low_under_a_staircase_with_pressures_is_its_plain_pressure_not_a_line_resistance() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Staircase,
+        duration: 60.0,
+        seed: 6,
+        ..ProtocolSpec::default()
+    };
+    supply_set_low_found("supply-low-staircase", &spec);
+}
+
+#[test]
+fn a_supply_set_low_under_ramps_at_500_hertz_without_pressures_is_its_plain_pressure() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Ramps,
+        sample_rate: 500.0,
+        duration: 40.0,
+        pressures: false,
+        seed: 9,
+        ..ProtocolSpec::default()
+    };
+    supply_set_low_found("supply-low-ramps", &spec);
+}
