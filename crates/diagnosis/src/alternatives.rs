@@ -1,6 +1,6 @@
 //! A search that does not lock in: after a named effect has earned its name at a place, the
-//! simpler terms at that place are tried again in the replayed model, and one that does at
-//! least as well on the held-out blocks (its parameters' penalty counted) replaces it. A
+//! simpler terms at that place are tried again in the replayed model, and one that does
+//! better on the held-out blocks (its parameters' penalty counted) replaces it. A
 //! supply pressure set 30 kPa low is explained by the line resistance of the named
 //! `supply_pressure_drop` to within 10 noise floors, and by a plain `P_s` to the noise.
 
@@ -19,7 +19,7 @@ pub(crate) struct Check<'a> {
 impl Check<'_> {
     /// The model with `params` replayed: its held-out misfit (all channels, in noise floors
     /// squared) and its held-out force RMS error.
-    fn judge(&self, params: &Parameters, replays: &mut usize) -> Result<(f64, f64, Replay), String> {
+    fn judge(&self, params: &Parameters, replays: &mut usize) -> Result<(f64, f64), String> {
         let with = replay_fast(&Actuator::new(params.clone())?, self.cx.recording, self.cx.n)?;
         *replays += 1;
         let (_, heldout) = self
@@ -30,7 +30,7 @@ impl Check<'_> {
             &self.cx.training,
             false,
         );
-        Ok((heldout.iter().sum(), force, with))
+        Ok((heldout.iter().sum(), force))
     }
 }
 
@@ -65,7 +65,7 @@ pub(crate) fn simpler_than_named(
     if apply_named(&mut with_named, named).is_err() {
         return Ok(None);
     }
-    let (named_misfit, named_force, _) = check.judge(&with_named, replays)?;
+    let (named_misfit, named_force) = check.judge(&with_named, replays)?;
     let named_score = named_misfit + named_terms * penalty;
     for s in alternatives.into_iter().take(DISCOVERY_TRIALS) {
         let candidate = &s.fit.candidate;
@@ -76,7 +76,7 @@ pub(crate) fn simpler_than_named(
         if set.iter().any(|(n, v)| set_parameter(&mut trial, n, *v).is_err()) || trial.validate().is_err() {
             continue;
         }
-        let (misfit, force, _) = check.judge(&trial, replays)?;
+        let (misfit, force) = check.judge(&trial, replays)?;
         let score = misfit + used_terms(s) * penalty;
         progress(&format!(
             "  instead of {name}: {} leaves {misfit:.0} held out against its {named_misfit:.0} (noise floors squared), force {force:.4} against {named_force:.4} N",

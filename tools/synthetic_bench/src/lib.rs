@@ -410,6 +410,7 @@ mod tests {
             noise_seed: None,
             quantise: false,
             pre_time: 6.0,
+            ..RunOptions::default()
         }
     }
 
@@ -889,7 +890,7 @@ mod tests {
         let opts = RunOptions {
             noise_seed: None,
             quantise: false,
-            pre_time: RunOptions::default().pre_time,
+            ..RunOptions::default()
         };
         simulate(&BenchParams::default(), e, protocol_command, protocol_stopper, n, &opts)
     }

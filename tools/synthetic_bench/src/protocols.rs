@@ -224,7 +224,7 @@ impl ProtocolRecording {
 /// The random choices of one part of a protocol (`part`: 1 the command, 2 the stopper, 3 the
 /// tracked reference), each a stream apart from the others and from the sensor noise's.
 fn choices(seed: u64, part: u64) -> Rng {
-    Rng::new(seed ^ 0x5EED_0F_9207_0C01u64.wrapping_mul(part))
+    Rng::new(seed ^ 0x005E_ED0F_9207_0C01_u64.wrapping_mul(part))
 }
 
 /// Piecewise-constant levels: (start time, level), the first at 0.

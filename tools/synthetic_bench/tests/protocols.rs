@@ -152,7 +152,7 @@ fn stopper_moves_reach_their_peak_speed_and_stay_inside_the_cylinder() {
 #[test]
 fn the_protocol_checks_name_the_field_its_value_and_the_limit() {
     let refused = |spec: ProtocolSpec, words: &[&str]| {
-        let err = spec.check().err().expect("refused");
+        let err = spec.check().expect_err("refused");
         for w in words {
             assert!(err.contains(w), "{err:?} lacks {w:?}");
         }

@@ -189,3 +189,42 @@ fn a_supply_set_low_under_ramps_at_500_hertz_without_pressures_is_its_plain_pres
     };
     supply_set_low_found("supply-low-ramps", &spec);
 }
+
+#[test]
+fn clean_recordings_under_three_other_protocols_get_nothing() {
+    let specs = [
+        ProtocolSpec {
+            command: CommandProtocol::ForceTracking,
+            sample_rate: 500.0,
+            duration: 30.0,
+            force_noise: 0.08,
+            seed: 5,
+            ..ProtocolSpec::default()
+        },
+        ProtocolSpec {
+            command: CommandProtocol::Multisine,
+            stopper: StopperMotion::Moves { speed: 0.02 },
+            duration: 30.0,
+            pressures: false,
+            seed: 5,
+            ..ProtocolSpec::default()
+        },
+        ProtocolSpec {
+            command: CommandProtocol::Sine,
+            sample_rate: 250.0,
+            duration: 30.0,
+            seed: 5,
+            ..ProtocolSpec::default()
+        },
+    ];
+    for (k, spec) in specs.iter().enumerate() {
+        let d = diagnosed(&format!("clean-{k}"), spec, &BenchEffects::default());
+        assert!(
+            d.effects.is_empty() && d.discovered.is_empty(),
+            "{}: {}",
+            spec.label(),
+            d.summary().join(" | ")
+        );
+        assert_eq!(d.verdict(), "explained", "{}: {}", spec.label(), d.summary()[0]);
+    }
+}
