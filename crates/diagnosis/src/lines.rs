@@ -85,14 +85,26 @@ fn power_at(x: &[f64], f: f64, sample_rate: f64) -> f64 {
 }
 
 /// The most prominent line of `residual` (sampled at `sample_rate`, Hz) between two cycles
-/// over the recording and the Nyquist frequency, at a frequency where none of `inputs`
-/// carries a line; `None` when no bin stands [`LINE_PROMINENCE`] above its neighbourhood.
-pub fn strongest_line(residual: &[f64], sample_rate: f64, inputs: &[&[f64]]) -> Option<Line> {
-    strongest_line_above(residual, sample_rate, inputs, 0.0)
+/// over the recording and the Nyquist frequency; `None` when no bin stands
+/// [`LINE_PROMINENCE`] above its neighbourhood. A line that one of `inputs` carries is
+/// skipped when `response` (the model's output whose residual this is; empty for none)
+/// carries it too at a tenth of the residual's amplitude or more: a departure in how the
+/// plant answers an input line changes that answer by a fraction of it. A residual line ten
+/// times the model's own answer is no such departure: under force tracking the controller
+/// feeds a sensor's pick-up back into the command, and the plant's few hertz of bandwidth
+/// all but remove it from the force.
+pub fn strongest_line(residual: &[f64], sample_rate: f64, inputs: &[&[f64]], response: &[f64]) -> Option<Line> {
+    strongest_line_above(residual, sample_rate, inputs, response, 0.0)
 }
 
 /// [`strongest_line`] at `from_hz` or above.
-pub fn strongest_line_above(residual: &[f64], sample_rate: f64, inputs: &[&[f64]], from_hz: f64) -> Option<Line> {
+pub fn strongest_line_above(
+    residual: &[f64],
+    sample_rate: f64,
+    inputs: &[&[f64]],
+    response: &[f64],
+    from_hz: f64,
+) -> Option<Line> {
     let n = residual.len();
     if n < 4 * NEIGHBOURHOOD {
         return None;
@@ -103,6 +115,8 @@ pub fn strongest_line_above(residual: &[f64], sample_rate: f64, inputs: &[&[f64]
         "the inputs and the residual differ in length"
     );
     let input_power: Vec<Vec<f64>> = inputs.iter().map(|x| hann_power(x)).collect();
+    let response_power = (response.len() == n).then(|| hann_power(response));
+    let answered_by_the_model = |k: usize| response_power.as_ref().map_or(true, |r| r[k] >= 0.01 * power[k]);
     let bin_hz = sample_rate / n as f64;
     let lowest = ((from_hz / bin_hz).ceil() as usize).max(2);
     let carried_by_inputs = |k: usize| {
@@ -114,7 +128,7 @@ pub fn strongest_line_above(residual: &[f64], sample_rate: f64, inputs: &[&[f64]
         .filter(|&k| is_local_peak(&power, k))
         .map(|k| (k, prominence(&power, k)))
         .filter(|&(_, p)| p > LINE_PROMINENCE)
-        .filter(|&(k, _)| !carried_by_inputs(k))
+        .filter(|&(k, _)| !(carried_by_inputs(k) && answered_by_the_model(k)))
         .max_by(|a, b| (power[a.0]).total_cmp(&power[b.0]))?;
     // Gaussian interpolation on the log powers of the peak and its neighbours.
     let (a, b, c) = (power[k - 1].ln(), power[k].ln(), power[k + 1].ln());
@@ -155,7 +169,7 @@ pub fn strongest_line_above(residual: &[f64], sample_rate: f64, inputs: &[&[f64]
 pub fn without_lines(x: &[f64], sample_rate: f64, max_lines: usize) -> Vec<f64> {
     let mut out = x.to_vec();
     for _ in 0..max_lines {
-        let Some(line) = strongest_line_above(&out, sample_rate, &[], sample_rate / 50.0) else {
+        let Some(line) = strongest_line_above(&out, sample_rate, &[], &[], sample_rate / 50.0) else {
             break;
         };
         let w = 2.0 * std::f64::consts::PI * line.hz / sample_rate;
@@ -211,7 +225,7 @@ mod tests {
                 .enumerate()
                 .map(|(k, e)| e + 0.1 * (2.0 * PI * hz * k as f64 / rate + 0.4).sin())
                 .collect();
-            let line = strongest_line(&x, rate, &[]).expect("a line");
+            let line = strongest_line(&x, rate, &[], &[]).expect("a line");
             assert!(
                 (line.hz - hz).abs() < 1e-3 * hz,
                 "{} Hz against {hz} at {rate} Hz",
@@ -257,14 +271,14 @@ mod tests {
             .enumerate()
             .map(|(k, e)| e + 0.2 * (2.0 * PI * 231.3 * k as f64 / rate).cos())
             .collect();
-        let line = strongest_line(&x, rate, &[]).expect("a line");
+        let line = strongest_line(&x, rate, &[], &[]).expect("a line");
         assert!((line.hz - 231.3).abs() < 0.01, "{}", line.hz);
     }
 
     #[test]
     fn white_noise_and_a_broad_band_residual_have_no_line() {
         let n = 40_000;
-        assert_eq!(strongest_line(&noise(n, 0.05, 7), 1000.0, &[]), None);
+        assert_eq!(strongest_line(&noise(n, 0.05, 7), 1000.0, &[], &[]), None);
         // a low-passed random walk: broad-band, large, no line
         let mut level = 0.0;
         let walk: Vec<f64> = noise(n, 1.0, 9)
@@ -274,7 +288,7 @@ mod tests {
                 level
             })
             .collect();
-        assert_eq!(strongest_line(&walk, 1000.0, &[]), None);
+        assert_eq!(strongest_line(&walk, 1000.0, &[], &[]), None);
     }
 
     #[test]
@@ -283,12 +297,31 @@ mod tests {
         let command: Vec<f64> = (0..n)
             .map(|k| 2.5 + 3.0 * (2.0 * PI * 0.7 * k as f64 / rate).sin())
             .collect();
+        // the model answers the command's line with 8 N/V; the plant with 10 % more
+        let response: Vec<f64> = command.iter().map(|v| 8.0 * (v - 2.5)).collect();
         let residual: Vec<f64> = noise(n, 0.05, 11)
             .iter()
-            .zip(&command)
-            .map(|(e, v)| e + 0.3 * (v - 2.5))
+            .zip(&response)
+            .map(|(e, f)| e + 0.1 * f)
             .collect();
-        assert!(strongest_line(&residual, rate, &[]).is_some());
-        assert_eq!(strongest_line(&residual, rate, &[&command]), None);
+        assert!(strongest_line(&residual, rate, &[], &[]).is_some());
+        assert_eq!(strongest_line(&residual, rate, &[&command], &response), None);
+    }
+
+    #[test]
+    fn a_pickup_fed_back_into_the_command_is_still_a_disturbance() {
+        let (rate, n) = (500.0, 15_000);
+        let at = |k: usize, hz: f64| (2.0 * PI * hz * k as f64 / rate).sin();
+        // a controller's command: a slow sine and a trace of the 50 Hz pick-up it read
+        let command: Vec<f64> = (0..n).map(|k| 2.5 + 3.0 * at(k, 0.7) + 0.004 * at(k, 50.0)).collect();
+        // the model passes the slow sine and all but removes 50 Hz
+        let response: Vec<f64> = (0..n).map(|k| 24.0 * at(k, 0.7) + 1e-4 * at(k, 50.0)).collect();
+        let residual: Vec<f64> = noise(n, 0.05, 17)
+            .iter()
+            .enumerate()
+            .map(|(k, e)| e + 0.2 * at(k, 50.0))
+            .collect();
+        let line = strongest_line(&residual, rate, &[&command], &response).expect("the pick-up");
+        assert!((line.hz - 50.0).abs() < 0.01, "{}", line.hz);
     }
 }

@@ -167,7 +167,7 @@ fn replay_round(
             let n = force_residual.len();
             let sample_rate = (n - 1) as f64 / (recording.time[n - 1] - recording.time[0]).max(1e-12);
             let inputs = [&recording.v_da[..n], &recording.x_s[..n]];
-            lines::strongest_line(&force_residual, sample_rate, &inputs).map(|l| l.hz)
+            lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n]).map(|l| l.hz)
         });
     // Pressures within their noise: nothing upstream of the piston departs by more
     // than they can show, and only the mechanics and the force sensor are fitted.

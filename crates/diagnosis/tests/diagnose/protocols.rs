@@ -228,3 +228,16 @@ fn clean_recordings_under_three_other_protocols_get_nothing() {
         assert_eq!(d.verdict(), "explained", "{}: {}", spec.label(), d.summary()[0]);
     }
 }
+
+#[test]
+fn a_fifty_hertz_pickup_under_force_tracking_that_feeds_it_back_into_the_command_is_discovered() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::ForceTracking,
+        sample_rate: 500.0,
+        duration: 30.0,
+        force_noise: 0.08,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    pickup_found("pickup-tracking", &spec, 0.2, 50.0);
+}
