@@ -18,14 +18,18 @@
 //! The recordings themselves are [`recording`]; [`replay`](mod@replay) runs their inputs
 //! through the model (crate `jetpipe-model`).
 
+mod alternatives;
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;
 mod discover;
+pub mod lines;
+mod localize;
 mod named;
 pub mod noise;
 pub mod recording;
 pub mod replay;
+mod report;
 mod rounds;
 pub mod signals;
 pub mod signature;
@@ -41,6 +45,10 @@ use calibrate::Calibrated;
 use corrections::{catalogue, parameter_value, set_parameter, Candidate, Fit, Mechanism, Problem, Sensitivity, Term};
 use signals::{difference, force_from_pressures, rms, rms_where, ChainSignals, CHANNELS, CHANNEL_NAMES, FORCE};
 use signature::Signature;
+
+use localize::{
+    discovery_penalised, discovery_penalty_per_term, heldout_count, localize, parallel_map, penalised, rank, used_terms,
+};
 
 /// Length of the alternating training / held-out blocks.
 pub const BLOCK_SECONDS: f64 = 2.0;
@@ -315,215 +323,6 @@ impl Diagnosis {
     }
 }
 
-/// How many of a fitted candidate's terms are away from their neutral values.
-fn used_terms(s: &Scored) -> f64 {
-    s.fit
-        .values
-        .iter()
-        .zip(&s.fit.candidate.terms)
-        .filter(|(v, t)| **v != t.neutral)
-        .count() as f64
-}
-
-/// A candidate's held-out misfit (in noise floors squared) plus a BIC-like penalty of
-/// ln(held-out samples) per term used: best first, a term that adds nothing on the held-out
-/// blocks loses to a simpler candidate.
-fn penalised(s: &Scored, heldout_samples: f64) -> f64 {
-    s.fit.heldout_total() + used_terms(s) * heldout_samples.ln()
-}
-
-/// What each term of a discovered candidate must earn on the held-out blocks, in noise
-/// floors squared: BIC's ln(samples), and at least a hundredth of a noise floor squared per
-/// held-out sample. The second binds on long recordings, where ln n lets a term in for a
-/// trend of a few hundredths of the noise (a pressure transducer's 8 kPa offset was otherwise
-/// taken as an offset and a drift on both channels, for 11 Pa over 80 s against 150 Pa of
-/// noise).
-fn discovery_penalty_per_term(heldout_samples: f64) -> f64 {
-    heldout_samples
-        .ln()
-        .max(MIN_MEAN_SQUARE_GAIN_PER_TERM * heldout_samples)
-}
-
-/// See [`discovery_penalty_per_term`].
-const MIN_MEAN_SQUARE_GAIN_PER_TERM: f64 = 0.01;
-
-fn discovery_penalised(s: &Scored, heldout_samples: f64) -> f64 {
-    s.fit.heldout_total() + used_terms(s) * discovery_penalty_per_term(heldout_samples)
-}
-
-/// Runs `f` on every item over `jobs` threads, results in the items' order.
-fn parallel_map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let jobs = jobs.clamp(1, items.len().max(1));
-    if jobs == 1 {
-        return items.iter().map(f).collect();
-    }
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut out: Vec<(usize, R)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..jobs)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = vec![];
-                    loop {
-                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        if k >= items.len() {
-                            break;
-                        }
-                        mine.push((k, f(&items[k])));
-                    }
-                    mine
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("a diagnosis worker panicked"))
-            .collect()
-    });
-    out.sort_by_key(|(k, _)| *k);
-    out.into_iter().map(|(_, r)| r).collect()
-}
-
-fn heldout_count(training: &[bool]) -> usize {
-    training.iter().filter(|t| !**t).count().max(1)
-}
-
-/// Fit every candidate and rank the places of the chain.
-fn localize(
-    problem: &Problem,
-    base_replay: &Replay,
-    candidates: &[Candidate],
-    options: &Options,
-    progress: &mut dyn FnMut(&str),
-) -> (Localization, usize) {
-    let jobs = options.jobs;
-    let bars = &options.bars;
-    let base_prediction = [
-        base_replay.force.clone(),
-        base_replay.p1.clone(),
-        base_replay.p2.clone(),
-    ];
-    let (_, heldout_before) = problem.errors(&base_prediction);
-    let before_total: f64 = heldout_before.iter().sum::<f64>().max(1e-300);
-    // Sensitivities at the base point, shared by every candidate's first step.
-    let mut wanted: Vec<(&'static str, f64)> = vec![];
-    for c in candidates.iter().filter(|c| c.settings.is_empty()) {
-        for t in &c.terms {
-            let name = match t.mechanism {
-                Mechanism::Parameter(name) => Some((name, t.step)),
-                Mechanism::Modulated { parameter, .. } => candidates
-                    .iter()
-                    .flat_map(|c| &c.terms)
-                    .find(|u| u.mechanism == Mechanism::Parameter(parameter))
-                    .map(|u| (parameter, u.step)),
-                _ => None,
-            };
-            if let Some((name, step)) = name {
-                if !wanted.iter().any(|(n, _)| *n == name) {
-                    wanted.push((name, step));
-                }
-            }
-        }
-    }
-    progress(&format!(
-        "sensitivities of the outputs to {} model constants ({} threads)",
-        wanted.len(),
-        jobs
-    ));
-    let sensitivities: Vec<Option<Sensitivity>> =
-        parallel_map_shown("sensitivities", bars, &wanted, jobs, |(name, step)| {
-            problem.sensitivity(name, *step, base_replay)
-        });
-    let mut replays = wanted.len();
-    let shared = |name: &'static str| -> Option<Sensitivity> {
-        wanted
-            .iter()
-            .position(|(n, _)| *n == name)
-            .and_then(|k| sensitivities[k].clone())
-    };
-    let score = |fit: Fit| -> Scored {
-        let explained = 1.0 - fit.heldout_total() / before_total;
-        let residual = difference(&problem.recording.force, &fit.prediction[FORCE]);
-        let force_heldout_rms = rms_where(&residual, problem.training, false);
-        Scored {
-            fit,
-            explained,
-            force_heldout_rms,
-        }
-    };
-    progress(&format!("fitting {} candidate corrections", candidates.len()));
-    let first: Vec<Option<Fit>> = parallel_map_shown("candidates", bars, candidates, jobs, |c| {
-        problem.fit(c, 1, base_replay, &shared).ok()
-    });
-    let mut scored: Vec<Scored> = first.into_iter().flatten().map(score).collect();
-    replays += scored.iter().map(|s| s.fit.replays).sum::<usize>();
-    scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
-    // Refine the leaders (and every named effect near them) with more iterations.
-    let leaders: Vec<Candidate> = scored
-        .iter()
-        .filter(|s| {
-            s.fit
-                .candidate
-                .terms
-                .iter()
-                .any(|t| !matches!(t.mechanism, Mechanism::Output { .. }))
-        })
-        .filter(|s| s.explained >= WORTH_REFINING)
-        .take(REFINED)
-        .map(|s| s.fit.candidate.clone())
-        .collect();
-    progress(&format!("refining the {} leading candidates", leaders.len()));
-    // Fewer leaders than threads, and one of them may take most of the time (a smooth
-    // hysteresis law): its finite differences share the threads too.
-    problem.set_jobs(jobs);
-    let refined: Vec<Option<Fit>> = parallel_map_shown("refining", bars, &leaders, jobs, |c| {
-        problem.fit(c, REFINE_ITERATIONS, base_replay, &shared).ok()
-    });
-    problem.set_jobs(1);
-    for fit in refined.into_iter().flatten() {
-        replays += fit.replays;
-        let better = score(fit);
-        if let Some(s) = scored.iter_mut().find(|s| s.fit.candidate == better.fit.candidate) {
-            if better.explained > s.explained {
-                *s = better;
-            }
-        }
-    }
-    for (l, e, label) in rank(&mut scored).by_location.iter().take(4) {
-        progress(&format!("  {l:<16} explains {:5.1} % ({label})", 100.0 * e));
-    }
-    (rank(&mut scored), replays)
-}
-
-/// Rank the places of the chain by their best candidate.
-fn rank(scored: &mut [Scored]) -> Localization {
-    scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
-    let mut by_location: Vec<(&'static str, f64, &'static str)> = vec![];
-    for s in scored.iter() {
-        if !by_location.iter().any(|(l, _, _)| *l == s.fit.candidate.location) {
-            by_location.push((s.fit.candidate.location, s.explained, s.fit.candidate.label));
-        }
-    }
-    let (location, family) = match scored.first() {
-        Some(best) if best.explained >= LOCATED_SHARE => {
-            // The family: the simplest candidate at that place that explains nearly as much.
-            let place = best.fit.candidate.location;
-            let simplest = scored
-                .iter()
-                .filter(|s| s.fit.candidate.location == place && s.explained >= best.explained - 0.02)
-                .min_by_key(|s| s.fit.candidate.terms.len())
-                .unwrap_or(best);
-            (place, simplest.fit.candidate.family)
-        }
-        _ => ("unknown", "unknown"),
-    };
-    Localization {
-        location,
-        family,
-        by_location,
-        candidates: scored.to_vec(),
-    }
-}
-
 /// The pressure channels' split: the force against A_p (p1 − p2), the pressures against
 /// the model's.
 fn pressure_split(
@@ -696,9 +495,12 @@ impl<'a> Context<'a> {
     ) -> Self {
         let training = training_mask(&recording.time);
         let n = recording.len();
-        let noise = noise::noise_floor(&recording.force);
+        // A sharp line (a pick-up) is a departure to find, not noise.
+        let sample_rate = (n - 1) as f64 / (recording.time[n - 1] - recording.time[0]).max(1e-12);
+        let floor = |x: &[f64]| noise::noise_floor(&lines::without_lines(x, sample_rate, 3));
+        let noise = floor(&recording.force);
         let pressure_noise = match (&recording.p1, &recording.p2) {
-            (Some(a), Some(b)) => Some([noise::noise_floor(a), noise::noise_floor(b)]),
+            (Some(a), Some(b)) => Some([floor(a), floor(b)]),
             _ => None,
         };
         if let Some(q) = noise::quantisation_step(&recording.force) {
@@ -1097,227 +899,4 @@ fn whiteness(residual: &[f64], lags: usize) -> (f64, f64) {
         q += rho * rho / (n - lag) as f64;
     }
     (n as f64 * (n as f64 + 2.0) * q, first)
-}
-
-fn parameters_json(values: &[(&'static str, f64)]) -> Value {
-    Value::Object(values.iter().map(|(n, v)| (n.to_string(), json!(v))).collect())
-}
-
-impl Diagnosis {
-    /// The summary, opening with the verdict in words.
-    pub fn summary(&self) -> Vec<String> {
-        let mut lines = vec![];
-        let ratio = self.after.heldout_rms / self.noise_floor.max(1e-12);
-        let mut names: Vec<&str> = self.effects.iter().map(|e| e.name).collect();
-        names.extend(self.discovered.iter().map(|d| d.candidate));
-        lines.push(match (&self.unexplained, names.is_empty()) {
-            (Some(u), _) if self.explained() => format!("Explained in the force, not in the pressures: {}", u.sentence),
-            (None, true) => format!(
-                "Explained: the thesis model reproduces the force to within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N); nothing was added.",
-                self.after.heldout_rms, self.noise_floor
-            ),
-            (None, false) if self.effects.is_empty() && self.discovered.iter().all(|d| d.pressures_heldout.is_some()) => {
-                format!(
-                    "Explained with {}: the pressures now agree with the recording's, and the force stays within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N).",
-                    names.join(" and "),
-                    self.after.heldout_rms,
-                    self.noise_floor
-                )
-            }
-            (None, false) => format!(
-                "Explained with {}: the held-out force error falls from {:.4} N to {:.4} N, {ratio:.1}× the noise floor {:.4} N.",
-                names.join(" and "),
-                self.before.heldout_rms,
-                self.after.heldout_rms,
-                self.noise_floor
-            ),
-            (Some(u), _) => format!(
-                "Not explained{}: {}",
-                if names.is_empty() {
-                    String::new()
-                } else {
-                    format!(" by {} alone", names.join(" and "))
-                },
-                u.sentence
-            ),
-        });
-        if let Some(s) = &self.pressure_split {
-            lines.push(s.sentence.clone());
-        }
-        lines.extend(self.input_checks.iter().cloned());
-        for c in &self.calibrated {
-            lines.push(format!(
-                "Calibrated {} = {:.4e} (thesis {:.4e}){}",
-                c.name,
-                c.value,
-                c.thesis,
-                if c.flags.is_empty() {
-                    String::new()
-                } else {
-                    format!(": {}", c.flags.join("; "))
-                }
-            ));
-        }
-        for d in &self.discovered {
-            lines.push(match d.pressures_heldout {
-                Some((before, after)) => format!(
-                    "+ discovered: {} It lowers the held-out pressure errors from {:.0} and {:.0} Pa to {:.0} and {:.0} Pa in the model; the force error stays at {:.4} N.",
-                    d.reading, before[0], before[1], after[0], after[1], d.heldout_after
-                ),
-                None => format!(
-                    "+ discovered: {} It lowers the held-out force error from {:.4} N to {:.4} N in the model ({:.1} % of its mean square).",
-                    d.reading,
-                    d.heldout_before,
-                    d.heldout_after,
-                    100.0 * d.share
-                ),
-            });
-        }
-        for e in &self.effects {
-            let values: Vec<String> = e.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
-            lines.push(format!("+ {} ({}): {}", e.name, values.join(", "), e.evidence));
-            if !e.remainder_follows.is_empty() {
-                lines.push(format!("  what it leaves follows {}", e.remainder_follows));
-            }
-        }
-        if let Some((a, b)) = self.joint_refit {
-            lines.push(format!(
-                "Refitted together, the added parameters lower the held-out force error from {a:.4} N to {b:.4} N (the values above are the refitted ones)."
-            ));
-        }
-        lines.push(format!(
-            "Force RMS error {:.4} N before, {:.4} N after (held-out {:.4} N before, {:.4} N after).",
-            self.before.rms, self.after.rms, self.before.heldout_rms, self.after.heldout_rms
-        ));
-        lines
-    }
-
-    pub fn to_json(&self, recording_name: &str) -> Value {
-        let err = |e: &Errors| match e.pressure_rms {
-            Some(p) => json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse, "pressure_rms_Pa": p.to_vec()}),
-            None => json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse}),
-        };
-        // Every parameter of the final model that is not the thesis's: with these the FMU
-        // is the model whose errors the report gives.
-        let thesis = Parameters::default();
-        let mut start_values = serde_json::Map::new();
-        for &value_reference in Parameters::VALUE_REFERENCES {
-            let value = self.parameters.get(value_reference);
-            if value != thesis.get(value_reference) {
-                if let Some(v) = value {
-                    start_values.insert(
-                        jetpipe_model::physics::parameters::variable_name(value_reference).to_string(),
-                        json!(v),
-                    );
-                }
-            }
-        }
-        let mut report = json!({
-            "recording": recording_name,
-            "samples": self.samples,
-            "noise_floor_N": self.noise_floor,
-            "verdict": self.verdict(),
-            "summary": self.summary(),
-            "input_checks": self.input_checks,
-            "before": err(&self.before),
-            "after": err(&self.after),
-            "heldout": {"before_rms_N": self.before.heldout_rms, "after_rms_N": self.after.heldout_rms},
-            "effects": self.effects.iter().map(|e| json!({
-                "name": e.name,
-                "location": e.location,
-                "parameters": parameters_json(&e.parameters),
-                "heldout_before_rms_N": e.heldout_before,
-                "heldout_after_rms_N": e.heldout_after,
-                "share_of_heldout_explained": e.share,
-                "remainder_follows": e.remainder_follows,
-                "evidence": e.evidence,
-            })).collect::<Vec<_>>(),
-            "discovered": self.discovered.iter().map(|d| json!({
-                "location": d.location,
-                "family": d.family,
-                "candidate": d.candidate,
-                "parameters": parameters_json(&d.parameters),
-                "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(discover::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
-                "reading": d.reading,
-                "heldout_before_rms_N": d.heldout_before,
-                "heldout_after_rms_N": d.heldout_after,
-                "share_of_heldout_explained": d.share,
-                "pressures_heldout_before_rms_Pa": d.pressures_heldout.map(|(b, _)| b.to_vec()),
-                "pressures_heldout_after_rms_Pa": d.pressures_heldout.map(|(_, a)| a.to_vec()),
-            })).collect::<Vec<_>>(),
-            "calibrated": self.calibrated.iter().map(|c| (c.name.to_string(), json!({
-                "value": c.value,
-                "thesis": c.thesis,
-                "relative_shift": if c.thesis != 0.0 { (c.value - c.thesis) / c.thesis.abs() } else { 0.0 },
-                "first_half": c.halves_in_time.0,
-                "second_half": c.halves_in_time.1,
-                "commands_below_median": c.halves_in_command.0,
-                "commands_above_median": c.halves_in_command.1,
-                "flags": c.flags,
-            }))).collect::<serde_json::Map<_, _>>(),
-            "candidates": self.candidates.iter().map(|c| json!({
-                "candidate": c.fit.candidate.label,
-                "location": c.fit.candidate.location,
-                "family": c.fit.candidate.family,
-                "named_effect": c.fit.candidate.named,
-                "parameters": parameters_json(&c.parameters()),
-                "explained_share_heldout": c.explained,
-                "force_heldout_rms_N": c.force_heldout_rms,
-            })).collect::<Vec<_>>(),
-            "residual_tests": self.residual_tests,
-            "fmu_start_values": start_values,
-            "stopper_positions": "the model was driven with x_s_m averaged over samples k-3..k+3 (fewer at the ends), as the FMU must be to reproduce these errors",
-            "joint_refit": self.joint_refit.map(|(a, b)| json!({"heldout_before_rms_N": a, "heldout_after_rms_N": b})),
-            "replays": self.replays,
-        });
-        let object = report.as_object_mut().expect("a JSON object");
-        if let Some(p) = self.pressure_noise {
-            object.insert("noise_floor_Pa".into(), json!({"p1": p[0], "p2": p[1]}));
-        }
-        if let Some(u) = &self.unexplained {
-            object.insert(
-                "unexplained".into(),
-                json!({
-                    "rms_N": u.rms,
-                    "ratio_to_noise": u.ratio_to_noise,
-                    "location": u.location,
-                    "family": u.family,
-                    "alternatives": u.alternatives,
-                    "signature": u.signature.to_json("N"),
-                    "sentence": u.sentence,
-                    "channel": if self.explained() { "pressures" } else { "force" },
-                }),
-            );
-        }
-        object.insert(
-            "pressure_split".into(),
-            match &self.pressure_split {
-                Some(s) => json!({
-                    "available": true,
-                    "force_vs_pressures_rms_N": s.force_vs_pressures_rms,
-                    "force_vs_pressures_ratio_to_noise": s.force_vs_pressures_ratio,
-                    "pressures_vs_model_rms_Pa": s.pressure_rms,
-                    "pressures_vs_model_ratio_to_noise": s.pressure_ratio,
-                    "sentence": s.sentence,
-                }),
-                None => json!({
-                    "available": false,
-                    "sentence": "Without pressure channels a departure upstream of the piston, in the mechanics and in the force sensor can move the force alike; the location comes from the force alone and is less certain.",
-                }),
-            },
-        );
-        if let Some(l) = &self.localization {
-            object.insert(
-                "localization".into(),
-                json!({
-                    "location": l.location,
-                    "family": l.family,
-                    "by_location": l.by_location.iter().map(|(loc, e, label)| json!({
-                        "location": loc, "explained_share_heldout": e, "best_candidate": label,
-                    })).collect::<Vec<_>>(),
-                }),
-            );
-        }
-        report
-    }
 }

@@ -85,6 +85,24 @@ pub(crate) fn run_rounds(
         } else {
             None
         };
+        // A named effect is a hypothesis, not a lock: a simpler term at its place that does
+        // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
+        // not a line resistance).
+        let added = match added {
+            Some(Addition::Named(s, sentence)) => {
+                let check = alternatives::Check {
+                    cx,
+                    problem: &problem,
+                    count: r.count,
+                    force_before: r.force_before,
+                };
+                match alternatives::simpler_than_named(&check, &found, &f.params, &s, replays, progress)? {
+                    Some((term, trial)) => Some(Addition::Discovered(term, Box::new(trial))),
+                    None => Some(Addition::Named(s, sentence)),
+                }
+            }
+            other => other,
+        };
         match added {
             Some(Addition::Discovered(term, trial)) => {
                 f.discovered.push(term);
@@ -141,8 +159,16 @@ fn replay_round(
     }
     let force_residual = difference(&recording.force, &current.force);
     let line = signature::spectrum(&recording.time, &force_residual);
-    let periodic =
-        (line.peak_over_median > 100.0 && line.low_share < 0.5 && line.peak_hz > 0.2).then_some(line.peak_hz);
+    // A line on the logarithmic grid of the signature, else a sharp line anywhere up to the
+    // Nyquist frequency that the inputs do not carry (`lines.rs`).
+    let periodic = (line.peak_over_median > 100.0 && line.low_share < 0.5 && line.peak_hz > 0.2)
+        .then_some(line.peak_hz)
+        .or_else(|| {
+            let n = force_residual.len();
+            let sample_rate = (n - 1) as f64 / (recording.time[n - 1] - recording.time[0]).max(1e-12);
+            let inputs = [&recording.v_da[..n], &recording.x_s[..n]];
+            lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n]).map(|l| l.hz)
+        });
     // Pressures within their noise: nothing upstream of the piston departs by more
     // than they can show, and only the mechanics and the force sensor are fitted.
     let pressures_agree = problem.weights[1] > 0.0

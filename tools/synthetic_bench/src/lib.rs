@@ -7,1128 +7,29 @@
 //! `fmu`): equations are re-derived from the specification, integrated by classical fixed-step
 //! RK4 (20 µs), and every effect uses a form that differs from the obvious one.
 //!
-//! Forms of the effects (all off by default; with all off the model is the thesis model):
 //!
-//! * `jet_pipe_hysteresis` (`hysteresis_width`, m): a Bouc–Wen state z (n = 1) driven by the static
-//!   jet-pipe position x̄ = f3(k_m i): ż = A ẋ̄ − β |ẋ̄| z − γ ẋ̄ |z| with A = 0.5, β = 0.75/w,
-//!   γ = 0.25/w, so that z saturates at ±w/2 after a large sweep; the jet pipe dynamics are
-//!   driven by x̄ − z (rising branch w/2 below the midpoint line, falling branch w/2 above it:
-//!   full separation w). Minor loops arise by themselves. The history before the recording is a
-//!   falling approach (z = −w/2), as when the command goes from 0 V down to the first command.
-//! * `piston_friction` (`friction_coulomb` = F_c, N): Stribeck curve on the stopper velocity v,
-//!   F_f = [F_c + (F_s − F_c) exp(−(v/v_s)²)] tanh(v/v_ε) + b v with F_s = 1.5 F_c,
-//!   v_s = 5 mm/s, v_ε = 0.2 mm/s, b = F_c · 1 s/m; F_act = max(A_p(P1 − P2) − F_f, F_spring).
-//!   Zero while the stopper is still.
-//! * `dead_volume` (`dead_volume_1`, `dead_volume_2`, m³): a side volume per chamber (lines,
-//!   transducer port) joined to the chamber through a short laminar line, ṁ = (P_i − P_di)/R_l,
-//!   R_l = γ R T τ_l / V_d with τ_l = 1 ms, so the line fills in about 1 ms and the volume acts as
-//!   added volume below ≈ 100 Hz. The side volume follows (2.29) at temperature T.
-//! * `supply_pressure_drop` (`supply_resistance` = R_s, Pa·s/kg): a plenum of 2 cm³ (enlarged
-//!   automatically only when R_s is so small that RK4 would need it) between P_s and the jet
-//!   pipe, fed through a compressible orifice of C_d A = sqrt(ṁ_nom / (ρ_s R_s)),
-//!   ṁ_nom = 2.0e-4 kg/s, ρ_s = P_s/(R T); for an incompressible orifice dΔp/dṁ = 2Δp/ṁ, so this
-//!   gives dP/dṁ = R_s at ṁ_nom (a drop of R_s ṁ_nom / 2 there). The jet-pipe supply flows are
-//!   drawn from the plenum, at the plenum pressure.
-//! * `heat_transfer` (α, 0..1): for α > 0 each chamber gets a temperature state and the energy
-//!   equation Ṗ = (γ/V)(R Σ ṁ_k T_k,up − P V̇) + P (T_w − T)/(T τ_th),
-//!   Ṫ = T (Ṗ/P + V̇/V) − R T² ṁ/(P V), with the wall at 293.15 K and
-//!   τ_th = 0.5 ms · 1000^(1−α) / α (α = 1: 0.5 ms, nearly isothermal up to ≈ 100 Hz;
-//!   α = 0.5: 32 ms; α = 0.25: 0.36 s). Outflows leave at the chamber temperature, inflows
-//!   arrive at the upstream temperature (supply at T). α = 0 is exactly (2.29) at constant T.
-//! * `transport_delay` (`command_delay`, s): the current driver sees the D/A output delayed,
-//!   the zero-order-hold history evaluated at t − τ (the logged v_da is the undelayed command).
-//! * `sensor_offset_gain`: logged force = gain · F_act + offset (before noise and quantisation).
-//!
-//! Undeclared mechanisms (`BenchEffects::undeclared`, all neutral by default; with all neutral
-//! the rows are bit-identical to those of the code before they were added). They test whether
-//! the diagnosis places a departure it cannot name at the right `location` along the signal
-//! chain and in the right `family`; [`UNDECLARED`] lists each at its standard size. The force
-//! effect quoted is the noiseless, unquantised difference from the effect-free run over the
-//! whole 80 s protocol (rms / max), as printed by the test
-//! `undeclared_force_effects_over_the_protocol`:
-//!
-//! * `p1_sensor_offset` (`pressure_sensors`/`parameter_offset`, `pressure_sensor_offset_1`,
-//!   standard 8 kPa): logged p1 = P1 + offset before noise and quantisation; force and p2 are
-//!   bit-identical (force effect 0; p1 shifted by 8 kPa = 53 noise rms).
-//! * `supply_drift` (`supply`/`drift`, `supply_drift` = d, standard 30 kPa): the pressure at the
-//!   supply source is P_s − d · clamp(t / 80 s, 0, 1); constant before t = 0. With the supply
-//!   plenum on it feeds the plenum. Force effect 1.6 N rms / 3.9 N max.
-//! * `supply_ripple` (`supply`/`periodic`, `supply_ripple_amplitude` = a,
-//!   `supply_ripple_frequency` = f, standard 15 kPa at 7 Hz): source pressure
-//!   P_s + a sin(2π f t), for all t including the settling time. Force 1.0 N rms / 3.0 N max.
-//! * `command_limit` (`command`/`limit`, `command_limit` = L, standard 7 V): the current driver
-//!   sees clamp(v_da, −L, L); the logged v_da is the requested command. Rows are bit-identical
-//!   while |v_da| < L. Force 0.66 N rms / 3.4 N max (segments A and B above 7 V).
-//! * `current_slew_limit` (`current_driver`/`limit`, `current_slew_limit` = S, standard 3 A/s):
-//!   the driver's compliance voltage limits di/dt to ±S: di/dt = clamp(ω_cd (k_cd v + i_0 − i),
-//!   −S, S). Statics unchanged; steps (D) and the fast end of the chirp (C) are slewed. (A static
-//!   current clamp at ±I would be indistinguishable from `command_limit` at ±I/k_cd with
-//!   i_0 = 0, so the current driver's limit is its slew rate.) Force 0.68 N rms / 16 N max.
-//! * `jet_pipe_lag` (`jet_pipe`/`dynamics`, `jet_pipe_lag` = τ, standard 15 ms): an extra
-//!   first-order lag τ ẋ_L = x̄ − x_L between the static curve f3 (after the hysteresis, if on)
-//!   and the jet pipe's first-order/second-order dynamics. Force 0.72 N rms / 8.6 N max.
-//! * `chamber_1_leak` (`chambers`/`extra_flow`, `chamber_leak_1` = C_d·A, standard 0.01 mm²):
-//!   chamber 1 loses ṁ = orifice(C_d·A, P1 → 101 325 Pa) by the same compressible law as the
-//!   ports (outflow at the chamber temperature). Force 1.6 N rms / 3.4 N max.
-//! * `viscous_friction` (`mechanics`/`extra_force`, `viscous_friction` = b, standard 60 N·s/m):
-//!   F_act = max(A_p(P1 − P2) − F_f − b v, F_spring) with v the stopper velocity (the sign of
-//!   `piston_friction`: lower while extending). Bit-identical while the stopper is still
-//!   (t < 60 s). Force 1.5 N rms / 5.7 N max.
-//! * `contact_compliance` (`mechanics`/`compliance`, `contact_stiffness` = k, standard
-//!   2·10⁴ N/m): a spring between stopper and piston; the piston sits δ beyond the stopper with
-//!   τ_c δ̇ = F_act/k − δ, τ_c = 0.5 ms (piston mass and seal damping), and the chamber volumes
-//!   and their rates use x_s + δ, ẋ_s + δ̇ (the return spring and the friction still use the
-//!   stopper). Statics unchanged. Force 1.4 N rms / 6.1 N max.
-//! * `force_sensor_lag` (`force_sensor`/`dynamics`, `force_sensor_lag` = τ_F, standard 10 ms):
-//!   the logged force is F_L with τ_F Ḟ_L = F_act − F_L, integrated with the plant (then gain
-//!   and offset of `sensor_offset_gain`). Pressures bit-identical. Force 0.91 N rms / 6.3 N max.
-//! * `return_back_pressure` (`return`/`parameter_offset`, `return_back_pressure`, standard
-//!   40 kPa): the ports exhaust into P_r + 40 kPa (a clogged muffler); the chamber 1 leak and
-//!   the initial pressures keep the thesis P_r. Force 1.3 N rms / 3.7 N max (p2 6.9 kPa rms).
-//! * `p2_sensor_delay` (`pressure_sensors`/`delay`, `pressure_sensor_delay_2`, standard 10 ms,
-//!   rounded to whole samples): logged p2 at sample k is P2 at sample k − d (the value at t = 0
-//!   before), then noise and quantisation; force and p1 bit-identical (force effect 0).
-//! * `receiver_offset` (`jet_pipe`/`parameter_offset`, `receiver_offset`, standard 10 µm): the
-//!   port areas are evaluated at x_jp + (x_jp_offset + 10 µm), i.e. the receivers sit further
-//!   from the jet pipe null (the static force curve shifts along the command axis). The
-//!   offset is the jet pipe's constant x_jp_offset of x_abs = x_jp + x_jp_offset (2.4)–(2.7),
-//!   so the chain places it at the jet pipe. Force 1.9 N rms / 3.0 N max.
-//! * `force_sensor_backlash` (`force_sensor`/`hysteresis`, `force_sensor_backlash` = w,
-//!   standard 1.5 N): the reading passes a play operator of half width r = w/2 at the samples,
-//!   y_k = clamp(y_{k−1}, F_k − r, F_k + r), y_0 = F_0 (after the force lag, before gain,
-//!   offset, noise and quantisation). Pressures bit-identical. Force 0.71 N rms / 0.75 N max.
-//! * `jet_pipe_curve` (`jet_pipe`/`nonlinearity`, `jet_pipe_curve_blend` = β, standard 1):
-//!   f3 becomes x_sat [(1 − β) tanh u + β u/√(1 + u²)], u = k_m i / f_sat: the same slope at 0
-//!   and the same saturation, a softer knee (the Bouc–Wen drive uses its slope). Force
-//!   1.7 N rms / 2.9 N max.
-//! * `return_area_reduction` (`valve`/`asymmetry`, `return_area_reduction` = r, standard 0.05):
-//!   both return (vent) areas A_r1, A_r2 are multiplied by 1 − r, the supply areas are not
-//!   (supply against return, symmetric between the ports; not the shared port 2 example).
-//!   Force 1.7 N rms / 2.4 N max.
-//! * `port_1_restriction` (`valve`/`restriction`, `port_1_restriction` = C_d·A, standard
-//!   0.2 mm², about 40 % of a fully open port): receiver port 1 fills and vents a line of
-//!   3 cm³ (at T, (2.29); enlarged only if RK4 at 20 µs would need it) that reaches chamber 1
-//!   through an orifice of that C_d·A (same compressible law, inflow to the chamber at T).
-//!   Force 2.2 N rms / 6.9 N max.
-//!
-//! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
-//! zero and the compressible law's value at 20 Pa (continuous, Lipschitz).
+//! The effects and their forms are in [`mechanisms`]; the plant in `plant.rs`; the bench
+//! protocol and quantisation in [`bench_protocol`]; other protocols (staircases, multisines,
+//! PRBS, sines, ramps, force tracking; stopper motion; 250 Hz–2 kHz) in [`protocols`].
 
 use std::f64::consts::PI;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Effects beyond the thesis model. `Default` switches every effect off.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BenchEffects {
-    /// Full separation (m) of the rising and falling branches of the static jet pipe position.
-    pub hysteresis_width: f64,
-    /// Coulomb friction level (N) of the piston; stiction 1.5×, see module docs.
-    pub friction_coulomb: f64,
-    /// Dead volume (m³) joined to chamber 1.
-    pub dead_volume_1: f64,
-    /// Dead volume (m³) joined to chamber 2.
-    pub dead_volume_2: f64,
-    /// Supply line resistance (Pa·s/kg), dP/dṁ at the nominal flow 2e-4 kg/s.
-    pub supply_resistance: f64,
-    /// Heat exchange of the chambers with the wall, 0 (adiabatic, (2.29)) .. 1 (nearly isothermal).
-    pub heat_transfer: f64,
-    /// Delay (s) of the command seen by the current driver.
-    pub command_delay: f64,
-    /// Force sensor offset (N).
-    pub force_sensor_offset: f64,
-    /// Force sensor gain (1 = none).
-    pub force_sensor_gain: f64,
-    /// Mechanisms the diagnosis does not name (see [`UNDECLARED`]); `Default` switches all off.
-    pub undeclared: UndeclaredEffects,
-}
+pub mod bench_protocol;
+pub mod mechanisms;
+mod plant;
+pub mod protocols;
 
-/// Mechanisms beyond the seven named effects, for testing where along the signal chain the
-/// diagnosis places a departure it cannot name. Every field is neutral at its default (0), and
-/// with all neutral the recording is bit-identical to one without them. Forms and standard sizes
-/// are in the module docs and in [`UNDECLARED`].
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct UndeclaredEffects {
-    /// `pressure_sensors`/`parameter_offset`: offset (Pa) of the chamber 1 pressure transducer.
-    pub pressure_sensor_offset_1: f64,
-    /// `supply`/`drift`: fall (Pa) of the supply pressure, linear from t = 0 to t = 80 s.
-    pub supply_drift: f64,
-    /// `supply`/`periodic`: amplitude (Pa) of a supply pressure ripple.
-    pub supply_ripple_amplitude: f64,
-    /// Frequency (Hz) of the supply ripple.
-    pub supply_ripple_frequency: f64,
-    /// `command`/`limit`: the D/A output seen by the current driver saturates at ± this (V);
-    /// 0 = no limit.
-    pub command_limit: f64,
-    /// `current_driver`/`limit`: the coil current slews at most this fast (A/s); 0 = no limit.
-    pub current_slew_limit: f64,
-    /// `jet_pipe`/`dynamics`: time constant (s) of an extra first-order lag between the static
-    /// curve f3 and the jet pipe dynamics.
-    pub jet_pipe_lag: f64,
-    /// `chambers`/`extra_flow`: C_d·A (m²) of a leak from chamber 1 to the atmosphere.
-    pub chamber_leak_1: f64,
-    /// `mechanics`/`extra_force`: viscous friction coefficient (N·s/m) on the stopper velocity.
-    pub viscous_friction: f64,
-    /// `mechanics`/`compliance`: stiffness (N/m) between piston and stopper; 0 = rigid.
-    pub contact_stiffness: f64,
-    /// `force_sensor`/`dynamics`: time constant (s) of a first-order lag of the force sensor.
-    pub force_sensor_lag: f64,
-    /// `return`/`parameter_offset`: the return (exhaust) pressure is higher by this (Pa).
-    pub return_back_pressure: f64,
-    /// `pressure_sensors`/`delay`: the chamber 2 pressure is logged this late (s, rounded to
-    /// whole 1 ms samples).
-    pub pressure_sensor_delay_2: f64,
-    /// `valve`/`parameter_offset`: the receivers sit this much (m) further from the jet pipe
-    /// null than the thesis offset `x_jp_offset`.
-    pub receiver_offset: f64,
-    /// `force_sensor`/`hysteresis`: full width (N) of a play (backlash) operator on the force
-    /// reading.
-    pub force_sensor_backlash: f64,
-    /// `jet_pipe`/`nonlinearity`: blend β (0..1) of the static curve f3 towards the algebraic
-    /// sigmoid: x̄ = x_sat [(1 − β) tanh u + β u/√(1 + u²)].
-    pub jet_pipe_curve_blend: f64,
-    /// `valve`/`asymmetry`: fractional reduction of both return (vent) areas, supply areas
-    /// unchanged.
-    pub return_area_reduction: f64,
-    /// `valve`/`restriction`: C_d·A (m²) of an orifice between receiver port 1 and chamber 1,
-    /// with a line volume on the receiver side; 0 = none.
-    pub port_1_restriction: f64,
-}
-
-impl Default for BenchEffects {
-    fn default() -> Self {
-        Self {
-            hysteresis_width: 0.0,
-            friction_coulomb: 0.0,
-            dead_volume_1: 0.0,
-            dead_volume_2: 0.0,
-            supply_resistance: 0.0,
-            heat_transfer: 0.0,
-            command_delay: 0.0,
-            force_sensor_offset: 0.0,
-            force_sensor_gain: 1.0,
-            undeclared: UndeclaredEffects::default(),
-        }
-    }
-}
-
-/// One undeclared mechanism at its standard test size: where along the signal chain it acts
-/// (`location`) and what kind of departure it is (`family`), in the vocabulary of the diagnosis.
-#[derive(Clone, Copy, Debug)]
-pub struct UndeclaredMechanism {
-    /// Short identifier (also the value of `benchgen --undeclared`).
-    pub name: &'static str,
-    /// `command`, `current_driver`, `jet_pipe`, `valve`, `supply`, `return`, `chambers`,
-    /// `mechanics`, `force_sensor` or `pressure_sensors`.
-    pub location: &'static str,
-    /// `parameter_offset`, `drift`, `periodic`, `limit`, `dynamics`, `delay`, `extra_flow`,
-    /// `extra_force`, `compliance`, `nonlinearity`, `asymmetry`, `restriction` or `hysteresis`.
-    pub family: &'static str,
-    /// The truth in one line, with the standard size.
-    pub truth: &'static str,
-    /// The effects with only this mechanism on, at its standard size.
-    pub effects: fn() -> BenchEffects,
-    /// The model's (and the FMU's) parameters that are this mechanism at its standard
-    /// size, where the model has them; empty where it has no such parameters (then a
-    /// diagnosis can place the mechanism but not add it).
-    pub model_parameters: &'static [(&'static str, f64)],
-}
-
-fn with_undeclared(u: UndeclaredEffects) -> BenchEffects {
-    BenchEffects {
-        undeclared: u,
-        ..Default::default()
-    }
-}
-
-fn std_p1_sensor_offset() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        pressure_sensor_offset_1: 8000.0,
-        ..Default::default()
-    })
-}
-fn std_supply_drift() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        supply_drift: 30_000.0,
-        ..Default::default()
-    })
-}
-fn std_supply_ripple() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        supply_ripple_amplitude: 15_000.0,
-        supply_ripple_frequency: 7.0,
-        ..Default::default()
-    })
-}
-fn std_command_limit() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        command_limit: 7.0,
-        ..Default::default()
-    })
-}
-fn std_current_slew_limit() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        current_slew_limit: 3.0,
-        ..Default::default()
-    })
-}
-fn std_jet_pipe_lag() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        jet_pipe_lag: 15e-3,
-        ..Default::default()
-    })
-}
-fn std_chamber_leak_1() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        chamber_leak_1: 0.01e-6,
-        ..Default::default()
-    })
-}
-fn std_viscous_friction() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        viscous_friction: 60.0,
-        ..Default::default()
-    })
-}
-fn std_contact_compliance() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        contact_stiffness: 2e4,
-        ..Default::default()
-    })
-}
-fn std_return_back_pressure() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        return_back_pressure: 40_000.0,
-        ..Default::default()
-    })
-}
-fn std_p2_sensor_delay() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        pressure_sensor_delay_2: 10e-3,
-        ..Default::default()
-    })
-}
-fn std_receiver_offset() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        receiver_offset: 10e-6,
-        ..Default::default()
-    })
-}
-fn std_force_sensor_backlash() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        force_sensor_backlash: 1.5,
-        ..Default::default()
-    })
-}
-fn std_jet_pipe_curve() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        jet_pipe_curve_blend: 1.0,
-        ..Default::default()
-    })
-}
-fn std_return_area_reduction() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        return_area_reduction: 0.05,
-        ..Default::default()
-    })
-}
-fn std_port_1_restriction() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        port_1_restriction: 0.2e-6,
-        ..Default::default()
-    })
-}
-fn std_force_sensor_lag() -> BenchEffects {
-    with_undeclared(UndeclaredEffects {
-        force_sensor_lag: 10e-3,
-        ..Default::default()
-    })
-}
-
-/// The undeclared mechanisms, each at its standard test size (module docs: forms and the
-/// measured noiseless force effect). None is one of the four shared examples (current driver
-/// gain, port 2 area asymmetry, vented return, quadratic force sensor). Together they cover
-/// all ten locations and all thirteen families (checked by a test).
-///
-/// ```no_run
-/// use synthetic_bench::{generate, undeclared_mechanism, UNDECLARED};
-/// for m in UNDECLARED {
-///     let rows = generate(&(m.effects)(), 1, 80.0); // 80 s protocol with noise, seed 1
-///     println!("{} at {}/{}: {} rows", m.name, m.location, m.family, rows.len());
-/// }
-/// let leak = (undeclared_mechanism("chamber_1_leak").unwrap().effects)();
-/// let _rows = generate(&leak, 7, 80.0);
-/// ```
-pub const UNDECLARED: &[UndeclaredMechanism] = &[
-    UndeclaredMechanism {
-        name: "p1_sensor_offset",
-        location: "pressure_sensors",
-        family: "parameter_offset",
-        truth: "the chamber 1 pressure transducer reads 8 kPa high; force and p2 are unaffected",
-        effects: std_p1_sensor_offset,
-        model_parameters: &[("p1_sensor_offset", 8e3)],
-    },
-    UndeclaredMechanism {
-        name: "supply_drift",
-        location: "supply",
-        family: "drift",
-        truth: "the supply pressure falls linearly by 30 kPa from t = 0 to t = 80 s",
-        effects: std_supply_drift,
-        model_parameters: &[("supply_drift", -30e3 / 80.0)],
-    },
-    UndeclaredMechanism {
-        name: "supply_ripple",
-        location: "supply",
-        family: "periodic",
-        truth: "the supply pressure carries a 15 kPa, 7 Hz sinusoidal ripple (compressor)",
-        effects: std_supply_ripple,
-        model_parameters: &[("supply_ripple_sine", 15e3), ("supply_ripple_frequency", 7.0)],
-    },
-    UndeclaredMechanism {
-        name: "command_limit",
-        location: "command",
-        family: "limit",
-        truth: "the D/A output seen by the current driver saturates at ±7 V (logged command is the requested one)",
-        effects: std_command_limit,
-        model_parameters: &[("command_limit", 7.0)],
-    },
-    UndeclaredMechanism {
-        name: "current_slew_limit",
-        location: "current_driver",
-        family: "limit",
-        truth: "the coil current slews at most 3 A/s (driver voltage headroom)",
-        effects: std_current_slew_limit,
-        model_parameters: &[("current_slew_limit", 3.0)],
-    },
-    UndeclaredMechanism {
-        name: "jet_pipe_lag",
-        location: "jet_pipe",
-        family: "dynamics",
-        truth: "an extra first-order lag of 15 ms between the static curve f3 and the jet pipe dynamics",
-        effects: std_jet_pipe_lag,
-        model_parameters: &[],
-    },
-    UndeclaredMechanism {
-        name: "chamber_1_leak",
-        location: "chambers",
-        family: "extra_flow",
-        truth: "chamber 1 leaks to the atmosphere through C_d·A = 0.01 mm² (compressible orifice law)",
-        effects: std_chamber_leak_1,
-        model_parameters: &[("chamber_vent_1", 0.01e-6)],
-    },
-    UndeclaredMechanism {
-        name: "viscous_friction",
-        location: "mechanics",
-        family: "extra_force",
-        truth: "viscous friction 60 N·s/m on the stopper velocity: force reads F_act − b v",
-        effects: std_viscous_friction,
-        model_parameters: &[("viscous_friction", 60.0)],
-    },
-    UndeclaredMechanism {
-        name: "contact_compliance",
-        location: "mechanics",
-        family: "compliance",
-        truth: "a 2e4 N/m spring between piston and stopper: the piston, and the volumes, shift by F/k",
-        effects: std_contact_compliance,
-        model_parameters: &[("stopper_compliance", 1.0 / 2e4)],
-    },
-    UndeclaredMechanism {
-        name: "force_sensor_lag",
-        location: "force_sensor",
-        family: "dynamics",
-        truth: "the force sensor reads through a first-order lag of 10 ms",
-        effects: std_force_sensor_lag,
-        model_parameters: &[("force_sensor_lag", 0.01)],
-    },
-    UndeclaredMechanism {
-        name: "return_back_pressure",
-        location: "return",
-        family: "parameter_offset",
-        truth: "the return (exhaust) pressure is 40 kPa above the thesis value (clogged exhaust muffler)",
-        effects: std_return_back_pressure,
-        model_parameters: &[("P_r", 101_325.0 + 40e3)],
-    },
-    UndeclaredMechanism {
-        name: "p2_sensor_delay",
-        location: "pressure_sensors",
-        family: "delay",
-        truth: "the chamber 2 pressure is logged 10 ms late; force and p1 are unaffected",
-        effects: std_p2_sensor_delay,
-        model_parameters: &[("p2_sensor_delay", 10e-3)],
-    },
-    UndeclaredMechanism {
-        name: "receiver_offset",
-        location: "jet_pipe",
-        family: "parameter_offset",
-        truth: "the receivers sit 10 µm further from the jet pipe null (x_jp_offset 0.099 → 0.109 mm)",
-        effects: std_receiver_offset,
-        model_parameters: &[("x_jp_offset", 0.109e-3)],
-    },
-    UndeclaredMechanism {
-        name: "force_sensor_backlash",
-        location: "force_sensor",
-        family: "hysteresis",
-        truth: "the force reading passes a play (backlash) operator of full width 1.5 N",
-        effects: std_force_sensor_backlash,
-        model_parameters: &[("force_sensor_play", 1.5)],
-    },
-    UndeclaredMechanism {
-        name: "jet_pipe_curve",
-        location: "jet_pipe",
-        family: "nonlinearity",
-        truth: "the static jet pipe curve is x_sat u/sqrt(1 + u^2) instead of x_sat tanh u (same slope at 0, same saturation)",
-        effects: std_jet_pipe_curve,
-        model_parameters: &[("f3_algebraic_share", 1.0)],
-    },
-    UndeclaredMechanism {
-        name: "return_area_reduction",
-        location: "valve",
-        family: "asymmetry",
-        truth: "both return (vent) areas are 5 % smaller, the supply areas unchanged (supply against return)",
-        effects: std_return_area_reduction,
-        model_parameters: &[("return_area_scale_1", 0.95), ("return_area_scale_2", 0.95)],
-    },
-    UndeclaredMechanism {
-        name: "port_1_restriction",
-        location: "valve",
-        family: "restriction",
-        truth: "receiver port 1 reaches chamber 1 through a 3 cm³ line and an orifice of C_d·A = 0.2 mm²",
-        effects: std_port_1_restriction,
-        model_parameters: &[("port_restriction_area_1", 0.2e-6), ("port_line_volume_1", 3e-6)],
-    },
-];
-
-/// The undeclared mechanism of this name, if any.
-pub fn undeclared_mechanism(name: &str) -> Option<&'static UndeclaredMechanism> {
-    UNDECLARED.iter().find(|m| m.name == name)
-}
-
-/// Constants of the thesis model with the defaults of docs/model.md (SI units).
-#[derive(Clone, Debug, PartialEq)]
-pub struct BenchParams {
-    pub p_supply: f64,
-    pub p_return: f64,
-    pub temperature: f64,
-    pub gamma: f64,
-    pub r_gas: f64,
-    pub k_cd: f64,
-    pub i_offset: f64,
-    pub omega_cd: f64,
-    pub k_m: f64,
-    pub omega_1: f64,
-    pub omega_2: f64,
-    pub zeta_2: f64,
-    pub x_jp_sat: f64,
-    pub f_jp_sat: f64,
-    pub x_jp_offset: f64,
-    pub d_jp: f64,
-    pub c_d: f64,
-    pub c_dm_a_lpp: f64,
-    pub c_db_a_lpp: f64,
-    pub l_cyl: f64,
-    pub l_p: f64,
-    pub l_s: f64,
-    pub l_sup: f64,
-    pub l_spring0: f64,
-    pub d_cyl: f64,
-    pub k_spring: f64,
-}
-
-impl Default for BenchParams {
-    fn default() -> Self {
-        Self {
-            p_supply: 652_925.0,
-            p_return: 101_325.0,
-            temperature: 293.15,
-            gamma: 1.4,
-            r_gas: 287.0,
-            k_cd: 0.04,
-            i_offset: 0.0,
-            omega_cd: 7050.0,
-            k_m: 1.946,
-            omega_1: 973.9,
-            omega_2: 1856.7,
-            zeta_2: 0.019,
-            x_jp_sat: 0.5e-3,
-            f_jp_sat: 0.45,
-            x_jp_offset: 0.099e-3,
-            d_jp: 0.9652e-3,
-            c_d: 0.696,
-            c_dm_a_lpp: -0.0475e-6,
-            c_db_a_lpp: 0.0971e-6,
-            l_cyl: 78e-3,
-            l_p: 8e-3,
-            l_s: 7e-3,
-            l_sup: 11e-3,
-            l_spring0: 69.1e-3,
-            d_cyl: 15.875e-3,
-            k_spring: 88.14,
-        }
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Geometry: circle overlaps (own closed forms, checked against grid integration in the tests)
-// ---------------------------------------------------------------------------------------------
-
-/// Overlap of two circles of equal radius `r` whose centres are `d` apart: r²(θ − sin θ),
-/// θ the central angle of the common chord.
-fn lens_equal(d: f64, r: f64) -> f64 {
-    let d = d.abs();
-    if d >= 2.0 * r {
-        return 0.0;
-    }
-    let theta = 2.0 * (d / (2.0 * r)).acos();
-    r * r * (theta - theta.sin())
-}
-
-/// Overlap of a circle of radius `a` with a circle of radius `b ≥ a`, centres `d` apart: the sum
-/// of the two circular segments cut by the common chord, each r²(φ − sin φ cos φ) with φ the
-/// half angle seen from its centre.
-fn lens_general(d: f64, a: f64, b: f64) -> f64 {
-    let d = d.abs();
-    if d >= a + b {
-        return 0.0;
-    }
-    if d <= b - a {
-        return PI * a * a;
-    }
-    let ca = ((d * d + a * a - b * b) / (2.0 * d * a)).clamp(-1.0, 1.0);
-    let cb = ((d * d + b * b - a * a) / (2.0 * d * b)).clamp(-1.0, 1.0);
-    let (pa, pb) = (ca.acos(), cb.acos());
-    a * a * (pa - pa.sin() * ca) + b * b * (pb - pb.sin() * cb)
-}
-
-/// Supply and return areas of ports 1 and 2 at jet pipe absolute position `x`:
-/// (A_s1, A_r1, A_s2, A_r2).
-fn port_areas(x: f64, d_jp: f64) -> (f64, f64, f64, f64) {
-    let r = 0.5 * d_jp;
-    let a_port = PI * r * r;
-    let (d1, d2) = (x - d_jp, x + d_jp);
-    let a_s1 = lens_equal(d1, r);
-    let a_s2 = lens_equal(d2, r);
-    let a_r1 = (a_port - lens_general(d1, r, 3.0 * r)).max(0.0);
-    let a_r2 = (a_port - lens_general(d2, r, 3.0 * r)).max(0.0);
-    (a_s1, a_r1, a_s2, a_r2)
-}
-
-// ---------------------------------------------------------------------------------------------
-// Model
-// ---------------------------------------------------------------------------------------------
-
-const NS: usize = 16;
-type State = [f64; NS];
-const S_I: usize = 0; // coil current
-const S_X1: usize = 1; // output of the first-order jet pipe lag
-const S_XJP: usize = 2; // jet pipe position (before offset)
-const S_VJP: usize = 3; // its velocity
-const S_Z: usize = 4; // Bouc–Wen hysteresis state
-const S_P1: usize = 5;
-const S_P2: usize = 6;
-const S_T1: usize = 7;
-const S_T2: usize = 8;
-const S_PD1: usize = 9; // dead volume pressures
-const S_PD2: usize = 10;
-const S_PPL: usize = 11; // supply plenum pressure
-const S_XL: usize = 12; // output of the extra jet pipe lag (undeclared)
-const S_FF: usize = 13; // force sensor lag output (undeclared)
-const S_DEL: usize = 14; // piston-stopper contact deflection (undeclared)
-const S_PL1: usize = 15; // port 1 line pressure upstream of the restriction (undeclared)
-
-/// Integration step (s): 50 steps per 1 ms command/log period.
-const H: f64 = 20e-6;
-const STEPS_PER_SAMPLE: usize = 50;
-const SAMPLE: f64 = 1e-3;
-/// Below this pressure difference the orifice law is the secant line through zero.
-const DP_LIN: f64 = 20.0;
-const M_DOT_NOMINAL: f64 = 2.0e-4;
-const PLENUM_VOLUME: f64 = 2e-6;
-const LINE_TAU: f64 = 1e-3;
-const TAU_ISO: f64 = 0.5e-3;
-/// Atmosphere into which the undeclared chamber leak vents (Pa).
-const P_ATM: f64 = 101_325.0;
-/// Line volume between receiver port 1 and the undeclared restriction (m³), enlarged only
-/// when RK4 would need it.
-const LINE1_VOLUME: f64 = 3e-6;
-/// Relaxation time of the piston on its contact compliance (s): mass and seal damping.
-const TAU_CONTACT: f64 = 0.5e-3;
-
-struct Model {
-    p: BenchParams,
-    e: BenchEffects,
-    a_p: f64,
-    l_dead: f64, // L_p + L_s + L_sup
-    r_crit: f64,
-    c1: f64,
-    c2: f64,
-    inv_gamma: f64,
-    // effects
-    hyst: bool,
-    bw_a: f64,
-    bw_beta: f64,
-    bw_gamma: f64,
-    heat: bool,
-    inv_tau_th: f64,
-    dead1: bool,
-    dead2: bool,
-    g_line1: f64, // 1/R_line
-    g_line2: f64,
-    supply: bool,
-    cda_supply: f64,
-    v_plenum: f64,
-    // undeclared mechanisms
-    cmd_limit: bool,
-    slew: bool,
-    jp_lag: bool,
-    leak1: bool,
-    viscous: bool,
-    contact: bool,
-    f_lag: bool,
-    ret_bp: bool,
-    rcv_off: bool,
-    blend: bool,
-    ret_area: bool,
-    line1: bool,
-    v_line1: f64,
-}
-
-impl Model {
-    fn new(p: &BenchParams, e: &BenchEffects) -> Self {
-        let g = p.gamma;
-        let rt = p.r_gas * p.temperature;
-        let a_p = PI * p.d_cyl * p.d_cyl / 4.0;
-        let w = e.hysteresis_width;
-        let hyst = w > 0.0;
-        let heat = e.heat_transfer > 0.0;
-        let alpha = e.heat_transfer.clamp(0.0, 1.0);
-        let inv_tau_th = if heat {
-            alpha / (TAU_ISO * 1000f64.powf(1.0 - alpha))
-        } else {
-            0.0
-        };
-        let dead1 = e.dead_volume_1 > 0.0;
-        let dead2 = e.dead_volume_2 > 0.0;
-        let g_line = |v: f64| if v > 0.0 { v / (g * rt * LINE_TAU) } else { 0.0 };
-        let supply = e.supply_resistance > 0.0;
-        let rho_s = p.p_supply / rt;
-        let cda_supply = if supply {
-            (M_DOT_NOMINAL / (rho_s * e.supply_resistance)).sqrt()
-        } else {
-            0.0
-        };
-        // Plenum: 2 cm³, or larger if the linear-zone conductances would make RK4 marginal.
-        let rho_max = p.p_supply.max(p.p_return) / rt;
-        let slope = |cda: f64| cda * (2.0 * rho_max / DP_LIN).sqrt();
-        let port_max = p.c_d * PI * p.d_jp * p.d_jp / 4.0;
-        let v_needed = g * rt * H * (slope(cda_supply) + 2.0 * slope(port_max)) / 1.0;
-        let v_plenum = PLENUM_VOLUME.max(v_needed);
-        let cda_line1 = e.undeclared.port_1_restriction.max(0.0);
-        let v_line1 = LINE1_VOLUME.max(g * rt * H * (slope(cda_line1) + 2.0 * slope(port_max)));
-        Self {
-            p: p.clone(),
-            e: e.clone(),
-            a_p,
-            l_dead: p.l_p + p.l_s + p.l_sup,
-            r_crit: (2.0 / (g + 1.0)).powf(g / (g - 1.0)),
-            c1: (g / p.r_gas * (2.0 / (g + 1.0)).powf((g + 1.0) / (g - 1.0))).sqrt(),
-            c2: (g / p.r_gas * (2.0 / (g - 1.0))).sqrt(),
-            inv_gamma: 1.0 / g,
-            hyst,
-            bw_a: 0.5,
-            bw_beta: if hyst { 0.75 / w } else { 0.0 },
-            bw_gamma: if hyst { 0.25 / w } else { 0.0 },
-            heat,
-            inv_tau_th,
-            dead1,
-            dead2,
-            g_line1: g_line(e.dead_volume_1),
-            g_line2: g_line(e.dead_volume_2),
-            supply,
-            cda_supply,
-            v_plenum,
-            cmd_limit: e.undeclared.command_limit > 0.0,
-            slew: e.undeclared.current_slew_limit > 0.0,
-            jp_lag: e.undeclared.jet_pipe_lag > 0.0,
-            leak1: e.undeclared.chamber_leak_1 > 0.0,
-            viscous: e.undeclared.viscous_friction > 0.0,
-            contact: e.undeclared.contact_stiffness > 0.0,
-            f_lag: e.undeclared.force_sensor_lag > 0.0,
-            ret_bp: e.undeclared.return_back_pressure != 0.0,
-            rcv_off: e.undeclared.receiver_offset != 0.0,
-            blend: e.undeclared.jet_pipe_curve_blend != 0.0,
-            ret_area: e.undeclared.return_area_reduction != 0.0,
-            line1: e.undeclared.port_1_restriction > 0.0,
-            v_line1,
-        }
-    }
-
-    /// Command as the current driver sees it (after the undeclared D/A limit).
-    #[inline]
-    fn driver_input(&self, v: f64) -> f64 {
-        if self.cmd_limit {
-            let l = self.e.undeclared.command_limit;
-            v.clamp(-l, l)
-        } else {
-            v
-        }
-    }
-
-    /// Compressible orifice flow (2.18)–(2.22) from `pu` to `pd` (pu > pd), ≥ 0.
-    #[inline]
-    fn flow_down(&self, cda: f64, pu: f64, tu: f64, pd: f64) -> f64 {
-        let r = pd / pu;
-        let k = cda * pu / tu.sqrt();
-        if r <= self.r_crit {
-            k * self.c1
-        } else {
-            // r^(2/γ) − r^((γ+1)/γ) = a (a − r), a = r^(1/γ)
-            let a = r.powf(self.inv_gamma);
-            k * self.c2 * (a * (a - r)).max(0.0).sqrt()
-        }
-    }
-
-    /// Signed mass flow from side a to side b through C_d·A = `cda`, regularised near Δp = 0.
-    #[inline]
-    fn orifice(&self, cda: f64, pa: f64, ta: f64, pb: f64, tb: f64) -> f64 {
-        if cda <= 0.0 {
-            return 0.0;
-        }
-        let (pu, tu, pd, s) = if pa >= pb {
-            (pa, ta, pb, 1.0)
-        } else {
-            (pb, tb, pa, -1.0)
-        };
-        let dp = pu - pd;
-        if dp >= DP_LIN {
-            s * self.flow_down(cda, pu, tu, pd)
-        } else {
-            s * self.flow_down(cda, pu, tu, pu - DP_LIN) * (dp / DP_LIN)
-        }
-    }
-
-    fn volumes(&self, xs: f64) -> (f64, f64) {
-        let xp = xs - self.l_dead;
-        let v1 = self.a_p * xp + 0.0;
-        let v2 = self.a_p * (self.p.l_cyl - xp - self.p.l_p);
-        (v1, v2)
-    }
-
-    fn static_position(&self, i: f64) -> f64 {
-        if self.blend {
-            let u = self.p.k_m * i / self.p.f_jp_sat;
-            let b = self.e.undeclared.jet_pipe_curve_blend;
-            return self.p.x_jp_sat * ((1.0 - b) * u.tanh() + b * u / (1.0 + u * u).sqrt());
-        }
-        self.p.x_jp_sat * (self.p.k_m * i / self.p.f_jp_sat).tanh()
-    }
-
-    fn spring_force(&self, xs: f64) -> f64 {
-        self.p.k_spring * (self.p.l_spring0 - (xs - self.p.l_s - self.p.l_p))
-    }
-
-    fn friction(&self, v: f64) -> f64 {
-        let fc = self.e.friction_coulomb;
-        if fc <= 0.0 {
-            return 0.0;
-        }
-        let fs = 1.5 * fc;
-        let (v_s, v_eps, b) = (5e-3, 0.2e-3, fc * 1.0);
-        (fc + (fs - fc) * (-(v / v_s) * (v / v_s)).exp()) * (v / v_eps).tanh() + b * v
-    }
-
-    /// True actuator force (2.36)–(2.38) with friction.
-    fn force(&self, y: &State, xs: f64, xs_dot: f64) -> f64 {
-        let mut fp = self.a_p * (y[S_P1] - y[S_P2]) - self.friction(xs_dot);
-        if self.viscous {
-            fp -= self.e.undeclared.viscous_friction * xs_dot;
-        }
-        fp.max(self.spring_force(xs))
-    }
-
-    /// Time derivatives.
-    /// `p_src` is the supply pressure at the source (the thesis constant unless an undeclared
-    /// supply drift or ripple is on).
-    fn rhs(&self, y: &State, v_cmd: f64, xs: f64, xs_dot: f64, p_src: f64, dy: &mut State) {
-        let p = &self.p;
-        let t0 = p.temperature;
-        let rt = p.r_gas * t0;
-        // current driver (2.1)–(2.3)
-        let i = y[S_I];
-        let v_cmd = self.driver_input(v_cmd);
-        let mut di = p.omega_cd * (p.k_cd * v_cmd + p.i_offset - i);
-        if self.slew {
-            let s = self.e.undeclared.current_slew_limit;
-            di = di.clamp(-s, s);
-        }
-        dy[S_I] = di;
-        // static jet pipe curve f3 and hysteresis
-        let u = p.k_m * i / p.f_jp_sat;
-        let th = u.tanh();
-        let mut xbar = p.x_jp_sat * th;
-        // slope dx̄/du / x_sat
-        let mut slope = 1.0 - th * th;
-        if self.blend {
-            // undeclared: static curve blended towards the algebraic sigmoid
-            let b = self.e.undeclared.jet_pipe_curve_blend;
-            let q = 1.0 / (1.0 + u * u).sqrt();
-            xbar = p.x_jp_sat * ((1.0 - b) * th + b * u * q);
-            slope = (1.0 - b) * slope + b * q * q * q;
-        }
-        let mut target = xbar;
-        if self.hyst {
-            let xbar_dot = p.x_jp_sat * slope * p.k_m * di / p.f_jp_sat;
-            let z = y[S_Z];
-            dy[S_Z] = self.bw_a * xbar_dot - self.bw_beta * xbar_dot.abs() * z - self.bw_gamma * xbar_dot * z.abs();
-            target -= z;
-        } else {
-            dy[S_Z] = 0.0;
-        }
-        // undeclared extra lag between f3 and the jet pipe dynamics
-        if self.jp_lag {
-            dy[S_XL] = (target - y[S_XL]) / self.e.undeclared.jet_pipe_lag;
-            target = y[S_XL];
-        } else {
-            dy[S_XL] = 0.0;
-        }
-        // jet pipe: first-order lag then second-order mode, unity DC gain
-        dy[S_X1] = p.omega_1 * (target - y[S_X1]);
-        dy[S_XJP] = y[S_VJP];
-        dy[S_VJP] = p.omega_2 * p.omega_2 * (y[S_X1] - y[S_XJP]) - 2.0 * p.zeta_2 * p.omega_2 * y[S_VJP];
-        // orifice areas
-        let x_abs = if self.rcv_off {
-            y[S_XJP] + (p.x_jp_offset + self.e.undeclared.receiver_offset)
-        } else {
-            y[S_XJP] + p.x_jp_offset
-        };
-        let (a_s1, mut a_r1, a_s2, mut a_r2) = port_areas(x_abs, p.d_jp);
-        if self.ret_area {
-            let f = 1.0 - self.e.undeclared.return_area_reduction;
-            a_r1 *= f;
-            a_r2 *= f;
-        }
-        let (p1, p2) = (y[S_P1], y[S_P2]);
-        let (t1, t2) = if self.heat { (y[S_T1], y[S_T2]) } else { (t0, t0) };
-        let ps = if self.supply { y[S_PPL] } else { p_src };
-        let pr = if self.ret_bp {
-            p.p_return + self.e.undeclared.return_back_pressure
-        } else {
-            p.p_return
-        };
-        // with the undeclared port 1 restriction, port 1 feeds a line at temperature T
-        let (p1v, t1v) = if self.line1 { (y[S_PL1], t0) } else { (p1, t1) };
-        let m_s1 = self.orifice(p.c_d * a_s1, ps, t0, p1v, t1v);
-        let m_r1 = self.orifice(p.c_d * a_r1, p1v, t1v, pr, t0);
-        // line → chamber 1 through the restriction
-        let m_ln = if self.line1 {
-            let m = self.orifice(self.e.undeclared.port_1_restriction, p1v, t0, p1, t1);
-            dy[S_PL1] = p.gamma * rt * (m_s1 - m_r1 - m) / self.v_line1;
-            m
-        } else {
-            dy[S_PL1] = 0.0;
-            0.0
-        };
-        let m_s2 = self.orifice(p.c_d * a_s2, ps, t0, p2, t2);
-        let m_r2 = self.orifice(p.c_d * a_r2, p2, t2, pr, t0);
-        // leakage past the piston (2.23), positive 1 → 2
-        let (pu, pd) = if p1 >= p2 { (p1, p2) } else { (p2, p1) };
-        let cda_l = (p.c_dm_a_lpp * (pd / pu) + p.c_db_a_lpp).max(0.0);
-        let m_l = self.orifice(cda_l, p1, t1, p2, t2);
-        // dead volumes (side branches), positive chamber → branch
-        let m_d1 = if self.dead1 {
-            (p1 - y[S_PD1]) * self.g_line1
-        } else {
-            0.0
-        };
-        let m_d2 = if self.dead2 {
-            (p2 - y[S_PD2]) * self.g_line2
-        } else {
-            0.0
-        };
-        dy[S_PD1] = if self.dead1 {
-            p.gamma * rt * m_d1 / self.e.dead_volume_1
-        } else {
-            0.0
-        };
-        dy[S_PD2] = if self.dead2 {
-            p.gamma * rt * m_d2 / self.e.dead_volume_2
-        } else {
-            0.0
-        };
-        // supply plenum
-        if self.supply {
-            let m_in = self.orifice(self.cda_supply, p_src, t0, ps, t0);
-            dy[S_PPL] = p.gamma * rt * (m_in - m_s1 - m_s2) / self.v_plenum;
-        } else {
-            dy[S_PPL] = 0.0;
-        }
-        // undeclared leak of chamber 1 to the atmosphere, positive outwards
-        let m_a1 = if self.leak1 {
-            self.orifice(self.e.undeclared.chamber_leak_1, p1, t1, P_ATM, t0)
-        } else {
-            0.0
-        };
-        // undeclared compliance between piston and stopper: the piston sits δ beyond the
-        // stopper, δ relaxing to F/k
-        let (x_pist, x_pist_dot) = if self.contact {
-            let f = self.force(y, xs, xs_dot);
-            let dd = (f / self.e.undeclared.contact_stiffness - y[S_DEL]) / TAU_CONTACT;
-            dy[S_DEL] = dd;
-            (xs + y[S_DEL], xs_dot + dd)
-        } else {
-            dy[S_DEL] = 0.0;
-            (xs, xs_dot)
-        };
-        // undeclared force sensor lag
-        dy[S_FF] = if self.f_lag {
-            (self.force(y, xs, xs_dot) - y[S_FF]) / self.e.undeclared.force_sensor_lag
-        } else {
-            0.0
-        };
-        // chambers
-        let (v1, v2) = self.volumes(x_pist);
-        let (dv1, dv2) = (self.a_p * x_pist_dot, -self.a_p * x_pist_dot);
-        let mut m1 = if self.line1 {
-            m_ln - m_l - m_d1
-        } else {
-            m_s1 - m_r1 - m_l - m_d1
-        };
-        if self.leak1 {
-            m1 -= m_a1;
-        }
-        let m2 = m_s2 - m_r2 + m_l - m_d2;
-        if !self.heat {
-            dy[S_P1] = p.gamma / v1 * (rt * m1 - p1 * dv1);
-            dy[S_P2] = p.gamma / v2 * (rt * m2 - p2 * dv2);
-            dy[S_T1] = 0.0;
-            dy[S_T2] = 0.0;
-        } else {
-            // enthalpy flux Σ ṁ_k T_k,up (inflows at their source temperature, outflows at T_i)
-            let up = |m: f64, t_src: f64, t_own: f64| if m > 0.0 { m * t_src } else { m * t_own };
-            let mut h1 = if self.line1 {
-                up(m_ln, t0, t1) + up(-m_l, t2, t1) + up(-m_d1, t0, t1)
-            } else {
-                up(m_s1, t0, t1) + up(-m_r1, t0, t1) + up(-m_l, t2, t1) + up(-m_d1, t0, t1)
-            };
-            if self.leak1 {
-                h1 += up(-m_a1, t0, t1);
-            }
-            let h2 = up(m_s2, t0, t2) + up(-m_r2, t0, t2) + up(m_l, t1, t2) + up(-m_d2, t0, t2);
-            let chamber = |pc: f64, tc: f64, v: f64, dv: f64, m: f64, h: f64| {
-                let dp = p.gamma / v * (p.r_gas * h - pc * dv) + pc * (t0 - tc) / tc * self.inv_tau_th;
-                let dt = tc * (dp / pc + dv / v) - p.r_gas * tc * tc * m / (pc * v);
-                (dp, dt)
-            };
-            let (dp1, dt1) = chamber(p1, t1, v1, dv1, m1, h1);
-            let (dp2, dt2) = chamber(p2, t2, v2, dv2, m2, h2);
-            dy[S_P1] = dp1;
-            dy[S_P2] = dp2;
-            dy[S_T1] = dt1;
-            dy[S_T2] = dt2;
-        }
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Protocol (bench/README.md)
-// ---------------------------------------------------------------------------------------------
-
-/// Length of the bench protocol (s).
-pub const PROTOCOL_DURATION: f64 = 80.0;
-/// Stopper position outside segment E (m).
-pub const STOPPER_HOME: f64 = 0.054;
-
-fn piecewise_linear(t: f64, pts: &[(f64, f64)]) -> f64 {
-    if t <= pts[0].0 {
-        return pts[0].1;
-    }
-    for w in pts.windows(2) {
-        let ((t0, v0), (t1, v1)) = (w[0], w[1]);
-        if t <= t1 {
-            return v0 + (v1 - v0) * (t - t0) / (t1 - t0);
-        }
-    }
-    pts[pts.len() - 1].1
-}
-
-/// The commanded voltage of the protocol at time `t` (before D/A quantisation).
-pub fn protocol_command(t: f64) -> f64 {
-    if t < 20.0 {
-        // A: triangle −4 → 10 → −4 V at 1.4 V/s
-        let tt = t.max(0.0);
-        if tt <= 10.0 {
-            -4.0 + 1.4 * tt
-        } else {
-            10.0 - 1.4 * (tt - 10.0)
-        }
-    } else if t < 35.0 {
-        piecewise_linear(
-            t,
-            &[
-                (20.0, -4.0),
-                (23.0, 6.0),
-                (25.0, 2.0),
-                (28.0, 8.0),
-                (30.0, 4.0),
-                (33.0, 10.0),
-                (35.0, 2.5),
-            ],
-        )
-    } else if t < 50.0 {
-        // C: logarithmic chirp 0.2 → 30 Hz over 15 s around 2.5 V, amplitude 1 V
-        let (f0, f1, tc) = (0.2, 30.0, 15.0);
-        let k: f64 = f1 / f0;
-        let tau = t - 35.0;
-        let phase = 2.0 * PI * f0 * tc / k.ln() * (k.powf(tau / tc) - 1.0);
-        2.5 + phase.sin()
-    } else if t < 60.0 {
-        const STEPS: [f64; 5] = [1.0, 4.0, 2.0, 6.0, 1.0];
-        STEPS[(((t - 50.0) / 2.0).floor() as usize).min(4)]
-    } else {
-        2.5
-    }
-}
-
-/// Stopper position (m) and velocity (m/s) of the protocol at time `t`.
-pub fn protocol_stopper(t: f64) -> (f64, f64) {
-    let a = 0.010;
-    if t < 60.0 {
-        (STOPPER_HOME, 0.0)
-    } else if t < 70.0 {
-        let w = 2.0 * PI * 0.5;
-        (
-            STOPPER_HOME + a * (w * (t - 60.0)).sin(),
-            a * w * (w * (t - 60.0)).cos(),
-        )
-    } else {
-        let w = 2.0 * PI * 1.5;
-        (
-            STOPPER_HOME + a * (w * (t - 70.0)).sin(),
-            a * w * (w * (t - 70.0)).cos(),
-        )
-    }
-}
-
-/// 12-bit D/A over ±10 V.
-pub fn quantise_da(v: f64) -> f64 {
-    let lsb = 20.0 / 4096.0;
-    let code = ((v + 10.0) / lsb).round().clamp(0.0, 4095.0);
-    -10.0 + code * lsb
-}
-
-fn quantise_force(f: f64) -> f64 {
-    let lsb = 1000.0 / 65536.0;
-    let code = ((f + 500.0) / lsb).round().clamp(0.0, 65535.0);
-    -500.0 + code * lsb
-}
-
-fn quantise_pressure(p: f64) -> f64 {
-    let lsb = 1.0e6 / 65536.0;
-    (p / lsb).round().clamp(0.0, 65535.0) * lsb
-}
-
-fn quantise_stopper(x: f64) -> f64 {
-    (x * 1e6).round() * 1e-6
-}
+pub use bench_protocol::{protocol_command, protocol_stopper, quantise_da, PROTOCOL_DURATION, STOPPER_HOME};
+use bench_protocol::{quantise_force, quantise_pressure, quantise_stopper};
+pub use mechanisms::*;
+pub use plant::BenchParams;
+use plant::*;
+pub use protocols::{
+    command_signal, generate_protocol, generate_protocol_with, stopper_signal, CommandProtocol, ProtocolRecording,
+    ProtocolSpec, StopperMotion,
+};
 
 // ---------------------------------------------------------------------------------------------
 // Noise: splitmix64-seeded xorshift64* with Box–Muller
@@ -1181,12 +82,18 @@ impl Rng {
 /// Options of a run (the public [`generate`] uses the bench values).
 #[derive(Clone, Debug)]
 pub struct RunOptions {
-    /// Sensor noise (force 0.05 N rms, pressures 150 Pa rms); `None` for noiseless runs.
+    /// Seed of the sensor noise; `None` for noiseless runs.
     pub noise_seed: Option<u64>,
     /// Quantise the logged signals like the bench A/Ds.
     pub quantise: bool,
     /// Simulated time before t = 0 at the first command (s): settling plus the 3 s hold.
     pub pre_time: f64,
+    /// Sampling period (s): a whole number of the 20 µs integration steps (the bench: 1 ms).
+    pub sample_period: f64,
+    /// RMS of the force sensor's noise, N (the bench: 0.05 N).
+    pub force_noise: f64,
+    /// RMS of each pressure transducer's noise, Pa (the bench: 150 Pa).
+    pub pressure_noise: f64,
 }
 
 impl Default for RunOptions {
@@ -1195,12 +102,26 @@ impl Default for RunOptions {
             noise_seed: None,
             quantise: true,
             pre_time: 8.0,
+            sample_period: SAMPLE,
+            force_noise: 0.05,
+            pressure_noise: 150.0,
         }
     }
 }
 
-/// Run a recording of `n_samples` rows at 1 kHz. `command(t)` gives the un-quantised command at
-/// the sample instants (it is D/A-quantised and held for 1 ms); `stopper(t)` the stopper position
+/// Where a run's command comes from.
+pub enum CommandSource<'a> {
+    /// A function of time, evaluated at the sample instants.
+    Open(&'a dyn Fn(f64) -> f64),
+    /// A controller: given the time and the force just logged at that sample (noise and
+    /// quantisation included, as a bench controller reads it), the command for the sample
+    /// period that starts there. Before t = 0 it is asked once, with no force (`None`).
+    Closed(&'a mut dyn FnMut(f64, Option<f64>) -> f64),
+}
+
+/// Run a recording of `n_samples` rows at the options' sampling period (1 kHz by default).
+/// `command(t)` gives the un-quantised command at the sample instants (it is D/A-quantised
+/// and held for a sample period); `stopper(t)` the stopper position
 /// and velocity at any time. Before t = 0 the first command and stopper position are held.
 pub fn simulate<C, S>(
     params: &BenchParams,
@@ -1214,17 +135,51 @@ where
     C: Fn(f64) -> f64,
     S: Fn(f64) -> (f64, f64),
 {
+    run(
+        params,
+        effects,
+        CommandSource::Open(&command),
+        &stopper,
+        n_samples,
+        opts,
+    )
+}
+
+/// Run a recording of `n_samples` rows at the options' sampling period, its command from
+/// `command` (D/A-quantised and held for a sample period) and the stopper at `stopper(t)`
+/// (position and velocity at any time). Before t = 0 the first command and stopper position
+/// are held.
+///
+/// # Panics
+/// When the sampling period is not a whole number of 20 µs integration steps.
+pub fn run(
+    params: &BenchParams,
+    effects: &BenchEffects,
+    mut command: CommandSource,
+    stopper: &dyn Fn(f64) -> (f64, f64),
+    n_samples: usize,
+    opts: &RunOptions,
+) -> Vec<[f64; 6]> {
     let m = Model::new(params, effects);
-    let cmds: Vec<f64> = (0..n_samples.max(1))
-        .map(|k| quantise_da(command(k as f64 * SAMPLE)))
-        .collect();
+    let sample = opts.sample_period;
+    let steps_per_sample = (sample / H).round() as usize;
+    assert!(
+        steps_per_sample >= 1 && (steps_per_sample as f64 * H - sample).abs() < 1e-12,
+        "sample_period = {sample} s is not a whole number of the {H} s integration steps"
+    );
+    let mut cmds: Vec<f64> = match &mut command {
+        CommandSource::Open(f) => (0..n_samples.max(1))
+            .map(|k| quantise_da(f(k as f64 * sample)))
+            .collect(),
+        CommandSource::Closed(controller) => vec![quantise_da(controller(0.0, None))],
+    };
     let delay = effects.command_delay.max(0.0);
-    let cmd_at = |t: f64| -> f64 {
+    let cmd_at = |cmds: &[f64], t: f64| -> f64 {
         let te = t - delay;
         if te < 0.0 {
             return cmds[0];
         }
-        let k = (te / SAMPLE).floor() as usize;
+        let k = (te / sample).floor() as usize;
         cmds[k.min(cmds.len() - 1)]
     };
     let stop_at = |t: f64| if t < 0.0 { stopper(0.0).0 } else { stopper(t).0 };
@@ -1277,13 +232,13 @@ where
     let mut k4 = [0.0; NS];
     let mut tmp = [0.0; NS];
     let eps = 1e-6 * H;
-    let mut do_step = |y: &mut State, n: i64| {
+    let mut do_step = |y: &mut State, n: i64, cmds: &[f64]| {
         let t_lo = n as f64 * H;
         let t_hi = (n + 1) as f64 * H;
         // inputs evaluated inside the step (left/right limits at its ends)
         let inp = |t: f64| {
             let te = t.clamp(t_lo + eps, t_hi - eps);
-            (cmd_at(te), stop_at(te), stopv_at(te), psrc_at(te))
+            (cmd_at(cmds, te), stop_at(te), stopv_at(te), psrc_at(te))
         };
         let (v, xs, xd, ps) = inp(t_lo);
         m.rhs(y, v, xs, xd, ps, &mut k1);
@@ -1306,20 +261,20 @@ where
         }
     };
     while step < 0 {
-        do_step(&mut y, step);
+        do_step(&mut y, step, &cmds);
         step += 1;
     }
 
     let mut rng = opts.noise_seed.map(Rng::new);
     let mut rows = Vec::with_capacity(n_samples);
     // undeclared p2 transducer delay, whole samples; before t = 0 the plant is at rest
-    let p2_delay = (und.pressure_sensor_delay_2.max(0.0) / SAMPLE).round() as usize;
+    let p2_delay = (und.pressure_sensor_delay_2.max(0.0) / sample).round() as usize;
     let mut p2_hist: Vec<f64> = Vec::new();
     // undeclared force sensor play operator, half width r, starting centred
     let play_r = 0.5 * und.force_sensor_backlash.max(0.0);
     let mut play_y: Option<f64> = None;
-    for (k, &cmd) in cmds.iter().enumerate().take(n_samples) {
-        let t = k as f64 * SAMPLE;
+    for k in 0..n_samples {
+        let t = k as f64 * sample;
         let (xs, xd) = stopper(t);
         let mut f_true = if m.f_lag { y[S_FF] } else { m.force(&y, xs, xd) };
         if play_r > 0.0 {
@@ -1328,6 +283,12 @@ where
             f_true = yp;
         }
         let mut f = effects.force_sensor_gain * f_true + effects.force_sensor_offset;
+        if und.force_sensor_saturation > 0.0 {
+            f = f.clamp(-und.force_sensor_saturation, und.force_sensor_saturation);
+        }
+        if und.force_sensor_pickup_amplitude != 0.0 {
+            f += und.force_sensor_pickup_amplitude * (2.0 * PI * und.force_sensor_pickup_frequency * t + 1.0).sin();
+        }
         let (mut p1, mut p2) = (y[S_P1], y[S_P2]);
         if und.pressure_sensor_offset_1 != 0.0 {
             p1 += und.pressure_sensor_offset_1;
@@ -1337,20 +298,29 @@ where
             p2 = p2_hist[k.saturating_sub(p2_delay)];
         }
         if let Some(r) = rng.as_mut() {
-            f += 0.05 * r.normal();
-            p1 += 150.0 * r.normal();
-            p2 += 150.0 * r.normal();
+            f += opts.force_noise * r.normal();
+            p1 += opts.pressure_noise * r.normal();
+            p2 += opts.pressure_noise * r.normal();
         }
-        let mut row = [t, cmd, xs, f, p1, p2];
+        let mut row = [t, 0.0, xs, f, p1, p2];
         if opts.quantise {
             row[2] = quantise_stopper(xs);
             row[3] = quantise_force(f);
             row[4] = quantise_pressure(p1);
             row[5] = quantise_pressure(p2);
         }
+        if let CommandSource::Closed(controller) = &mut command {
+            let next = quantise_da(controller(t, Some(row[3])));
+            if k == 0 {
+                cmds[0] = next;
+            } else {
+                cmds.push(next);
+            }
+        }
+        row[1] = cmds[k];
         rows.push(row);
-        for _ in 0..STEPS_PER_SAMPLE {
-            do_step(&mut y, step);
+        for _ in 0..steps_per_sample {
+            do_step(&mut y, step, &cmds);
             step += 1;
         }
     }
@@ -1440,6 +410,7 @@ mod tests {
             noise_seed: None,
             quantise: false,
             pre_time: 6.0,
+            ..RunOptions::default()
         }
     }
 
@@ -1919,7 +890,7 @@ mod tests {
         let opts = RunOptions {
             noise_seed: None,
             quantise: false,
-            pre_time: RunOptions::default().pre_time,
+            ..RunOptions::default()
         };
         simulate(&BenchParams::default(), e, protocol_command, protocol_stopper, n, &opts)
     }

@@ -47,3 +47,56 @@ fn benchgen_refuses_an_unknown_mechanism() {
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("unknown undeclared mechanism"));
 }
+
+#[test]
+fn benchgen_writes_a_protocol_recording_without_pressures_at_the_asked_rate() {
+    let dir = std::env::temp_dir().join(format!("benchgen-protocol-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("multisine.csv");
+    let output = Command::new(env!("CARGO_BIN_EXE_benchgen"))
+        .args([
+            "--out",
+            out.to_str().unwrap(),
+            "--protocol",
+            "multisine",
+            "--duration",
+            "20",
+        ])
+        .args([
+            "--sample-rate",
+            "2000",
+            "--no-pressures",
+            "--stopper",
+            "sine:0.054:0.005:2.5",
+        ])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "time_s,v_da_V,x_s_m,force_N");
+    assert_eq!(lines.len(), 1 + 40_000);
+    let time = |line: &str| line.split(',').next().unwrap().parse::<f64>().unwrap();
+    assert!((time(lines[2]) - time(lines[1]) - 0.0005).abs() < 1e-9);
+}
+
+#[test]
+fn benchgen_refuses_a_sampling_rate_off_the_integration_step_naming_it() {
+    let output = Command::new(env!("CARGO_BIN_EXE_benchgen"))
+        .args([
+            "--out",
+            "unused.csv",
+            "--protocol",
+            "prbs",
+            "--duration",
+            "20",
+            "--sample-rate",
+            "300",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(err.contains("sample_rate = 300 Hz"), "{err}");
+}

@@ -1,5 +1,6 @@
-//! `benchgen`: write a synthetic bench recording (protocol of `bench/README.md`) from the
-//! independent simulator of the `synthetic_bench` library, with chosen effects beyond the thesis model.
+//! `benchgen`: write a synthetic bench recording (the protocol of `bench/README.md`, or another
+//! with `--protocol`) from the independent simulator of the `synthetic_bench` library, with
+//! chosen effects beyond the thesis model.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -7,7 +8,8 @@ use std::time::Instant;
 
 use clap::Parser;
 use synthetic_bench::{
-    generate, undeclared_mechanism, write_csv, BenchEffects, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
+    generate, generate_protocol_with, undeclared_mechanism, write_csv, BenchEffects, BenchParams, CommandProtocol,
+    ProtocolSpec, StopperMotion, UndeclaredEffects, PROTOCOL_DURATION, UNDECLARED,
 };
 
 #[derive(Parser)]
@@ -22,9 +24,30 @@ struct Cli {
     /// Seed of the sensor noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Length of the recording, s (at most 80: the protocol is truncated).
+    /// Length of the recording, s: with the bench protocol at most 80 (it is truncated), with
+    /// --protocol 20–120.
     #[arg(long, default_value_t = PROTOCOL_DURATION)]
     duration: f64,
+    /// Another protocol than the bench's: staircase, multisine, prbs, sine, ramps or
+    /// force_tracking (a PI controller on the logged force).
+    #[arg(long)]
+    protocol: Option<String>,
+    /// With --protocol: the stopper's motion, `fixed:X` (m), `sine:CENTRE:AMPLITUDE:HZ` (m, m,
+    /// Hz) or `moves:SPEED` (m/s, between random positions).
+    #[arg(long, default_value = "fixed:0.054")]
+    stopper: String,
+    /// With --protocol: sampling rate, Hz (250–2000, a whole number of 20 µs steps a sample).
+    #[arg(long, default_value_t = 1000.0)]
+    sample_rate: f64,
+    /// With --protocol: RMS noise of the force sensor, N.
+    #[arg(long, default_value_t = 0.05)]
+    force_noise: f64,
+    /// With --protocol: RMS noise of each pressure transducer, Pa.
+    #[arg(long, default_value_t = 150.0)]
+    pressure_noise: f64,
+    /// With --protocol: write no pressure columns.
+    #[arg(long)]
+    no_pressures: bool,
     /// jet_pipe_hysteresis: full branch separation of the static jet pipe position, m (e.g. 0.16e-3).
     #[arg(long, default_value_t = 0.0)]
     hysteresis_width: f64,
@@ -113,6 +136,21 @@ struct Cli {
     /// port_1_restriction: C_d·A of an orifice between receiver port 1 and chamber 1, m² (e.g. 2e-7).
     #[arg(long)]
     port_1_restriction: Option<f64>,
+    /// A pick-up on the force reading, a sin(2π f t + 1 rad): its amplitude, N (e.g. 0.1).
+    #[arg(long)]
+    force_sensor_pickup_amplitude: Option<f64>,
+    /// Its frequency, Hz (e.g. 50).
+    #[arg(long)]
+    force_sensor_pickup_frequency: Option<f64>,
+    /// A dead zone in the D/A output the current driver sees: its half width, V (e.g. 0.4).
+    #[arg(long)]
+    command_dead_zone: Option<f64>,
+    /// The force reading saturates at ± this, N (e.g. 85).
+    #[arg(long)]
+    force_sensor_saturation: Option<f64>,
+    /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
+    #[arg(long)]
+    supply_pressure: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -157,6 +195,16 @@ fn main() -> ExitCode {
     set(&mut und.jet_pipe_curve_blend, cli.jet_pipe_curve_blend);
     set(&mut und.return_area_reduction, cli.return_area_reduction);
     set(&mut und.port_1_restriction, cli.port_1_restriction);
+    set(
+        &mut und.force_sensor_pickup_amplitude,
+        cli.force_sensor_pickup_amplitude,
+    );
+    set(
+        &mut und.force_sensor_pickup_frequency,
+        cli.force_sensor_pickup_frequency,
+    );
+    set(&mut und.command_dead_zone, cli.command_dead_zone);
+    set(&mut und.force_sensor_saturation, cli.force_sensor_saturation);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -171,6 +219,9 @@ fn main() -> ExitCode {
         und.jet_pipe_curve_blend,
         und.return_area_reduction,
         und.port_1_restriction,
+        und.force_sensor_pickup_frequency,
+        und.command_dead_zone,
+        und.force_sensor_saturation,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -180,6 +231,7 @@ fn main() -> ExitCode {
             und.supply_ripple_amplitude,
             und.return_back_pressure,
             und.receiver_offset,
+            und.force_sensor_pickup_amplitude,
         ]
         .iter()
         .all(|x| x.is_finite());
@@ -224,6 +276,46 @@ fn main() -> ExitCode {
         eprintln!("benchgen: effect parameters must be finite and non-negative (heat transfer ≤ 1)");
         return ExitCode::from(2);
     }
+    if let Some(name) = cli.protocol.as_deref() {
+        let spec = match protocol_spec(&cli, name) {
+            Ok(spec) => spec,
+            Err(e) => {
+                eprintln!("benchgen: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        let start = Instant::now();
+        let mut params = BenchParams::default();
+        if let Some(p) = cli.supply_pressure {
+            if !(p > params.p_return && p.is_finite()) {
+                eprintln!(
+                    "benchgen: --supply-pressure = {p} Pa must exceed the return pressure {} Pa",
+                    params.p_return
+                );
+                return ExitCode::from(2);
+            }
+            params.p_supply = p;
+        }
+        let recording = match generate_protocol_with(&params, &spec, &effects) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("benchgen: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        if let Err(e) = recording.write_csv(&cli.out) {
+            eprintln!("benchgen: cannot write {}: {e}", cli.out.display());
+            return ExitCode::FAILURE;
+        }
+        eprintln!(
+            "benchgen: {} rows of {} to {} in {:.2} s ({effects:?})",
+            recording.rows.len(),
+            spec.label(),
+            cli.out.display(),
+            start.elapsed().as_secs_f64()
+        );
+        return ExitCode::SUCCESS;
+    }
     let start = Instant::now();
     let rows = generate(&effects, cli.seed, cli.duration);
     let elapsed = start.elapsed().as_secs_f64();
@@ -237,4 +329,44 @@ fn main() -> ExitCode {
         cli.out.display()
     );
     ExitCode::SUCCESS
+}
+
+/// The protocol of `--protocol` and the options that go with it.
+fn protocol_spec(cli: &Cli, name: &str) -> Result<ProtocolSpec, String> {
+    let number = |field: &str, text: &str| -> Result<f64, String> {
+        text.parse::<f64>()
+            .map_err(|_| format!("--stopper: {field} = {text:?} is not a number"))
+    };
+    let parts: Vec<&str> = cli.stopper.split(':').collect();
+    let stopper = match parts.as_slice() {
+        ["fixed", x] => StopperMotion::Fixed {
+            position: number("position", x)?,
+        },
+        ["sine", c, a, f] => StopperMotion::Sine {
+            centre: number("centre", c)?,
+            amplitude: number("amplitude", a)?,
+            frequency: number("frequency", f)?,
+        },
+        ["moves", v] => StopperMotion::Moves {
+            speed: number("speed", v)?,
+        },
+        _ => {
+            return Err(format!(
+                "--stopper {:?} is not fixed:X, sine:CENTRE:AMPLITUDE:HZ or moves:SPEED",
+                cli.stopper
+            ))
+        }
+    };
+    let spec = ProtocolSpec {
+        command: CommandProtocol::from_name(name)?,
+        stopper,
+        sample_rate: cli.sample_rate,
+        duration: cli.duration,
+        force_noise: cli.force_noise,
+        pressure_noise: cli.pressure_noise,
+        pressures: !cli.no_pressures,
+        seed: cli.seed,
+    };
+    spec.check()?;
+    Ok(spec)
 }

@@ -1,0 +1,742 @@
+//! Fitting a candidate: bounded Gauss–Newton on the training blocks through the model's
+//! sensitivities, golden-section searches for the terms with none, held-out scores.
+
+use super::*;
+
+/// Golden-section steps of a searched term: its bracket shrinks to 0.618^16 = 5e-4 of its
+/// range (a thousandth of a decade over three), or, for the first pass's ranking, to
+/// 0.618^10 = 8e-3 (6 % in value over three decades; a limit's range is linear, 0.8 % of
+/// it). The leaders' refinement and a discovered term's trial search to the finer bracket.
+const GOLDEN_STEPS: usize = 16;
+const COARSE_GOLDEN_STEPS: usize = 10;
+
+/// The fixed part of a fitting problem: the recording, the base model, the blocks and
+/// the channels' weights.
+pub struct Problem<'a> {
+    pub recording: &'a Recording,
+    pub base: &'a Parameters,
+    /// Training samples (the others are held out).
+    pub training: &'a [bool],
+    /// 1/noise floor of each channel (0 for a channel the recording lacks).
+    pub weights: [f64; CHANNELS],
+    pub measured: [&'a [f64]; CHANNELS],
+    velocity: Vec<f64>,
+    /// The stopper's mean position, where the position regressor vanishes.
+    pub mean_position: f64,
+    /// The middle and the span of the recording's time, for the ramp regressor.
+    pub t_mid: f64,
+    pub t_span: f64,
+    /// Threads for the finite-difference replays of one Gauss–Newton step (1 while the
+    /// candidates themselves are spread over the threads).
+    pub jobs: std::sync::atomic::AtomicUsize,
+}
+
+impl<'a> Problem<'a> {
+    pub fn new(recording: &'a Recording, base: &'a Parameters, training: &'a [bool], noise: [f64; CHANNELS]) -> Self {
+        let empty: &[f64] = &[];
+        let measured = [
+            recording.force.as_slice(),
+            recording.p1.as_deref().unwrap_or(empty),
+            recording.p2.as_deref().unwrap_or(empty),
+        ];
+        let mut weights = [0.0; CHANNELS];
+        for c in 0..CHANNELS {
+            if !measured[c].is_empty() && noise[c] > 0.0 {
+                weights[c] = 1.0 / noise[c];
+            }
+        }
+        let n = recording.len();
+        let (t0, t1) = (recording.time[0], recording.time[n - 1]);
+        Self {
+            recording,
+            base,
+            training,
+            weights,
+            measured,
+            velocity: stopper_velocity(recording),
+            mean_position: recording.x_s.iter().sum::<f64>() / n as f64,
+            t_mid: 0.5 * (t0 + t1),
+            t_span: (t1 - t0).max(1e-9),
+            jobs: std::sync::atomic::AtomicUsize::new(1),
+        }
+    }
+
+    /// Spread each Gauss–Newton step's finite-difference replays over `jobs` threads.
+    pub fn set_jobs(&self, jobs: usize) {
+        self.jobs.store(jobs.max(1), std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Model outputs with the nonlinear terms at `values` (linear terms are added by
+    /// [`Self::predict`]).
+    fn replay(&self, candidate: &Candidate, values: &[f64]) -> Result<Replay, String> {
+        let mut p = self.base.clone();
+        for &(name, value) in &candidate.settings {
+            set_parameter(&mut p, name, value)?;
+        }
+        for (term, &value) in candidate.terms.iter().zip(values) {
+            if let Some(name) = term.mechanism.model_parameter() {
+                set_parameter(&mut p, name, value)?;
+            }
+        }
+        replay_fast(&Actuator::new(p)?, self.recording, self.recording.len())
+    }
+
+    fn regressor(&self, regressor: Regressor, own: &[f64], floor: &[bool], k: usize) -> f64 {
+        let t = self.recording.time[k];
+        let v = self.velocity[k];
+        let set_by_pressures = !floor[k];
+        match regressor {
+            Regressor::One => 1.0,
+            Regressor::Own => own[k],
+            Regressor::OwnSquared => own[k] * own[k],
+            Regressor::OwnCubed => own[k] * own[k] * own[k],
+            Regressor::Friction if set_by_pressures && v.abs() > 1e-9 => -v.signum(),
+            Regressor::SmoothFriction(vc) if set_by_pressures => {
+                -jetpipe_model::physics::effects::friction_force(1.0, vc, 0.0, 0.0, v)
+            }
+            Regressor::Stribeck(vc, vs) if set_by_pressures => {
+                -jetpipe_model::physics::effects::friction_force(0.0, vc, 1.0, vs, v)
+            }
+            Regressor::Viscous if set_by_pressures => -v,
+            Regressor::Position if set_by_pressures => -(self.recording.x_s[k] - self.mean_position),
+            Regressor::Friction
+            | Regressor::SmoothFriction(_)
+            | Regressor::Stribeck(..)
+            | Regressor::Viscous
+            | Regressor::Position => 0.0,
+            Regressor::Ramp => (t - self.t_mid) / self.t_span,
+            Regressor::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
+            Regressor::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
+        }
+    }
+}
+
+fn modulation_at(m: Modulation, t: f64, t_mid: f64, t_span: f64) -> f64 {
+    match m {
+        Modulation::Ramp => (t - t_mid) / t_span,
+        Modulation::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
+        Modulation::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
+    }
+}
+
+/// A candidate fitted: its values, what it predicts, and its errors.
+#[derive(Clone, Debug)]
+pub struct Fit {
+    pub candidate: Candidate,
+    pub values: Vec<f64>,
+    pub prediction: [Vec<f64>; CHANNELS],
+    /// Weighted sums of squares per channel on the training and held-out samples.
+    pub train: [f64; CHANNELS],
+    pub heldout: [f64; CHANNELS],
+    pub replays: usize,
+}
+
+impl Fit {
+    pub fn train_total(&self) -> f64 {
+        self.train.iter().sum()
+    }
+    pub fn heldout_total(&self) -> f64 {
+        self.heldout.iter().sum()
+    }
+}
+
+/// Sensitivities of the model's outputs to the nonlinear terms, shared by candidates that
+/// start from the same point.
+pub type Sensitivity = [Vec<f64>; CHANNELS];
+
+/// Everything needed at one point of a candidate's terms.
+struct Point {
+    values: Vec<f64>,
+    replay: Replay,
+}
+
+impl Problem<'_> {
+    /// Predictions of the measured channels for a candidate at `values`, from a replay at
+    /// those values and the sensitivities of modulated parameters.
+    fn predict(&self, terms: &[Term], point: &Point, sensitivities: &[Option<Sensitivity>]) -> [Vec<f64>; CHANNELS] {
+        let r = &point.replay;
+        let mut out = [r.force.clone(), r.p1.clone(), r.p2.clone()];
+        let n = self.recording.len();
+        let mut floor: Option<Vec<bool>> = None;
+        for (j, (term, &value)) in terms.iter().zip(&point.values).enumerate() {
+            if value == 0.0 {
+                continue;
+            }
+            match term.mechanism {
+                Mechanism::Output { channel, regressor } => {
+                    let own = [&r.force, &r.p1, &r.p2][channel];
+                    let floor = floor.get_or_insert_with(|| self.floor(r));
+                    for k in 0..n {
+                        out[channel][k] += value * self.regressor(regressor, own, floor, k);
+                    }
+                }
+                Mechanism::Modulated { modulation, .. } => {
+                    if let Some(s) = &sensitivities[j] {
+                        for c in 0..CHANNELS {
+                            if s[c].is_empty() {
+                                continue;
+                            }
+                            for k in 0..n {
+                                let m = modulation_at(modulation, self.recording.time[k], self.t_mid, self.t_span);
+                                out[c][k] += value * s[c][k] * m;
+                            }
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
+    }
+
+    /// Samples where the spring floor, not the pressures, sets the modelled force.
+    fn floor(&self, r: &Replay) -> Vec<bool> {
+        let p = &self.base;
+        let area = std::f64::consts::PI * p.d_cyl * p.d_cyl / 4.0;
+        (0..self.recording.len())
+            .map(|k| {
+                let spring = jetpipe_model::physics::piston::spring_force(
+                    p.k_spring,
+                    p.l_spring0,
+                    p.l_s,
+                    p.l_p,
+                    self.recording.x_s[k],
+                );
+                area * (r.p1[k] - r.p2[k]) <= spring
+            })
+            .collect()
+    }
+
+    /// Weighted sums of squares per channel, training and held-out.
+    pub fn errors(&self, prediction: &[Vec<f64>; CHANNELS]) -> ([f64; CHANNELS], [f64; CHANNELS]) {
+        let mut train = [0.0; CHANNELS];
+        let mut heldout = [0.0; CHANNELS];
+        for c in 0..CHANNELS {
+            let w = self.weights[c];
+            if w == 0.0 {
+                continue;
+            }
+            for (k, (&m, &y)) in self.measured[c].iter().zip(&prediction[c]).enumerate() {
+                let e = w * (m - y);
+                if self.training[k] {
+                    train[c] += e * e;
+                } else {
+                    heldout[c] += e * e;
+                }
+            }
+        }
+        (train, heldout)
+    }
+
+    /// Sensitivity of the outputs to one parameter at a point of the base model.
+    pub fn sensitivity(&self, name: &'static str, step: f64, at: &Replay) -> Option<Sensitivity> {
+        let mut p = self.base.clone();
+        let value = parameter_value(&p, name);
+        set_parameter(&mut p, name, value + step).ok()?;
+        let model = Actuator::new(p).ok()?;
+        let moved = replay_fast(&model, self.recording, self.recording.len()).ok()?;
+        let d = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| (x - y) / step).collect() };
+        Some([d(&moved.force, &at.force), d(&moved.p1, &at.p1), d(&moved.p2, &at.p2)])
+    }
+
+    /// Fit a candidate: bounded Gauss–Newton from its neutral values, at most `iterations`
+    /// linearisations. `start` may give the base replay and the sensitivities to the
+    /// candidate's nonlinear terms at the neutral point (shared between candidates).
+    pub fn fit(
+        &self,
+        candidate: &Candidate,
+        iterations: usize,
+        base_replay: &Replay,
+        shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
+    ) -> Result<Fit, String> {
+        let terms = &candidate.terms;
+        if terms.iter().any(|t| t.mechanism == Mechanism::Shape) {
+            return self.fit_shape(candidate, base_replay);
+        }
+        if terms.iter().any(|t| t.mechanism.is_searched()) {
+            if terms.len() > 1 {
+                return self.fit_search_then_refine(candidate, iterations, base_replay);
+            }
+            // The first pass only ranks the candidates: a coarser search does for that.
+            let steps = if iterations <= 1 {
+                COARSE_GOLDEN_STEPS
+            } else {
+                GOLDEN_STEPS
+            };
+            return self.fit_search(candidate, base_replay, steps);
+        }
+        // Sensitivities of the modulated parameters (at the base point: first order).
+        let modulated: Vec<Option<Sensitivity>> = terms
+            .iter()
+            .map(|t| match t.mechanism {
+                Mechanism::Modulated { parameter, .. } => shared(parameter),
+                _ => None,
+            })
+            .collect();
+        let mut point = Point {
+            values: terms.iter().map(|t| t.neutral).collect(),
+            replay: base_replay.clone(),
+        };
+        let mut replays = 0;
+        let mut prediction = self.predict(terms, &point, &modulated);
+        let (mut train, _) = self.errors(&prediction);
+        for iteration in 0..iterations.max(1) {
+            // Columns: nonlinear terms by finite differences (shared ones at the start), their
+            // replays spread over the threads; `known` ends up holding both kinds.
+            let mut known: Vec<Option<Sensitivity>> = terms
+                .iter()
+                .map(|term| match term.mechanism {
+                    Mechanism::Parameter(name) if iteration == 0 && candidate.settings.is_empty() => shared(name),
+                    _ => None,
+                })
+                .collect();
+            let differenced: Vec<(usize, f64)> = terms
+                .iter()
+                .enumerate()
+                .filter(|(j, term)| {
+                    known[*j].is_none()
+                        && matches!(
+                            term.mechanism,
+                            Mechanism::Parameter(_) | Mechanism::CommandLag | Mechanism::InputCubic
+                        )
+                })
+                .map(|(j, term)| {
+                    let step = if point.values[j] + term.step <= term.upper {
+                        term.step
+                    } else {
+                        -term.step
+                    };
+                    (j, step)
+                })
+                .collect();
+            let jobs = self.jobs.load(std::sync::atomic::Ordering::Relaxed);
+            let moved_replays = crate::parallel_map(&differenced, jobs, |&(j, step)| {
+                let mut moved = point.values.clone();
+                moved[j] += step;
+                self.replay(candidate, &moved).ok().map(|r| {
+                    let d =
+                        |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| (x - y) / step).collect() };
+                    [
+                        d(&r.force, &point.replay.force),
+                        d(&r.p1, &point.replay.p1),
+                        d(&r.p2, &point.replay.p2),
+                    ]
+                })
+            });
+            replays += differenced.len();
+            for (&(j, _), column) in differenced.iter().zip(moved_replays) {
+                known[j] = column;
+            }
+            let mut columns: Vec<Sensitivity> = Vec::with_capacity(terms.len());
+            for (j, term) in terms.iter().enumerate() {
+                let column = match term.mechanism {
+                    _ if known[j].is_some() => known[j].take(),
+                    Mechanism::Output { .. } | Mechanism::Modulated { .. } => {
+                        let mut unit = point.values.clone();
+                        unit.iter_mut().zip(terms).for_each(|(v, t)| {
+                            if t.mechanism.is_linear() {
+                                *v = 0.0
+                            }
+                        });
+                        unit[j] = 1.0;
+                        let only = Point {
+                            values: unit,
+                            replay: point.replay.clone(),
+                        };
+                        let with = self.predict(terms, &only, &modulated);
+                        Some([
+                            difference(&with[0], &point.replay.force),
+                            difference(&with[1], &point.replay.p1),
+                            difference(&with[2], &point.replay.p2),
+                        ])
+                    }
+                    _ => None,
+                };
+                columns.push(column.unwrap_or_else(|| [vec![], vec![], vec![]]));
+            }
+            let step = self.solve(terms, &point.values, &columns, &prediction);
+            // Line search on the true model.
+            let mut accepted = false;
+            let mut alpha = 1.0;
+            for _ in 0..4 {
+                let values: Vec<f64> = point
+                    .values
+                    .iter()
+                    .zip(&step)
+                    .zip(terms)
+                    .map(|((v, s), t)| (v + alpha * s).clamp(t.lower, t.upper))
+                    .collect();
+                let nonlinear_moved = terms
+                    .iter()
+                    .zip(values.iter().zip(&point.values))
+                    .any(|(t, (a, b))| !t.mechanism.is_linear() && a != b);
+                let replay = if nonlinear_moved {
+                    replays += 1;
+                    match self.replay(candidate, &values) {
+                        Ok(r) => r,
+                        Err(_) => {
+                            alpha *= 0.5;
+                            continue;
+                        }
+                    }
+                } else {
+                    point.replay.clone()
+                };
+                let trial = Point { values, replay };
+                let trial_prediction = self.predict(terms, &trial, &modulated);
+                let (trial_train, _) = self.errors(&trial_prediction);
+                if trial_train.iter().sum::<f64>() < train.iter().sum::<f64>() {
+                    point = trial;
+                    prediction = trial_prediction;
+                    train = trial_train;
+                    accepted = true;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            if !accepted || terms.iter().all(|t| t.mechanism.is_linear()) {
+                break;
+            }
+        }
+        let (train, heldout) = self.errors(&prediction);
+        Ok(Fit {
+            candidate: candidate.clone(),
+            values: point.values,
+            prediction,
+            train,
+            heldout,
+            replays,
+        })
+    }
+
+    /// Bounded linear least squares for the step of every term, on the training samples.
+    fn solve(
+        &self,
+        terms: &[Term],
+        values: &[f64],
+        columns: &[Sensitivity],
+        prediction: &[Vec<f64>; CHANNELS],
+    ) -> Vec<f64> {
+        let m = terms.len();
+        let usable: Vec<bool> = columns.iter().map(|c| c.iter().any(|ch| !ch.is_empty())).collect();
+        let mut ata = vec![vec![0.0; m]; m];
+        let mut atb = vec![0.0; m];
+        for c in 0..CHANNELS {
+            let w2 = self.weights[c] * self.weights[c];
+            if w2 == 0.0 {
+                continue;
+            }
+            for k in 0..self.recording.len() {
+                if !self.training[k] {
+                    continue;
+                }
+                let r = self.measured[c][k] - prediction[c][k];
+                for a in 0..m {
+                    let ja = if usable[a] && !columns[a][c].is_empty() {
+                        columns[a][c][k]
+                    } else {
+                        0.0
+                    };
+                    if ja == 0.0 {
+                        continue;
+                    }
+                    atb[a] += w2 * ja * r;
+                    for b in a..m {
+                        let jb = if usable[b] && !columns[b][c].is_empty() {
+                            columns[b][c][k]
+                        } else {
+                            0.0
+                        };
+                        ata[a][b] += w2 * ja * jb;
+                    }
+                }
+            }
+        }
+        for a in 0..m {
+            for b in 0..a {
+                ata[a][b] = ata[b][a];
+            }
+        }
+        let lower: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.lower - v).collect();
+        let upper: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.upper - v).collect();
+        bounded_least_squares(&ata, &atb, &usable, &lower, &upper)
+    }
+
+    /// A transform with one coefficient whose sensitivity vanishes where it is off (a
+    /// limit does nothing until it clips, a slew limit until the command jumps) or that
+    /// acts on a measured channel exactly (a delay, a lag, a play): golden-section search
+    /// on the coefficient, on a logarithmic scale where it spans decades.
+    /// A candidate whose regressors share one or two shape parameters (a friction's speed
+    /// scales): golden-section search of their logarithms (the second outside the first),
+    /// the linear amplitudes solved at each trial point.
+    fn fit_shape(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
+        let shapes: Vec<usize> = (0..candidate.terms.len())
+            .filter(|&k| candidate.terms[k].mechanism == Mechanism::Shape)
+            .collect();
+        let range = |k: usize| (candidate.terms[shapes[k]].lower, candidate.terms[shapes[k]].upper);
+        let value_of = |k: usize, u: f64| {
+            let (lower, upper) = range(k);
+            lower * (upper / lower).powf(u)
+        };
+        let shaped = |vc: f64, vs: f64| -> Candidate {
+            let mut c = candidate.clone();
+            c.terms.retain(|t| t.mechanism != Mechanism::Shape);
+            for t in c.terms.iter_mut() {
+                if let Mechanism::Output { channel, regressor } = t.mechanism {
+                    let regressor = match regressor {
+                        Regressor::SmoothFriction(_) => Regressor::SmoothFriction(vc),
+                        Regressor::Stribeck(..) => Regressor::Stribeck(vc, vs),
+                        other => other,
+                    };
+                    t.mechanism = Mechanism::Output { channel, regressor };
+                }
+            }
+            c
+        };
+        let none = |_: &'static str| None;
+        let fit_at = |vc: f64, vs: f64| self.fit(&shaped(vc, vs), 1, base_replay, &none).ok();
+        let cost = |fit: &Option<Fit>| fit.as_ref().map_or(f64::INFINITY, |f| f.train_total());
+        // The best u in [0, 1] of a unimodal cost, and its cost.
+        let golden = |iterations: usize, f: &dyn Fn(f64) -> f64| -> (f64, f64) {
+            let phi = (5f64.sqrt() - 1.0) / 2.0;
+            let (mut a, mut b) = (0.0, 1.0);
+            let mut c = b - phi * (b - a);
+            let mut d = a + phi * (b - a);
+            let (mut fc, mut fd) = (f(c), f(d));
+            for _ in 0..iterations {
+                if fc < fd {
+                    b = d;
+                    d = c;
+                    fd = fc;
+                    c = b - phi * (b - a);
+                    fc = f(c);
+                } else {
+                    a = c;
+                    c = d;
+                    fc = fd;
+                    d = a + phi * (b - a);
+                    fd = f(d);
+                }
+            }
+            if fc < fd {
+                (c, fc)
+            } else {
+                (d, fd)
+            }
+        };
+        let inner = |vs: f64| golden(14, &|u| cost(&fit_at(value_of(0, u), vs)));
+        let (vc, vs) = if shapes.len() >= 2 {
+            let (u_s, _) = golden(10, &|u| inner(value_of(1, u)).1);
+            let vs = value_of(1, u_s);
+            (value_of(0, inner(vs).0), vs)
+        } else {
+            (value_of(0, inner(0.0).0), 0.0)
+        };
+        let fit = fit_at(vc, vs).ok_or("the shaped fit failed")?;
+        let mut values = fit.values.clone();
+        values.insert(shapes[0], vc);
+        if shapes.len() >= 2 {
+            values.insert(shapes[1], vs);
+        }
+        Ok(Fit {
+            candidate: candidate.clone(),
+            values,
+            ..fit
+        })
+    }
+
+    /// A searched term followed by parameters that only act once it is on (an orifice and the
+    /// volume behind it): the search with the parameters at their starts, then Gauss–Newton on
+    /// all of them from there, the searched term now a parameter. A first pass (one
+    /// iteration: the ranking of every candidate) searches coarser. It still takes its one
+    /// Gauss–Newton step: the volume can matter more than the orifice (a wide orifice in front
+    /// of a line acts as a volume added to the chamber), and without the step such a candidate
+    /// would rank below the ones that mimic it and never be refined.
+    fn fit_search_then_refine(
+        &self,
+        candidate: &Candidate,
+        iterations: usize,
+        base_replay: &Replay,
+    ) -> Result<Fit, String> {
+        let (first, rest) = candidate.terms.split_first().ok_or("a candidate without terms")?;
+        let mut settings = candidate.settings.clone();
+        settings.extend(
+            rest.iter()
+                .filter_map(|t| t.mechanism.model_parameter().map(|name| (name, t.neutral))),
+        );
+        let searched = Candidate {
+            terms: vec![first.clone()],
+            settings,
+            ..candidate.clone()
+        };
+        let first_pass = iterations <= 1;
+        let found = self.fit_search(
+            &searched,
+            base_replay,
+            if first_pass { COARSE_GOLDEN_STEPS } else { GOLDEN_STEPS },
+        )?;
+        let neutral: Vec<f64> = candidate.terms.iter().map(|t| t.neutral).collect();
+        if found.values[0] == first.neutral {
+            // Nothing the search could find: the candidate stays off, and so do the parameters
+            // that act only behind it.
+            let mut values = neutral;
+            for (value, term) in values.iter_mut().zip(&candidate.terms).skip(1) {
+                if let Some(name) = term.mechanism.model_parameter() {
+                    *value = parameter_value(self.base, name);
+                }
+            }
+            return Ok(Fit {
+                candidate: candidate.clone(),
+                values,
+                ..found
+            });
+        }
+        let name = first
+            .mechanism
+            .model_parameter()
+            .ok_or("a searched term without a parameter")?;
+        let mut refined = candidate.clone();
+        refined.terms[0] = Term {
+            mechanism: Mechanism::Parameter(name),
+            neutral: found.values[0],
+            step: 0.02 * found.values[0],
+            ..first.clone()
+        };
+        let start: Vec<f64> = refined.terms.iter().map(|t| t.neutral).collect();
+        let start_replay = self.replay(&refined, &start)?;
+        let none = |_: &'static str| None;
+        let fit = self.fit(&refined, iterations, &start_replay, &none)?;
+        Ok(Fit {
+            candidate: candidate.clone(),
+            replays: fit.replays + found.replays + 1,
+            ..fit
+        })
+    }
+
+    fn fit_search(&self, candidate: &Candidate, base_replay: &Replay, golden_steps: usize) -> Result<Fit, String> {
+        let p = self.base;
+        let term = &candidate.terms[0];
+        let commands = self.recording.v_da.iter();
+        let (lower, upper, logarithmic) = match term.mechanism {
+            Mechanism::CurrentLimit => {
+                let largest = commands
+                    .map(|v| current_driver::static_current(p.k_cd, p.i_offset, *v).abs())
+                    .fold(0.0, f64::max);
+                (0.2 * largest, largest, false)
+            }
+            Mechanism::CommandLimit => {
+                let largest = commands.map(|v| v.abs()).fold(0.0, f64::max);
+                (0.2 * largest, largest, false)
+            }
+            _ => (term.lower, term.upper, true),
+        };
+        let base = Prediction::of_replay(base_replay);
+        let mut replays = 0;
+        let mut evaluate = |value: f64| -> (f64, Option<[Vec<f64>; CHANNELS]>) {
+            let prediction = match term.mechanism {
+                Mechanism::OutputFilter { channel, filter } => {
+                    let mut out = base.clone();
+                    out[channel] = filter.apply(&self.recording.time, &base[channel], value);
+                    Some(out)
+                }
+                _ => {
+                    replays += 1;
+                    self.replay(candidate, &[value]).ok().map(|r| Prediction::of_replay(&r))
+                }
+            };
+            match prediction {
+                Some(y) => (self.errors(&y).0.iter().sum(), Some(y)),
+                None => (f64::INFINITY, None),
+            }
+        };
+        let to_value = |u: f64| {
+            if logarithmic {
+                lower * (upper / lower).powf(u)
+            } else {
+                lower + (upper - lower) * u
+            }
+        };
+        let phi = (5f64.sqrt() - 1.0) / 2.0;
+        let (mut a, mut b) = (0.0, 1.0);
+        let mut c = b - phi * (b - a);
+        let mut d = a + phi * (b - a);
+        let (mut fc, mut fd) = (evaluate(to_value(c)).0, evaluate(to_value(d)).0);
+        for _ in 0..golden_steps {
+            if fc < fd {
+                b = d;
+                d = c;
+                fd = fc;
+                c = b - phi * (b - a);
+                fc = evaluate(to_value(c)).0;
+            } else {
+                a = c;
+                c = d;
+                fc = fd;
+                d = a + phi * (b - a);
+                fd = evaluate(to_value(d)).0;
+            }
+        }
+        let best = to_value(if fc < fd { c } else { d });
+        let (cost, prediction) = evaluate(best);
+        let (values, prediction) = match prediction {
+            Some(y) if cost < self.errors(&base).0.iter().sum::<f64>() => (vec![best], y),
+            _ => (vec![term.neutral], base),
+        };
+        let (train, heldout) = self.errors(&prediction);
+        Ok(Fit {
+            candidate: candidate.clone(),
+            values,
+            prediction,
+            train,
+            heldout,
+            replays,
+        })
+    }
+}
+
+struct Prediction;
+
+impl Prediction {
+    fn of_replay(r: &Replay) -> [Vec<f64>; CHANNELS] {
+        [r.force.clone(), r.p1.clone(), r.p2.clone()]
+    }
+}
+
+/// min |A x − b|² given the normal equations (ata, atb), with lower ≤ x ≤ upper and the
+/// unusable unknowns at 0: solve the free unknowns, clamp those that leave their bounds,
+/// and solve again for the rest (at most once per unknown).
+fn bounded_least_squares(ata: &[Vec<f64>], atb: &[f64], usable: &[bool], lower: &[f64], upper: &[f64]) -> Vec<f64> {
+    let m = atb.len();
+    let mut x = vec![0.0; m];
+    let mut fixed: Vec<bool> = usable.iter().map(|u| !u).collect();
+    for _ in 0..=m {
+        let free: Vec<usize> = (0..m).filter(|&j| !fixed[j]).collect();
+        if free.is_empty() {
+            return x;
+        }
+        let mut a = nalgebra::DMatrix::<f64>::zeros(free.len(), free.len());
+        let mut b = nalgebra::DVector::<f64>::zeros(free.len());
+        for (i, &fi) in free.iter().enumerate() {
+            b[i] = atb[fi] - (0..m).filter(|&j| fixed[j]).map(|j| ata[fi][j] * x[j]).sum::<f64>();
+            for (j, &fj) in free.iter().enumerate() {
+                a[(i, j)] = ata[fi][fj];
+            }
+            // A whisker of ridge keeps nearly collinear columns solvable.
+            a[(i, i)] += 1e-10 * ata[fi][fi].max(1e-300);
+        }
+        let Some(solution) = a.lu().solve(&b) else { return x };
+        let mut clamped = false;
+        for (i, &fi) in free.iter().enumerate() {
+            x[fi] = solution[i];
+            if !(lower[fi]..=upper[fi]).contains(&x[fi]) {
+                x[fi] = x[fi].clamp(lower[fi], upper[fi]);
+                fixed[fi] = true;
+                clamped = true;
+            }
+        }
+        if !clamped {
+            return x;
+        }
+    }
+    x
+}

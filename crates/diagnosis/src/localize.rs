@@ -1,0 +1,213 @@
+//! Step 4 of the crate's account: fit every candidate, score it on the held-out blocks
+//! and rank the places of the chain; the penalties by which simpler candidates win.
+
+use super::*;
+
+/// How many of a fitted candidate's terms are away from their neutral values.
+pub(crate) fn used_terms(s: &Scored) -> f64 {
+    s.fit
+        .values
+        .iter()
+        .zip(&s.fit.candidate.terms)
+        .filter(|(v, t)| **v != t.neutral)
+        .count() as f64
+}
+
+/// A candidate's held-out misfit (in noise floors squared) plus a BIC-like penalty of
+/// ln(held-out samples) per term used: best first, a term that adds nothing on the held-out
+/// blocks loses to a simpler candidate.
+pub(crate) fn penalised(s: &Scored, heldout_samples: f64) -> f64 {
+    s.fit.heldout_total() + used_terms(s) * heldout_samples.ln()
+}
+
+/// What each term of a discovered candidate must earn on the held-out blocks, in noise
+/// floors squared: BIC's ln(samples), and at least a hundredth of a noise floor squared per
+/// held-out sample. The second binds on long recordings, where ln n lets a term in for a
+/// trend of a few hundredths of the noise (a pressure transducer's 8 kPa offset was otherwise
+/// taken as an offset and a drift on both channels, for 11 Pa over 80 s against 150 Pa of
+/// noise).
+pub(crate) fn discovery_penalty_per_term(heldout_samples: f64) -> f64 {
+    heldout_samples
+        .ln()
+        .max(MIN_MEAN_SQUARE_GAIN_PER_TERM * heldout_samples)
+}
+
+/// See [`discovery_penalty_per_term`].
+pub(crate) const MIN_MEAN_SQUARE_GAIN_PER_TERM: f64 = 0.01;
+
+pub(crate) fn discovery_penalised(s: &Scored, heldout_samples: f64) -> f64 {
+    s.fit.heldout_total() + used_terms(s) * discovery_penalty_per_term(heldout_samples)
+}
+
+/// Runs `f` on every item over `jobs` threads, results in the items' order.
+pub(crate) fn parallel_map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let jobs = jobs.clamp(1, items.len().max(1));
+    if jobs == 1 {
+        return items.iter().map(f).collect();
+    }
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut out: Vec<(usize, R)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..jobs)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = vec![];
+                    loop {
+                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        if k >= items.len() {
+                            break;
+                        }
+                        mine.push((k, f(&items[k])));
+                    }
+                    mine
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("a diagnosis worker panicked"))
+            .collect()
+    });
+    out.sort_by_key(|(k, _)| *k);
+    out.into_iter().map(|(_, r)| r).collect()
+}
+
+pub(crate) fn heldout_count(training: &[bool]) -> usize {
+    training.iter().filter(|t| !**t).count().max(1)
+}
+
+/// Fit every candidate and rank the places of the chain.
+pub(crate) fn localize(
+    problem: &Problem,
+    base_replay: &Replay,
+    candidates: &[Candidate],
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> (Localization, usize) {
+    let jobs = options.jobs;
+    let bars = &options.bars;
+    let base_prediction = [
+        base_replay.force.clone(),
+        base_replay.p1.clone(),
+        base_replay.p2.clone(),
+    ];
+    let (_, heldout_before) = problem.errors(&base_prediction);
+    let before_total: f64 = heldout_before.iter().sum::<f64>().max(1e-300);
+    // Sensitivities at the base point, shared by every candidate's first step.
+    let mut wanted: Vec<(&'static str, f64)> = vec![];
+    for c in candidates.iter().filter(|c| c.settings.is_empty()) {
+        for t in &c.terms {
+            let name = match t.mechanism {
+                Mechanism::Parameter(name) => Some((name, t.step)),
+                Mechanism::Modulated { parameter, .. } => candidates
+                    .iter()
+                    .flat_map(|c| &c.terms)
+                    .find(|u| u.mechanism == Mechanism::Parameter(parameter))
+                    .map(|u| (parameter, u.step)),
+                _ => None,
+            };
+            if let Some((name, step)) = name {
+                if !wanted.iter().any(|(n, _)| *n == name) {
+                    wanted.push((name, step));
+                }
+            }
+        }
+    }
+    progress(&format!(
+        "sensitivities of the outputs to {} model constants ({} threads)",
+        wanted.len(),
+        jobs
+    ));
+    let sensitivities: Vec<Option<Sensitivity>> =
+        parallel_map_shown("sensitivities", bars, &wanted, jobs, |(name, step)| {
+            problem.sensitivity(name, *step, base_replay)
+        });
+    let mut replays = wanted.len();
+    let shared = |name: &'static str| -> Option<Sensitivity> {
+        wanted
+            .iter()
+            .position(|(n, _)| *n == name)
+            .and_then(|k| sensitivities[k].clone())
+    };
+    let score = |fit: Fit| -> Scored {
+        let explained = 1.0 - fit.heldout_total() / before_total;
+        let residual = difference(&problem.recording.force, &fit.prediction[FORCE]);
+        let force_heldout_rms = rms_where(&residual, problem.training, false);
+        Scored {
+            fit,
+            explained,
+            force_heldout_rms,
+        }
+    };
+    progress(&format!("fitting {} candidate corrections", candidates.len()));
+    let first: Vec<Option<Fit>> = parallel_map_shown("candidates", bars, candidates, jobs, |c| {
+        problem.fit(c, 1, base_replay, &shared).ok()
+    });
+    let mut scored: Vec<Scored> = first.into_iter().flatten().map(score).collect();
+    replays += scored.iter().map(|s| s.fit.replays).sum::<usize>();
+    scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
+    // Refine the leaders (and every named effect near them) with more iterations.
+    let leaders: Vec<Candidate> = scored
+        .iter()
+        .filter(|s| {
+            s.fit
+                .candidate
+                .terms
+                .iter()
+                .any(|t| !matches!(t.mechanism, Mechanism::Output { .. }))
+        })
+        .filter(|s| s.explained >= WORTH_REFINING)
+        .take(REFINED)
+        .map(|s| s.fit.candidate.clone())
+        .collect();
+    progress(&format!("refining the {} leading candidates", leaders.len()));
+    // Fewer leaders than threads, and one of them may take most of the time (a smooth
+    // hysteresis law): its finite differences share the threads too.
+    problem.set_jobs(jobs);
+    let refined: Vec<Option<Fit>> = parallel_map_shown("refining", bars, &leaders, jobs, |c| {
+        problem.fit(c, REFINE_ITERATIONS, base_replay, &shared).ok()
+    });
+    problem.set_jobs(1);
+    for fit in refined.into_iter().flatten() {
+        replays += fit.replays;
+        let better = score(fit);
+        if let Some(s) = scored.iter_mut().find(|s| s.fit.candidate == better.fit.candidate) {
+            if better.explained > s.explained {
+                *s = better;
+            }
+        }
+    }
+    for (l, e, label) in rank(&mut scored).by_location.iter().take(4) {
+        progress(&format!("  {l:<16} explains {:5.1} % ({label})", 100.0 * e));
+    }
+    (rank(&mut scored), replays)
+}
+
+/// Rank the places of the chain by their best candidate.
+pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
+    scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
+    let mut by_location: Vec<(&'static str, f64, &'static str)> = vec![];
+    for s in scored.iter() {
+        if !by_location.iter().any(|(l, _, _)| *l == s.fit.candidate.location) {
+            by_location.push((s.fit.candidate.location, s.explained, s.fit.candidate.label));
+        }
+    }
+    let (location, family) = match scored.first() {
+        Some(best) if best.explained >= LOCATED_SHARE => {
+            // The family: the simplest candidate at that place that explains nearly as much.
+            let place = best.fit.candidate.location;
+            let simplest = scored
+                .iter()
+                .filter(|s| s.fit.candidate.location == place && s.explained >= best.explained - 0.02)
+                .min_by_key(|s| s.fit.candidate.terms.len())
+                .unwrap_or(best);
+            (place, simplest.fit.candidate.family)
+        }
+        _ => ("unknown", "unknown"),
+    };
+    Localization {
+        location,
+        family,
+        by_location,
+        candidates: scored.to_vec(),
+    }
+}

@@ -1,0 +1,226 @@
+//! The report: the printed summary and the JSON of `jetpipe diagnose --report`.
+
+use super::*;
+
+fn parameters_json(values: &[(&'static str, f64)]) -> Value {
+    Value::Object(values.iter().map(|(n, v)| (n.to_string(), json!(v))).collect())
+}
+
+impl Diagnosis {
+    /// The summary, opening with the verdict in words.
+    pub fn summary(&self) -> Vec<String> {
+        let mut lines = vec![];
+        let ratio = self.after.heldout_rms / self.noise_floor.max(1e-12);
+        let mut names: Vec<&str> = self.effects.iter().map(|e| e.name).collect();
+        names.extend(self.discovered.iter().map(|d| d.candidate));
+        lines.push(match (&self.unexplained, names.is_empty()) {
+            (Some(u), _) if self.explained() => format!("Explained in the force, not in the pressures: {}", u.sentence),
+            (None, true) => format!(
+                "Explained: the thesis model reproduces the force to within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N); nothing was added.",
+                self.after.heldout_rms, self.noise_floor
+            ),
+            (None, false) if self.effects.is_empty() && self.discovered.iter().all(|d| d.pressures_heldout.is_some()) => {
+                format!(
+                    "Explained with {}: the pressures now agree with the recording's, and the force stays within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N).",
+                    names.join(" and "),
+                    self.after.heldout_rms,
+                    self.noise_floor
+                )
+            }
+            (None, false) => format!(
+                "Explained with {}: the held-out force error falls from {:.4} N to {:.4} N, {ratio:.1}× the noise floor {:.4} N.",
+                names.join(" and "),
+                self.before.heldout_rms,
+                self.after.heldout_rms,
+                self.noise_floor
+            ),
+            (Some(u), _) => format!(
+                "Not explained{}: {}",
+                if names.is_empty() {
+                    String::new()
+                } else {
+                    format!(" by {} alone", names.join(" and "))
+                },
+                u.sentence
+            ),
+        });
+        if let Some(s) = &self.pressure_split {
+            lines.push(s.sentence.clone());
+        }
+        lines.extend(self.input_checks.iter().cloned());
+        for c in &self.calibrated {
+            lines.push(format!(
+                "Calibrated {} = {:.4e} (thesis {:.4e}){}",
+                c.name,
+                c.value,
+                c.thesis,
+                if c.flags.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {}", c.flags.join("; "))
+                }
+            ));
+        }
+        for d in &self.discovered {
+            lines.push(match d.pressures_heldout {
+                Some((before, after)) => format!(
+                    "+ discovered: {} It lowers the held-out pressure errors from {:.0} and {:.0} Pa to {:.0} and {:.0} Pa in the model; the force error stays at {:.4} N.",
+                    d.reading, before[0], before[1], after[0], after[1], d.heldout_after
+                ),
+                None => format!(
+                    "+ discovered: {} It lowers the held-out force error from {:.4} N to {:.4} N in the model ({:.1} % of its mean square).",
+                    d.reading,
+                    d.heldout_before,
+                    d.heldout_after,
+                    100.0 * d.share
+                ),
+            });
+        }
+        for e in &self.effects {
+            let values: Vec<String> = e.parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
+            lines.push(format!("+ {} ({}): {}", e.name, values.join(", "), e.evidence));
+            if !e.remainder_follows.is_empty() {
+                lines.push(format!("  what it leaves follows {}", e.remainder_follows));
+            }
+        }
+        if let Some((a, b)) = self.joint_refit {
+            lines.push(format!(
+                "Refitted together, the added parameters lower the held-out force error from {a:.4} N to {b:.4} N (the values above are the refitted ones)."
+            ));
+        }
+        lines.push(format!(
+            "Force RMS error {:.4} N before, {:.4} N after (held-out {:.4} N before, {:.4} N after).",
+            self.before.rms, self.after.rms, self.before.heldout_rms, self.after.heldout_rms
+        ));
+        lines
+    }
+
+    pub fn to_json(&self, recording_name: &str) -> Value {
+        let err = |e: &Errors| match e.pressure_rms {
+            Some(p) => json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse, "pressure_rms_Pa": p.to_vec()}),
+            None => json!({"force_rms_N": e.rms, "force_nrmse": e.nrmse}),
+        };
+        // Every parameter of the final model that is not the thesis's: with these the FMU
+        // is the model whose errors the report gives.
+        let thesis = Parameters::default();
+        let mut start_values = serde_json::Map::new();
+        for &value_reference in Parameters::VALUE_REFERENCES {
+            let value = self.parameters.get(value_reference);
+            if value != thesis.get(value_reference) {
+                if let Some(v) = value {
+                    start_values.insert(
+                        jetpipe_model::physics::parameters::variable_name(value_reference).to_string(),
+                        json!(v),
+                    );
+                }
+            }
+        }
+        let mut report = json!({
+            "recording": recording_name,
+            "samples": self.samples,
+            "noise_floor_N": self.noise_floor,
+            "verdict": self.verdict(),
+            "summary": self.summary(),
+            "input_checks": self.input_checks,
+            "before": err(&self.before),
+            "after": err(&self.after),
+            "heldout": {"before_rms_N": self.before.heldout_rms, "after_rms_N": self.after.heldout_rms},
+            "effects": self.effects.iter().map(|e| json!({
+                "name": e.name,
+                "location": e.location,
+                "parameters": parameters_json(&e.parameters),
+                "heldout_before_rms_N": e.heldout_before,
+                "heldout_after_rms_N": e.heldout_after,
+                "share_of_heldout_explained": e.share,
+                "remainder_follows": e.remainder_follows,
+                "evidence": e.evidence,
+            })).collect::<Vec<_>>(),
+            "discovered": self.discovered.iter().map(|d| json!({
+                "location": d.location,
+                "family": d.family,
+                "candidate": d.candidate,
+                "parameters": parameters_json(&d.parameters),
+                "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(discover::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
+                "reading": d.reading,
+                "heldout_before_rms_N": d.heldout_before,
+                "heldout_after_rms_N": d.heldout_after,
+                "share_of_heldout_explained": d.share,
+                "pressures_heldout_before_rms_Pa": d.pressures_heldout.map(|(b, _)| b.to_vec()),
+                "pressures_heldout_after_rms_Pa": d.pressures_heldout.map(|(_, a)| a.to_vec()),
+            })).collect::<Vec<_>>(),
+            "calibrated": self.calibrated.iter().map(|c| (c.name.to_string(), json!({
+                "value": c.value,
+                "thesis": c.thesis,
+                "relative_shift": if c.thesis != 0.0 { (c.value - c.thesis) / c.thesis.abs() } else { 0.0 },
+                "first_half": c.halves_in_time.0,
+                "second_half": c.halves_in_time.1,
+                "commands_below_median": c.halves_in_command.0,
+                "commands_above_median": c.halves_in_command.1,
+                "flags": c.flags,
+            }))).collect::<serde_json::Map<_, _>>(),
+            "candidates": self.candidates.iter().map(|c| json!({
+                "candidate": c.fit.candidate.label,
+                "location": c.fit.candidate.location,
+                "family": c.fit.candidate.family,
+                "named_effect": c.fit.candidate.named,
+                "parameters": parameters_json(&c.parameters()),
+                "explained_share_heldout": c.explained,
+                "force_heldout_rms_N": c.force_heldout_rms,
+            })).collect::<Vec<_>>(),
+            "residual_tests": self.residual_tests,
+            "fmu_start_values": start_values,
+            "stopper_positions": "the model was driven with x_s_m averaged over samples k-3..k+3 (fewer at the ends), as the FMU must be to reproduce these errors",
+            "joint_refit": self.joint_refit.map(|(a, b)| json!({"heldout_before_rms_N": a, "heldout_after_rms_N": b})),
+            "replays": self.replays,
+        });
+        let object = report.as_object_mut().expect("a JSON object");
+        if let Some(p) = self.pressure_noise {
+            object.insert("noise_floor_Pa".into(), json!({"p1": p[0], "p2": p[1]}));
+        }
+        if let Some(u) = &self.unexplained {
+            object.insert(
+                "unexplained".into(),
+                json!({
+                    "rms_N": u.rms,
+                    "ratio_to_noise": u.ratio_to_noise,
+                    "location": u.location,
+                    "family": u.family,
+                    "alternatives": u.alternatives,
+                    "signature": u.signature.to_json("N"),
+                    "sentence": u.sentence,
+                    "channel": if self.explained() { "pressures" } else { "force" },
+                }),
+            );
+        }
+        object.insert(
+            "pressure_split".into(),
+            match &self.pressure_split {
+                Some(s) => json!({
+                    "available": true,
+                    "force_vs_pressures_rms_N": s.force_vs_pressures_rms,
+                    "force_vs_pressures_ratio_to_noise": s.force_vs_pressures_ratio,
+                    "pressures_vs_model_rms_Pa": s.pressure_rms,
+                    "pressures_vs_model_ratio_to_noise": s.pressure_ratio,
+                    "sentence": s.sentence,
+                }),
+                None => json!({
+                    "available": false,
+                    "sentence": "Without pressure channels a departure upstream of the piston, in the mechanics and in the force sensor can move the force alike; the location comes from the force alone and is less certain.",
+                }),
+            },
+        );
+        if let Some(l) = &self.localization {
+            object.insert(
+                "localization".into(),
+                json!({
+                    "location": l.location,
+                    "family": l.family,
+                    "by_location": l.by_location.iter().map(|(loc, e, label)| json!({
+                        "location": loc, "explained_share_heldout": e, "best_candidate": label,
+                    })).collect::<Vec<_>>(),
+                }),
+            );
+        }
+        report
+    }
+}

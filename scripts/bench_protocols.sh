@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Benchmark of `jetpipe diagnose` across protocols and mechanisms: benchgen writes each
+# mechanism under each protocol (its own integrator, noise and quantisation), the diagnosis
+# runs on it, and one Markdown table row per recording says whether the place and family are
+# the truth's, the verdict, and the held-out error after in noise floors.
+#
+#   bash scripts/bench_protocols.sh [SECONDS]     (default 40 s recordings)
+#
+# JETPIPE_BENCH_PROTOCOLS and JETPIPE_BENCH_MECHANISMS (space-separated names of the lists
+# below) choose a subset.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-40}"
+cargo build --release --bin jetpipe --bin benchgen >/dev/null 2>&1
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+
+# name|benchgen protocol options
+protocols=(
+    "staircase_1k_p|--protocol staircase --sample-rate 1000"
+    "multisine_1k_nop|--protocol multisine --sample-rate 1000 --no-pressures"
+    "prbs_2k_shake_p|--protocol prbs --sample-rate 2000 --stopper sine:0.054:0.004:2.5 --force-noise 0.03"
+    "ramps_500_moves_nop|--protocol ramps --sample-rate 500 --stopper moves:0.02 --no-pressures"
+    "tracking_500_p|--protocol force_tracking --sample-rate 500 --force-noise 0.08"
+    "sine_250_p|--protocol sine --sample-rate 250"
+)
+# name|truth location|truth family|benchgen effect options
+mechanisms=(
+    "clean|none|none|"
+    "pickup_50hz|force_sensor|periodic|--force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
+    "supply_30kpa_low|supply|parameter_offset|--supply-pressure 622925"
+    "receiver_offset|jet_pipe|parameter_offset|--undeclared receiver_offset"
+    "jet_pipe_lag|jet_pipe|dynamics|--undeclared jet_pipe_lag"
+    "chamber_1_leak|chambers|extra_flow|--undeclared chamber_1_leak"
+    "force_sensor_lag|force_sensor|dynamics|--undeclared force_sensor_lag"
+    "command_dead_zone|command|nonlinearity|--command-dead-zone 0.4"
+    "force_sensor_saturation|force_sensor|limit|--force-sensor-saturation 85"
+)
+
+chosen() { # NAME LIST: whether NAME is in the space-separated LIST (or LIST is empty)
+    [ -z "$2" ] && return 0
+    for x in $2; do [ "$x" = "$1" ] && return 0; done
+    return 1
+}
+
+echo "| protocol | mechanism | truth | verdict | found (location, family) | right place | held-out after / noise | wall (s) |"
+echo "|---|---|---|---|---|---|---|---|"
+for p in "${protocols[@]}"; do
+    pname="${p%%|*}"
+    popts="${p#*|}"
+    chosen "$pname" "${JETPIPE_BENCH_PROTOCOLS:-}" || continue
+    for m in "${mechanisms[@]}"; do
+        IFS='|' read -r mname mloc mfam mopts <<<"$m"
+        chosen "$mname" "${JETPIPE_BENCH_MECHANISMS:-}" || continue
+        rec="$work/${pname}_${mname}.csv"
+        # shellcheck disable=SC2086
+        ./target/release/benchgen --out "$rec" --seed 5 --duration "$seconds" $popts $mopts >/dev/null 2>&1
+        start=$(date +%s%N)
+        ./target/release/jetpipe diagnose "$rec" --report "$work/report.json" >/dev/null 2>&1 || true
+        end=$(date +%s%N)
+        ms=$(((end - start) / 1000000))
+        row=$(python3 - "$work/report.json" "$mloc" "$mfam" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+loc, fam = sys.argv[2], sys.argv[3]
+places = [(t["location"], t["family"]) for t in d["discovered"]]
+places += [("named: " + e["name"], e["location"]) for e in d["effects"]]
+if "unexplained" in d and d["unexplained"].get("channel", "force") == "force":
+    u = d["unexplained"]
+    places.append((u["location"], u["family"]))
+found = "; ".join(f"{a}, {b}" for a, b in places) or "nothing"
+if loc == "none":
+    right = "yes" if not d["discovered"] and not d["effects"] else "no"
+else:
+    right = "yes" if places and places[0] == (loc, fam) else ("place" if places and places[0][0] == loc else "no")
+ratio = d["heldout"]["after_rms_N"] / d["noise_floor_N"]
+print(f'{d["verdict"]} | {found} | {right} | {ratio:.2f}')
+PY
+) || row="error | — | no | —"
+        echo "| $pname | $mname | $mloc, $mfam | $row | $((ms / 1000)).$(((ms % 1000) / 100)) |"
+    done
+done

@@ -1,0 +1,303 @@
+//! The protocol generator: its signals checked against what each protocol promises (levels,
+//! spectra, bit sequences, speeds), its recordings against the sampling, noise and channels
+//! asked for, and its refusals.
+
+use synthetic_bench::protocols::{DURATION_RANGE, STOPPER_RANGE};
+use synthetic_bench::{
+    command_signal, generate_protocol, stopper_signal, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion,
+};
+
+fn samples(f: &dyn Fn(f64) -> f64, rate: f64, duration: f64) -> Vec<f64> {
+    (0..(rate * duration) as usize).map(|k| f(k as f64 / rate)).collect()
+}
+
+/// |DFT| at frequency `f` of `x` sampled at `rate`, scaled to a sine's amplitude.
+fn amplitude_at(x: &[f64], rate: f64, f: f64) -> f64 {
+    let (mut re, mut im) = (0.0, 0.0);
+    for (k, v) in x.iter().enumerate() {
+        let phase = 2.0 * std::f64::consts::PI * f * k as f64 / rate;
+        re += v * phase.cos();
+        im += v * phase.sin();
+    }
+    2.0 * (re * re + im * im).sqrt() / x.len() as f64
+}
+
+#[test]
+fn each_open_loop_command_is_a_function_of_its_seed_alone() {
+    for kind in CommandProtocol::ALL
+        .iter()
+        .copied()
+        .filter(|k| *k != CommandProtocol::ForceTracking)
+    {
+        let a = samples(&*command_signal(kind, 7, 30.0).unwrap(), 100.0, 30.0);
+        let b = samples(&*command_signal(kind, 7, 30.0).unwrap(), 100.0, 30.0);
+        let c = samples(&*command_signal(kind, 8, 30.0).unwrap(), 100.0, 30.0);
+        assert_eq!(a, b, "{}", kind.name());
+        assert_ne!(a, c, "{}: another seed gives the same command", kind.name());
+        assert!(
+            a.iter().all(|v| v.abs() <= 10.0),
+            "{} leaves the D/A range",
+            kind.name()
+        );
+    }
+}
+
+#[test]
+fn the_staircase_holds_levels_within_its_range_for_its_hold_times() {
+    let x = samples(
+        &*command_signal(CommandProtocol::Staircase, 3, 120.0).unwrap(),
+        1000.0,
+        120.0,
+    );
+    assert!(x.iter().all(|v| (-3.0..=9.0).contains(v)));
+    let changes: Vec<usize> = (1..x.len()).filter(|&k| x[k] != x[k - 1]).collect();
+    // holds of 0.3–3 s: 40–400 changes in 120 s
+    assert!((40..=400).contains(&changes.len()), "{} changes", changes.len());
+    for w in changes.windows(2) {
+        let hold = (w[1] - w[0]) as f64 / 1000.0;
+        assert!((0.299..=3.001).contains(&hold), "a level held {hold} s");
+    }
+}
+
+#[test]
+fn the_multisine_has_its_twelve_lines_and_nothing_between_them() {
+    let rate = 200.0;
+    let duration = 100.0; // every line's frequency is off the 0.01 Hz grid by less than a bin
+    let x = samples(
+        &*command_signal(CommandProtocol::Multisine, 2, duration).unwrap(),
+        rate,
+        duration,
+    );
+    let mean = x.iter().sum::<f64>() / x.len() as f64;
+    assert!((mean - 2.5).abs() < 0.05, "mean {mean}");
+    let centred: Vec<f64> = x.iter().map(|v| v - mean).collect();
+    for k in 0..12 {
+        let f = 0.1 * 200f64.powf(k as f64 / 11.0);
+        // a line between grid frequencies leaks; its peak over the nearest bins is still near 0.6 V
+        let peak = (-2..=2)
+            .map(|d| amplitude_at(&centred, rate, ((f * duration).round() + d as f64) / duration))
+            .fold(0.0, f64::max);
+        assert!(peak > 0.35 && peak < 0.65, "line at {f:.3} Hz: {peak:.3} V");
+    }
+    for f in [25.0, 40.0, 60.0] {
+        assert!(amplitude_at(&centred, rate, f) < 0.05, "power at {f} Hz");
+    }
+}
+
+#[test]
+fn the_prbs_switches_between_two_levels_on_its_bit_clock_with_balanced_bits() {
+    let x = samples(&*command_signal(CommandProtocol::Prbs, 5, 41.0).unwrap(), 1000.0, 40.92);
+    assert!(x.iter().all(|v| *v == 0.5 || *v == 4.5));
+    for k in 1..x.len() {
+        if x[k] != x[k - 1] {
+            assert_eq!(k % 40, 0, "a switch at sample {k}, off the 40 ms bit clock");
+        }
+    }
+    // one period of a maximal 10-bit sequence: 512 ones and 511 zeros
+    let ones = (0..1023).filter(|b| x[b * 40] == 4.5).count();
+    assert_eq!(ones, 512);
+}
+
+#[test]
+fn the_slow_sine_stays_between_its_extremes_at_a_frequency_below_one_hertz() {
+    let x = samples(&*command_signal(CommandProtocol::Sine, 9, 60.0).unwrap(), 500.0, 60.0);
+    let (lo, hi) = x.iter().fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(*v), b.max(*v)));
+    assert!((lo + 1.5).abs() < 0.01 && (hi - 6.5).abs() < 0.01, "{lo} … {hi}");
+    let crossings = (1..x.len()).filter(|&k| (x[k] - 2.5) * (x[k - 1] - 2.5) < 0.0).count();
+    assert!(
+        (11..=121).contains(&crossings),
+        "{crossings} crossings of the mean in 60 s"
+    );
+}
+
+#[test]
+fn the_ramps_are_continuous_and_move_at_bounded_rates() {
+    let x = samples(&*command_signal(CommandProtocol::Ramps, 4, 60.0).unwrap(), 1000.0, 60.0);
+    let max_rate = (1..x.len())
+        .map(|k| (x[k] - x[k - 1]).abs() * 1000.0)
+        .fold(0.0, f64::max);
+    // 12 V in at least 0.5 s
+    assert!(max_rate <= 24.0 + 1e-9, "{max_rate} V/s");
+    assert!(x.iter().all(|v| (-3.0..=9.0).contains(v)));
+}
+
+#[test]
+fn the_force_tracking_protocol_is_refused_as_a_function_of_time() {
+    let err = command_signal(CommandProtocol::ForceTracking, 1, 30.0).err().unwrap();
+    assert!(err.contains("force_tracking"), "{err}");
+}
+
+#[test]
+fn stopper_moves_reach_their_peak_speed_and_stay_inside_the_cylinder() {
+    for speed in [0.005, 0.02, 0.1] {
+        let s = stopper_signal(StopperMotion::Moves { speed }, 11, 60.0);
+        let rate = 2000.0;
+        let (mut peak, mut x_prev) = (0.0f64, s(0.0).0);
+        for k in 1..(60.0 * rate) as usize {
+            let (x, v) = s(k as f64 / rate);
+            assert!((0.035 - 1e-12..=0.080 + 1e-12).contains(&x), "x = {x} at sample {k}");
+            // the velocity is the derivative of the position
+            let slope = (x - x_prev) * rate;
+            assert!((slope - v).abs() <= 0.01 * speed, "slope {slope} against v {v}");
+            peak = peak.max(v.abs());
+            x_prev = x;
+        }
+        assert!(
+            peak <= speed * 1.0001 && peak >= 0.95 * speed,
+            "peak {peak} for {speed}"
+        );
+    }
+}
+
+#[test]
+fn the_protocol_checks_name_the_field_its_value_and_the_limit() {
+    let refused = |spec: ProtocolSpec, words: &[&str]| {
+        let err = spec.check().expect_err("refused");
+        for w in words {
+            assert!(err.contains(w), "{err:?} lacks {w:?}");
+        }
+    };
+    refused(
+        ProtocolSpec {
+            sample_rate: 3000.0,
+            ..Default::default()
+        },
+        &["sample_rate", "3000", "2000"],
+    );
+    refused(
+        ProtocolSpec {
+            sample_rate: 300.0,
+            ..Default::default()
+        },
+        &["sample_rate", "300", "integration steps"],
+    );
+    refused(
+        ProtocolSpec {
+            duration: 10.0,
+            ..Default::default()
+        },
+        &["duration", "10", &DURATION_RANGE.0.to_string()],
+    );
+    refused(
+        ProtocolSpec {
+            force_noise: -0.1,
+            ..Default::default()
+        },
+        &["force_noise", "-0.1"],
+    );
+    refused(
+        ProtocolSpec {
+            stopper: StopperMotion::Sine {
+                centre: 0.085,
+                amplitude: 0.01,
+                frequency: 2.5,
+            },
+            ..Default::default()
+        },
+        &["stopper centre + amplitude", "0.095", &STOPPER_RANGE.1.to_string()],
+    );
+    for rate in [250.0, 500.0, 1000.0, 1250.0, 2000.0] {
+        assert!(
+            ProtocolSpec {
+                sample_rate: rate,
+                ..Default::default()
+            }
+            .check()
+            .is_ok(),
+            "{rate} Hz"
+        );
+    }
+}
+
+#[test]
+fn a_recording_has_the_asked_sampling_channels_and_noise() {
+    // The same seed with and without noise: the same command and stopper, so the difference
+    // is the noise (plus the force channel's 0.015 N quantisation, 0.0044 N RMS).
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Prbs,
+        stopper: StopperMotion::Sine {
+            centre: 0.054,
+            amplitude: 0.005,
+            frequency: 2.5,
+        },
+        sample_rate: 250.0,
+        duration: 20.0,
+        force_noise: 0.08,
+        pressure_noise: 300.0,
+        pressures: false,
+        seed: 21,
+    };
+    let noisy = generate_protocol(&spec, &BenchEffects::default()).unwrap();
+    let clean = generate_protocol(
+        &ProtocolSpec {
+            force_noise: 0.0,
+            pressure_noise: 0.0,
+            ..spec.clone()
+        },
+        &BenchEffects::default(),
+    )
+    .unwrap();
+    assert_eq!(noisy.rows.len(), 5000);
+    assert!((noisy.rows[1][0] - 0.004).abs() < 1e-12 && (noisy.rows[4999][0] - 19.996).abs() < 1e-9);
+    let rms = |c: usize| {
+        (noisy
+            .rows
+            .iter()
+            .zip(&clean.rows)
+            .map(|(a, b)| (a[c] - b[c]).powi(2))
+            .sum::<f64>()
+            / 5000.0)
+            .sqrt()
+    };
+    assert!((rms(3) - 0.08).abs() < 0.006, "force noise {}", rms(3));
+    assert!((rms(4) - 300.0).abs() < 25.0, "p1 noise {}", rms(4));
+    assert!(noisy
+        .rows
+        .iter()
+        .zip(&clean.rows)
+        .all(|(a, b)| a[1] == b[1] && a[2] == b[2]));
+    let path = std::env::temp_dir().join(format!("protocol_nop_{}.csv", std::process::id()));
+    noisy.write_csv(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let _ = std::fs::remove_file(&path);
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("time_s,v_da_V,x_s_m,force_N"));
+    assert_eq!(lines.next().unwrap().split(',').count(), 4);
+}
+
+#[test]
+fn the_force_tracking_controller_brings_the_logged_force_to_each_reference() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::ForceTracking,
+        sample_rate: 500.0,
+        duration: 20.0,
+        seed: 4,
+        ..Default::default()
+    };
+    let rec = generate_protocol(&spec, &BenchEffects::default()).unwrap();
+    let reference = rec.reference.as_ref().unwrap();
+    // At the end of each level held 1 s or longer, the force is within 1.5 N of the reference.
+    let mut checked = 0;
+    let mut start = 0;
+    for k in 1..=reference.len() {
+        if k == reference.len() || reference[k] != reference[k - 1] {
+            if k - start >= 500 {
+                let end: Vec<f64> = rec.rows[k - 50..k].iter().map(|r| r[3]).collect();
+                let mean = end.iter().sum::<f64>() / 50.0;
+                assert!(
+                    (mean - reference[k - 1]).abs() < 1.5,
+                    "{mean:.2} N against the reference {:.2} N at t = {:.2} s",
+                    reference[k - 1],
+                    rec.rows[k - 1][0]
+                );
+                checked += 1;
+            }
+            start = k;
+        }
+    }
+    assert!(checked >= 4, "{checked} levels checked");
+    // the command is the controller's, D/A-quantised: it moves, within ±10 V
+    let commands: Vec<f64> = rec.rows.iter().map(|r| r[1]).collect();
+    assert!(commands.iter().all(|v| v.abs() <= 10.0));
+    assert!(commands.windows(2).filter(|w| w[0] != w[1]).count() > 1000);
+}
