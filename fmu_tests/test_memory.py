@@ -10,7 +10,7 @@ call-sequence fuzzer.
   - a negative control (one instance deliberately not freed) shows each checker sees the
     FMU's allocations.
 * the C driver of test_c_driver.py (1 s at 1 ms) under Valgrind;
-* the Rust call-sequence fuzzer (tests/fmi_call_fuzz.rs), bounded, under Valgrind.
+* the Rust call-sequence fuzzer (tests/fmi_call_fuzz/), bounded, under Valgrind.
 
 gcc and valgrind are on the CI image; the tests skip (saying which) only when one is missing.
 """
