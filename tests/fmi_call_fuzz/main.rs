@@ -23,9 +23,9 @@
 
 #![allow(non_upper_case_globals)]
 
+mod argument_calls;
 #[path = "../common/mod.rs"]
 mod common;
-mod argument_calls;
 
 use std::collections::BTreeMap;
 use std::ffi::CString;
