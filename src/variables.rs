@@ -209,6 +209,22 @@ pub const UNITS: &[UnitDefinition] = &[
         a: 1,
         k: 0,
     },
+    UnitDefinition {
+        name: "kg",
+        kg: 1,
+        m: 0,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N.s2/m2",
+        kg: 1,
+        m: -1,
+        s: 0,
+        a: 0,
+        k: 0,
+    },
 ];
 
 const fn causality(c: table::Causality) -> Causality {

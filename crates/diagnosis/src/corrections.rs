@@ -8,8 +8,11 @@
 //! * **a transform inserted in the chain**: on the command ([`Mechanism::CommandLag`],
 //!   [`Mechanism::CurrentLimit`]) or on a measured channel ([`Mechanism::Output`] with a
 //!   sensor regressor);
-//! * **an extra term in a balance**: a force on the piston as a function of the stopper's
-//!   motion ([`Mechanism::Output`] with a mechanics regressor), a mass flow through a vent.
+//! * **an extra term in a balance**: a force on the piston from a library of local signals
+//!   at the piston (the stopper's position, velocity, acceleration, the sign of its velocity,
+//!   v|v|, the sign of its velocity times the chambers' pressures above the return's:
+//!   [`Mechanism::Output`] with a mechanics regressor), each column's effect on the measured
+//!   force the column itself where the pressures set the force; a mass flow through a vent.
 //!
 //! Each [`Candidate`] is a set of such terms at one place of the chain. It is fitted by
 //! Gauss–Newton with bounds on the training blocks of every measured channel at once (each
@@ -51,6 +54,15 @@ pub enum Regressor {
     Viscous,
     /// x_s minus its mean where the pressures set the force: a spring on the piston.
     Position,
+    /// The stopper acceleration as the model forms it (`jetpipe_model::physics::extra_force`)
+    /// where the pressures set the force: a moving mass (its coefficient −m).
+    Acceleration,
+    /// v |v| there: quadratic damping (its coefficient negative).
+    VelocitySquared,
+    /// tanh(v / v_e) (P1 + P2 − 2 P_r) there, with the model's pressures: a seal friction
+    /// that grows with the pressure. The speed v_e (`extra_force_sign_velocity`) is the
+    /// candidate's [`Mechanism::Shape`] term (0: the base model's).
+    SignPressure(f64),
     /// (t − t_mid) / (t_end − t_start): drift.
     Ramp,
     Sine(f64),

@@ -32,6 +32,9 @@ pub fn model_terms(
     let mut friction = 0.0;
     let mut viscous = 0.0;
     let mut position = 0.0;
+    let mut acceleration = 0.0;
+    let mut quadratic = 0.0;
+    let mut sign_pressure = 0.0;
     // Coefficients of the pressure channels' regressors: (one, own, ramp) per transducer.
     let mut transducer = [[0.0; 3]; 2];
     // Modulations of a constant: (parameter, ramp coefficient, sine, cosine, frequency).
@@ -60,6 +63,13 @@ pub fn model_terms(
                 }
             }
             m if m.model_parameter().is_some() => set.push((m.model_parameter()?, value)),
+            // The seal's speed scale, a shape the FMU carries; one seal term at a time.
+            Mechanism::Shape if term.name == "extra_force_sign_velocity" => {
+                if base.extra_force_sign_pressure != 0.0 {
+                    return None;
+                }
+                set.push((term.name, value));
+            }
             Mechanism::OutputFilter { channel, filter } => {
                 let name = filter.sensor_parameter(channel)?;
                 if parameter_value(base, name) != 0.0 && value != 0.0 {
@@ -97,6 +107,9 @@ pub fn model_terms(
                 Regressor::SmoothFriction(_) | Regressor::Stribeck(..) => return None,
                 Regressor::Viscous => viscous += value,
                 Regressor::Position => position += value,
+                Regressor::Acceleration => acceleration += value,
+                Regressor::VelocitySquared => quadratic += value,
+                Regressor::SignPressure(_) => sign_pressure += value,
             },
             _ => return None,
         }
@@ -158,6 +171,25 @@ pub fn model_terms(
     }
     if viscous != 0.0 {
         set.push(("viscous_friction", p.viscous_friction + viscous / g));
+    }
+    // The library's terms add to the force the sensor reads.
+    if acceleration != 0.0 {
+        set.push((
+            "extra_force_acceleration",
+            p.extra_force_acceleration + acceleration / g,
+        ));
+    }
+    if quadratic != 0.0 {
+        set.push((
+            "extra_force_velocity_squared",
+            p.extra_force_velocity_squared + quadratic / g,
+        ));
+    }
+    if sign_pressure != 0.0 {
+        set.push((
+            "extra_force_sign_pressure",
+            p.extra_force_sign_pressure + sign_pressure / g,
+        ));
     }
     if position != 0.0 {
         let (k0, x0) = (p.position_force_rate, p.position_force_reference);
@@ -260,5 +292,50 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
             }
         })
         .collect();
-    format!("At the {location} ({family}), a {label}: {}.", parts.join(", "))
+    let physical: Vec<String> = set
+        .iter()
+        .filter_map(|&(name, value)| physical_reading(name, value - parameter_value(before, name)))
+        .collect();
+    let mut sentence = format!("At the {location} ({family}), a {label}: {}.", parts.join(", "));
+    for p in physical {
+        sentence.push(' ');
+        sentence.push_str(&p);
+    }
+    sentence
+}
+
+/// What an extra force on the piston of `added` times its signal is, in physical words.
+fn physical_reading(name: &str, added: f64) -> Option<String> {
+    if added == 0.0 {
+        return None;
+    }
+    Some(match name {
+        "extra_force_acceleration" if added < 0.0 => format!(
+            "A force of {added:.3} kg × the stopper's acceleration acts on the piston: a moving mass of {:.0} g.",
+            -added * 1e3
+        ),
+        "extra_force_acceleration" => format!(
+            "A force of {added:.3} kg × the stopper's acceleration acts on the piston: it pushes with the acceleration, as no moving mass would."
+        ),
+        "extra_force_velocity_squared" if added < 0.0 => format!(
+            "A force of {added:.4e} N·s²/m² × v|v| (v the stopper's velocity) acts on the piston: quadratic damping, {:.3} N at 0.1 m/s.",
+            -added * 0.01
+        ),
+        "extra_force_velocity_squared" => {
+            format!("A force of {added:.4e} N·s²/m² × v|v| (v the stopper's velocity) acts on the piston.")
+        }
+        "extra_force_sign_pressure" if added < 0.0 => format!(
+            "A force of {added:.4e} m² × sign(v) (P1 + P2 − 2 P_r) acts on the piston: a seal friction that grows by {:.3} N per bar of pressure in the chambers.",
+            -added * 1e5
+        ),
+        "extra_force_sign_pressure" => {
+            format!("A force of {added:.4e} m² × sign(v) (P1 + P2 − 2 P_r) acts on the piston.")
+        }
+        "viscous_friction" if added > 0.0 => format!(
+            "A force of {:.4e} N·s/m × the stopper's velocity acts on the piston: viscous friction, {:.3} N at 0.1 m/s.",
+            -added,
+            added * 0.1
+        ),
+        _ => return None,
+    })
 }

@@ -96,15 +96,9 @@ pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Resul
             break;
         }
         sim.set_command(recording.v_da[k])?;
+        // the stopper moves linearly between samples
         let parts = ((t[k + 1] - t[k]) / MAX_FAST_STEP).ceil().max(1.0) as usize;
-        for j in 1..parts {
-            // the stopper moves linearly between samples
-            let share = j as f64 / parts as f64;
-            let x = recording.x_s[k] + share * (recording.x_s[k + 1] - recording.x_s[k]);
-            sim.step_to(t[k] + share * (t[k + 1] - t[k]), x)
-                .map_err(|e| describe(e, k + 1))?;
-        }
-        sim.step_to(t[k + 1], recording.x_s[k + 1])
+        sim.step_to_in_parts(t[k + 1], recording.x_s[k + 1], parts)
             .map_err(|e| describe(e, k + 1))?;
     }
     out.steps = sim.simulation().statistics().steps;

@@ -97,6 +97,11 @@ pub mod vr {
     pub const VISCOUS_FRICTION: u32 = 470;
     pub const POSITION_FORCE_RATE: u32 = 471;
     pub const POSITION_FORCE_REFERENCE: u32 = 472;
+    pub const EXTRA_FORCE_ACCELERATION: u32 = 473;
+    pub const EXTRA_FORCE_VELOCITY_SQUARED: u32 = 474;
+    pub const EXTRA_FORCE_SIGN_PRESSURE: u32 = 475;
+    pub const EXTRA_FORCE_PRESSURE_DIFFERENCE: u32 = 476;
+    pub const EXTRA_FORCE_SIGN_VELOCITY: u32 = 477;
     pub const RETURN_VENT_AREA: u32 = 480;
     pub const SUPPLY_DRIFT: u32 = 490;
     pub const SUPPLY_RIPPLE_SINE: u32 = 491;
@@ -715,6 +720,26 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("(2.32)")
         .because("1 m: as the lengths"),
+    parameter("extra_force_acceleration", vr::EXTRA_FORCE_ACCELERATION, "kg", 0.0, "extra force on the piston: the force the sensor reads gains this times the stopper acceleration (the change of the stopper's mean velocity between the last two communication steps, over their mean length) where the pressures set the force; a moving mass m is -m (0 = off)")
+        .at_least(-100.0).at_most(100.0)
+        .cite("(2.36)")
+        .because("100 kg: a thousand times the piston's mass"),
+    parameter("extra_force_velocity_squared", vr::EXTRA_FORCE_VELOCITY_SQUARED, "N.s2/m2", 0.0, "extra force on the piston: the force the sensor reads gains this times v |v|, v the stopper velocity, where the pressures set the force; quadratic damping is negative (0 = off)")
+        .at_least(-1e7).at_most(1e7)
+        .cite("(2.36)")
+        .because("1e7 N.s2/m2: 1000 N at 1 cm/s"),
+    parameter("extra_force_sign_pressure", vr::EXTRA_FORCE_SIGN_PRESSURE, "m2", 0.0, "extra force on the piston: the force the sensor reads gains this times tanh(v / extra_force_sign_velocity) (P1 + P2 - 2 P_r) where the pressures set the force; a seal friction that grows with the pressure is negative (0 = off)")
+        .at_least(-1e-3).at_most(1e-3)
+        .cite("(2.36)")
+        .because("1e-3 m2: about four times the piston area"),
+    parameter("extra_force_pressure_difference", vr::EXTRA_FORCE_PRESSURE_DIFFERENCE, "m2", 0.0, "extra force on the piston: the force the sensor reads gains this times (P1 - P2) where the pressures set the force: an error of the effective piston area (0 = off)")
+        .at_least(-1e-3).at_most(1e-3)
+        .cite("(2.36)")
+        .because("1e-3 m2: about four times the piston area"),
+    parameter("extra_force_sign_velocity", vr::EXTRA_FORCE_SIGN_VELOCITY, "m/s", 1e-3, "the speed over which the smooth sign tanh(v / this) of extra_force_sign_pressure turns")
+        .at_least(1e-6).at_most(1.0)
+        .cite("")
+        .because("1 m/s: far beyond the stopper's speeds; 1 um/s: a sharp sign"),
     parameter("return_vent_area", vr::RETURN_VENT_AREA, "m2", 0.0, "return restriction: the return orifices vent into a plenum that empties to P_r through an orifice of this discharge coefficient times area, (2.18) (0 = off: the return orifices see P_r)")
         .at_least(0.0).at_most(1e-4)
         .cite("(2.18)")

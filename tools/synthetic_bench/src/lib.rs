@@ -276,7 +276,15 @@ pub fn run(
     for k in 0..n_samples {
         let t = k as f64 * sample;
         let (xs, xd) = stopper(t);
-        let mut f_true = if m.f_lag { y[S_FF] } else { m.force(&y, xs, xd) };
+        let mut f_true = if m.f_lag {
+            y[S_FF]
+        } else if und.moving_mass != 0.0 {
+            let delta = 1e-6;
+            let acc = (stopper(t + delta).1 - stopper((t - delta).max(0.0)).1) / (t + delta - (t - delta).max(0.0));
+            m.force_moving(&y, xs, xd, acc)
+        } else {
+            m.force(&y, xs, xd)
+        };
         if play_r > 0.0 {
             let yp = play_y.map_or(f_true, |yp| yp.clamp(f_true - play_r, f_true + play_r));
             play_y = Some(yp);

@@ -192,6 +192,17 @@ pub struct UndeclaredEffects {
     /// `force_sensor`/`limit`: the force reading saturates at ± this (N), after gain and
     /// offset, before noise and quantisation; 0 = none.
     pub force_sensor_saturation: f64,
+    /// `mechanics`/`extra_force`: a mass (kg) that moves with the stopper between the piston
+    /// and the sensor: the reading loses m · d²x_s/dt² (the stopper's own acceleration, by a
+    /// centred difference of its velocity over ±1 µs); not passed through the contact
+    /// compliance or the force sensor lag. 0 = none.
+    pub moving_mass: f64,
+    /// `mechanics`/`extra_force`: a seal friction growing with the chambers' gauge pressure,
+    /// μ (P1 + P2 − 2 P_r) tanh(v / 0.2 mm/s), μ in N/Pa (m²); 0 = none.
+    pub seal_pressure_friction: f64,
+    /// `mechanics`/`extra_force`: quadratic damping q v|v| (N·s²/m²) opposing the stopper's
+    /// velocity; 0 = none.
+    pub quadratic_damping: f64,
 }
 
 impl Default for BenchEffects {

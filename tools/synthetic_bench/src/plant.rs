@@ -343,9 +343,27 @@ impl Model {
 
     /// True actuator force (2.36)–(2.38) with friction.
     pub(crate) fn force(&self, y: &State, xs: f64, xs_dot: f64) -> f64 {
+        self.force_moving(y, xs, xs_dot, 0.0)
+    }
+
+    /// The actuator force with the stopper accelerating at `xs_acc`: a moving mass between
+    /// piston and sensor takes m · xs_acc of the pressure force.
+    pub(crate) fn force_moving(&self, y: &State, xs: f64, xs_dot: f64, xs_acc: f64) -> f64 {
         let mut fp = self.a_p * (y[S_P1] - y[S_P2]) - self.friction(xs_dot);
         if self.viscous {
             fp -= self.e.undeclared.viscous_friction * xs_dot;
+        }
+        let u = &self.e.undeclared;
+        if u.quadratic_damping != 0.0 {
+            fp -= u.quadratic_damping * xs_dot * xs_dot.abs();
+        }
+        if u.seal_pressure_friction != 0.0 {
+            // seals pressed harder by the chambers' gauge pressures; v_ε as the Coulomb seal's
+            let gauge = y[S_P1] + y[S_P2] - 2.0 * self.p.p_return;
+            fp -= u.seal_pressure_friction * gauge * (xs_dot / 0.2e-3).tanh();
+        }
+        if u.moving_mass != 0.0 {
+            fp -= u.moving_mass * xs_acc;
         }
         fp.max(self.spring_force(xs))
     }

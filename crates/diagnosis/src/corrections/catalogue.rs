@@ -513,6 +513,61 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             None,
             vec![output("position_stiffness", "N/m", FORCE, Regressor::Position, 10.0)],
         ),
+        // The extra force's library beyond friction, viscous friction and the position force:
+        // single columns, added one per round (forward selection on the held-out blocks)
+        // and refitted jointly. (P1 − P2), an error of the piston area, is in the model but
+        // not tried: it reads as the force sensor's gain wherever the pressures set the force.
+        c(
+            "moving mass",
+            "mechanics",
+            "extra_force",
+            None,
+            vec![output(
+                "extra_force_acceleration",
+                "kg",
+                FORCE,
+                Regressor::Acceleration,
+                0.01,
+            )],
+        ),
+        c(
+            "quadratic damping",
+            "mechanics",
+            "extra_force",
+            None,
+            vec![output(
+                "extra_force_velocity_squared",
+                "N.s2/m2",
+                FORCE,
+                Regressor::VelocitySquared,
+                10.0,
+            )],
+        ),
+        c(
+            "seal friction growing with the pressure",
+            "mechanics",
+            "extra_force",
+            None,
+            vec![
+                output(
+                    "extra_force_sign_pressure",
+                    "m2",
+                    FORCE,
+                    Regressor::SignPressure(0.0),
+                    1e-7,
+                ),
+                // The speed over which the seal turns, as the smooth Coulomb friction's.
+                Term {
+                    name: "extra_force_sign_velocity",
+                    unit: "m/s",
+                    mechanism: Mechanism::Shape,
+                    neutral: 0.0,
+                    step: 0.0,
+                    lower: 1e-4,
+                    upper: 0.02,
+                },
+            ],
+        ),
         c(
             "force sensor offset and gain",
             "force_sensor",

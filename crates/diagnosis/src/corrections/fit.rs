@@ -21,6 +21,8 @@ pub struct Problem<'a> {
     pub weights: [f64; CHANNELS],
     pub measured: [&'a [f64]; CHANNELS],
     velocity: Vec<f64>,
+    /// The stopper acceleration as the model forms it.
+    acceleration: Vec<f64>,
     /// The stopper's mean position, where the position regressor vanishes.
     pub mean_position: f64,
     /// The middle and the span of the recording's time, for the ramp regressor.
@@ -54,6 +56,7 @@ impl<'a> Problem<'a> {
             weights,
             measured,
             velocity: stopper_velocity(recording),
+            acceleration: jetpipe_model::physics::extra_force::stopper_accelerations(&recording.time, &recording.x_s),
             mean_position: recording.x_s.iter().sum::<f64>() / n as f64,
             t_mid: 0.5 * (t0 + t1),
             t_span: (t1 - t0).max(1e-9),
@@ -81,7 +84,7 @@ impl<'a> Problem<'a> {
         replay_fast(&Actuator::new(p)?, self.recording, self.recording.len())
     }
 
-    fn regressor(&self, regressor: Regressor, own: &[f64], floor: &[bool], k: usize) -> f64 {
+    fn regressor(&self, regressor: Regressor, r: &Replay, own: &[f64], floor: &[bool], k: usize) -> f64 {
         let t = self.recording.time[k];
         let v = self.velocity[k];
         let set_by_pressures = !floor[k];
@@ -99,11 +102,21 @@ impl<'a> Problem<'a> {
             }
             Regressor::Viscous if set_by_pressures => -v,
             Regressor::Position if set_by_pressures => -(self.recording.x_s[k] - self.mean_position),
+            Regressor::Acceleration if set_by_pressures => self.acceleration[k],
+            Regressor::VelocitySquared if set_by_pressures => v * v.abs(),
+            Regressor::SignPressure(ve) if set_by_pressures => {
+                let p = self.base;
+                let ve = if ve > 0.0 { ve } else { p.extra_force_sign_velocity };
+                jetpipe_model::physics::extra_force::signals(v, ve, r.p1[k], r.p2[k], p.p_r)[1]
+            }
             Regressor::Friction
             | Regressor::SmoothFriction(_)
             | Regressor::Stribeck(..)
             | Regressor::Viscous
-            | Regressor::Position => 0.0,
+            | Regressor::Position
+            | Regressor::Acceleration
+            | Regressor::VelocitySquared
+            | Regressor::SignPressure(_) => 0.0,
             Regressor::Ramp => (t - self.t_mid) / self.t_span,
             Regressor::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
             Regressor::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
@@ -167,7 +180,7 @@ impl Problem<'_> {
                     let own = [&r.force, &r.p1, &r.p2][channel];
                     let floor = floor.get_or_insert_with(|| self.floor(r));
                     for k in 0..n {
-                        out[channel][k] += value * self.regressor(regressor, own, floor, k);
+                        out[channel][k] += value * self.regressor(regressor, r, own, floor, k);
                     }
                 }
                 Mechanism::Modulated { modulation, .. } => {
@@ -486,6 +499,7 @@ impl Problem<'_> {
                     let regressor = match regressor {
                         Regressor::SmoothFriction(_) => Regressor::SmoothFriction(vc),
                         Regressor::Stribeck(..) => Regressor::Stribeck(vc, vs),
+                        Regressor::SignPressure(_) => Regressor::SignPressure(vc),
                         other => other,
                     };
                     t.mechanism = Mechanism::Output { channel, regressor };

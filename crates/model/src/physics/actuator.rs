@@ -13,7 +13,7 @@ use super::orifice_geometry::{analytic_stretch, first_tangency_between, tabulate
 use super::parameters::Parameters;
 use super::restrictions::{self, node, Restrictions, PRESSURES_WITH_VOLUMES};
 use super::sensors::{Channel, SensorLaw};
-use super::{current_driver, jet_pipe, piston};
+use super::{current_driver, extra_force, jet_pipe, piston};
 
 pub const N_STATES: usize = 6;
 pub type State = SVector<f64, N_STATES>;
@@ -127,6 +127,12 @@ pub struct Actuator {
     /// Whether the outputs are the thesis's alone: no friction or extra piston force, every
     /// transducer reading its quantity itself.
     thesis_outputs: bool,
+    /// Whether the extra force's library terms beyond viscous friction and the position
+    /// force are on ([`super::extra_force`]).
+    extra_library: bool,
+    /// Whether the extra force follows the stopper acceleration (`extra_force_acceleration`
+    /// ≠ 0): a simulation then forms it after each step.
+    pub acceleration_term: bool,
 }
 
 /// Which terms of the chambers' pressure rates a model has, decided once when it is built, so
@@ -167,15 +173,23 @@ impl Actuator {
         } else {
             RateTerms::Thesis
         };
+        let extra_library = params.extra_force_acceleration != 0.0
+            || params.extra_force_velocity_squared != 0.0
+            || params.extra_force_sign_pressure != 0.0
+            || params.extra_force_pressure_difference != 0.0;
+        let acceleration_term = params.extra_force_acceleration != 0.0;
         let thesis_outputs = params.friction_coulomb == 0.0
             && params.friction_stribeck == 0.0
             && params.viscous_friction == 0.0
             && params.position_force_rate == 0.0
+            && !extra_library
             && Channel::ALL
                 .iter()
                 .all(|&channel| SensorLaw::of(&params, channel).is_identity());
         Ok(Self {
             thesis_outputs,
+            extra_library,
+            acceleration_term,
             rate_terms,
             restrictions,
             params,
@@ -608,6 +622,19 @@ impl Actuator {
     /// The outputs at time `time` (the transducers' drifts and pick-up depend on it; their
     /// filters are the caller's: see [`super::sensors::SensorMemory`]).
     pub fn outputs_at(&self, y: &State, x_s: f64, stopper_velocity: f64, time: f64) -> Outputs {
+        self.outputs_in_motion(y, x_s, stopper_velocity, 0.0, time)
+    }
+
+    /// [`Self::outputs_at`] with the stopper's acceleration as the model forms it (see
+    /// [`super::extra_force`]; it matters only with `extra_force_acceleration`).
+    pub fn outputs_in_motion(
+        &self,
+        y: &State,
+        x_s: f64,
+        stopper_velocity: f64,
+        stopper_acceleration: f64,
+        time: f64,
+    ) -> Outputs {
         use index::*;
         if self.thesis_outputs {
             // (2.36)–(2.38) with no friction term (a friction of ±0 subtracted from a
@@ -638,7 +665,7 @@ impl Actuator {
                 p.friction_stribeck_velocity,
                 stopper_velocity,
             )
-            - self.extra_piston_force(x_s, stopper_velocity);
+            - self.extra_piston_force(x_s, stopper_velocity, stopper_acceleration, y[P1], y[P2]);
         let f_act = piston::actuator_force(pressure_force, self.spring_force(x_s));
         Outputs {
             f_act,
@@ -652,11 +679,20 @@ impl Actuator {
         }
     }
 
-    /// Forces on the piston beyond the thesis's (2.33)–(2.38) and Coulomb friction: viscous
-    /// friction and a force on the stopper position (off by default).
-    fn extra_piston_force(&self, x_s: f64, stopper_velocity: f64) -> f64 {
+    /// Forces on the piston beyond the thesis's (2.33)–(2.38) and Coulomb friction, opposing
+    /// the pressure force: viscous friction, a force on the stopper position and the extra
+    /// force's library terms, which add to the pressure force (off by default).
+    fn extra_piston_force(&self, x_s: f64, stopper_velocity: f64, stopper_acceleration: f64, p1: f64, p2: f64) -> f64 {
         let p = &self.params;
         let mut f = 0.0;
+        if self.extra_library {
+            let [quadratic, sign_pressure, difference] =
+                extra_force::signals(stopper_velocity, p.extra_force_sign_velocity, p1, p2, p.p_r);
+            f -= p.extra_force_acceleration * stopper_acceleration
+                + p.extra_force_velocity_squared * quadratic
+                + p.extra_force_sign_pressure * sign_pressure
+                + p.extra_force_pressure_difference * difference;
+        }
         if p.viscous_friction != 0.0 {
             f += p.viscous_friction * stopper_velocity;
         }

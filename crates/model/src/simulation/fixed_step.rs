@@ -84,6 +84,25 @@ impl FixedStep {
     /// On failure the state, time and stopper stay at the last sample (the command stage and
     /// the delay line have taken the step's command).
     pub fn step_to(&mut self, time: f64, x_s: f64) -> Result<(), StepFailure> {
+        let start = (self.simulation.time, self.simulation.x_s);
+        self.step_part(time, x_s, Some(start))
+    }
+
+    /// [`Self::step_to`] in `parts` equal steps, the stopper moving linearly: the stopper
+    /// acceleration of the extra force is formed once, over the whole interval, as a
+    /// simulation stepped once to `time` forms it.
+    pub fn step_to_in_parts(&mut self, time: f64, x_s: f64, parts: usize) -> Result<(), StepFailure> {
+        let (t0, x0) = (self.simulation.time, self.simulation.x_s);
+        for j in 1..parts {
+            let share = j as f64 / parts as f64;
+            self.step_part(t0 + share * (time - t0), x0 + share * (x_s - x0), None)?;
+        }
+        self.step_part(time, x_s, Some((t0, x0)))
+    }
+
+    /// A step to `time`, `x_s`; `interval_start` (time, x_s) when it ends an interval of the
+    /// stopper's motion, which began there.
+    fn step_part(&mut self, time: f64, x_s: f64, interval_start: Option<(f64, f64)>) -> Result<(), StepFailure> {
         let t0 = self.simulation.time;
         let step = time - t0;
         if !(step.is_finite() && step > 0.0) {
@@ -125,7 +144,15 @@ impl FixedStep {
         sim.nodes = pressures;
         sim.chamber_rates_at_end = None;
         sim.statistics.add(&work);
-        let mut y = sim.model.outputs_at(&sim.state, x_s, rate, time);
+        if sim.plan.stopper_acceleration {
+            if let Some((t_start, x_start)) = interval_start {
+                let length = time - t_start;
+                sim.stopper_acceleration = sim.stopper_motion.advance((x_s - x_start) / length, length);
+            }
+        }
+        let mut y = sim
+            .model
+            .outputs_in_motion(&sim.state, x_s, rate, sim.stopper_acceleration, time);
         sim.record_transducers(&mut y);
         self.outputs = y;
         Ok(())

@@ -38,6 +38,7 @@ use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::extra_force::StopperMotion;
 use crate::physics::restrictions::node;
 use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
 use crate::physics::time_varying;
@@ -121,6 +122,11 @@ pub struct Simulation {
     /// Mean stopper velocity over the last step (for piston friction).
     stopper_velocity: f64,
     x_s_at_last_step: f64,
+    /// The stopper's motion over the last step, from which the extra force's stopper
+    /// acceleration is formed ([`crate::physics::extra_force`]; followed only when that term
+    /// is on), and the acceleration at the end of the last step (0 when off).
+    stopper_motion: StopperMotion,
+    stopper_acceleration: f64,
     /// The command stage's memory (see [`crate::physics::command_stage`]).
     command_stage: CommandStage,
     /// The transducers' memories, in the order of [`Channel::ALL`], for those that filter
@@ -153,6 +159,10 @@ struct StepPlan {
     filtering_transducers: bool,
     /// The hysteresis operator has a memory to follow.
     hysteresis: bool,
+    /// The extra force follows the stopper acceleration, formed from the steps' motions.
+    stopper_acceleration: bool,
+    /// Something is recorded after each step: a transducer's memory or the stopper's motion.
+    after_step: bool,
 }
 
 impl StepPlan {
@@ -163,6 +173,8 @@ impl StepPlan {
             command_path: command_stage::is_active(p) || p.command_delay != 0.0,
             filtering_transducers: transducers.iter().any(Option::is_some),
             hysteresis: model.hysteresis.is_active(),
+            stopper_acceleration: model.acceleration_term,
+            after_step: transducers.iter().any(Option::is_some) || model.acceleration_term,
         }
     }
 }
@@ -257,6 +269,8 @@ impl Simulation {
             }],
             stopper_velocity: 0.0,
             x_s_at_last_step: x_s,
+            stopper_motion: StopperMotion::at_rest(),
+            stopper_acceleration: 0.0,
             command_stage,
             transducers,
             propagator,
@@ -334,9 +348,13 @@ impl Simulation {
     }
 
     pub fn outputs(&self) -> Outputs {
-        let mut y = self
-            .model
-            .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time);
+        let mut y = self.model.outputs_in_motion(
+            &self.state,
+            self.x_s,
+            self.stopper_velocity,
+            self.stopper_acceleration,
+            self.time,
+        );
         if !self.plan.filtering_transducers {
             return y;
         }

@@ -18,6 +18,7 @@ use crate::integrator::{Sdirk4, Statistics};
 use crate::physics::actuator::{Actuator, State, N_STATES};
 use crate::physics::command_stage::CommandStage;
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::extra_force::StopperMotion;
 use crate::physics::restrictions::node;
 use crate::physics::sensors::SensorMemory;
 
@@ -43,17 +44,19 @@ pub struct SimulationSnapshot {
     command_history: Vec<CommandChange>,
     stopper_velocity: f64,
     x_s_at_last_step: f64,
+    stopper_motion: StopperMotion,
+    stopper_acceleration: f64,
     command_stage: CommandStage,
     transducers: [Option<SensorMemory>; 3],
 }
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-pub const SNAPSHOT_LAYOUT: f64 = 3.0;
+pub const SNAPSHOT_LAYOUT: f64 = 4.0;
 
-/// Numbers before the two counted lists: the layout, 18 scalars, the state, the volumes'
+/// Numbers before the two counted lists: the layout, 21 scalars, the state, the volumes'
 /// pressures, the plays, the command stage (3) and the six work counters as two halves each.
-const FIXED_VALUES: usize = 1 + 18 + N_STATES + node::COUNT + PLAY_OPERATORS + 3 + 2 * STATISTICS;
+const FIXED_VALUES: usize = 1 + 21 + N_STATES + node::COUNT + PLAY_OPERATORS + 3 + 2 * STATISTICS;
 const STATISTICS: usize = 6;
 
 impl Simulation {
@@ -81,6 +84,8 @@ impl Simulation {
             command_history: self.command_history.clone(),
             stopper_velocity: self.stopper_velocity,
             x_s_at_last_step: self.x_s_at_last_step,
+            stopper_motion: self.stopper_motion,
+            stopper_acceleration: self.stopper_acceleration,
             command_stage: self.command_stage,
             transducers: self.transducers.clone(),
         }
@@ -111,6 +116,8 @@ impl Simulation {
         sim.command_history = s.command_history.clone();
         sim.stopper_velocity = s.stopper_velocity;
         sim.x_s_at_last_step = s.x_s_at_last_step;
+        sim.stopper_motion = s.stopper_motion;
+        sim.stopper_acceleration = s.stopper_acceleration;
         sim.command_stage = s.command_stage;
         sim.transducers = s.transducers.clone();
         sim.plan = StepPlan::of(&sim.model, &sim.transducers);
@@ -129,7 +136,9 @@ impl SimulationSnapshot {
     /// Layout: [`SNAPSHOT_LAYOUT`]; time, v_DA, x_s, der(v_DA), der(x_s), relative tolerance,
     /// method (0 split, 1 monolithic), chamber method (0 non-stiff first, 1 Dormand–Prince
     /// only, 2 SDIRK4), the two integrators' next, largest and first step sizes, input changed
-    /// (0 or 1), the step after a change, stopper velocity, x_s at the last step; the state;
+    /// (0 or 1), the step after a change, stopper velocity, x_s at the last step, the stopper
+    /// velocity over the step before the last and that step's length, and the stopper
+    /// acceleration they gave; the state;
     /// the pressures of the gas volumes behind restrictions (supply, return, line 1, line 2); the
     /// plays; the command stage (time, held, lagged); the work counters (steps, rejected,
     /// right-hand sides, Jacobians, Newton failures, stiff hand-overs), each as its low then
@@ -164,6 +173,9 @@ impl SimulationSnapshot {
             self.step_after_change,
             self.stopper_velocity,
             self.x_s_at_last_step,
+            self.stopper_motion.velocity,
+            self.stopper_motion.interval,
+            self.stopper_acceleration,
         ]);
         v.extend_from_slice(&self.state);
         v.extend_from_slice(&self.nodes);
@@ -210,9 +222,9 @@ impl SimulationSnapshot {
             at += n;
             slice
         };
-        let scalars = next(18);
-        let [time, v_da, x_s, v_da_rate, x_s_rate, relative_tolerance, method, chamber_method, next_step, max_step, first_step, chamber_next_step, chamber_max_step, chamber_first_step, input_changed, step_after_change, stopper_velocity, x_s_at_last_step]: [f64; 18] =
-            scalars.try_into().expect("18 values");
+        let scalars = next(21);
+        let [time, v_da, x_s, v_da_rate, x_s_rate, relative_tolerance, method, chamber_method, next_step, max_step, first_step, chamber_next_step, chamber_max_step, chamber_first_step, input_changed, step_after_change, stopper_velocity, x_s_at_last_step, motion_velocity, motion_interval, stopper_acceleration]: [f64; 21] =
+            scalars.try_into().expect("21 values");
         let mut state = [0.0; N_STATES];
         state.copy_from_slice(next(N_STATES));
         let mut nodes = [0.0; node::COUNT];
@@ -279,6 +291,9 @@ impl SimulationSnapshot {
             step_after_change,
             stopper_velocity,
             x_s_at_last_step,
+            motion_velocity,
+            motion_interval,
+            stopper_acceleration,
         ];
         let finite = numbers.iter().chain(&state).chain(&nodes).chain(&stage).chain(sensor).all(|v| v.is_finite())
             && command_history.iter().all(|c| c.v_da.is_finite() && c.rate.is_finite())
@@ -336,6 +351,11 @@ impl SimulationSnapshot {
             command_history,
             stopper_velocity,
             x_s_at_last_step,
+            stopper_motion: StopperMotion {
+                velocity: motion_velocity,
+                interval: motion_interval,
+            },
+            stopper_acceleration,
             command_stage: CommandStage::from_values(stage),
             transducers,
         })

@@ -121,14 +121,30 @@ impl Simulation {
         self.x_s_rate = 0.0;
         self.input_changed = false;
         self.stopper_velocity = (self.x_s - self.x_s_at_last_step) / step;
+        if self.plan.after_step {
+            self.record_after_step(step);
+        }
         self.x_s_at_last_step = self.x_s;
+        Ok(())
+    }
+
+    /// After a step of `step` seconds that moved the stopper linearly from
+    /// `x_s_at_last_step` to `x_s`: form the stopper acceleration and record the transducers'
+    /// readings, for those of the two the model has.
+    pub(super) fn record_after_step(&mut self, step: f64) {
+        if self.plan.stopper_acceleration {
+            self.stopper_acceleration = self.stopper_motion.advance(self.stopper_velocity, step);
+        }
         if self.plan.filtering_transducers {
-            let mut y = self
-                .model
-                .outputs_at(&self.state, self.x_s, self.stopper_velocity, self.time);
+            let mut y = self.model.outputs_in_motion(
+                &self.state,
+                self.x_s,
+                self.stopper_velocity,
+                self.stopper_acceleration,
+                self.time,
+            );
             self.record_transducers(&mut y);
         }
-        Ok(())
     }
 
     /// Record the transducers' static readings in `y` (at the simulation's time) in the

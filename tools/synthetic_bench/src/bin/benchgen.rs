@@ -148,6 +148,17 @@ struct Cli {
     /// The force reading saturates at ± this, N (e.g. 85).
     #[arg(long)]
     force_sensor_saturation: Option<f64>,
+    /// A mass moving with the stopper between piston and sensor, kg (e.g. 0.1): the reading
+    /// loses m times the stopper's acceleration. Move the stopper (--stopper) for it to show.
+    #[arg(long)]
+    moving_mass: Option<f64>,
+    /// A seal friction growing with the chambers' gauge pressure, N/Pa (e.g. 2e-6: 1 N at
+    /// 5 bar above the return): mu (P1 + P2 - 2 P_r) tanh(v / 0.2 mm/s).
+    #[arg(long)]
+    seal_pressure_friction: Option<f64>,
+    /// Quadratic damping on the stopper velocity, N.s2/m2 (e.g. 100): q v|v|.
+    #[arg(long)]
+    quadratic_damping: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -205,6 +216,9 @@ fn main() -> ExitCode {
     );
     set(&mut und.command_dead_zone, cli.command_dead_zone);
     set(&mut und.force_sensor_saturation, cli.force_sensor_saturation);
+    set(&mut und.moving_mass, cli.moving_mass);
+    set(&mut und.seal_pressure_friction, cli.seal_pressure_friction);
+    set(&mut und.quadratic_damping, cli.quadratic_damping);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -222,6 +236,9 @@ fn main() -> ExitCode {
         und.force_sensor_pickup_frequency,
         und.command_dead_zone,
         und.force_sensor_saturation,
+        und.moving_mass,
+        und.seal_pressure_friction,
+        und.quadratic_damping,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -239,7 +256,7 @@ fn main() -> ExitCode {
     if und_bad {
         eprintln!(
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
-             friction, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
+             friction, moving mass, seal friction, damping, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
              blend and return area reduction in 0..1"
         );
         return ExitCode::from(2);
