@@ -141,3 +141,26 @@ def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors
     for c in range(2):
         assert abs(through_fmu[c] - reported[c]) <= 0.05 * reported[c]
     assert max(through_fmu) < 0.5 * max(before)
+
+
+# An extra force on the piston from the library of local signals: a mass moving with the
+# stopper, whose acceleration the FMU forms from its communication steps as the diagnosis
+# forms it from the samples; and a seal friction growing with the chambers' pressures.
+@needs_binaries
+@pytest.mark.parametrize("name,args,parameter", [
+    ("moving_mass", ("--moving-mass", "0.1", "--stopper", "moves:0.2"), "extra_force_acceleration"),
+    ("seal_friction", ("--seal-pressure-friction", "1e-6", "--stopper", "moves:0.05"), "extra_force_sign_pressure"),
+])
+def test_fmu_start_values_of_an_extra_force_on_the_piston_reproduce_the_after_error(
+        unzipdir, model_description, vrs, tmp_path, name, args, parameter):
+    recording, report = generated_and_diagnosed(tmp_path, name, "--protocol", "staircase", "--duration", "20",
+                                                "--seed", "5", "--force-noise", "0.03", *args)
+    assert report["discovered"][0]["location"] == "mechanics", report["discovered"]
+    assert parameter in report["fmu_start_values"], report["fmu_start_values"]
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
+    rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
+    reported = report["after"]["force_rms_N"]
+    print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; "
+          f"before {report['before']['force_rms_N']:.4f} N")
+    assert rms < 0.5 * report["before"]["force_rms_N"]
+    assert abs(rms - reported) <= 0.05 * reported

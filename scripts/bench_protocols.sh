@@ -36,6 +36,22 @@ mechanisms=(
     "command_dead_zone|command|nonlinearity|--command-dead-zone 0.4"
     "force_sensor_saturation|force_sensor|limit|--force-sensor-saturation 85"
 )
+# Extra forces on the piston, which show only while the stopper moves: their own protocols.
+balance_protocols=(
+    "staircase_1k_moves_p|--protocol staircase --sample-rate 1000 --stopper moves:0.2 --force-noise 0.03"
+    "sine_2k_moves_p|--protocol sine --sample-rate 2000 --stopper moves:0.2 --force-noise 0.03"
+    "multisine_1k_moves_nop|--protocol multisine --sample-rate 1000 --stopper moves:0.2 --no-pressures --force-noise 0.03"
+    "ramps_500_moves_p|--protocol ramps --sample-rate 500 --stopper moves:0.1 --force-noise 0.03"
+    "multisine_250_shake_nop|--protocol multisine --sample-rate 250 --stopper sine:0.054:0.01:2.5 --no-pressures --force-noise 0.03"
+    "sine_250_slow_moves_nop|--protocol sine --sample-rate 250 --stopper moves:0.05 --no-pressures --force-noise 0.03"
+)
+balance_mechanisms=(
+    "clean|none|none|"
+    "moving_mass_100g|mechanics|extra_force|--moving-mass 0.1"
+    "quadratic_damping|mechanics|extra_force|--quadratic-damping 300"
+    "seal_pressure_friction|mechanics|extra_force|--seal-pressure-friction 1e-6"
+    "viscous_friction|mechanics|extra_force|--viscous-friction 60"
+)
 
 chosen() { # NAME LIST: whether NAME is in the space-separated LIST (or LIST is empty)
     [ -z "$2" ] && return 0
@@ -45,11 +61,14 @@ chosen() { # NAME LIST: whether NAME is in the space-separated LIST (or LIST is 
 
 echo "| protocol | mechanism | truth | verdict | found (location, family) | right place | held-out after / noise | wall (s) |"
 echo "|---|---|---|---|---|---|---|---|"
-for p in "${protocols[@]}"; do
+run_table() { # PROTOCOL-ARRAY-NAME MECHANISM-ARRAY-NAME
+local -n plist="$1"
+local -n mlist="$2"
+for p in "${plist[@]}"; do
     pname="${p%%|*}"
     popts="${p#*|}"
     chosen "$pname" "${JETPIPE_BENCH_PROTOCOLS:-}" || continue
-    for m in "${mechanisms[@]}"; do
+    for m in "${mlist[@]}"; do
         IFS='|' read -r mname mloc mfam mopts <<<"$m"
         chosen "$mname" "${JETPIPE_BENCH_MECHANISMS:-}" || continue
         rec="$work/${pname}_${mname}.csv"
@@ -80,3 +99,6 @@ PY
         echo "| $pname | $mname | $mloc, $mfam | $row | $((ms / 1000)).$(((ms % 1000) / 100)) |"
     done
 done
+}
+run_table protocols mechanisms
+run_table balance_protocols balance_mechanisms
