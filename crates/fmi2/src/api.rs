@@ -509,8 +509,15 @@ unsafe fn get_values<M: CoSimModel, T>(
             Ok(s) => s,
             Err(s) => return s,
         };
+        // Only in `instantiated` does what a variable is limit whether it may be read.
+        let restricted = inst.state == State::Instantiated;
         for (&r, slot) in vrs.iter().zip(values.iter_mut()) {
-            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_get(fname, v, inst.state)) {
+            let checked = match inst.variable(fname, r, ty) {
+                Ok(v) if restricted => check_get(fname, v, inst.state),
+                Ok(_) => Ok(()),
+                Err(m) => Err(m),
+            };
+            if let Err(m) = checked {
                 return inst.error(m);
             }
             match read(&inst.model, r) {
@@ -543,7 +550,10 @@ unsafe fn set_values<M: CoSimModel, T: Copy>(
             Err(s) => return s,
         };
         for &r in vrs {
-            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_set(fname, v, inst.state)) {
+            if let Err(m) = inst
+                .variable(fname, r, ty)
+                .and_then(|v| check_set(fname, v, inst.state))
+            {
                 return inst.error(m);
             }
         }

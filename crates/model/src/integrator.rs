@@ -289,18 +289,11 @@ impl Sdirk4 {
             first_step: None,
         };
         let outcome = match pair {
-            ExplicitPair::DormandPrince => explicit::integrate(
-                &explicit::DORMAND_PRINCE_54,
-                &mut memory,
-                system,
-                t0,
-                y0,
-                t1,
-                tol,
-                stats,
-            ),
+            ExplicitPair::DormandPrince => {
+                explicit::integrate::<N, 7, explicit::DormandPrince, S>(&mut memory, system, t0, y0, t1, tol, stats)
+            }
             ExplicitPair::Verner => {
-                explicit::integrate(&explicit::VERNER_65, &mut memory, system, t0, y0, t1, tol, stats)
+                explicit::integrate::<N, 9, explicit::Verner, S>(&mut memory, system, t0, y0, t1, tol, stats)
             }
         };
         self.next_step = memory.next_step;

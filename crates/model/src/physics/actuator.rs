@@ -129,6 +129,26 @@ pub struct Actuator {
     thesis_outputs: bool,
 }
 
+/// The factors of (2.29), dP/dt = (γ/V)(R T ṁ − P dV/dt), that do not change while the stopper
+/// stays put: γ/V and dV/dt of each chamber (with (2.30)–(2.32)) and R T. A step whose stopper
+/// does not move works them out once ([`Actuator::held_chambers`]) instead of in every
+/// right-hand side; the rates are formed by the operations of
+/// [`super::chambers::pressure_rate`], in its order, so they keep its bits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeldChambers {
+    gamma_over_volume: [f64; 2],
+    volume_rate: [f64; 2],
+    r_gas_temperature: f64,
+}
+
+impl HeldChambers {
+    /// (2.29) for chamber `i` (0 or 1) with net mass inflow `net` at pressure `pressure`.
+    #[inline(always)]
+    fn pressure_rate(&self, i: usize, net: f64, pressure: f64) -> f64 {
+        self.gamma_over_volume[i] * (self.r_gas_temperature * net - pressure * self.volume_rate[i])
+    }
+}
+
 /// Which terms of the chambers' pressure rates a model has, decided once when it is built, so
 /// that the thesis model's evaluations do not test, term by term, for effects that are off.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -446,6 +466,29 @@ impl Actuator {
     #[inline(always)]
     pub fn thesis_pressure_rates(&self, a: &OrificeAreas, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
         let p = &self.params;
+        let (net_1, net_2) = self.thesis_net_flows(a, p1, p2);
+        let (v1, v2) = self.cylinder.volumes(x_s);
+        let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
+        let n = self.polytropic_exponent;
+        (
+            pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1),
+            pressure_rate(n, p.r_gas, p.temperature, v2, dv2, net_2, p2),
+        )
+    }
+
+    /// [`Self::thesis_pressure_rates`] with the stopper's part worked out once for a step
+    /// ([`Self::held_chambers`]): the same bits.
+    #[inline(always)]
+    pub fn thesis_pressure_rates_held(&self, a: &OrificeAreas, p1: f64, p2: f64, held: &HeldChambers) -> (f64, f64) {
+        let (net_1, net_2) = self.thesis_net_flows(a, p1, p2);
+        (held.pressure_rate(0, net_1, p1), held.pressure_rate(1, net_2, p2))
+    }
+
+    /// The net mass inflows (2.24), (2.25) of the chambers through the valve's four orifices
+    /// (2.18)–(2.22) and past the piston (2.23), by the thesis's terms alone.
+    #[inline(always)]
+    fn thesis_net_flows(&self, a: &OrificeAreas, p1: f64, p2: f64) -> (f64, f64) {
+        let p = &self.params;
         let k = &self.flow;
         let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
         let supply_1 = orifice_flow::mass_flow_inline(k, cd_s1 * a.supply_1, p.p_s, p1);
@@ -461,13 +504,21 @@ impl Actuator {
         // (2.24), (2.25)
         let net_1 = supply_1 - return_1 - leakage;
         let net_2 = supply_2 - return_2 + leakage;
+        (net_1, net_2)
+    }
+
+    /// What (2.29) takes from the stopper and the gas over a step in which the stopper stays
+    /// at `x_s` (moving at `x_s_rate` = ±0): see [`HeldChambers`].
+    pub fn held_chambers(&self, x_s: f64, x_s_rate: f64) -> HeldChambers {
+        let p = &self.params;
         let (v1, v2) = self.cylinder.volumes(x_s);
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
         let n = self.polytropic_exponent;
-        (
-            pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1),
-            pressure_rate(n, p.r_gas, p.temperature, v2, dv2, net_2, p2),
-        )
+        HeldChambers {
+            gamma_over_volume: [n / v1, n / v2],
+            volume_rate: [dv1, dv2],
+            r_gas_temperature: p.r_gas * p.temperature,
+        }
     }
 
     /// (2.29) for both chambers with their net mass inflows.

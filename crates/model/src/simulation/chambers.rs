@@ -8,7 +8,7 @@ use nalgebra::SVector;
 
 use crate::electromechanics::{Trajectory, MAX_NODES};
 use crate::integrator::{finite_difference_jacobian, OdeSystem};
-use crate::physics::actuator::Actuator;
+use crate::physics::actuator::{Actuator, HeldChambers};
 use crate::physics::orifice_geometry::OrificeAreas;
 use crate::physics::restrictions::PRESSURES_WITH_VOLUMES;
 
@@ -20,6 +20,20 @@ pub(super) type EndRates<const N: usize> = (f64, SVector<f64, N>, SVector<f64, N
 /// law's own code, inlined into the integrator, with no test of which terms are live.
 pub(super) trait PressureLaw<const N: usize> {
     fn rates(model: &Actuator, areas: &OrificeAreas, p: &SVector<f64, N>, x_s: f64, x_s_rate: f64) -> SVector<f64, N>;
+
+    /// [`Self::rates`] over a step in which the stopper stays at `x_s` (`x_s_rate` = ±0), with
+    /// what the chambers take from it worked out once for the step in `held`; the same bits.
+    #[inline(always)]
+    fn rates_held(
+        model: &Actuator,
+        _held: &HeldChambers,
+        areas: &OrificeAreas,
+        p: &SVector<f64, N>,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> SVector<f64, N> {
+        Self::rates(model, areas, p, x_s, x_s_rate)
+    }
 }
 
 /// P1 and P2 by the thesis's terms alone ([`crate::physics::actuator::RateTerms::Thesis`]).
@@ -36,6 +50,19 @@ impl PressureLaw<2> for ThesisLaw {
     #[inline(always)]
     fn rates(model: &Actuator, areas: &OrificeAreas, p: &SVector<f64, 2>, x_s: f64, x_s_rate: f64) -> SVector<f64, 2> {
         let (a, b) = model.thesis_pressure_rates(areas, p[0], p[1], x_s, x_s_rate);
+        SVector::<f64, 2>::new(a, b)
+    }
+
+    #[inline(always)]
+    fn rates_held(
+        model: &Actuator,
+        held: &HeldChambers,
+        areas: &OrificeAreas,
+        p: &SVector<f64, 2>,
+        _x_s: f64,
+        _x_s_rate: f64,
+    ) -> SVector<f64, 2> {
+        let (a, b) = model.thesis_pressure_rates_held(areas, p[0], p[1], held);
         SVector::<f64, 2>::new(a, b)
     }
 }
@@ -99,6 +126,9 @@ pub(super) struct ChamberSystem<'a, const N: usize, L> {
     /// first question.
     pub(super) tangency_free: std::cell::Cell<Option<bool>>,
     pub(super) duration: f64,
+    /// What the chambers take from a stopper that stays put over the step (`x_s_rate` = ±0),
+    /// worked out once ([`Actuator::held_chambers`]); `None` while it moves.
+    held: Option<HeldChambers>,
     law: std::marker::PhantomData<L>,
 }
 
@@ -127,6 +157,7 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
             stretch_at: std::cell::Cell::new(None),
             tangency_free: std::cell::Cell::new(None),
             duration,
+            held: (x_s_rate == 0.0).then(|| model.held_chambers(x_s, x_s_rate)),
             law: std::marker::PhantomData,
         }
     }
@@ -235,8 +266,13 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
         rates
     }
 
+    #[inline(always)]
     pub(super) fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
-        L::rates(self.model, areas, p, self.x_s + self.x_s_rate * t, self.x_s_rate)
+        // x_s + ±0·t is x_s (a stopper inside the cylinder is never at 0).
+        match &self.held {
+            Some(held) => L::rates_held(self.model, held, areas, p, self.x_s, self.x_s_rate),
+            None => L::rates(self.model, areas, p, self.x_s + self.x_s_rate * t, self.x_s_rate),
+        }
     }
 }
 
