@@ -458,7 +458,14 @@ impl<C: StaticCurve> Trajectory<'_, C> {
                     form.derivatives_from(self.propagator, &self.series, &e),
                     self.drive.with_decay(s, e.decay),
                 ),
-                _ => (form.derivatives(self.propagator, &self.series, s), self.current(s)),
+                // The current's e^{−ω s} is the exponentials' decay, to the bit.
+                _ => {
+                    let e = self.propagator.exponentials(s, true);
+                    (
+                        form.derivatives_from(self.propagator, &self.series, &e),
+                        self.drive.with_decay(s, e.decay),
+                    )
+                }
             }),
             (None, Some(form)) if form.covers(s) => Some((form.derivatives(self.propagator, s), self.current(s))),
             _ => None,

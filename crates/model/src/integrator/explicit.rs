@@ -284,6 +284,43 @@ impl Pair<9> for Verner {
 /// Most stages a [`Pair`] may have (Verner's nine); the stages are unrolled up to it.
 const MAX_STAGES: usize = 9;
 
+/// Stage i's state, y + Σ_j h a_ij k_j over the non-zero a_ij in order of j: one unrolled sum
+/// per row, its coefficients constants, so that only the stages' one right-hand side is
+/// compiled into the integrator's loop (eight inlined copies of it made the code too large
+/// for the instruction cache).
+#[inline(always)]
+fn stage_sum<const N: usize, const S: usize, P: Pair<S>>(
+    i: usize,
+    y: &SVector<f64, N>,
+    k: &[SVector<f64, N>; S],
+    h: f64,
+) -> SVector<f64, N> {
+    macro_rules! row {
+        ($i:literal) => {{
+            let mut stage = *y;
+            if $i < S {
+                for j in 0..$i {
+                    let a = P::TABLEAU.a[$i][j];
+                    if a != 0.0 {
+                        stage += k[j] * (h * a);
+                    }
+                }
+            }
+            stage
+        }};
+    }
+    match i {
+        1 => row!(1),
+        2 => row!(2),
+        3 => row!(3),
+        4 => row!(4),
+        5 => row!(5),
+        6 => row!(6),
+        7 => row!(7),
+        _ => row!(8),
+    }
+}
+
 /// Integrate from (t0, y0) towards t1 with the pair `P`. Returns the state at t1, or a handover
 /// (last accepted time and state) when the system turned stiff or the step size collapsed.
 pub fn integrate<const N: usize, const S: usize, P: Pair<S>, Sys: OdeSystem<N>>(
@@ -326,35 +363,16 @@ pub fn integrate<const N: usize, const S: usize, P: Pair<S>, Sys: OdeSystem<N>>(
             };
         }
         system.prepare_stages(t, h_try, &tableau.c[1..], &stage_times[1..]);
-        // Stage i: y + Σ_j h a_ij k_j over the non-zero a_ij in order of j, then its slope.
-        macro_rules! stage {
-            ($i:literal) => {
-                if $i < S {
-                    let mut stage = y;
-                    for j in 0..$i {
-                        let a = tableau.a[$i][j];
-                        if a != 0.0 {
-                            stage += k[j] * (h_try * a);
-                        }
-                    }
-                    k[$i] = system.rhs(stage_times[$i], &stage);
-                    if $i == i_stiff {
-                        stiffness_stage = stage;
-                    }
-                    if $i == S - 1 {
-                        y_new = stage;
-                    }
-                }
-            };
+        for i in 1..S {
+            let stage = stage_sum::<N, S, P>(i, &y, &k, h_try);
+            k[i] = system.rhs(stage_times[i], &stage);
+            if i == i_stiff {
+                stiffness_stage = stage;
+            }
+            if i == S - 1 {
+                y_new = stage;
+            }
         }
-        stage!(1);
-        stage!(2);
-        stage!(3);
-        stage!(4);
-        stage!(5);
-        stage!(6);
-        stage!(7);
-        stage!(8);
         stats.rhs_evaluations += S as u64 - 1;
         let mut difference = SVector::<f64, N>::zeros();
         for (i, &e) in tableau.error_weights.iter().enumerate() {

@@ -187,6 +187,14 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
         if let Some(known) = self.stage_areas.borrow().at(t) {
             return known;
         }
+        self.position_and_areas_off_the_stages(t)
+    }
+
+    /// [`Self::position_and_areas`] at a time that is not one of the current explicit step's
+    /// stages (Newton iterations, Jacobians, the ringing test): out of line, so that the
+    /// stages' right-hand side stays small in the integrator's loop.
+    #[inline(never)]
+    fn position_and_areas_off_the_stages(&self, t: f64) -> (f64, OrificeAreas) {
         match self.areas_at.get() {
             Some((cached, position, areas)) if cached == t => (position, areas),
             _ => {
@@ -257,22 +265,19 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
         }
     }
 
-    /// The rates at t = duration, recorded with the position and pressures (see `end_rates`).
-    #[inline(always)]
-    pub(super) fn rates_at_end(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
-        let (position, areas) = self.position_and_areas(self.duration);
-        let rates = self.rates(&areas, self.duration, p);
-        self.end_rates.set(Some((position, *p, rates)));
-        rates
-    }
-
     #[inline(always)]
     pub(super) fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         // x_s + ±0·t is x_s (a stopper inside the cylinder is never at 0).
         match &self.held {
             Some(held) => L::rates_held(self.model, held, areas, p, self.x_s, self.x_s_rate),
-            None => L::rates(self.model, areas, p, self.x_s + self.x_s_rate * t, self.x_s_rate),
+            None => self.rates_with_the_stopper_moving(areas, t, p),
         }
+    }
+
+    /// [`Self::rates`] while the stopper moves: out of line (see `position_and_areas_off_the_stages`).
+    #[inline(never)]
+    fn rates_with_the_stopper_moving(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
+        L::rates(self.model, areas, p, self.x_s + self.x_s_rate * t, self.x_s_rate)
     }
 }
 
@@ -297,15 +302,19 @@ impl<const N: usize, L: PressureLaw<N>> OdeSystem<N> for ChamberSystem<'_, N, L>
     // rates at the end, the stage areas' lookup): out of line, the right-hand side with f2
     // cost 2.5 % more instructions per step, the rates at the end and the lookup another
     // 1.7 % (callgrind, the standard scenario's inputs at 1 kHz).
+    // At t = duration the rates are recorded with the position and pressures (see
+    // `end_rates`); one inlined copy of the law serves every stage.
     #[inline(always)]
     fn rhs(&self, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         if t == 0.0 {
             return self.rates_at_start(p);
         }
+        let (position, areas) = self.position_and_areas(t);
+        let rates = self.rates(&areas, t, p);
         if t == self.duration {
-            return self.rates_at_end(p);
+            self.end_rates.set(Some((position, *p, rates)));
         }
-        self.rates(&self.areas(t), t, p)
+        rates
     }
     /// The jet pipe positions at all stages at once ([`Trajectory::node_positions`]), then
     /// their areas (once for stages at the same position, like DP5's two at c = 1).
