@@ -365,7 +365,7 @@ pub fn integrate<const N: usize, const S: usize, P: Pair<S>, Sys: OdeSystem<N>>(
         system.prepare_stages(t, h_try, &tableau.c[1..], &stage_times[1..]);
         for i in 1..S {
             let stage = stage_sum::<N, S, P>(i, &y, &k, h_try);
-            k[i] = system.rhs(stage_times[i], &stage);
+            k[i] = system.rhs_at_stage(i - 1, stage_times[i], &stage);
             if i == i_stiff {
                 stiffness_stage = stage;
             }

@@ -495,12 +495,7 @@ impl Actuator {
         let return_1 = orifice_flow::mass_flow_inline(k, cd_r1 * a.return_1, p1, p.p_r);
         let supply_2 = orifice_flow::mass_flow_inline(k, cd_s2 * a.supply_2, p.p_s, p2);
         let return_2 = orifice_flow::mass_flow_inline(k, cd_r2 * a.return_2, p2, p.p_r);
-        let leakage = orifice_flow::mass_flow_inline(
-            k,
-            orifice_flow::leakage_cd_area(p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
-            p1,
-            p2,
-        );
+        let leakage = orifice_flow::leakage_flow_inline(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2);
         // (2.24), (2.25)
         let net_1 = supply_1 - return_1 - leakage;
         let net_2 = supply_2 - return_2 + leakage;

@@ -265,6 +265,23 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
         }
     }
 
+    /// The rates at `t` ≠ 0 with the jet pipe at `position`; at t = duration recorded with the
+    /// position and pressures (see `end_rates`).
+    #[inline(always)]
+    fn rates_recording_the_end(
+        &self,
+        position: f64,
+        areas: &OrificeAreas,
+        t: f64,
+        p: &SVector<f64, N>,
+    ) -> SVector<f64, N> {
+        let rates = self.rates(areas, t, p);
+        if t == self.duration {
+            self.end_rates.set(Some((position, *p, rates)));
+        }
+        rates
+    }
+
     #[inline(always)]
     pub(super) fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         // x_s + ±0·t is x_s (a stopper inside the cylinder is never at 0).
@@ -285,15 +302,26 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
 #[derive(Default)]
 pub(super) struct StageAreas {
     pub(super) count: usize,
+    /// Whether `times[..count]` never decreases (an equal time is then next to its first).
+    pub(super) ordered: bool,
     pub(super) times: [f64; MAX_NODES],
     pub(super) positions: [f64; MAX_NODES],
     pub(super) areas: [OrificeAreas; MAX_NODES],
 }
 
 impl StageAreas {
+    /// The first entry at time `t`.
     pub(super) fn at(&self, t: f64) -> Option<(f64, OrificeAreas)> {
         let i = self.times[..self.count].iter().position(|&time| time == t)?;
         Some((self.positions[i], self.areas[i]))
+    }
+
+    /// Entry `i` if it is at time `t` and is the first at that time (what [`Self::at`] finds),
+    /// known without a search while the times are ordered; `None` otherwise.
+    #[inline(always)]
+    pub(super) fn entry(&self, i: usize, t: f64) -> Option<(f64, OrificeAreas)> {
+        let first = i < self.count && self.times[i] == t && (i == 0 || (self.ordered && self.times[i - 1] < t));
+        first.then(|| (self.positions[i], self.areas[i]))
     }
 }
 
@@ -310,11 +338,17 @@ impl<const N: usize, L: PressureLaw<N>> OdeSystem<N> for ChamberSystem<'_, N, L>
             return self.rates_at_start(p);
         }
         let (position, areas) = self.position_and_areas(t);
-        let rates = self.rates(&areas, t, p);
-        if t == self.duration {
-            self.end_rates.set(Some((position, *p, rates)));
+        self.rates_recording_the_end(position, &areas, t, p)
+    }
+    /// The stage's entry of the stage areas when it is the one [`StageAreas::at`] would find
+    /// (see [`StageAreas::entry`]), so that an explicit step's stages need no search.
+    #[inline(always)]
+    fn rhs_at_stage(&self, stage: usize, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
+        let known = self.stage_areas.borrow().entry(stage, t);
+        match known {
+            Some((position, areas)) if t != 0.0 => self.rates_recording_the_end(position, &areas, t, p),
+            _ => self.rhs(t, p),
         }
-        rates
     }
     /// The jet pipe positions at all stages at once ([`Trajectory::node_positions`]), then
     /// their areas (once for stages at the same position, like DP5's two at c = 1).
@@ -337,6 +371,7 @@ impl<const N: usize, L: PressureLaw<N>> OdeSystem<N> for ChamberSystem<'_, N, L>
             };
         }
         table.count = count;
+        table.ordered = times[..count].windows(2).all(|pair| pair[0] <= pair[1]);
     }
     /// Where the jet pipe crosses a tangency of the orifice geometry: the areas, and so the
     /// pressure rates, have a corner or a 3/2 power in time there. Looked for at the middle
