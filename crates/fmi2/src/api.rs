@@ -512,13 +512,13 @@ unsafe fn get_values<M: CoSimModel, T>(
         // Only in `instantiated` does what a variable is limit whether it may be read.
         let restricted = inst.state == State::Instantiated;
         for (&r, slot) in vrs.iter().zip(values.iter_mut()) {
-            let checked = match inst.variable(fname, r, ty) {
-                Ok(v) if restricted => check_get(fname, v, inst.state),
-                Ok(_) => Ok(()),
-                Err(m) => Err(m),
-            };
-            if let Err(m) = checked {
-                return inst.error(m);
+            if restricted || inst.tabled_variable(r, ty).is_none() {
+                let checked = inst
+                    .variable(fname, r, ty)
+                    .and_then(|v| check_get(fname, v, inst.state));
+                if let Err(m) = checked {
+                    return inst.error(m);
+                }
             }
             match read(&inst.model, r) {
                 Ok(x) => *slot = x,

@@ -62,6 +62,7 @@ pub fn unregister_handle(p: *const c_void, kind: HandleKind) -> bool {
 }
 
 /// Whether `p` is a live handle of this kind (no memory behind `p` is read).
+#[inline]
 pub fn is_registered_handle(p: *const c_void, kind: HandleKind) -> bool {
     if p.is_null() {
         return false;
@@ -69,6 +70,12 @@ pub fn is_registered_handle(p: *const c_void, kind: HandleKind) -> bool {
     if kind == HandleKind::Instance && RECENT_INSTANCE.load(Ordering::Acquire) == p as usize {
         return true;
     }
+    is_in_the_registry(p, kind)
+}
+
+/// [`is_registered_handle`] by the registry itself, under its lock.
+#[inline(never)]
+fn is_in_the_registry(p: *const c_void, kind: HandleKind) -> bool {
     let set = live_handles();
     let live = set.as_ref().map_or(false, |s| s.contains(&(p as usize, kind)));
     if live && kind == HandleKind::Instance {
@@ -145,17 +152,20 @@ impl<M: CoSimModel> Instance<M> {
     /// `vr` has that type, searched for otherwise (and for the message when there is none).
     #[inline]
     pub fn variable(&self, fname: &str, vr: u32, ty: VarType) -> Result<&'static Variable, String> {
-        let variables = M::info().variables;
-        if let Some(v) = self
-            .variable_rows
-            .get(vr as usize)
-            .and_then(|&row| variables.get(usize::from(row)))
-        {
-            if v.var_type == ty {
-                return Ok(v);
-            }
+        match self.tabled_variable(vr, ty) {
+            Some(v) => Ok(v),
+            None => crate::api::lookup::<M>(fname, vr, ty),
         }
-        crate::api::lookup::<M>(fname, vr, ty)
+    }
+
+    /// The variable [`Self::variable`] finds when the table of rows has it; `None` when the
+    /// table does not (the variable may still exist: then `variable` searches for it).
+    #[inline]
+    pub fn tabled_variable(&self, vr: u32, ty: VarType) -> Option<&'static Variable> {
+        let v = M::info()
+            .variables
+            .get(usize::from(*self.variable_rows.get(vr as usize)?))?;
+        (v.var_type == ty).then_some(v)
     }
 
     /// Whether `c` is a live instance: registered by `fmi2Instantiate` and not yet freed

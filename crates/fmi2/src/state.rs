@@ -230,6 +230,7 @@ pub const TABLE: &[(Function, &str, Mask)] = &[
 ];
 
 impl Function {
+    #[inline]
     fn row(self) -> &'static (Function, &'static str, Mask) {
         // The table lists the functions in their declaration order (tested); the search is
         // for a table that does not.
@@ -243,14 +244,17 @@ impl Function {
     }
 
     /// The C name, e.g. `"fmi2DoStep"`.
+    #[inline]
     pub fn name(self) -> &'static str {
         self.row().1
     }
 
+    #[inline]
     pub fn mask(self) -> Mask {
         self.row().2
     }
 
+    #[inline]
     pub fn allowed_in(self, state: State) -> bool {
         self.mask() & state.bit() != 0
     }

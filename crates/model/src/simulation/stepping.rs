@@ -106,13 +106,13 @@ impl Simulation {
             })?;
         }
         let t_end = self.time + step;
-        let segments = self.seen_command_segments(step);
-        for (duration, v, v_rate) in segments {
-            self.advance(duration, v, v_rate).map_err(|failure| {
-                self.v_da_rate = 0.0;
-                self.x_s_rate = 0.0;
-                failure
-            })?;
+        if self.plan.command_path {
+            for (duration, v, v_rate) in self.seen_command_segments(step) {
+                self.advance_or_drop_the_rates(duration, v, v_rate)?;
+            }
+        } else {
+            // Without a command stage or delay the driver sees v_DA itself, in one piece.
+            self.advance_or_drop_the_rates(step, self.v_da, self.v_da_rate)?;
         }
         self.time = t_end;
         self.x_s = x_s_end;
@@ -129,6 +129,15 @@ impl Simulation {
             self.record_transducers(&mut y);
         }
         Ok(())
+    }
+
+    /// [`Self::advance`]; on a failure the input derivatives are dropped.
+    fn advance_or_drop_the_rates(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<(), StepFailure> {
+        self.advance(duration, v, v_rate).map_err(|failure| {
+            self.v_da_rate = 0.0;
+            self.x_s_rate = 0.0;
+            failure
+        })
     }
 
     /// Record the transducers' static readings in `y` (at the simulation's time) in the
