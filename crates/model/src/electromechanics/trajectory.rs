@@ -125,12 +125,13 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
         } else {
             None
         };
-        let mut trajectory = Trajectory {
+        let series_form = SeriesForm::new(self, &q0, &series);
+        let assemble = |series_form, series, ramp_form| Trajectory {
             propagator: self,
             drive,
             q0,
             ramp_form,
-            series_form: SeriesForm::new(self, &q0, &series),
+            series_form,
             series,
             plays: *plays,
             turning_point,
@@ -140,6 +141,12 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
             late: None,
             last_node: std::cell::Cell::new(None),
         };
+        if !series.is_empty() && series_from.is_none() {
+            // The closed-form series, nothing more to work out: built where it is returned
+            // (a trajectory is some 800 bytes, and moving it cost a tenth of its building).
+            return assemble(series_form, series, ramp_form);
+        }
+        let mut trajectory = assemble(series_form, series, ramp_form);
         if trajectory.series.is_empty() {
             trajectory.kinks = trajectory.find_kinks();
         }
