@@ -110,8 +110,9 @@ pub(super) struct ChamberSystem<'a, const N: usize, L> {
     pub(super) areas_at: std::cell::Cell<Option<(f64, f64, OrificeAreas)>>,
     /// The areas at the stage times of the current explicit step, worked out together in
     /// [`OdeSystem::prepare_stages`]. An entry from an earlier step is still right: the
-    /// areas depend on the time alone.
-    pub(super) stage_areas: std::cell::RefCell<StageAreas>,
+    /// areas depend on the time alone. The table is the simulation's, emptied here, so that
+    /// a step does not clear its 400 bytes.
+    pub(super) stage_areas: &'a std::cell::RefCell<StageAreas>,
     /// The pressures and rates at the step's start (t = 0), asked for twice: by the ringing
     /// test and by the integrator's first stage.
     pub(super) start_rates: std::cell::Cell<Option<(SVector<f64, N>, SVector<f64, N>)>>,
@@ -138,6 +139,7 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
     pub(super) fn new(
         model: &'a Actuator,
         trajectory: &'a Trajectory<'a>,
+        stage_areas: &'a std::cell::RefCell<StageAreas>,
         duration: f64,
         start_position: f64,
         start_rates: Option<(SVector<f64, N>, SVector<f64, N>)>,
@@ -151,7 +153,10 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
             x_s_rate,
             start_position,
             areas_at: std::cell::Cell::new(None),
-            stage_areas: std::cell::RefCell::new(StageAreas::default()),
+            stage_areas: {
+                stage_areas.borrow_mut().count = 0;
+                stage_areas
+            },
             start_rates: std::cell::Cell::new(start_rates),
             end_rates: std::cell::Cell::new(None),
             stretch_at: std::cell::Cell::new(None),
@@ -299,7 +304,7 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
 }
 
 /// Jet pipe positions and orifice areas at the stage times of one step.
-#[derive(Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct StageAreas {
     pub(super) count: usize,
     /// Whether `times[..count]` never decreases (an equal time is then next to its first).
@@ -420,9 +425,11 @@ mod tests {
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
         // The chambers' time starts at the step's start, as the trajectory's does.
+        let stage_areas = std::cell::RefCell::new(StageAreas::default());
         let system = ChamberSystem::<2, ThesisLaw>::new(
             &model,
             &trajectory,
+            &stage_areas,
             0.002,
             sim.state[index::JET_POSITION],
             None,
@@ -466,9 +473,11 @@ mod tests {
         let propagator = sim.propagator.as_ref().unwrap();
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
+        let stage_areas = std::cell::RefCell::new(StageAreas::default());
         let system = ChamberSystem::<2, ThesisLaw>::new(
             &model,
             &trajectory,
+            &stage_areas,
             0.01,
             sim.state[index::JET_POSITION],
             None,

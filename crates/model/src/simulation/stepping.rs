@@ -209,6 +209,7 @@ impl Simulation {
         let system = ChamberSystem::<N, L>::new(
             &self.model,
             &trajectory,
+            &self.stage_areas,
             duration,
             start_position,
             known_rates,
