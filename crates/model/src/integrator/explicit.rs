@@ -356,8 +356,8 @@ pub fn integrate<const N: usize, const S: usize, P: Pair<S>, Sys: OdeSystem<N>>(
         let mut stiffness_stage = y;
         let mut y_new = y;
         let mut stage_times = [t; S];
-        for (i, time) in stage_times.iter_mut().enumerate().skip(1) {
-            *time = match step_end {
+        for i in 1..S {
+            stage_times[i] = match step_end {
                 Some(end) if i == S - 1 => end,
                 _ => t + tableau.c[i] * h_try,
             };
