@@ -63,6 +63,8 @@ pub struct ElectromechanicalPropagator<C = F3> {
     pub(super) ringing_envelope: ExpMemo,
     /// The exponentials at the last s asked for (see [`ExponentialsMemo`]).
     pub(super) last_exponentials: ExponentialsMemo,
+    /// f3's tanh at the centre of the last series (a held command's steps share it).
+    pub(super) tanh_memo: jet_pipe::TanhMemo,
 }
 
 /// [`ElectromechanicalPropagator::exponentials`] at the last s asked for, and whether with the
@@ -177,6 +179,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
             real_mode_growth: ExpMemo::new(lambda[0].re),
             ringing_envelope: ExpMemo::new(lambda[1].re),
             last_exponentials: ExponentialsMemo::default(),
+            tanh_memo: jet_pipe::TanhMemo::default(),
         })
     }
 }

@@ -106,7 +106,10 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
                             Some(HysteresisOverStep::Affine { constant, slope }) => (constant, slope),
                             _ => (0.0, 1.0),
                         };
-                        if let Some(terms) = self.curve.series(centre, epsilon, MAX_SERIES_TERMS, slope) {
+                        let terms =
+                            self.curve
+                                .series_with_memo(centre, epsilon, MAX_SERIES_TERMS, slope, &self.tanh_memo);
+                        if let Some(terms) = terms {
                             series = terms;
                             series[0] += constant;
                         }
