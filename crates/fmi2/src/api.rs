@@ -98,6 +98,7 @@ unsafe fn guarded<M: CoSimModel>(
 }
 
 /// `p[..n]` as a slice; NULL with `n > 0` is an error (NULL with `n == 0` is fine).
+#[inline]
 unsafe fn in_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
@@ -114,6 +115,7 @@ unsafe fn in_slice<'a, T, M: CoSimModel>(
     }
 }
 
+#[inline]
 unsafe fn out_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
