@@ -65,6 +65,8 @@ pub struct ElectromechanicalPropagator<C = F3> {
     pub(super) last_exponentials: ExponentialsMemo,
     /// f3's tanh at the centre of the last series (a held command's steps share it).
     pub(super) tanh_memo: jet_pipe::TanhMemo,
+    /// 2π/ω_d (s), the ringing pair's period, asked for twice a step.
+    pub(super) ringing_period: f64,
 }
 
 /// [`ElectromechanicalPropagator::exponentials`] at the last s asked for, and whether with the
@@ -180,6 +182,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
             ringing_envelope: ExpMemo::new(lambda[1].re),
             last_exponentials: ExponentialsMemo::default(),
             tanh_memo: jet_pipe::TanhMemo::default(),
+            ringing_period: 2.0 * std::f64::consts::PI / lambda[1].im.abs(),
         })
     }
 }

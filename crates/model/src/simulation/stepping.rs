@@ -29,9 +29,7 @@ impl Simulation {
         step: f64,
     ) -> f64 {
         let after_current_transient = step.min(5.0 / self.model.params.omega_cd);
-        let amplitude = trajectory
-            .ringing_amplitude(0.0)
-            .max(trajectory.ringing_amplitude(after_current_transient));
+        let amplitude = trajectory.ringing_amplitude_at_start_or(after_current_transient);
         if amplitude == 0.0 {
             return 0.0;
         }
