@@ -223,31 +223,11 @@ impl ActuatorFmu {
     pub fn simulation(&self) -> Option<&Simulation> {
         self.simulation.as_ref()
     }
-}
 
-impl CoSimModel for ActuatorFmu {
-    fn info() -> &'static ModelInfo {
-        &MODEL_INFO
-    }
-
-    fn instantiate() -> Self {
-        Self {
-            params: Parameters::default(),
-            v_da: start(vr::V_DA),
-            x_s: start(vr::X_S),
-            v_da_rate: 0.0,
-            x_s_rate: 0.0,
-            start_at_equilibrium: start(vr::START_AT_EQUILIBRIUM) != 0.0,
-            p1_start: start(vr::P1_START),
-            p2_start: start(vr::P2_START),
-            tolerance: DEFAULT_RELATIVE_TOLERANCE,
-            start_time: 0.0,
-            simulation: None,
-            x_s_valid: start(vr::X_S),
-        }
-    }
-
-    fn get_real(&self, value_reference: u32) -> Result<f64, String> {
+    /// [`CoSimModel::get_real`] for any variable, before and after initialisation.
+    #[cold]
+    #[inline(never)]
+    fn get_real_otherwise(&self, value_reference: u32) -> Result<f64, String> {
         match value_reference {
             vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, Simulation::v_da)),
             vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, Simulation::x_s)),
@@ -286,6 +266,51 @@ impl CoSimModel for ActuatorFmu {
                 .get(value_reference)
                 .ok_or_else(|| format!("no Real variable with value reference {value_reference}")),
         }
+    }
+}
+
+impl CoSimModel for ActuatorFmu {
+    fn info() -> &'static ModelInfo {
+        &MODEL_INFO
+    }
+
+    fn instantiate() -> Self {
+        Self {
+            params: Parameters::default(),
+            v_da: start(vr::V_DA),
+            x_s: start(vr::X_S),
+            v_da_rate: 0.0,
+            x_s_rate: 0.0,
+            start_at_equilibrium: start(vr::START_AT_EQUILIBRIUM) != 0.0,
+            p1_start: start(vr::P1_START),
+            p2_start: start(vr::P2_START),
+            tolerance: DEFAULT_RELATIVE_TOLERANCE,
+            start_time: 0.0,
+            simulation: None,
+            x_s_valid: start(vr::X_S),
+        }
+    }
+
+    /// The inputs and outputs of a simulation at once (an importer reads them every step);
+    /// everything else, and everything before initialisation ends, from
+    /// [`ActuatorFmu::get_real_otherwise`].
+    #[inline]
+    fn get_real(&self, value_reference: u32) -> Result<f64, String> {
+        let simulation = match &self.simulation {
+            Some(simulation) => simulation,
+            None => return self.get_real_otherwise(value_reference),
+        };
+        let state = simulation.state();
+        Ok(match value_reference {
+            vr::P1 => state[index::P1],
+            vr::P2 => state[index::P2],
+            vr::I => state[index::CURRENT],
+            vr::X_JP => state[index::JET_POSITION],
+            vr::F_ACT => simulation.outputs().f_act,
+            vr::V_DA => simulation.v_da(),
+            vr::X_S => simulation.x_s(),
+            _ => return self.get_real_otherwise(value_reference),
+        })
     }
 
     fn set_real(&mut self, value_reference: u32, value: f64) -> Result<(), String> {

@@ -98,6 +98,7 @@ unsafe fn guarded<M: CoSimModel>(
 }
 
 /// `p[..n]` as a slice; NULL with `n > 0` is an error (NULL with `n == 0` is fine).
+#[inline]
 unsafe fn in_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
@@ -114,6 +115,7 @@ unsafe fn in_slice<'a, T, M: CoSimModel>(
     }
 }
 
+#[inline]
 unsafe fn out_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
@@ -509,9 +511,16 @@ unsafe fn get_values<M: CoSimModel, T>(
             Ok(s) => s,
             Err(s) => return s,
         };
+        // Only in `instantiated` does what a variable is limit whether it may be read.
+        let restricted = inst.state == State::Instantiated;
         for (&r, slot) in vrs.iter().zip(values.iter_mut()) {
-            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_get(fname, v, inst.state)) {
-                return inst.error(m);
+            if restricted || inst.tabled_variable(r, ty).is_none() {
+                let checked = inst
+                    .variable(fname, r, ty)
+                    .and_then(|v| check_get(fname, v, inst.state));
+                if let Err(m) = checked {
+                    return inst.error(m);
+                }
             }
             match read(&inst.model, r) {
                 Ok(x) => *slot = x,
@@ -543,7 +552,10 @@ unsafe fn set_values<M: CoSimModel, T: Copy>(
             Err(s) => return s,
         };
         for &r in vrs {
-            if let Err(m) = lookup::<M>(fname, r, ty).and_then(|v| check_set(fname, v, inst.state)) {
+            if let Err(m) = inst
+                .variable(fname, r, ty)
+                .and_then(|v| check_set(fname, v, inst.state))
+            {
                 return inst.error(m);
             }
         }

@@ -3,9 +3,10 @@
 use std::collections::BTreeSet;
 use std::ffi::{CStr, CString};
 use std::os::raw::c_void;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use super::model::CoSimModel;
+use super::model::{CoSimModel, VarType, Variable};
 use super::state::State;
 use super::types::*;
 
@@ -31,6 +32,12 @@ fn live_handles() -> std::sync::MutexGuard<'static, Option<BTreeSet<(usize, Hand
     LIVE_HANDLES.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// The instance handle last found live in the registry (0: none), so that the calls of one
+/// step find their instance without taking the lock. Written only while the registry's lock
+/// is held, and cleared there when that handle is unregistered: it never holds the address
+/// of a freed instance.
+static RECENT_INSTANCE: AtomicUsize = AtomicUsize::new(0);
+
 /// Record `p` as a live handle of this kind.
 pub fn register_handle(p: *const c_void, kind: HandleKind) {
     live_handles()
@@ -42,6 +49,10 @@ pub fn register_handle(p: *const c_void, kind: HandleKind) {
 pub fn unregister_handle(p: *const c_void, kind: HandleKind) -> bool {
     let mut set = live_handles();
     let removed = set.as_mut().map_or(false, |s| s.remove(&(p as usize, kind)));
+    if kind == HandleKind::Instance {
+        // under the lock, before the instance is freed
+        let _ = RECENT_INSTANCE.compare_exchange(p as usize, 0, Ordering::AcqRel, Ordering::Acquire);
+    }
     if set.as_ref().map_or(false, |s| s.is_empty()) {
         // an emptied BTreeSet keeps its root node: release it, so that no allocation
         // outlives the last handle (and a dlclose'd library leaves no block behind)
@@ -51,11 +62,26 @@ pub fn unregister_handle(p: *const c_void, kind: HandleKind) -> bool {
 }
 
 /// Whether `p` is a live handle of this kind (no memory behind `p` is read).
+#[inline]
 pub fn is_registered_handle(p: *const c_void, kind: HandleKind) -> bool {
-    !p.is_null()
-        && live_handles()
-            .as_ref()
-            .map_or(false, |s| s.contains(&(p as usize, kind)))
+    if p.is_null() {
+        return false;
+    }
+    if kind == HandleKind::Instance && RECENT_INSTANCE.load(Ordering::Acquire) == p as usize {
+        return true;
+    }
+    is_in_the_registry(p, kind)
+}
+
+/// [`is_registered_handle`] by the registry itself, under its lock.
+#[inline(never)]
+fn is_in_the_registry(p: *const c_void, kind: HandleKind) -> bool {
+    let set = live_handles();
+    let live = set.as_ref().map_or(false, |s| s.contains(&(p as usize, kind)));
+    if live && kind == HandleKind::Instance {
+        RECENT_INSTANCE.store(p as usize, Ordering::Release);
+    }
+    live
 }
 
 /// Log categories the layer itself uses.
@@ -84,6 +110,10 @@ pub struct Instance<M: CoSimModel> {
     /// Where the model declares the "logCalls" category in `M::info().log_categories`, found
     /// once: every call asks whether to trace itself.
     calls_category: Option<usize>,
+    /// By value reference, the first row of `M::info().variables` with it ([`NO_ROW`]: none),
+    /// so that the getters and setters find a variable without a search; empty when the
+    /// references are too large for such a table (then [`Instance::variable`] searches).
+    variable_rows: Vec<u16>,
     pub state: State,
     /// `last_successful_time` of the last `fmi2DoStep` that returned fmi2Discard (the
     /// model's `time()` is what `fmi2GetRealStatus` reports).
@@ -108,12 +138,34 @@ impl<M: CoSimModel> Instance<M> {
             logging_on,
             categories_enabled: vec![logging_on; n],
             calls_category: M::info().log_categories.iter().position(|(name, _)| *name == CAT_CALLS),
+            variable_rows: variable_rows(M::info().variables),
             state: State::Instantiated,
             last_successful_time: None,
             last_error: None,
             #[cfg(test)]
             captured: Vec::new(),
         }
+    }
+
+    /// The variable with value reference `vr` and type `ty`: what [`crate::api::lookup`]
+    /// finds (the first such row), looked up in the table of rows when the first row with
+    /// `vr` has that type, searched for otherwise (and for the message when there is none).
+    #[inline]
+    pub fn variable(&self, fname: &str, vr: u32, ty: VarType) -> Result<&'static Variable, String> {
+        match self.tabled_variable(vr, ty) {
+            Some(v) => Ok(v),
+            None => crate::api::lookup::<M>(fname, vr, ty),
+        }
+    }
+
+    /// The variable [`Self::variable`] finds when the table of rows has it; `None` when the
+    /// table does not (the variable may still exist: then `variable` searches for it).
+    #[inline]
+    pub fn tabled_variable(&self, vr: u32, ty: VarType) -> Option<&'static Variable> {
+        let v = M::info()
+            .variables
+            .get(usize::from(*self.variable_rows.get(vr as usize)?))?;
+        (v.var_type == ty).then_some(v)
     }
 
     /// Whether `c` is a live instance: registered by `fmi2Instantiate` and not yet freed
@@ -193,6 +245,30 @@ impl<M: CoSimModel> Instance<M> {
         self.log_error(message.as_ref());
         fmi2Error
     }
+}
+
+/// In [`Instance`]'s table of rows: no variable has this value reference.
+const NO_ROW: u16 = u16::MAX;
+
+/// Value references up to this one get a row in [`Instance`]'s table (2 bytes each).
+const MAX_TABLED_REFERENCE: u32 = 1 << 14;
+
+/// The first row of `variables` for each value reference, or an empty table when a value
+/// reference or the number of rows is too large for one.
+fn variable_rows(variables: &[Variable]) -> Vec<u16> {
+    let largest = variables.iter().map(|v| v.value_reference).max();
+    let largest = match largest {
+        Some(largest) if largest < MAX_TABLED_REFERENCE && variables.len() < usize::from(NO_ROW) => largest,
+        _ => return Vec::new(),
+    };
+    let mut rows = vec![NO_ROW; largest as usize + 1];
+    for (row, v) in variables.iter().enumerate() {
+        let slot = &mut rows[v.value_reference as usize];
+        if *slot == NO_ROW {
+            *slot = row as u16;
+        }
+    }
+    rows
 }
 
 /// A `CString` from arbitrary text (interior NULs become U+FFFD).

@@ -230,22 +230,31 @@ pub const TABLE: &[(Function, &str, Mask)] = &[
 ];
 
 impl Function {
+    #[inline]
     fn row(self) -> &'static (Function, &'static str, Mask) {
-        TABLE
-            .iter()
-            .find(|row| row.0 == self)
-            .expect("every Function has a row in TABLE")
+        // The table lists the functions in their declaration order (tested); the search is
+        // for a table that does not.
+        match TABLE.get(self as usize) {
+            Some(row) if row.0 == self => row,
+            _ => TABLE
+                .iter()
+                .find(|row| row.0 == self)
+                .expect("every Function has a row in TABLE"),
+        }
     }
 
     /// The C name, e.g. `"fmi2DoStep"`.
+    #[inline]
     pub fn name(self) -> &'static str {
         self.row().1
     }
 
+    #[inline]
     pub fn mask(self) -> Mask {
         self.row().2
     }
 
+    #[inline]
     pub fn allowed_in(self, state: State) -> bool {
         self.mask() & state.bit() != 0
     }

@@ -211,6 +211,36 @@ fn null_and_dead_instances_are_errors_for_every_function() {
 }
 
 #[test]
+fn variables_found_by_the_table_of_rows_are_those_the_search_finds() {
+    use super::model::{VarType, Variable};
+    let instance = Instance::new(M::instantiate(), "rows", None, false);
+    let largest = M::info().variables.iter().map(|v| v.value_reference).max().unwrap();
+    for vr in (0..=largest + 2).chain([u32::MAX]) {
+        for ty in [VarType::Real, VarType::Integer, VarType::Boolean] {
+            let by_rows = instance.variable("f", vr, ty).map(|v| v as *const Variable);
+            let by_search = api::lookup::<M>("f", vr, ty).map(|v| v as *const Variable);
+            assert_eq!(by_rows, by_search, "vr {vr} {ty:?}");
+        }
+    }
+}
+
+#[test]
+fn a_freed_instance_is_not_live_though_it_was_the_last_one_found() {
+    use super::instance::{is_registered_handle, HandleKind};
+    let sink = RefCell::new(Vec::new());
+    unsafe {
+        let c = new_instance(&sink, false);
+        // Found live: it is now the instance of the last call, checked without the lock.
+        assert!(Instance::<M>::is_live(c));
+        assert!(is_registered_handle(c, HandleKind::Instance));
+        assert_eq!(api::free_instance::<M>(c), fmi2OK);
+        // The registry alone answers: the freed memory is not read.
+        assert!(!is_registered_handle(c, HandleKind::Instance));
+        assert!(!Instance::<M>::is_live(c));
+    }
+}
+
+#[test]
 fn free_clears_the_magic() {
     let sink = RefCell::new(Vec::new());
     unsafe {

@@ -45,6 +45,14 @@ pub trait OdeSystem<const N: usize> {
     /// once here; the default does nothing.
     fn prepare_stages(&self, _t: f64, _h: f64, _nodes: &[f64], _times: &[f64]) {}
 
+    /// f at the time `t` of entry `stage` of the `times` last given to
+    /// [`Self::prepare_stages`]: what [`Self::rhs`] gives there, found without looking the time
+    /// up. The default is [`Self::rhs`].
+    #[inline(always)]
+    fn rhs_at_stage(&self, _stage: usize, t: f64, y: &SVector<f64, N>) -> SVector<f64, N> {
+        self.rhs(t, y)
+    }
+
     /// ∂f/∂y. The default is a forward difference; systems with known structure override it.
     fn jacobian(&self, t: f64, y: &SVector<f64, N>, f_y: &SVector<f64, N>) -> SMatrix<f64, N, N> {
         finite_difference_jacobian(|yy| self.rhs(t, yy), y, f_y)
@@ -289,18 +297,11 @@ impl Sdirk4 {
             first_step: None,
         };
         let outcome = match pair {
-            ExplicitPair::DormandPrince => explicit::integrate(
-                &explicit::DORMAND_PRINCE_54,
-                &mut memory,
-                system,
-                t0,
-                y0,
-                t1,
-                tol,
-                stats,
-            ),
+            ExplicitPair::DormandPrince => {
+                explicit::integrate::<N, 7, explicit::DormandPrince, S>(&mut memory, system, t0, y0, t1, tol, stats)
+            }
             ExplicitPair::Verner => {
-                explicit::integrate(&explicit::VERNER_65, &mut memory, system, t0, y0, t1, tol, stats)
+                explicit::integrate::<N, 9, explicit::Verner, S>(&mut memory, system, t0, y0, t1, tol, stats)
             }
         };
         self.next_step = memory.next_step;

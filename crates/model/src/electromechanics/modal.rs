@@ -61,6 +61,25 @@ pub struct ElectromechanicalPropagator<C = F3> {
     /// step and the ringing test ask at the same s every step of a regular grid.
     pub(super) real_mode_growth: ExpMemo,
     pub(super) ringing_envelope: ExpMemo,
+    /// The exponentials at the last s asked for (see [`ExponentialsMemo`]).
+    pub(super) last_exponentials: ExponentialsMemo,
+    /// f3's tanh at the centre of the last series (a held command's steps share it).
+    pub(super) tanh_memo: jet_pipe::TanhMemo,
+    /// 2π/ω_d (s), the ringing pair's period, asked for twice a step.
+    pub(super) ringing_period: f64,
+}
+
+/// [`ElectromechanicalPropagator::exponentials`] at the last s asked for, and whether with the
+/// current transient's: each step asks for its state at the step's end, the same s from one
+/// communication step to the next. A memo: it changes no result, so two propagators that
+/// differ only in it are equal.
+#[derive(Clone, Debug, Default)]
+pub(super) struct ExponentialsMemo(std::cell::Cell<Option<(f64, Exponentials, bool)>>);
+
+impl PartialEq for ExponentialsMemo {
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 /// e^{rate·s} for a fixed rate, kept for the last s asked for. A memo: it changes no result,
@@ -161,6 +180,9 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
             advances: AdvanceCache::default(),
             real_mode_growth: ExpMemo::new(lambda[0].re),
             ringing_envelope: ExpMemo::new(lambda[1].re),
+            last_exponentials: ExponentialsMemo::default(),
+            tanh_memo: jet_pipe::TanhMemo::default(),
+            ringing_period: 2.0 * std::f64::consts::PI / lambda[1].im.abs(),
         })
     }
 }
@@ -320,6 +342,21 @@ impl<C> ElectromechanicalPropagator<C> {
                 decay: if with_decay { 1.0 } else { 0.0 },
             };
         }
+        if let Some((kept, e, has_decay)) = self.last_exponentials.0.get() {
+            if kept == s && (has_decay || !with_decay) {
+                return Exponentials {
+                    decay: if with_decay { e.decay } else { 0.0 },
+                    ..e
+                };
+            }
+        }
+        let e = self.exponentials_at(s, with_decay);
+        self.last_exponentials.0.set(Some((s, e, with_decay)));
+        e
+    }
+
+    /// [`Self::exponentials`] at s ≠ 0, computed.
+    fn exponentials_at(&self, s: f64, with_decay: bool) -> Exponentials {
         let envelope = (self.lambda[1].re * s).exp();
         let (sin, cos) = (self.lambda[1].im * s).sin_cos();
         Exponentials {

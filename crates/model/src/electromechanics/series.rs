@@ -158,12 +158,8 @@ impl SeriesForm {
         (lo + constant - transient, hi + constant + transient)
     }
 
-    pub(super) fn derivatives<C>(&self, p: &ElectromechanicalPropagator<C>, series: &[f64], s: f64) -> [f64; 3] {
-        self.derivatives_from(p, series, &p.exponentials(s, true))
-    }
-
-    /// [`Self::derivatives`] from the exponentials at `s` (with `decay`), for the `series`
-    /// the form was built from.
+    /// The position and its first two derivatives from the exponentials at `s` (with
+    /// `decay`), for the `series` the form was built from.
     pub(super) fn derivatives_from<C>(
         &self,
         p: &ElectromechanicalPropagator<C>,

@@ -135,6 +135,26 @@ pub struct Actuator {
     pub acceleration_term: bool,
 }
 
+/// The factors of (2.29), dP/dt = (γ/V)(R T ṁ − P dV/dt), that do not change while the stopper
+/// stays put: γ/V and dV/dt of each chamber (with (2.30)–(2.32)) and R T. A step whose stopper
+/// does not move works them out once ([`Actuator::held_chambers`]) instead of in every
+/// right-hand side; the rates are formed by the operations of
+/// [`super::chambers::pressure_rate`], in its order, so they keep its bits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeldChambers {
+    gamma_over_volume: [f64; 2],
+    volume_rate: [f64; 2],
+    r_gas_temperature: f64,
+}
+
+impl HeldChambers {
+    /// (2.29) for chamber `i` (0 or 1) with net mass inflow `net` at pressure `pressure`.
+    #[inline(always)]
+    fn pressure_rate(&self, i: usize, net: f64, pressure: f64) -> f64 {
+        self.gamma_over_volume[i] * (self.r_gas_temperature * net - pressure * self.volume_rate[i])
+    }
+}
+
 /// Which terms of the chambers' pressure rates a model has, decided once when it is built, so
 /// that the thesis model's evaluations do not test, term by term, for effects that are off.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -460,21 +480,7 @@ impl Actuator {
     #[inline(always)]
     pub fn thesis_pressure_rates(&self, a: &OrificeAreas, p1: f64, p2: f64, x_s: f64, x_s_rate: f64) -> (f64, f64) {
         let p = &self.params;
-        let k = &self.flow;
-        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
-        let supply_1 = orifice_flow::mass_flow_inline(k, cd_s1 * a.supply_1, p.p_s, p1);
-        let return_1 = orifice_flow::mass_flow_inline(k, cd_r1 * a.return_1, p1, p.p_r);
-        let supply_2 = orifice_flow::mass_flow_inline(k, cd_s2 * a.supply_2, p.p_s, p2);
-        let return_2 = orifice_flow::mass_flow_inline(k, cd_r2 * a.return_2, p2, p.p_r);
-        let leakage = orifice_flow::mass_flow_inline(
-            k,
-            orifice_flow::leakage_cd_area(p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
-            p1,
-            p2,
-        );
-        // (2.24), (2.25)
-        let net_1 = supply_1 - return_1 - leakage;
-        let net_2 = supply_2 - return_2 + leakage;
+        let (net_1, net_2) = self.thesis_net_flows(a, p1, p2);
         let (v1, v2) = self.cylinder.volumes(x_s);
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
         let n = self.polytropic_exponent;
@@ -482,6 +488,46 @@ impl Actuator {
             pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1),
             pressure_rate(n, p.r_gas, p.temperature, v2, dv2, net_2, p2),
         )
+    }
+
+    /// [`Self::thesis_pressure_rates`] with the stopper's part worked out once for a step
+    /// ([`Self::held_chambers`]): the same bits.
+    #[inline(always)]
+    pub fn thesis_pressure_rates_held(&self, a: &OrificeAreas, p1: f64, p2: f64, held: &HeldChambers) -> (f64, f64) {
+        let (net_1, net_2) = self.thesis_net_flows(a, p1, p2);
+        (held.pressure_rate(0, net_1, p1), held.pressure_rate(1, net_2, p2))
+    }
+
+    /// The net mass inflows (2.24), (2.25) of the chambers through the valve's four orifices
+    /// (2.18)–(2.22) and past the piston (2.23), by the thesis's terms alone.
+    #[inline(always)]
+    fn thesis_net_flows(&self, a: &OrificeAreas, p1: f64, p2: f64) -> (f64, f64) {
+        let p = &self.params;
+        let k = &self.flow;
+        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
+        let supply_1 = orifice_flow::mass_flow_inline(k, cd_s1 * a.supply_1, p.p_s, p1);
+        let return_1 = orifice_flow::mass_flow_inline(k, cd_r1 * a.return_1, p1, p.p_r);
+        let supply_2 = orifice_flow::mass_flow_inline(k, cd_s2 * a.supply_2, p.p_s, p2);
+        let return_2 = orifice_flow::mass_flow_inline(k, cd_r2 * a.return_2, p2, p.p_r);
+        let leakage = orifice_flow::leakage_flow_inline(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2);
+        // (2.24), (2.25)
+        let net_1 = supply_1 - return_1 - leakage;
+        let net_2 = supply_2 - return_2 + leakage;
+        (net_1, net_2)
+    }
+
+    /// What (2.29) takes from the stopper and the gas over a step in which the stopper stays
+    /// at `x_s` (moving at `x_s_rate` = ±0): see [`HeldChambers`].
+    pub fn held_chambers(&self, x_s: f64, x_s_rate: f64) -> HeldChambers {
+        let p = &self.params;
+        let (v1, v2) = self.cylinder.volumes(x_s);
+        let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
+        let n = self.polytropic_exponent;
+        HeldChambers {
+            gamma_over_volume: [n / v1, n / v2],
+            volume_rate: [dv1, dv2],
+            r_gas_temperature: p.r_gas * p.temperature,
+        }
     }
 
     /// (2.29) for both chambers with their net mass inflows.

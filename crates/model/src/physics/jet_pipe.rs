@@ -48,6 +48,43 @@ pub trait StaticCurve {
     fn series(&self, _x0: f64, _epsilon: f64, _max_terms: usize, _gain: f64) -> Option<SeriesCoefficients> {
         None
     }
+    /// [`Self::series`], with a memo of the curve's value at the last x0 for a curve that
+    /// can use it (the tanh's: a held command's steps share their x0). The same coefficients.
+    fn series_with_memo(
+        &self,
+        x0: f64,
+        epsilon: f64,
+        max_terms: usize,
+        gain: f64,
+        _memo: &TanhMemo,
+    ) -> Option<SeriesCoefficients> {
+        self.series(x0, epsilon, max_terms, gain)
+    }
+}
+
+/// tanh at the last argument asked for, kept to the bit (see
+/// [`StaticCurve::series_with_memo`]). A memo: it changes no result, so two holders that differ
+/// only in it are equal.
+#[derive(Clone, Debug, Default)]
+pub struct TanhMemo(std::cell::Cell<Option<(u64, f64)>>);
+
+impl TanhMemo {
+    pub fn tanh(&self, x: f64) -> f64 {
+        match self.0.get() {
+            Some((bits, value)) if bits == x.to_bits() => value,
+            _ => {
+                let value = x.tanh();
+                self.0.set(Some((x.to_bits(), value)));
+                value
+            }
+        }
+    }
+}
+
+impl PartialEq for TanhMemo {
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 /// f3 as docs/model.md fixes it: x̄ = x_jp_sat tanh(F_jp / F_jp_sat). The thesis's f3 is the
@@ -111,6 +148,20 @@ impl StaticCurve for F3 {
             return Some(tanh);
         }
         Some(tanh.min((x0 * x0 + 1.0).sqrt()))
+    }
+
+    fn series_with_memo(
+        &self,
+        x0: f64,
+        epsilon: f64,
+        max_terms: usize,
+        gain: f64,
+        memo: &TanhMemo,
+    ) -> Option<SeriesCoefficients> {
+        if self.algebraic_share == 0.0 {
+            return self.tanh.series_with_memo(x0, epsilon, max_terms, gain, memo);
+        }
+        self.series(x0, epsilon, max_terms, gain)
     }
 
     fn series(&self, x0: f64, epsilon: f64, max_terms: usize, gain: f64) -> Option<SeriesCoefficients> {
@@ -189,11 +240,29 @@ impl StaticCurve for TanhSaturation {
     }
 
     fn series(&self, x0: f64, epsilon: f64, max_terms: usize, gain: f64) -> Option<SeriesCoefficients> {
-        let mut coefficients = tanh_series(x0, epsilon, max_terms);
+        Some(self.scaled(tanh_series(x0, epsilon, max_terms), gain))
+    }
+
+    fn series_with_memo(
+        &self,
+        x0: f64,
+        epsilon: f64,
+        max_terms: usize,
+        gain: f64,
+        memo: &TanhMemo,
+    ) -> Option<SeriesCoefficients> {
+        Some(self.scaled(tanh_series_from(memo.tanh(x0), epsilon, max_terms), gain))
+    }
+}
+
+impl TanhSaturation {
+    /// The series of tanh scaled to the curve's: x_jp_sat·gain times each coefficient.
+    #[inline]
+    fn scaled(&self, mut coefficients: SeriesCoefficients, gain: f64) -> SeriesCoefficients {
         for a in coefficients.iter_mut() {
             *a *= self.x_jp_sat * gain;
         }
-        Some(coefficients)
+        coefficients
     }
 }
 
@@ -215,11 +284,16 @@ const RECIPROCALS: [f64; TANH_SERIES_TERMS] = {
 /// (at most [`TANH_SERIES_TERMS`]). They converge for |ε| below the distance to tanh's
 /// nearest pole, [`TanhSaturation::series_radius`].
 pub fn tanh_series(x0: f64, epsilon: f64, max_terms: usize) -> SeriesCoefficients {
+    tanh_series_from(x0.tanh(), epsilon, max_terms)
+}
+
+/// [`tanh_series`] from tanh x0.
+pub fn tanh_series_from(tanh_x0: f64, epsilon: f64, max_terms: usize) -> SeriesCoefficients {
     let max_terms = max_terms.min(TANH_SERIES_TERMS);
     // The terms go to an array first, and to the small vector whole (indexing a SmallVec
     // checks where it lives at every element); only a series longer than the array spills.
     let mut inline = [0.0; SERIES_INLINE_TERMS];
-    inline[0] = x0.tanh();
+    inline[0] = tanh_x0;
     if epsilon == 0.0 {
         return SeriesCoefficients::from_buf_and_len(inline, 1);
     }
@@ -419,6 +493,32 @@ mod tests {
         let h = 1e-7;
         let numeric = (f3.value(0.2 + h) - f3.value(0.2 - h)) / (2.0 * h);
         assert!((numeric - f3.slope(0.2)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_series_with_the_tanh_memo_are_the_series_to_the_bit() {
+        let memo = TanhMemo::default();
+        for share in [0.0, 0.4] {
+            let p = Parameters {
+                f3_algebraic_share: share,
+                ..Parameters::default()
+            };
+            let f3 = F3::from_parameters(&p);
+            // Repeated centres (a held command's steps) and new ones, with and without a jump.
+            for (x0, eps) in [
+                (0.3, 0.1),
+                (0.3, 0.01),
+                (0.3, 0.0),
+                (-1.2, 0.4),
+                (-1.2, 0.0),
+                (0.3, 0.2),
+            ] {
+                let kept = f3.series_with_memo(x0, eps, 64, 0.7, &memo).unwrap();
+                let fresh = f3.series(x0, eps, 64, 0.7).unwrap();
+                let bits = |a: &SeriesCoefficients| a.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&kept), bits(&fresh), "share {share} x0 {x0} eps {eps}");
+            }
+        }
     }
 
     #[test]

@@ -177,15 +177,24 @@ pub fn mass_flow(k: &FlowConstants, cd_area: f64, p_from: f64, p_to: f64) -> f64
 /// evaluates it five times (where the compiler would otherwise keep one out-of-line copy).
 #[inline(always)]
 pub fn mass_flow_inline(k: &FlowConstants, cd_area: f64, p_from: f64, p_to: f64) -> f64 {
+    // A closed orifice first: two of the valve's four are closed over the operating range.
+    if cd_area == 0.0 {
+        return 0.0;
+    }
     let (p_up, p_down, sign) = if p_from >= p_to {
         (p_from, p_to, 1.0)
     } else {
         (p_to, p_from, -1.0)
     };
-    if p_up <= 0.0 || cd_area == 0.0 {
+    if p_up <= 0.0 {
         return 0.0;
     }
-    let ratio = p_down / p_up;
+    flow_from_upstream(k, cd_area, p_up, p_down / p_up, sign)
+}
+
+/// (2.18) from the upstream pressure and the pressure ratio, with the direction's `sign`.
+#[inline(always)]
+fn flow_from_upstream(k: &FlowConstants, cd_area: f64, p_up: f64, ratio: f64, sign: f64) -> f64 {
     let scale = cd_area * p_up * k.inv_sqrt_temperature;
     let flow = if ratio <= k.critical_ratio {
         scale * k.c1
@@ -203,6 +212,22 @@ pub fn leakage_cd_area(c_dm_a_lpp: f64, c_db_a_lpp: f64, p1: f64, p2: f64) -> f6
         return 0.0;
     }
     (c_dm_a_lpp * (p_down / p_up) + c_db_a_lpp).max(0.0)
+}
+
+/// [`leakage_flow`] inlined, for the thesis model's right-hand side: the pressure ratio that
+/// sets (2.23)'s discharge coefficient is the flow's own, divided once.
+#[inline(always)]
+pub fn leakage_flow_inline(k: &FlowConstants, c_dm_a_lpp: f64, c_db_a_lpp: f64, p1: f64, p2: f64) -> f64 {
+    let (p_up, p_down, sign) = if p1 >= p2 { (p1, p2, 1.0) } else { (p2, p1, -1.0) };
+    if p_up <= 0.0 {
+        return 0.0;
+    }
+    let ratio = p_down / p_up;
+    let cd_area = (c_dm_a_lpp * ratio + c_db_a_lpp).max(0.0);
+    if cd_area == 0.0 {
+        return 0.0;
+    }
+    flow_from_upstream(k, cd_area, p_up, ratio, sign)
 }
 
 /// Leakage mass flow from chamber 1 to chamber 2 (negative when P2 > P1).

@@ -97,7 +97,15 @@ pub fn orifice_areas(d_jp: f64, x_abs: f64) -> OrificeAreas {
 /// and the jet lies right over a port at ξ = ±1 (a corner); beyond ±3D nothing changes.
 /// The integrators end their steps where the jet pipe crosses one of these.
 pub fn analytic_stretch(d_jp: f64, x_abs: f64) -> i32 {
-    (x_abs / d_jp).floor().clamp(-4.0, 3.0) as i32
+    // ⌊ξ⌋ clamped to [−4, 3], as ⌊clamp(ξ)⌋ by truncation: `floor` is a library call on the
+    // baseline x86-64 target, and the integrator asks twice per step (NaN gives 0 either way).
+    let xi = (x_abs / d_jp).clamp(-4.0, 3.0);
+    let truncated = xi as i32;
+    if truncated as f64 > xi {
+        truncated - 1
+    } else {
+        truncated
+    }
 }
 
 /// The tangency between stretches `from` and `to` (adjacent or not) that a jet pipe moving from
@@ -233,6 +241,27 @@ mod tests {
     use super::*;
 
     const D: f64 = 0.9652e-3;
+
+    #[test]
+    fn stretches_are_the_clamped_floor_of_the_position_in_diameters() {
+        let mut xis: Vec<f64> = (-1000..=1000).map(|k| k as f64 * 0.0073).collect();
+        xis.extend([
+            -4.0, -3.0, -2.0, -1.0, -0.0, 0.0, 1.0, 2.0, 3.0, 4.0, -4.5, 3.5, 1e300, -1e300,
+        ]);
+        xis.extend([
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -1e-300,
+            1.0 - 1e-16,
+            -1.0 - 2e-16,
+        ]);
+        for xi in xis {
+            let x_abs = xi * D;
+            let expected = (x_abs / D).floor().clamp(-4.0, 3.0) as i32;
+            assert_eq!(analytic_stretch(D, x_abs), expected, "ξ = {xi}");
+        }
+    }
 
     /// Area of (disc a ∩ disc b) minus nothing, or of (disc a \ disc b), by integrating the
     /// chord overlap over y with the substitution y = r_a sin θ (smooth at the poles).

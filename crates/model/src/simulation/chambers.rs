@@ -8,7 +8,7 @@ use nalgebra::SVector;
 
 use crate::electromechanics::{Trajectory, MAX_NODES};
 use crate::integrator::{finite_difference_jacobian, OdeSystem};
-use crate::physics::actuator::Actuator;
+use crate::physics::actuator::{Actuator, HeldChambers};
 use crate::physics::orifice_geometry::OrificeAreas;
 use crate::physics::restrictions::PRESSURES_WITH_VOLUMES;
 
@@ -20,6 +20,20 @@ pub(super) type EndRates<const N: usize> = (f64, SVector<f64, N>, SVector<f64, N
 /// law's own code, inlined into the integrator, with no test of which terms are live.
 pub(super) trait PressureLaw<const N: usize> {
     fn rates(model: &Actuator, areas: &OrificeAreas, p: &SVector<f64, N>, x_s: f64, x_s_rate: f64) -> SVector<f64, N>;
+
+    /// [`Self::rates`] over a step in which the stopper stays at `x_s` (`x_s_rate` = ±0), with
+    /// what the chambers take from it worked out once for the step in `held`; the same bits.
+    #[inline(always)]
+    fn rates_held(
+        model: &Actuator,
+        _held: &HeldChambers,
+        areas: &OrificeAreas,
+        p: &SVector<f64, N>,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> SVector<f64, N> {
+        Self::rates(model, areas, p, x_s, x_s_rate)
+    }
 }
 
 /// P1 and P2 by the thesis's terms alone ([`crate::physics::actuator::RateTerms::Thesis`]).
@@ -36,6 +50,19 @@ impl PressureLaw<2> for ThesisLaw {
     #[inline(always)]
     fn rates(model: &Actuator, areas: &OrificeAreas, p: &SVector<f64, 2>, x_s: f64, x_s_rate: f64) -> SVector<f64, 2> {
         let (a, b) = model.thesis_pressure_rates(areas, p[0], p[1], x_s, x_s_rate);
+        SVector::<f64, 2>::new(a, b)
+    }
+
+    #[inline(always)]
+    fn rates_held(
+        model: &Actuator,
+        held: &HeldChambers,
+        areas: &OrificeAreas,
+        p: &SVector<f64, 2>,
+        _x_s: f64,
+        _x_s_rate: f64,
+    ) -> SVector<f64, 2> {
+        let (a, b) = model.thesis_pressure_rates_held(areas, p[0], p[1], held);
         SVector::<f64, 2>::new(a, b)
     }
 }
@@ -83,8 +110,9 @@ pub(super) struct ChamberSystem<'a, const N: usize, L> {
     pub(super) areas_at: std::cell::Cell<Option<(f64, f64, OrificeAreas)>>,
     /// The areas at the stage times of the current explicit step, worked out together in
     /// [`OdeSystem::prepare_stages`]. An entry from an earlier step is still right: the
-    /// areas depend on the time alone.
-    pub(super) stage_areas: std::cell::RefCell<StageAreas>,
+    /// areas depend on the time alone. The table is the simulation's, emptied here, so that
+    /// a step does not clear its 400 bytes.
+    pub(super) stage_areas: &'a std::cell::RefCell<StageAreas>,
     /// The pressures and rates at the step's start (t = 0), asked for twice: by the ringing
     /// test and by the integrator's first stage.
     pub(super) start_rates: std::cell::Cell<Option<(SVector<f64, N>, SVector<f64, N>)>>,
@@ -99,6 +127,9 @@ pub(super) struct ChamberSystem<'a, const N: usize, L> {
     /// first question.
     pub(super) tangency_free: std::cell::Cell<Option<bool>>,
     pub(super) duration: f64,
+    /// What the chambers take from a stopper that stays put over the step (`x_s_rate` = ±0),
+    /// worked out once ([`Actuator::held_chambers`]); `None` while it moves.
+    held: Option<HeldChambers>,
     law: std::marker::PhantomData<L>,
 }
 
@@ -108,6 +139,7 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
     pub(super) fn new(
         model: &'a Actuator,
         trajectory: &'a Trajectory<'a>,
+        stage_areas: &'a std::cell::RefCell<StageAreas>,
         duration: f64,
         start_position: f64,
         start_rates: Option<(SVector<f64, N>, SVector<f64, N>)>,
@@ -121,12 +153,16 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
             x_s_rate,
             start_position,
             areas_at: std::cell::Cell::new(None),
-            stage_areas: std::cell::RefCell::new(StageAreas::default()),
+            stage_areas: {
+                stage_areas.borrow_mut().count = 0;
+                stage_areas
+            },
             start_rates: std::cell::Cell::new(start_rates),
             end_rates: std::cell::Cell::new(None),
             stretch_at: std::cell::Cell::new(None),
             tangency_free: std::cell::Cell::new(None),
             duration,
+            held: (x_s_rate == 0.0).then(|| model.held_chambers(x_s, x_s_rate)),
             law: std::marker::PhantomData,
         }
     }
@@ -156,6 +192,14 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
         if let Some(known) = self.stage_areas.borrow().at(t) {
             return known;
         }
+        self.position_and_areas_off_the_stages(t)
+    }
+
+    /// [`Self::position_and_areas`] at a time that is not one of the current explicit step's
+    /// stages (Newton iterations, Jacobians, the ringing test): out of line, so that the
+    /// stages' right-hand side stays small in the integrator's loop.
+    #[inline(never)]
+    fn position_and_areas_off_the_stages(&self, t: f64) -> (f64, OrificeAreas) {
         match self.areas_at.get() {
             Some((cached, position, areas)) if cached == t => (position, areas),
             _ => {
@@ -226,33 +270,63 @@ impl<'a, const N: usize, L: PressureLaw<N>> ChamberSystem<'a, N, L> {
         }
     }
 
-    /// The rates at t = duration, recorded with the position and pressures (see `end_rates`).
+    /// The rates at `t` ≠ 0 with the jet pipe at `position`; at t = duration recorded with the
+    /// position and pressures (see `end_rates`).
     #[inline(always)]
-    pub(super) fn rates_at_end(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
-        let (position, areas) = self.position_and_areas(self.duration);
-        let rates = self.rates(&areas, self.duration, p);
-        self.end_rates.set(Some((position, *p, rates)));
+    fn rates_recording_the_end(
+        &self,
+        position: f64,
+        areas: &OrificeAreas,
+        t: f64,
+        p: &SVector<f64, N>,
+    ) -> SVector<f64, N> {
+        let rates = self.rates(areas, t, p);
+        if t == self.duration {
+            self.end_rates.set(Some((position, *p, rates)));
+        }
         rates
     }
 
+    #[inline(always)]
     pub(super) fn rates(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
+        // x_s + ±0·t is x_s (a stopper inside the cylinder is never at 0).
+        match &self.held {
+            Some(held) => L::rates_held(self.model, held, areas, p, self.x_s, self.x_s_rate),
+            None => self.rates_with_the_stopper_moving(areas, t, p),
+        }
+    }
+
+    /// [`Self::rates`] while the stopper moves: out of line (see `position_and_areas_off_the_stages`).
+    #[inline(never)]
+    fn rates_with_the_stopper_moving(&self, areas: &OrificeAreas, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         L::rates(self.model, areas, p, self.x_s + self.x_s_rate * t, self.x_s_rate)
     }
 }
 
 /// Jet pipe positions and orifice areas at the stage times of one step.
-#[derive(Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct StageAreas {
     pub(super) count: usize,
+    /// Whether `times[..count]` never decreases (an equal time is then next to its first).
+    pub(super) ordered: bool,
     pub(super) times: [f64; MAX_NODES],
     pub(super) positions: [f64; MAX_NODES],
     pub(super) areas: [OrificeAreas; MAX_NODES],
 }
 
 impl StageAreas {
+    /// The first entry at time `t`.
     pub(super) fn at(&self, t: f64) -> Option<(f64, OrificeAreas)> {
         let i = self.times[..self.count].iter().position(|&time| time == t)?;
         Some((self.positions[i], self.areas[i]))
+    }
+
+    /// Entry `i` if it is at time `t` and is the first at that time (what [`Self::at`] finds),
+    /// known without a search while the times are ordered; `None` otherwise.
+    #[inline(always)]
+    pub(super) fn entry(&self, i: usize, t: f64) -> Option<(f64, OrificeAreas)> {
+        let first = i < self.count && self.times[i] == t && (i == 0 || (self.ordered && self.times[i - 1] < t));
+        first.then(|| (self.positions[i], self.areas[i]))
     }
 }
 
@@ -261,15 +335,25 @@ impl<const N: usize, L: PressureLaw<N>> OdeSystem<N> for ChamberSystem<'_, N, L>
     // rates at the end, the stage areas' lookup): out of line, the right-hand side with f2
     // cost 2.5 % more instructions per step, the rates at the end and the lookup another
     // 1.7 % (callgrind, the standard scenario's inputs at 1 kHz).
+    // At t = duration the rates are recorded with the position and pressures (see
+    // `end_rates`); one inlined copy of the law serves every stage.
     #[inline(always)]
     fn rhs(&self, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
         if t == 0.0 {
             return self.rates_at_start(p);
         }
-        if t == self.duration {
-            return self.rates_at_end(p);
+        let (position, areas) = self.position_and_areas(t);
+        self.rates_recording_the_end(position, &areas, t, p)
+    }
+    /// The stage's entry of the stage areas when it is the one [`StageAreas::at`] would find
+    /// (see [`StageAreas::entry`]), so that an explicit step's stages need no search.
+    #[inline(always)]
+    fn rhs_at_stage(&self, stage: usize, t: f64, p: &SVector<f64, N>) -> SVector<f64, N> {
+        let known = self.stage_areas.borrow().entry(stage, t);
+        match known {
+            Some((position, areas)) if t != 0.0 => self.rates_recording_the_end(position, &areas, t, p),
+            _ => self.rhs(t, p),
         }
-        self.rates(&self.areas(t), t, p)
     }
     /// The jet pipe positions at all stages at once ([`Trajectory::node_positions`]), then
     /// their areas (once for stages at the same position, like DP5's two at c = 1).
@@ -292,6 +376,7 @@ impl<const N: usize, L: PressureLaw<N>> OdeSystem<N> for ChamberSystem<'_, N, L>
             };
         }
         table.count = count;
+        table.ordered = times[..count].windows(2).all(|pair| pair[0] <= pair[1]);
     }
     /// Where the jet pipe crosses a tangency of the orifice geometry: the areas, and so the
     /// pressure rates, have a corner or a 3/2 power in time there. Looked for at the middle
@@ -340,9 +425,11 @@ mod tests {
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, -10.0, 0.0, &sim.plays);
         // The chambers' time starts at the step's start, as the trajectory's does.
+        let stage_areas = std::cell::RefCell::new(StageAreas::default());
         let system = ChamberSystem::<2, ThesisLaw>::new(
             &model,
             &trajectory,
+            &stage_areas,
             0.002,
             sim.state[index::JET_POSITION],
             None,
@@ -386,9 +473,11 @@ mod tests {
         let propagator = sim.propagator.as_ref().unwrap();
         let start = sim.electromechanical_state();
         let trajectory = propagator.trajectory(&start, 4.0, 0.0, &sim.plays);
+        let stage_areas = std::cell::RefCell::new(StageAreas::default());
         let system = ChamberSystem::<2, ThesisLaw>::new(
             &model,
             &trajectory,
+            &stage_areas,
             0.01,
             sim.state[index::JET_POSITION],
             None,

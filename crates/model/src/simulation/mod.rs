@@ -140,6 +140,9 @@ pub struct Simulation {
     /// function of: when the next step starts from the same jet pipe position, pressures and
     /// stopper motion, they are its rates at the start and are not evaluated again.
     chamber_rates_at_end: Option<ChamberRatesAtEnd>,
+    /// The split method's table of the orifice areas at an explicit step's stages, lent to
+    /// each step's chamber system (it holds nothing from one step to the next).
+    stage_areas: std::cell::RefCell<chambers::StageAreas>,
     /// Which of a step's optional stages the model has, decided once from its parameters.
     plan: StepPlan,
 }
@@ -275,6 +278,7 @@ impl Simulation {
             transducers,
             propagator,
             chamber_rates_at_end: None,
+            stage_areas: std::cell::RefCell::new(chambers::StageAreas::default()),
             plan,
         }
     }

@@ -29,9 +29,7 @@ impl Simulation {
         step: f64,
     ) -> f64 {
         let after_current_transient = step.min(5.0 / self.model.params.omega_cd);
-        let amplitude = trajectory
-            .ringing_amplitude(0.0)
-            .max(trajectory.ringing_amplitude(after_current_transient));
+        let amplitude = trajectory.ringing_amplitude_at_start_or(after_current_transient);
         if amplitude == 0.0 {
             return 0.0;
         }
@@ -106,13 +104,13 @@ impl Simulation {
             })?;
         }
         let t_end = self.time + step;
-        let segments = self.seen_command_segments(step);
-        for (duration, v, v_rate) in segments {
-            self.advance(duration, v, v_rate).map_err(|failure| {
-                self.v_da_rate = 0.0;
-                self.x_s_rate = 0.0;
-                failure
-            })?;
+        if self.plan.command_path {
+            for (duration, v, v_rate) in self.seen_command_segments(step) {
+                self.advance_or_drop_the_rates(duration, v, v_rate)?;
+            }
+        } else {
+            // Without a command stage or delay the driver sees v_DA itself, in one piece.
+            self.advance_or_drop_the_rates(step, self.v_da, self.v_da_rate)?;
         }
         self.time = t_end;
         self.x_s = x_s_end;
@@ -145,6 +143,15 @@ impl Simulation {
             );
             self.record_transducers(&mut y);
         }
+    }
+
+    /// [`Self::advance`]; on a failure the input derivatives are dropped.
+    fn advance_or_drop_the_rates(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<(), StepFailure> {
+        self.advance(duration, v, v_rate).map_err(|failure| {
+            self.v_da_rate = 0.0;
+            self.x_s_rate = 0.0;
+            failure
+        })
     }
 
     /// Record the transducers' static readings in `y` (at the simulation's time) in the
@@ -216,6 +223,7 @@ impl Simulation {
         let system = ChamberSystem::<N, L>::new(
             &self.model,
             &trajectory,
+            &self.stage_areas,
             duration,
             start_position,
             known_rates,
