@@ -35,6 +35,9 @@ mechanisms=(
     "force_sensor_lag|force_sensor|dynamics|--undeclared force_sensor_lag"
     "command_dead_zone|command|nonlinearity|--command-dead-zone 0.4"
     "force_sensor_saturation|force_sensor|limit|--force-sensor-saturation 85"
+    "force_sensor_saturation_40|force_sensor|limit|--force-sensor-saturation 40"
+    "p1_sensor_saturation|pressure_sensors|limit|--pressure-sensor-saturation 450000"
+    "p2_sensor_quadratic|pressure_sensors|nonlinearity|--pressure-sensor-quadratic 5e-8"
 )
 
 chosen() { # NAME LIST: whether NAME is in the space-separated LIST (or LIST is empty)

@@ -148,6 +148,12 @@ struct Cli {
     /// The force reading saturates at ± this, N (e.g. 85).
     #[arg(long)]
     force_sensor_saturation: Option<f64>,
+    /// The chamber 1 pressure transducer's range ends at this absolute pressure, Pa (e.g. 4.5e5).
+    #[arg(long)]
+    pressure_sensor_saturation: Option<f64>,
+    /// The chamber 2 transducer reads P2 + q (P2 − 101 325 Pa)²: q, 1/Pa (e.g. 2e-7).
+    #[arg(long)]
+    pressure_sensor_quadratic: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -205,6 +211,8 @@ fn main() -> ExitCode {
     );
     set(&mut und.command_dead_zone, cli.command_dead_zone);
     set(&mut und.force_sensor_saturation, cli.force_sensor_saturation);
+    set(&mut und.pressure_sensor_saturation_1, cli.pressure_sensor_saturation);
+    set(&mut und.pressure_sensor_quadratic_2, cli.pressure_sensor_quadratic);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -222,6 +230,7 @@ fn main() -> ExitCode {
         und.force_sensor_pickup_frequency,
         und.command_dead_zone,
         und.force_sensor_saturation,
+        und.pressure_sensor_saturation_1,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -232,6 +241,7 @@ fn main() -> ExitCode {
             und.return_back_pressure,
             und.receiver_offset,
             und.force_sensor_pickup_amplitude,
+            und.pressure_sensor_quadratic_2,
         ]
         .iter()
         .all(|x| x.is_finite());
