@@ -4,12 +4,14 @@
 //! * `synthetic`: the synthetic bench's recordings of the named effects;
 //! * `undeclared`: the synthetic bench's undeclared mechanisms;
 //! * `protocols`: the general discovery pieces on recordings under other protocols.
+//! * `curves`: the static-curve class at the command and the transducers.
 //!
 //! Why one binary and not three: cargo runs test binaries one after another and each
 //! harness runs its tests two at a time, so a binary's last, long test left a core idle
 //! until it ended, three times over. Here the harness takes the next of all the
 //! diagnoses whenever one ends, and both cores stay busy until the last few.
 
+mod curves;
 mod protocols;
 mod shared;
 mod synthetic;
