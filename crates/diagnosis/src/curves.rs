@@ -369,8 +369,14 @@ pub fn is_command_curve(candidate: &Candidate) -> bool {
     candidate.settings.iter().any(|(n, _)| *n == "command_curve_knots")
 }
 
-/// The static-curve candidates at the places the knots allow.
-pub fn candidates(knots: &CurveKnots, has_pressures: bool) -> Vec<Candidate> {
+/// The static-curve candidates at the places the knots allow, where the model `base` has no
+/// curve yet (a second curve there would replace the first, not add to it).
+pub fn candidates(base: &Parameters, knots: &CurveKnots, has_pressures: bool) -> Vec<Candidate> {
+    let free = [
+        !base.force_sensor_curve.is_on(),
+        !base.p1_sensor_curve.is_on(),
+        !base.p2_sensor_curve.is_on(),
+    ];
     let mut list = vec![];
     let c = |label, location, terms, settings| Candidate {
         label,
@@ -380,16 +386,18 @@ pub fn candidates(knots: &CurveKnots, has_pressures: bool) -> Vec<Candidate> {
         terms,
         settings,
     };
-    if knots.command.len() >= 3 {
+    if knots.command.len() >= 3 && !base.command_curve.is_on() {
         let (terms, settings) = command_terms(&knots.command);
         list.push(c("command static curve", "command", terms, settings));
     }
-    if knots.channels[FORCE].len() >= 3 {
+    if knots.channels[FORCE].len() >= 3 && free[FORCE] {
         let terms = channel_terms(FORCE, &knots.channels[FORCE], "N");
         list.push(c("force sensor static curve", "force_sensor", terms, vec![]));
     }
     if has_pressures {
-        let one = |ch: usize| (knots.channels[ch].len() >= 3).then(|| channel_terms(ch, &knots.channels[ch], "Pa"));
+        let one = |ch: usize| {
+            (knots.channels[ch].len() >= 3 && free[ch]).then(|| channel_terms(ch, &knots.channels[ch], "Pa"))
+        };
         if let Some(t) = one(P1) {
             list.push(c(
                 "chamber 1 pressure sensor static curve",

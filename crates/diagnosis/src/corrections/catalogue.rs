@@ -676,6 +676,6 @@ pub fn catalogue(
             ],
         ));
     }
-    list.extend(crate::curves::candidates(knots, has_pressures));
+    list.extend(crate::curves::candidates(base, knots, has_pressures));
     list
 }
