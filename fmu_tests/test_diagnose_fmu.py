@@ -164,3 +164,32 @@ def test_fmu_start_values_of_an_extra_force_on_the_piston_reproduce_the_after_er
           f"before {report['before']['force_rms_N']:.4f} N")
     assert rms < 0.5 * report["before"]["force_rms_N"]
     assert abs(rms - reported) <= 0.05 * reported
+# A static curve (piecewise linear through its knots) on the force sensor and on a pressure
+# transducer, found under another protocol than the bench's: the report's knots, set on the
+# FMU, give its errors after.
+@needs_binaries
+@pytest.mark.parametrize("name,options,prefix,outputs", [
+    ("force_saturation", ("--protocol", "staircase", "--force-sensor-saturation", "40"),
+     "force_sensor_curve", ("F_meas",)),
+    ("p1_saturation", ("--protocol", "ramps", "--sample-rate", "500", "--pressure-sensor-saturation", "450000"),
+     "p1_sensor_curve", ("P1_meas", "P2_meas")),
+])
+def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
+        unzipdir, model_description, vrs, tmp_path, name, options, prefix, outputs):
+    recording, report = generated_and_diagnosed(tmp_path, name, "--seed", "5", "--duration", "20", *options)
+    assert report["effects"] == [], report["effects"]
+    start_values = report["fmu_start_values"]
+    assert start_values.get(f"{prefix}_knots", 0) >= 3, start_values
+    assert report["discovered"][0]["family"] == "limit", report["discovered"]
+    read = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, outputs=outputs)
+    if outputs == ("F_meas",):
+        rms = float(np.sqrt(np.mean((recording["force_N"] - read) ** 2)))
+        reported = report["after"]["force_rms_N"]
+        print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N")
+        assert abs(rms - reported) <= 0.1 * reported
+    else:
+        through_fmu = [float(np.sqrt(np.mean((recording[c] - p) ** 2))) for c, p in zip(("p1_Pa", "p2_Pa"), read)]
+        reported = report["after"]["pressure_rms_Pa"]
+        print(f"{name}: pressure errors after reported {reported}, FMU replay {through_fmu}")
+        for c in range(2):
+            assert abs(through_fmu[c] - reported[c]) <= 0.1 * reported[c]

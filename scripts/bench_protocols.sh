@@ -35,6 +35,10 @@ mechanisms=(
     "force_sensor_lag|force_sensor|dynamics|--undeclared force_sensor_lag"
     "command_dead_zone|command|nonlinearity|--command-dead-zone 0.4"
     "force_sensor_saturation|force_sensor|limit|--force-sensor-saturation 85"
+    "force_sensor_saturation_40|force_sensor|limit|--force-sensor-saturation 40"
+    "p1_sensor_saturation|pressure_sensors|limit|--pressure-sensor-saturation 450000"
+    "p2_sensor_quadratic|pressure_sensors|nonlinearity|--pressure-sensor-quadratic 5e-8"
+    "force_sensor_offset_gain|force_sensor|parameter_offset|--force-sensor-offset 0.7 --force-sensor-gain 1.02"
 )
 # Extra forces on the piston, which show only while the stopper moves: their own protocols.
 balance_protocols=(
@@ -92,8 +96,13 @@ if loc == "none":
     right = "yes" if not d["discovered"] and not d["effects"] else "no"
 else:
     right = "yes" if places and places[0] == (loc, fam) else ("place" if places and places[0][0] == loc else "no")
-ratio = d["heldout"]["after_rms_N"] / d["noise_floor_N"]
-print(f'{d["verdict"]} | {found} | {right} | {ratio:.2f}')
+ratio = f'{d["heldout"]["after_rms_N"] / d["noise_floor_N"]:.2f}'
+# A transducer's term: the pressures held out after it, in their noise floors, too.
+for t in d["discovered"]:
+    if t.get("pressures_heldout_after_rms_Pa") and d.get("noise_floor_Pa"):
+        after = t["pressures_heldout_after_rms_Pa"]
+        ratio += " (P1 {:.2f}, P2 {:.2f})".format(after[0] / d["noise_floor_Pa"]["p1"], after[1] / d["noise_floor_Pa"]["p2"])
+print(f'{d["verdict"]} | {found} | {right} | {ratio}')
 PY
 ) || row="error | — | no | —"
         echo "| $pname | $mname | $mloc, $mfam | $row | $((ms / 1000)).$(((ms % 1000) / 100)) |"

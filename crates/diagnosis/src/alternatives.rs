@@ -90,7 +90,7 @@ pub(crate) fn simpler_than_named(
             let before = check.force_before;
             let term = DiscoveredTerm {
                 location: place,
-                family: candidate.family,
+                family: crate::curves::family(candidate.family, &set),
                 candidate: candidate.label,
                 reading: discover::reading(candidate.label, place, candidate.family, &set, params),
                 parameters: set,

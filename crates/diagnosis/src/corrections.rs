@@ -67,6 +67,15 @@ pub enum Regressor {
     Ramp,
     Sine(f64),
     Cosine(f64),
+    /// The share of the segment [lo, hi] that the channel's modelled value has risen
+    /// through (0 below it, 1 above it; the end segments continued below or above): a
+    /// static curve's increment ([`crate::curves`]).
+    Segment {
+        lo: f64,
+        hi: f64,
+        below: bool,
+        above: bool,
+    },
 }
 
 /// How a sensor may read its quantity.

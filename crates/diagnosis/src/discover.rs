@@ -20,6 +20,9 @@ pub fn model_terms(
     base: &Parameters,
     problem: &Problem,
 ) -> Option<Vec<(&'static str, f64)>> {
+    if crate::curves::is_channel_curve(candidate) {
+        return crate::curves::channel_model_terms(candidate, values, base);
+    }
     let terms = &candidate.terms;
     let mut set: Vec<(&'static str, f64)> = candidate.settings.clone();
     // Coefficients of the force channel's regressors.
@@ -110,6 +113,7 @@ pub fn model_terms(
                 Regressor::Acceleration => acceleration += value,
                 Regressor::VelocitySquared => quadratic += value,
                 Regressor::SignPressure(_) => sign_pressure += value,
+                Regressor::Segment { .. } => return None,
             },
             _ => return None,
         }
@@ -263,6 +267,7 @@ pub fn model_terms(
     if unique.is_empty() {
         return None;
     }
+    crate::curves::monotone_command(&mut unique);
     Some(unique)
 }
 
@@ -277,6 +282,12 @@ pub fn unit_of(name: &str) -> &'static str {
 
 /// One sentence on what was added: each parameter against its value in the model before.
 pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, f64)], before: &Parameters) -> String {
+    if let Some(curve) = crate::curves::reading(set) {
+        return format!(
+            "At the {location} ({}): {curve}",
+            crate::curves::family("nonlinearity", set)
+        );
+    }
     let parts: Vec<String> = set
         .iter()
         .map(|&(name, value)| {

@@ -22,6 +22,7 @@ mod alternatives;
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;
+pub mod curves;
 mod discover;
 pub mod lines;
 mod localize;
@@ -651,6 +652,8 @@ pub(crate) fn refit_jointly(
         .chain(found.discovered.iter().flat_map(|d| d.parameters.iter()))
         .map(|(name, _)| *name)
         .filter(|name| parameter_value(params, name) != 0.0)
+        // A curve's knot count and abscissae are its grid, not amounts to refit.
+        .filter(|name| !name.ends_with("_curve_knots") && !name.contains("_curve_x_"))
         .collect();
     progress(&format!("joint refit of the {} parameters added", names.len()));
     let problem = Problem::new(recording, params, &cx.training, cx.channel_noise);

@@ -159,6 +159,14 @@ pub(crate) fn localize(
         .take(REFINED)
         .map(|s| s.fit.candidate.clone())
         .collect();
+    // The command's static curve is always refined when worth it: one Gauss–Newton step
+    // from the identity leaves it behind the single-constant candidates it competes with.
+    let mut leaders = leaders;
+    for s in scored.iter().filter(|s| s.explained >= WORTH_REFINING) {
+        if crate::curves::is_command_curve(&s.fit.candidate) && !leaders.contains(&s.fit.candidate) {
+            leaders.push(s.fit.candidate.clone());
+        }
+    }
     progress(&format!("refining the {} leading candidates", leaders.len()));
     // Fewer leaders than threads, and one of them may take most of the time (a smooth
     // hysteresis law): its finite differences share the threads too.

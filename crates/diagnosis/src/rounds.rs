@@ -174,7 +174,8 @@ fn replay_round(
     let pressures_agree = problem.weights[1] > 0.0
         && problem.weights[2] > 0.0
         && (1..CHANNELS).all(|c| (heldout[c] / count).sqrt() <= EXPLAINED_WITHIN_NOISE);
-    let candidates: Vec<Candidate> = catalogue(&f.params, cx.pressure_noise.is_some(), periodic)
+    let knots = curve_knots(cx, problem, &current);
+    let candidates: Vec<Candidate> = catalogue(&f.params, cx.pressure_noise.is_some(), periodic, &knots)
         .into_iter()
         .filter(|c| !f.effects.iter().any(|e| Some(e.name) == c.named))
         .filter(|c| !pressures_agree || matches!(c.location, "mechanics" | "force_sensor"))
@@ -199,6 +200,38 @@ fn replay_round(
         pressures_agree,
         candidates,
     }))
+}
+
+/// Where the static curves' knots go ([`crate::curves`]): on each measured channel against
+/// the model's reading of it; on the command against the force's residual through its
+/// sensitivity to a constant shift of the command (a shift of i_offset by k_cd per volt:
+/// the driver is linear), one replay.
+fn curve_knots(cx: &Context, problem: &Problem, current: &Replay) -> crate::curves::CurveKnots {
+    let modelled = [&current.force, &current.p1, &current.p2];
+    let mut knots = crate::curves::CurveKnots::default();
+    for c in 0..CHANNELS {
+        if problem.weights[c] > 0.0 {
+            knots.channels[c] = crate::curves::placed_knots(
+                modelled[c],
+                problem.measured[c],
+                &cx.training,
+                crate::curves::SENSOR_KNOTS,
+            );
+        }
+    }
+    let k_cd = problem.base.k_cd;
+    if let Some(s) = problem.sensitivity("i_offset", 1e-3, current) {
+        let per_volt: Vec<f64> = s[FORCE].iter().map(|x| x * k_cd).collect();
+        let residual = difference(&cx.recording.force, &current.force);
+        knots.command = crate::curves::placed_command_knots(
+            &cx.recording.v_da[..cx.n],
+            &residual,
+            &per_volt,
+            &cx.training,
+            crate::curves::COMMAND_KNOTS,
+        );
+    }
+    knots
 }
 
 /// Named effects are the hypotheses tried first: once a term outside them has been added,
@@ -431,7 +464,7 @@ fn discover_term(
             progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
             let term = DiscoveredTerm {
                 location: candidate.location,
-                family: candidate.family,
+                family: crate::curves::family(candidate.family, &set),
                 candidate: candidate.label,
                 reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
                 parameters: set,

@@ -125,6 +125,32 @@ pub mod vr {
     pub const PORT_RESTRICTION_AREA_2: u32 = 524;
     pub const PORT_LINE_VOLUME_1: u32 = 525;
     pub const PORT_LINE_VOLUME_2: u32 = 526;
+
+    // Static curves (crate::physics::static_curve), off with no knots.
+    pub const COMMAND_CURVE_KNOTS: u32 = 600;
+    /// Abscissa of knot k (k = 1..8) at this plus k − 1; the value at COMMAND_CURVE_Y plus k − 1.
+    pub const COMMAND_CURVE_X: u32 = 601;
+    pub const COMMAND_CURVE_X_LAST: u32 = COMMAND_CURVE_X + 7;
+    pub const COMMAND_CURVE_Y: u32 = 611;
+    pub const COMMAND_CURVE_Y_LAST: u32 = COMMAND_CURVE_Y + 7;
+    pub const FORCE_SENSOR_CURVE_KNOTS: u32 = 620;
+    /// Abscissa of knot k (k = 1..8) at this plus k − 1; the value at FORCE_SENSOR_CURVE_Y plus k − 1.
+    pub const FORCE_SENSOR_CURVE_X: u32 = 621;
+    pub const FORCE_SENSOR_CURVE_X_LAST: u32 = FORCE_SENSOR_CURVE_X + 7;
+    pub const FORCE_SENSOR_CURVE_Y: u32 = 631;
+    pub const FORCE_SENSOR_CURVE_Y_LAST: u32 = FORCE_SENSOR_CURVE_Y + 7;
+    pub const P1_SENSOR_CURVE_KNOTS: u32 = 640;
+    /// Abscissa of knot k (k = 1..8) at this plus k − 1; the value at P1_SENSOR_CURVE_Y plus k − 1.
+    pub const P1_SENSOR_CURVE_X: u32 = 641;
+    pub const P1_SENSOR_CURVE_X_LAST: u32 = P1_SENSOR_CURVE_X + 7;
+    pub const P1_SENSOR_CURVE_Y: u32 = 651;
+    pub const P1_SENSOR_CURVE_Y_LAST: u32 = P1_SENSOR_CURVE_Y + 7;
+    pub const P2_SENSOR_CURVE_KNOTS: u32 = 660;
+    /// Abscissa of knot k (k = 1..8) at this plus k − 1; the value at P2_SENSOR_CURVE_Y plus k − 1.
+    pub const P2_SENSOR_CURVE_X: u32 = 661;
+    pub const P2_SENSOR_CURVE_X_LAST: u32 = P2_SENSOR_CURVE_X + 7;
+    pub const P2_SENSOR_CURVE_Y: u32 = 671;
+    pub const P2_SENSOR_CURVE_Y_LAST: u32 = P2_SENSOR_CURVE_Y + 7;
 }
 
 /// The D/A converter's range: a command outside it is refused.
@@ -314,6 +340,9 @@ const RESISTANCE: &str =
     "at the jet pipe's flow of about 1e-3 kg/s, 1e12 Pa.s/kg would drop 1e9 Pa, a thousand times the supply pressure";
 const AREA_SCALE: &str = "ten times the drawn area of (2.8)-(2.17); the diagnosis fits at most 3";
 const DEAD_VOLUME: &str = "1e-3 m3 (a litre): seventy times the two chambers' 1.4e-5 m3";
+const CURVE_COMMAND: &str = "the D/A spans 10 V either way; ten times that is no command";
+const CURVE_FORCE: &str = "1000 N: nine times the largest force the actuator gives (109 N)";
+const CURVE_PRESSURE: &str = PRESSURE;
 
 /// Every variable of the FMU, one row each: name, value reference, unit, start, limits,
 /// description and thesis reference. Defaults: Table 3.1 of the thesis and docs/model.md.
@@ -832,6 +861,74 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1e-3)
         .cite("(2.29)")
         .because(DEAD_VOLUME),
+    parameter("command_curve_knots", vr::COMMAND_CURVE_KNOTS, "1", 0.0, "command static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
+    parameter("command_curve_x_1", vr::COMMAND_CURVE_X + 0, "V", 0.0, "command static curve: knot 1, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_2", vr::COMMAND_CURVE_X + 1, "V", 0.0, "command static curve: knot 2, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_3", vr::COMMAND_CURVE_X + 2, "V", 0.0, "command static curve: knot 3, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_4", vr::COMMAND_CURVE_X + 3, "V", 0.0, "command static curve: knot 4, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_5", vr::COMMAND_CURVE_X + 4, "V", 0.0, "command static curve: knot 5, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_6", vr::COMMAND_CURVE_X + 5, "V", 0.0, "command static curve: knot 6, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_7", vr::COMMAND_CURVE_X + 6, "V", 0.0, "command static curve: knot 7, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_8", vr::COMMAND_CURVE_X + 7, "V", 0.0, "command static curve: knot 8, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_1", vr::COMMAND_CURVE_Y + 0, "V", 0.0, "command static curve: knot 1, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_2", vr::COMMAND_CURVE_Y + 1, "V", 0.0, "command static curve: knot 2, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_3", vr::COMMAND_CURVE_Y + 2, "V", 0.0, "command static curve: knot 3, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_4", vr::COMMAND_CURVE_Y + 3, "V", 0.0, "command static curve: knot 4, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_5", vr::COMMAND_CURVE_Y + 4, "V", 0.0, "command static curve: knot 5, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_6", vr::COMMAND_CURVE_Y + 5, "V", 0.0, "command static curve: knot 6, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_7", vr::COMMAND_CURVE_Y + 6, "V", 0.0, "command static curve: knot 7, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_8", vr::COMMAND_CURVE_Y + 7, "V", 0.0, "command static curve: knot 8, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("force_sensor_curve_knots", vr::FORCE_SENSOR_CURVE_KNOTS, "1", 0.0, "force sensor static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
+    parameter("force_sensor_curve_x_1", vr::FORCE_SENSOR_CURVE_X + 0, "N", 0.0, "force sensor static curve: knot 1, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_2", vr::FORCE_SENSOR_CURVE_X + 1, "N", 0.0, "force sensor static curve: knot 2, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_3", vr::FORCE_SENSOR_CURVE_X + 2, "N", 0.0, "force sensor static curve: knot 3, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_4", vr::FORCE_SENSOR_CURVE_X + 3, "N", 0.0, "force sensor static curve: knot 4, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_5", vr::FORCE_SENSOR_CURVE_X + 4, "N", 0.0, "force sensor static curve: knot 5, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_6", vr::FORCE_SENSOR_CURVE_X + 5, "N", 0.0, "force sensor static curve: knot 6, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_7", vr::FORCE_SENSOR_CURVE_X + 6, "N", 0.0, "force sensor static curve: knot 7, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_8", vr::FORCE_SENSOR_CURVE_X + 7, "N", 0.0, "force sensor static curve: knot 8, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_1", vr::FORCE_SENSOR_CURVE_Y + 0, "N", 0.0, "force sensor static curve: knot 1, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_2", vr::FORCE_SENSOR_CURVE_Y + 1, "N", 0.0, "force sensor static curve: knot 2, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_3", vr::FORCE_SENSOR_CURVE_Y + 2, "N", 0.0, "force sensor static curve: knot 3, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_4", vr::FORCE_SENSOR_CURVE_Y + 3, "N", 0.0, "force sensor static curve: knot 4, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_5", vr::FORCE_SENSOR_CURVE_Y + 4, "N", 0.0, "force sensor static curve: knot 5, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_6", vr::FORCE_SENSOR_CURVE_Y + 5, "N", 0.0, "force sensor static curve: knot 6, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_7", vr::FORCE_SENSOR_CURVE_Y + 6, "N", 0.0, "force sensor static curve: knot 7, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_8", vr::FORCE_SENSOR_CURVE_Y + 7, "N", 0.0, "force sensor static curve: knot 8, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("p1_sensor_curve_knots", vr::P1_SENSOR_CURVE_KNOTS, "1", 0.0, "pressure transducer 1 static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
+    parameter("p1_sensor_curve_x_1", vr::P1_SENSOR_CURVE_X + 0, "Pa", 0.0, "pressure transducer 1 static curve: knot 1, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_2", vr::P1_SENSOR_CURVE_X + 1, "Pa", 0.0, "pressure transducer 1 static curve: knot 2, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_3", vr::P1_SENSOR_CURVE_X + 2, "Pa", 0.0, "pressure transducer 1 static curve: knot 3, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_4", vr::P1_SENSOR_CURVE_X + 3, "Pa", 0.0, "pressure transducer 1 static curve: knot 4, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_5", vr::P1_SENSOR_CURVE_X + 4, "Pa", 0.0, "pressure transducer 1 static curve: knot 5, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_6", vr::P1_SENSOR_CURVE_X + 5, "Pa", 0.0, "pressure transducer 1 static curve: knot 6, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_7", vr::P1_SENSOR_CURVE_X + 6, "Pa", 0.0, "pressure transducer 1 static curve: knot 7, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_8", vr::P1_SENSOR_CURVE_X + 7, "Pa", 0.0, "pressure transducer 1 static curve: knot 8, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_1", vr::P1_SENSOR_CURVE_Y + 0, "Pa", 0.0, "pressure transducer 1 static curve: knot 1, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_2", vr::P1_SENSOR_CURVE_Y + 1, "Pa", 0.0, "pressure transducer 1 static curve: knot 2, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_3", vr::P1_SENSOR_CURVE_Y + 2, "Pa", 0.0, "pressure transducer 1 static curve: knot 3, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_4", vr::P1_SENSOR_CURVE_Y + 3, "Pa", 0.0, "pressure transducer 1 static curve: knot 4, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_5", vr::P1_SENSOR_CURVE_Y + 4, "Pa", 0.0, "pressure transducer 1 static curve: knot 5, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_6", vr::P1_SENSOR_CURVE_Y + 5, "Pa", 0.0, "pressure transducer 1 static curve: knot 6, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_7", vr::P1_SENSOR_CURVE_Y + 6, "Pa", 0.0, "pressure transducer 1 static curve: knot 7, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_8", vr::P1_SENSOR_CURVE_Y + 7, "Pa", 0.0, "pressure transducer 1 static curve: knot 8, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_knots", vr::P2_SENSOR_CURVE_KNOTS, "1", 0.0, "pressure transducer 2 static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
+    parameter("p2_sensor_curve_x_1", vr::P2_SENSOR_CURVE_X + 0, "Pa", 0.0, "pressure transducer 2 static curve: knot 1, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_2", vr::P2_SENSOR_CURVE_X + 1, "Pa", 0.0, "pressure transducer 2 static curve: knot 2, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_3", vr::P2_SENSOR_CURVE_X + 2, "Pa", 0.0, "pressure transducer 2 static curve: knot 3, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_4", vr::P2_SENSOR_CURVE_X + 3, "Pa", 0.0, "pressure transducer 2 static curve: knot 4, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_5", vr::P2_SENSOR_CURVE_X + 4, "Pa", 0.0, "pressure transducer 2 static curve: knot 5, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_6", vr::P2_SENSOR_CURVE_X + 5, "Pa", 0.0, "pressure transducer 2 static curve: knot 6, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_7", vr::P2_SENSOR_CURVE_X + 6, "Pa", 0.0, "pressure transducer 2 static curve: knot 7, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_8", vr::P2_SENSOR_CURVE_X + 7, "Pa", 0.0, "pressure transducer 2 static curve: knot 8, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_1", vr::P2_SENSOR_CURVE_Y + 0, "Pa", 0.0, "pressure transducer 2 static curve: knot 1, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_2", vr::P2_SENSOR_CURVE_Y + 1, "Pa", 0.0, "pressure transducer 2 static curve: knot 2, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_3", vr::P2_SENSOR_CURVE_Y + 2, "Pa", 0.0, "pressure transducer 2 static curve: knot 3, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_4", vr::P2_SENSOR_CURVE_Y + 3, "Pa", 0.0, "pressure transducer 2 static curve: knot 4, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_5", vr::P2_SENSOR_CURVE_Y + 4, "Pa", 0.0, "pressure transducer 2 static curve: knot 5, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_6", vr::P2_SENSOR_CURVE_Y + 5, "Pa", 0.0, "pressure transducer 2 static curve: knot 6, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_7", vr::P2_SENSOR_CURVE_Y + 6, "Pa", 0.0, "pressure transducer 2 static curve: knot 7, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_8", vr::P2_SENSOR_CURVE_Y + 7, "Pa", 0.0, "pressure transducer 2 static curve: knot 8, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
 ];
 
 const N_VARIABLES: usize = TABLE.len();

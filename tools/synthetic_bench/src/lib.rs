@@ -301,6 +301,13 @@ pub fn run(
         if und.pressure_sensor_offset_1 != 0.0 {
             p1 += und.pressure_sensor_offset_1;
         }
+        if und.pressure_sensor_saturation_1 > 0.0 {
+            p1 = p1.min(und.pressure_sensor_saturation_1);
+        }
+        if und.pressure_sensor_quadratic_2 != 0.0 {
+            let gauge = p2 - 101_325.0;
+            p2 += und.pressure_sensor_quadratic_2 * gauge * gauge;
+        }
         if p2_delay > 0 {
             p2_hist.push(p2);
             p2 = p2_hist[k.saturating_sub(p2_delay)];

@@ -203,6 +203,12 @@ pub struct UndeclaredEffects {
     /// `mechanics`/`extra_force`: quadratic damping q v|v| (N·s²/m²) opposing the stopper's
     /// velocity; 0 = none.
     pub quadratic_damping: f64,
+    /// `pressure_sensors`/`limit`: the chamber 1 pressure transducer's range ends at this
+    /// absolute pressure (Pa): it reads min(P1, this), before noise and quantisation; 0 = none.
+    pub pressure_sensor_saturation_1: f64,
+    /// `pressure_sensors`/`nonlinearity`: the chamber 2 transducer reads
+    /// P2 + q (P2 − 101 325 Pa)² with q this (1/Pa), before noise and quantisation; 0 = none.
+    pub pressure_sensor_quadratic_2: f64,
 }
 
 impl Default for BenchEffects {

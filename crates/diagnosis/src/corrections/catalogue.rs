@@ -120,7 +120,13 @@ fn modulated(
 /// `periodic_hz` is the residual's spectral line, if it has one. Where two places fit
 /// alike (a command limit and a current limit), the earlier in the chain comes first and
 /// wins the tie.
-pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64>) -> Vec<Candidate> {
+/// `knots` places the static curves' knots ([`crate::curves`]).
+pub fn catalogue(
+    base: &Parameters,
+    has_pressures: bool,
+    periodic_hz: Option<f64>,
+    knots: &crate::curves::CurveKnots,
+) -> Vec<Candidate> {
     let c = |label, location, family, named, terms| Candidate {
         label,
         location,
@@ -725,5 +731,6 @@ pub fn catalogue(base: &Parameters, has_pressures: bool, periodic_hz: Option<f64
             ],
         ));
     }
+    list.extend(crate::curves::candidates(base, knots, has_pressures));
     list
 }

@@ -120,6 +120,7 @@ impl<'a> Problem<'a> {
             Regressor::Ramp => (t - self.t_mid) / self.t_span,
             Regressor::Sine(f) => (2.0 * std::f64::consts::PI * f * t).sin(),
             Regressor::Cosine(f) => (2.0 * std::f64::consts::PI * f * t).cos(),
+            Regressor::Segment { lo, hi, below, above } => crate::curves::segment(own[k], lo, hi, below, above),
         }
     }
 }

@@ -4,7 +4,8 @@
 //! * `synthetic`: the synthetic bench's recordings of the named effects;
 //! * `undeclared`: the synthetic bench's undeclared mechanisms;
 //! * `protocols`: the general discovery pieces on recordings under other protocols;
-//! * `balance`: an extra force in the piston's balance picked from a library of local signals.
+//! * `balance`: an extra force in the piston's balance picked from a library of local signals;
+//! * `curves`: the static-curve class at the command and the transducers.
 //!
 //! Why one binary and not three: cargo runs test binaries one after another and each
 //! harness runs its tests two at a time, so a binary's last, long test left a core idle
@@ -12,6 +13,7 @@
 //! diagnoses whenever one ends, and both cores stay busy until the last few.
 
 mod balance;
+mod curves;
 mod protocols;
 mod shared;
 mod synthetic;

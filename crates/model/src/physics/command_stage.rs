@@ -3,6 +3,7 @@
 //!
 //! | parameter | law |
 //! |---|---|
+//! | `command_curve_*` (V) | c(v): a static curve of the logged command, piecewise linear through its knots ([`super::static_curve`]) |
 //! | `f3_input_cubic` (V) | v + c (v / 10 V)³: a static curve before f3 (the current driver is linear and fast, so a curve on the tip force k_m i is the same as one on the command) |
 //! | `command_limit` (V) | clipped at ± the limit |
 //! | `current_limit` (A) | clipped where k_cd v + i_offset reaches ± the limit, (2.1) |
@@ -19,15 +20,17 @@ use super::parameters::Parameters;
 /// Whether any term of the command stage is on.
 pub fn is_active(p: &Parameters) -> bool {
     p.f3_input_cubic != 0.0
+        || p.command_curve.is_on()
         || p.command_limit > 0.0
         || p.current_limit > 0.0
         || p.current_slew_limit > 0.0
         || p.command_lag > 0.0
 }
 
-/// The static part of the stage: the cubic, then the command and current limits.
+/// The static part of the stage: the static curve, the cubic, then the command and current
+/// limits.
 pub fn static_map(p: &Parameters, v_da: f64) -> f64 {
-    let mut v = v_da;
+    let mut v = p.command_curve.at(v_da);
     if p.f3_input_cubic != 0.0 {
         v += p.f3_input_cubic * (v / 10.0).powi(3);
     }

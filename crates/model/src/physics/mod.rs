@@ -18,6 +18,7 @@
 //! | restrictions and gas volumes between the valve and the air (off by default) | [`restrictions`] | (2.18), (2.29) |
 //! | the command as the current driver sees it (off by default) | [`command_stage`] | (2.1) |
 //! | what the force and pressure transducers read | [`sensors`] | docs/model.md |
+//! | static curves at the command and the transducers (off by default) | [`static_curve`] | docs/model.md |
 //! | constants that vary in time (off by default) | [`time_varying`] | docs/model.md |
 //! | the assembled six-state model | [`actuator`] | (4.1) |
 
@@ -34,4 +35,5 @@ pub mod parameters;
 pub mod piston;
 pub mod restrictions;
 pub mod sensors;
+pub mod static_curve;
 pub mod time_varying;

@@ -3,6 +3,7 @@
 
 use super::chambers::CylinderGeometry;
 use super::orifice_flow::FlowConstants;
+use super::static_curve::StaticCurve;
 use crate::variables::{number, vr, VARIABLES};
 
 /// Every constant of the thesis model, in SI units.
@@ -110,6 +111,12 @@ pub struct Parameters {
     pub port_restriction_area_2: f64,
     pub port_line_volume_1: f64,
     pub port_line_volume_2: f64,
+    /// Static curves (off with no knots): the command the current driver sees as a function
+    /// of v_DA, and each transducer's reading as a function of its quantity.
+    pub command_curve: StaticCurve,
+    pub force_sensor_curve: StaticCurve,
+    pub p1_sensor_curve: StaticCurve,
+    pub p2_sensor_curve: StaticCurve,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -224,6 +231,10 @@ impl Default for Parameters {
             port_restriction_area_2: 0.0,
             port_line_volume_1: 0.0,
             port_line_volume_2: 0.0,
+            command_curve: StaticCurve::default(),
+            force_sensor_curve: StaticCurve::default(),
+            p1_sensor_curve: StaticCurve::default(),
+            p2_sensor_curve: StaticCurve::default(),
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -334,6 +345,74 @@ impl Parameters {
         vr::PORT_RESTRICTION_AREA_2,
         vr::PORT_LINE_VOLUME_1,
         vr::PORT_LINE_VOLUME_2,
+        vr::COMMAND_CURVE_KNOTS,
+        vr::COMMAND_CURVE_X + 0,
+        vr::COMMAND_CURVE_X + 1,
+        vr::COMMAND_CURVE_X + 2,
+        vr::COMMAND_CURVE_X + 3,
+        vr::COMMAND_CURVE_X + 4,
+        vr::COMMAND_CURVE_X + 5,
+        vr::COMMAND_CURVE_X + 6,
+        vr::COMMAND_CURVE_X + 7,
+        vr::COMMAND_CURVE_Y + 0,
+        vr::COMMAND_CURVE_Y + 1,
+        vr::COMMAND_CURVE_Y + 2,
+        vr::COMMAND_CURVE_Y + 3,
+        vr::COMMAND_CURVE_Y + 4,
+        vr::COMMAND_CURVE_Y + 5,
+        vr::COMMAND_CURVE_Y + 6,
+        vr::COMMAND_CURVE_Y + 7,
+        vr::FORCE_SENSOR_CURVE_KNOTS,
+        vr::FORCE_SENSOR_CURVE_X + 0,
+        vr::FORCE_SENSOR_CURVE_X + 1,
+        vr::FORCE_SENSOR_CURVE_X + 2,
+        vr::FORCE_SENSOR_CURVE_X + 3,
+        vr::FORCE_SENSOR_CURVE_X + 4,
+        vr::FORCE_SENSOR_CURVE_X + 5,
+        vr::FORCE_SENSOR_CURVE_X + 6,
+        vr::FORCE_SENSOR_CURVE_X + 7,
+        vr::FORCE_SENSOR_CURVE_Y + 0,
+        vr::FORCE_SENSOR_CURVE_Y + 1,
+        vr::FORCE_SENSOR_CURVE_Y + 2,
+        vr::FORCE_SENSOR_CURVE_Y + 3,
+        vr::FORCE_SENSOR_CURVE_Y + 4,
+        vr::FORCE_SENSOR_CURVE_Y + 5,
+        vr::FORCE_SENSOR_CURVE_Y + 6,
+        vr::FORCE_SENSOR_CURVE_Y + 7,
+        vr::P1_SENSOR_CURVE_KNOTS,
+        vr::P1_SENSOR_CURVE_X + 0,
+        vr::P1_SENSOR_CURVE_X + 1,
+        vr::P1_SENSOR_CURVE_X + 2,
+        vr::P1_SENSOR_CURVE_X + 3,
+        vr::P1_SENSOR_CURVE_X + 4,
+        vr::P1_SENSOR_CURVE_X + 5,
+        vr::P1_SENSOR_CURVE_X + 6,
+        vr::P1_SENSOR_CURVE_X + 7,
+        vr::P1_SENSOR_CURVE_Y + 0,
+        vr::P1_SENSOR_CURVE_Y + 1,
+        vr::P1_SENSOR_CURVE_Y + 2,
+        vr::P1_SENSOR_CURVE_Y + 3,
+        vr::P1_SENSOR_CURVE_Y + 4,
+        vr::P1_SENSOR_CURVE_Y + 5,
+        vr::P1_SENSOR_CURVE_Y + 6,
+        vr::P1_SENSOR_CURVE_Y + 7,
+        vr::P2_SENSOR_CURVE_KNOTS,
+        vr::P2_SENSOR_CURVE_X + 0,
+        vr::P2_SENSOR_CURVE_X + 1,
+        vr::P2_SENSOR_CURVE_X + 2,
+        vr::P2_SENSOR_CURVE_X + 3,
+        vr::P2_SENSOR_CURVE_X + 4,
+        vr::P2_SENSOR_CURVE_X + 5,
+        vr::P2_SENSOR_CURVE_X + 6,
+        vr::P2_SENSOR_CURVE_X + 7,
+        vr::P2_SENSOR_CURVE_Y + 0,
+        vr::P2_SENSOR_CURVE_Y + 1,
+        vr::P2_SENSOR_CURVE_Y + 2,
+        vr::P2_SENSOR_CURVE_Y + 3,
+        vr::P2_SENSOR_CURVE_Y + 4,
+        vr::P2_SENSOR_CURVE_Y + 5,
+        vr::P2_SENSOR_CURVE_Y + 6,
+        vr::P2_SENSOR_CURVE_Y + 7,
     ];
 
     fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
@@ -437,6 +516,34 @@ impl Parameters {
             vr::PORT_RESTRICTION_AREA_2 => &mut self.port_restriction_area_2,
             vr::PORT_LINE_VOLUME_1 => &mut self.port_line_volume_1,
             vr::PORT_LINE_VOLUME_2 => &mut self.port_line_volume_2,
+            vr::COMMAND_CURVE_KNOTS => &mut self.command_curve.knots,
+            r @ vr::COMMAND_CURVE_X..=vr::COMMAND_CURVE_X_LAST => {
+                &mut self.command_curve.x[(r - vr::COMMAND_CURVE_X) as usize]
+            }
+            r @ vr::COMMAND_CURVE_Y..=vr::COMMAND_CURVE_Y_LAST => {
+                &mut self.command_curve.y[(r - vr::COMMAND_CURVE_Y) as usize]
+            }
+            vr::FORCE_SENSOR_CURVE_KNOTS => &mut self.force_sensor_curve.knots,
+            r @ vr::FORCE_SENSOR_CURVE_X..=vr::FORCE_SENSOR_CURVE_X_LAST => {
+                &mut self.force_sensor_curve.x[(r - vr::FORCE_SENSOR_CURVE_X) as usize]
+            }
+            r @ vr::FORCE_SENSOR_CURVE_Y..=vr::FORCE_SENSOR_CURVE_Y_LAST => {
+                &mut self.force_sensor_curve.y[(r - vr::FORCE_SENSOR_CURVE_Y) as usize]
+            }
+            vr::P1_SENSOR_CURVE_KNOTS => &mut self.p1_sensor_curve.knots,
+            r @ vr::P1_SENSOR_CURVE_X..=vr::P1_SENSOR_CURVE_X_LAST => {
+                &mut self.p1_sensor_curve.x[(r - vr::P1_SENSOR_CURVE_X) as usize]
+            }
+            r @ vr::P1_SENSOR_CURVE_Y..=vr::P1_SENSOR_CURVE_Y_LAST => {
+                &mut self.p1_sensor_curve.y[(r - vr::P1_SENSOR_CURVE_Y) as usize]
+            }
+            vr::P2_SENSOR_CURVE_KNOTS => &mut self.p2_sensor_curve.knots,
+            r @ vr::P2_SENSOR_CURVE_X..=vr::P2_SENSOR_CURVE_X_LAST => {
+                &mut self.p2_sensor_curve.x[(r - vr::P2_SENSOR_CURVE_X) as usize]
+            }
+            r @ vr::P2_SENSOR_CURVE_Y..=vr::P2_SENSOR_CURVE_Y_LAST => {
+                &mut self.p2_sensor_curve.y[(r - vr::P2_SENSOR_CURVE_Y) as usize]
+            }
             _ => return None,
         })
     }
@@ -506,6 +613,10 @@ impl Parameters {
             ));
         }
         super::restrictions::check(self)?;
+        self.command_curve.check("command_curve", "V")?;
+        self.force_sensor_curve.check("force_sensor_curve", "N")?;
+        self.p1_sensor_curve.check("p1_sensor_curve", "Pa")?;
+        self.p2_sensor_curve.check("p2_sensor_curve", "Pa")?;
         if self.l_cyl <= self.l_p {
             return Err(format!(
                 "L_cyl = {} m is invalid: must exceed L_p = {} m",

@@ -4,7 +4,10 @@
 //!
 //! One law serves the three channels. The static reading of a value y at time t is
 //!
-//!   offset + gain y + quadratic y² + cubic y³ + drift t + a sin 2πft + b cos 2πft,
+//!   offset + gain c(y) + quadratic c(y)² + cubic c(y)³ + drift t + a sin 2πft + b cos 2πft,
+//!
+//! with c the transducer's static curve (`*_curve_*`, [`super::static_curve`]; the identity
+//! when off),
 //!
 //! and the transducer may pass it through, in this order, a delay, a first-order lag and a
 //! play (backlash) of a given width. The filters act on the reading as it is sampled at
@@ -12,9 +15,10 @@
 //! for the reading moving linearly over each interval. The FMU stepped at a recording's sample
 //! times and the replay of that recording read the same. The force sensor has every term
 //! (`force_sensor_*`); a pressure transducer has an offset, a gain, a drift, a delay and a lag
-//! (`p1_sensor_*`, `p2_sensor_*`).
+//! (`p1_sensor_*`, `p2_sensor_*`); each has a static curve.
 
 use super::parameters::Parameters;
+use super::static_curve::StaticCurve;
 use std::collections::VecDeque;
 
 /// The measured channels.
@@ -43,6 +47,8 @@ pub struct SensorLaw {
     pub delay: f64,
     pub lag: f64,
     pub play: f64,
+    /// The reading's static curve, applied to the quantity first.
+    pub curve: StaticCurve,
 }
 
 impl SensorLaw {
@@ -61,21 +67,28 @@ impl SensorLaw {
                 delay: p.force_sensor_delay,
                 lag: p.force_sensor_lag,
                 play: p.force_sensor_play,
+                curve: p.force_sensor_curve,
             },
-            Channel::Pressure1 => Self::pressure(
-                p.p1_sensor_offset,
-                p.p1_sensor_gain,
-                p.p1_sensor_drift,
-                p.p1_sensor_delay,
-                p.p1_sensor_lag,
-            ),
-            Channel::Pressure2 => Self::pressure(
-                p.p2_sensor_offset,
-                p.p2_sensor_gain,
-                p.p2_sensor_drift,
-                p.p2_sensor_delay,
-                p.p2_sensor_lag,
-            ),
+            Channel::Pressure1 => Self {
+                curve: p.p1_sensor_curve,
+                ..Self::pressure(
+                    p.p1_sensor_offset,
+                    p.p1_sensor_gain,
+                    p.p1_sensor_drift,
+                    p.p1_sensor_delay,
+                    p.p1_sensor_lag,
+                )
+            },
+            Channel::Pressure2 => Self {
+                curve: p.p2_sensor_curve,
+                ..Self::pressure(
+                    p.p2_sensor_offset,
+                    p.p2_sensor_gain,
+                    p.p2_sensor_drift,
+                    p.p2_sensor_delay,
+                    p.p2_sensor_lag,
+                )
+            },
         }
     }
 
@@ -92,11 +105,13 @@ impl SensorLaw {
             delay,
             lag,
             play: 0.0,
+            curve: StaticCurve::default(),
         }
     }
 
     /// The static reading (offset, gain, curve, drift and pick-up) of `value` at `time`.
     pub fn static_reading(&self, value: f64, time: f64) -> f64 {
+        let value = self.curve.at(value);
         let mut y = self.offset + self.gain * value;
         if self.quadratic != 0.0 || self.cubic != 0.0 {
             y += value * value * (self.quadratic + self.cubic * value);
@@ -127,13 +142,14 @@ impl SensorLaw {
     /// far as samples allow. The static part is inverted exactly; the delay by reading
     /// later samples (interpolated linearly; the last `delay` of the record holds its last
     /// value); the lag as y + τ dy/dt with centred differences (so it amplifies noise by
-    /// about τ/Δt). `None` for a curve, a pick-up or a play, which have no such inverse.
+    /// about τ/Δt). `None` for a curve (polynomial or static), a pick-up or a play, which have no such inverse.
     pub fn unread(&self, time: &[f64], readings: &[f64]) -> Option<Vec<f64>> {
         if self.quadratic != 0.0
             || self.cubic != 0.0
             || self.ripple_sine != 0.0
             || self.ripple_cosine != 0.0
             || self.play > 0.0
+            || self.curve.is_on()
         {
             return None;
         }

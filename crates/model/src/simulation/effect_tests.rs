@@ -326,3 +326,60 @@ fn with_the_extra_force_off_the_outputs_are_the_thesis_models_bits_and_a_snapsho
         );
     }
 }
+
+/// Every output of a stepped run with the command moving, bit for bit.
+fn output_bits(model: &Actuator) -> Vec<u64> {
+    let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-6).unwrap();
+    let mut bits = vec![];
+    for k in 1..=200 {
+        sim.set_command(1.0 + 3.0 * (k as f64 * 0.05).sin()).unwrap();
+        sim.step(1e-3).unwrap();
+        let y = sim.outputs();
+        for v in [y.f_act, y.f_meas, y.p1, y.p2, y.p1_meas, y.p2_meas, y.current, y.x_jp] {
+            bits.push(v.to_bits());
+        }
+    }
+    bits
+}
+
+#[test]
+fn a_static_curve_off_leaves_every_output_bit_identical_and_on_reads_through_its_knots() {
+    use crate::physics::static_curve::StaticCurve;
+    let thesis = thesis_model();
+    // Knots written but not in use (knots = 0): the thesis's outputs, bit for bit.
+    let written = with(|p| {
+        for curve in [
+            &mut p.command_curve,
+            &mut p.force_sensor_curve,
+            &mut p.p1_sensor_curve,
+            &mut p.p2_sensor_curve,
+        ] {
+            *curve = StaticCurve::through(&[-1.0, 0.0, 1.0], &[0.0, 0.0, 5.0]);
+            curve.knots = 0.0;
+        }
+    });
+    assert_eq!(output_bits(&written), output_bits(&thesis));
+    // A force sensor that saturates at 20 N, pressure transducers that clip at 4 bar.
+    let saturating = with(|p| {
+        p.force_sensor_curve = StaticCurve::through(&[0.0, 20.0, 30.0], &[0.0, 20.0, 20.0]);
+        p.p1_sensor_curve = StaticCurve::through(&[1e5, 4e5, 5e5], &[1e5, 4e5, 4e5]);
+    });
+    for v in [1.0, 6.0] {
+        let y = Simulation::at_equilibrium(saturating.clone(), v, 0.054, 0.0, 1e-6)
+            .unwrap()
+            .outputs();
+        assert_eq!(y.f_meas, y.f_act.min(20.0), "at {v} V: F_act {}", y.f_act);
+        assert!((y.p1_meas - y.p1.min(4e5)).abs() < 1e-6, "at {v} V: P1 {}", y.p1);
+        assert_eq!(y.p2_meas, y.p2);
+    }
+    // A dead zone of ±0.5 V in the command: inside it the actuator sits where 0 V puts it.
+    let dead = with(|p| p.command_curve = StaticCurve::through(&[-10.0, -0.5, 0.5, 10.0], &[-9.5, 0.0, 0.0, 9.5]));
+    let at = |model: &Actuator, v: f64| {
+        Simulation::at_equilibrium(model.clone(), v, 0.054, 0.0, 1e-6)
+            .unwrap()
+            .outputs()
+            .f_act
+    };
+    assert_eq!(at(&dead, 0.4), at(&thesis, 0.0));
+    assert!((at(&dead, 3.0) - at(&thesis, 2.5)).abs() < 1e-9);
+}

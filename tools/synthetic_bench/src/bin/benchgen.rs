@@ -159,6 +159,12 @@ struct Cli {
     /// Quadratic damping on the stopper velocity, N.s2/m2 (e.g. 100): q v|v|.
     #[arg(long)]
     quadratic_damping: Option<f64>,
+    /// The chamber 1 pressure transducer's range ends at this absolute pressure, Pa (e.g. 4.5e5).
+    #[arg(long)]
+    pressure_sensor_saturation: Option<f64>,
+    /// The chamber 2 transducer reads P2 + q (P2 − 101 325 Pa)²: q, 1/Pa (e.g. 2e-7).
+    #[arg(long)]
+    pressure_sensor_quadratic: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -219,6 +225,8 @@ fn main() -> ExitCode {
     set(&mut und.moving_mass, cli.moving_mass);
     set(&mut und.seal_pressure_friction, cli.seal_pressure_friction);
     set(&mut und.quadratic_damping, cli.quadratic_damping);
+    set(&mut und.pressure_sensor_saturation_1, cli.pressure_sensor_saturation);
+    set(&mut und.pressure_sensor_quadratic_2, cli.pressure_sensor_quadratic);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -239,6 +247,7 @@ fn main() -> ExitCode {
         und.moving_mass,
         und.seal_pressure_friction,
         und.quadratic_damping,
+        und.pressure_sensor_saturation_1,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -249,6 +258,7 @@ fn main() -> ExitCode {
             und.return_back_pressure,
             und.receiver_offset,
             und.force_sensor_pickup_amplitude,
+            und.pressure_sensor_quadratic_2,
         ]
         .iter()
         .all(|x| x.is_finite());

@@ -1,0 +1,752 @@
+//! The static-curve class: at the command, the force sensor and each pressure transducer, a
+//! piecewise linear curve (the model's `*_curve_*` parameters,
+//! `jetpipe_model::physics::static_curve`) fitted through the model, competing with the
+//! named effects and the other terms at its place.
+//!
+//! * **Where the knots go.** At quantiles of the signal at that place over the recording
+//!   (the model's reading of the channel, or the logged command), so every segment holds
+//!   data. On a measured channel the reading is linear in the knot values, so each trial
+//!   placement is a linear least-squares solve on the training samples, without a replay:
+//!   from the two ends of the range, knots are added one at a time at the 1/64 quantile
+//!   that lowers the misfit most, then moved one at a time between their neighbours (a
+//!   grid, then golden-section steps; two sweeps), which puts knots on a saturation's or a
+//!   dead zone's corners. The command's curve acts before the dynamics;
+//!   knots are placed the same way on the force's residual against the model's
+//!   sensitivity to a constant shift of the command (the departure c(v) − v seen through
+//!   the model to first order, exact where the command is held), then its values are
+//!   fitted by Gauss–Newton through the model itself (one replay per knot value and
+//!   iteration). It is always among the candidates refined after the first pass when that
+//!   pass finds it worth refining.
+//! * **Monotone.** A transducer's reading and the command the driver sees do not fall as
+//!   their input rises: on a channel the curve is fitted as an offset and non-negative
+//!   increments over the segments (bounded least squares); the command's knot values are
+//!   made non-decreasing (a running maximum) before the curve enters the model, whose
+//!   replay then judges it.
+//! * **Reading.** From the fitted curve: a flat end is a saturation (family `limit`), a
+//!   flat stretch inside a dead zone, otherwise the largest departure from the identity and
+//!   where it is.
+
+use crate::corrections::{Candidate, Mechanism, Regressor, Term};
+use crate::signals::{CHANNELS, FORCE, P1, P2};
+use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::physics::static_curve::{StaticCurve, MAX_KNOTS};
+use jetpipe_model::variables::VARIABLES;
+
+/// Knots of a curve on a measured channel.
+pub const SENSOR_KNOTS: usize = 8;
+/// Knots of the command's curve (each a replay per Gauss–Newton iteration).
+pub const COMMAND_KNOTS: usize = 8;
+/// A segment whose slope is below this share of the identity's is flat.
+const FLAT: f64 = 0.1;
+
+/// The knots' starting abscissae at each place: the command (V), then the channels' readings.
+#[derive(Clone, Debug, Default)]
+pub struct CurveKnots {
+    pub command: Vec<f64>,
+    pub channels: [Vec<f64>; CHANNELS],
+}
+
+/// The place of a channel's curve: its parameters' prefix and the reading's words.
+fn channel_prefix(channel: usize) -> &'static str {
+    match channel {
+        FORCE => "force_sensor_curve",
+        P1 => "p1_sensor_curve",
+        _ => "p2_sensor_curve",
+    }
+}
+
+/// The name of a variable of the table, as the table's own `&'static str`.
+pub fn variable_name(name: &str) -> &'static str {
+    VARIABLES
+        .iter()
+        .find(|v| v.name == name)
+        .map(|v| v.name)
+        .unwrap_or_else(|| panic!("{name} is not a variable of the model"))
+}
+
+/// Names of a curve's offset and increments on a channel (report names, not parameters).
+const INCREMENTS: [[&str; SENSOR_KNOTS]; CHANNELS] = [
+    [
+        "force_sensor_curve_offset",
+        "force_sensor_curve_rise_1",
+        "force_sensor_curve_rise_2",
+        "force_sensor_curve_rise_3",
+        "force_sensor_curve_rise_4",
+        "force_sensor_curve_rise_5",
+        "force_sensor_curve_rise_6",
+        "force_sensor_curve_rise_7",
+    ],
+    [
+        "p1_sensor_curve_offset",
+        "p1_sensor_curve_rise_1",
+        "p1_sensor_curve_rise_2",
+        "p1_sensor_curve_rise_3",
+        "p1_sensor_curve_rise_4",
+        "p1_sensor_curve_rise_5",
+        "p1_sensor_curve_rise_6",
+        "p1_sensor_curve_rise_7",
+    ],
+    [
+        "p2_sensor_curve_offset",
+        "p2_sensor_curve_rise_1",
+        "p2_sensor_curve_rise_2",
+        "p2_sensor_curve_rise_3",
+        "p2_sensor_curve_rise_4",
+        "p2_sensor_curve_rise_5",
+        "p2_sensor_curve_rise_6",
+        "p2_sensor_curve_rise_7",
+    ],
+];
+
+/// The share of a segment [lo, hi] that `v` has risen through: 0 below, 1 above, the end
+/// segments continued (`below`, `above`).
+pub fn segment(v: f64, lo: f64, hi: f64, below: bool, above: bool) -> f64 {
+    let mut u = (v - lo) / (hi - lo);
+    if !below {
+        u = u.max(0.0);
+    }
+    if !above {
+        u = u.min(1.0);
+    }
+    u
+}
+
+/// Quantiles 0, 1/(n−1), …, 1 of `values`, with knots closer than a hundredth of the range
+/// merged; empty when fewer than three remain.
+pub fn quantile_knots(values: &[f64], n: usize) -> Vec<f64> {
+    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    if sorted.len() < 2 * n {
+        return vec![];
+    }
+    sorted.sort_by(f64::total_cmp);
+    let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
+    let gap = 0.01 * (hi - lo);
+    if gap <= 0.0 {
+        return vec![];
+    }
+    let mut knots: Vec<f64> = vec![];
+    for j in 0..n {
+        let x = sorted[((sorted.len() - 1) * j) / (n - 1)];
+        match knots.last() {
+            Some(&last) if x - last < gap => {
+                if j == n - 1 {
+                    *knots.last_mut().expect("not empty") = x.max(last);
+                }
+            }
+            _ => knots.push(x),
+        }
+    }
+    if knots.len() < 3 {
+        return vec![];
+    }
+    knots
+}
+
+/// Sum of squares of `y` − `scale` × (the best curve through `knots` of `x`): least squares
+/// on the offset and the segments, a whisker of ridge. (`scale` 1 fits the reading itself;
+/// the command's curve fits a residual through a sensitivity.)
+fn misfit(knots: &[f64], x: &[f64], y: &[f64], scale: &[f64]) -> f64 {
+    let m = knots.len();
+    let basis = |v: f64, s: f64, out: &mut [f64]| {
+        out[0] = s;
+        for j in 1..m {
+            out[j] = s * segment(v, knots[j - 1], knots[j], j == 1, j == m - 1);
+        }
+    };
+    let mut ata = nalgebra::DMatrix::<f64>::zeros(m, m);
+    let mut atb = nalgebra::DVector::<f64>::zeros(m);
+    let mut row = vec![0.0; m];
+    for ((&v, &w), &s) in x.iter().zip(y).zip(scale) {
+        basis(v, s, &mut row);
+        for a in 0..m {
+            atb[a] += row[a] * w;
+            for b in a..m {
+                ata[(a, b)] += row[a] * row[b];
+            }
+        }
+    }
+    for a in 0..m {
+        for b in 0..a {
+            ata[(a, b)] = ata[(b, a)];
+        }
+        ata[(a, a)] += 1e-10 * ata[(a, a)].max(1e-300);
+    }
+    let Some(c) = ata.lu().solve(&atb) else {
+        return f64::INFINITY;
+    };
+    x.iter()
+        .zip(y)
+        .zip(scale)
+        .map(|((&v, &w), &s)| {
+            basis(v, s, &mut row);
+            let e = w - row.iter().zip(c.iter()).map(|(a, b)| a * b).sum::<f64>();
+            e * e
+        })
+        .sum()
+}
+
+/// Knots for a curve taking the model's reading `own` to the measured `measured` on the
+/// training samples: the ends of `own`'s range, knots added one at a time at whichever of
+/// its 1/64 quantiles lowers the least-squares misfit most, then each interior knot moved
+/// between its neighbours to where the curve fits best (two sweeps). At most 5000 samples
+/// are used, evenly spread.
+pub fn placed_knots(own: &[f64], measured: &[f64], training: &[bool], n: usize) -> Vec<f64> {
+    let ones = vec![1.0; own.len()];
+    placed(own, measured, &ones, training, n)
+}
+
+/// Knots for the command's curve: `residual` (the measured force minus the model's) taken
+/// as `sensitivity` (of the force to a constant shift of the command, N/V) times a curve's
+/// departure from the identity at the command `v_da`.
+pub fn placed_command_knots(
+    v_da: &[f64],
+    residual: &[f64],
+    sensitivity: &[f64],
+    training: &[bool],
+    n: usize,
+) -> Vec<f64> {
+    placed(v_da, residual, sensitivity, training, n)
+}
+
+fn placed(x_all: &[f64], y_all: &[f64], s_all: &[f64], training: &[bool], n: usize) -> Vec<f64> {
+    let picked: Vec<usize> = (0..x_all.len().min(y_all.len()).min(s_all.len()))
+        .filter(|&k| training[k] && x_all[k].is_finite() && y_all[k].is_finite() && s_all[k].is_finite())
+        .collect();
+    let stride = (picked.len() / 5000).max(1);
+    let x: Vec<f64> = picked.iter().step_by(stride).map(|&k| x_all[k]).collect();
+    let y: Vec<f64> = picked.iter().step_by(stride).map(|&k| y_all[k]).collect();
+    let s: Vec<f64> = picked.iter().step_by(stride).map(|&k| s_all[k]).collect();
+    // The ends, then knots added one at a time where they lower the misfit most, from
+    // the 1/64 quantiles of the signal: a curve's corners (a dead zone's two, a
+    // saturation's one) are found first.
+    let grid = quantile_knots(&x, 65);
+    if grid.len() < 3 {
+        return vec![];
+    }
+    let (first, last) = (grid[0], grid[grid.len() - 1]);
+    let gap = 0.01 * (last - first);
+    let mut knots = vec![first, last];
+    while knots.len() < n {
+        let best = grid
+            .iter()
+            .filter(|&&g| knots.iter().all(|k| (k - g).abs() >= gap))
+            .map(|&g| {
+                let mut trial = knots.clone();
+                trial.push(g);
+                trial.sort_by(f64::total_cmp);
+                (g, misfit(&trial, &x, &y, &s))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match best {
+            Some((g, _)) => {
+                knots.push(g);
+                knots.sort_by(f64::total_cmp);
+            }
+            None => break,
+        }
+    }
+    if knots.len() < 3 {
+        return vec![];
+    }
+    let phi = (5f64.sqrt() - 1.0) / 2.0;
+    for _sweep in 0..2 {
+        for j in 1..knots.len() - 1 {
+            let (lo, hi) = (knots[j - 1] + gap, knots[j + 1] - gap);
+            let cost = |v: f64| {
+                let mut trial = knots.clone();
+                trial[j] = v;
+                misfit(&trial, &x, &y, &s)
+            };
+            // A grid first (the cost may have several minima between the neighbours),
+            // then golden-section steps around the best point of the grid.
+            let at_start = cost(knots[j]);
+            const GRID: usize = 16;
+            let grid: Vec<(f64, f64)> = (0..=GRID)
+                .map(|g| {
+                    let v = lo + (hi - lo) * g as f64 / GRID as f64;
+                    (v, cost(v))
+                })
+                .collect();
+            let g = (0..=GRID)
+                .min_by(|&a, &b| grid[a].1.total_cmp(&grid[b].1))
+                .expect("a grid");
+            let (mut a, mut b) = (grid[g.saturating_sub(1)].0, grid[(g + 1).min(GRID)].0);
+            let mut c = b - phi * (b - a);
+            let mut d = a + phi * (b - a);
+            let (mut fc, mut fd) = (cost(c), cost(d));
+            for _ in 0..12 {
+                if fc < fd {
+                    b = d;
+                    d = c;
+                    fd = fc;
+                    c = b - phi * (b - a);
+                    fc = cost(c);
+                } else {
+                    a = c;
+                    c = d;
+                    fc = fd;
+                    d = a + phi * (b - a);
+                    fd = cost(d);
+                }
+            }
+            let (best, f) = [(c, fc), (d, fd), grid[g]]
+                .into_iter()
+                .min_by(|p, q| p.1.total_cmp(&q.1))
+                .expect("three points");
+            if f < at_start {
+                knots[j] = best;
+            }
+        }
+    }
+    knots
+}
+
+/// The curve candidate on a measured channel: an offset and one increment per segment of
+/// the knots `x` (non-negative: the curve does not fall).
+fn channel_terms(channel: usize, x: &[f64], unit: &'static str) -> Vec<Term> {
+    let names = &INCREMENTS[channel];
+    let typical = (x[x.len() - 1] - x[0]) / (x.len() - 1) as f64;
+    let mut terms = vec![Term {
+        name: names[0],
+        unit,
+        mechanism: Mechanism::Output {
+            channel,
+            regressor: Regressor::One,
+        },
+        neutral: 0.0,
+        step: 1e-3 * typical,
+        lower: f64::NEG_INFINITY,
+        upper: f64::INFINITY,
+    }];
+    for j in 1..x.len() {
+        terms.push(Term {
+            name: names[j],
+            unit,
+            mechanism: Mechanism::Output {
+                channel,
+                regressor: Regressor::Segment {
+                    lo: x[j - 1],
+                    hi: x[j],
+                    below: j == 1,
+                    above: j == x.len() - 1,
+                },
+            },
+            neutral: 0.0,
+            step: 1e-3 * typical,
+            lower: -(x[j] - x[j - 1]),
+            upper: f64::INFINITY,
+        });
+    }
+    terms
+}
+
+/// The command's curve: its knot values as model parameters, from the identity at the
+/// knots `x`.
+fn command_terms(x: &[f64]) -> (Vec<Term>, Vec<(&'static str, f64)>) {
+    let n = x.len();
+    let mut settings = vec![(variable_name("command_curve_knots"), n as f64)];
+    let mut terms = vec![];
+    for k in 0..n {
+        let xn = variable_name(&format!("command_curve_x_{}", k + 1));
+        let yn = variable_name(&format!("command_curve_y_{}", k + 1));
+        settings.push((xn, x[k]));
+        settings.push((yn, x[k]));
+        terms.push(Term {
+            name: yn,
+            unit: "V",
+            mechanism: Mechanism::Parameter(yn),
+            neutral: x[k],
+            step: 0.02,
+            lower: -100.0,
+            upper: 100.0,
+        });
+    }
+    (terms, settings)
+}
+
+/// Whether a candidate is the command's curve.
+pub fn is_command_curve(candidate: &Candidate) -> bool {
+    candidate.settings.iter().any(|(n, _)| *n == "command_curve_knots")
+}
+
+/// The static-curve candidates at the places the knots allow, where the model `base` has no
+/// curve yet (a second curve there would replace the first, not add to it).
+pub fn candidates(base: &Parameters, knots: &CurveKnots, has_pressures: bool) -> Vec<Candidate> {
+    let free = [
+        !base.force_sensor_curve.is_on(),
+        !base.p1_sensor_curve.is_on(),
+        !base.p2_sensor_curve.is_on(),
+    ];
+    let mut list = vec![];
+    let c = |label, location, terms, settings| Candidate {
+        label,
+        location,
+        family: "nonlinearity",
+        named: None,
+        terms,
+        settings,
+    };
+    if knots.command.len() >= 3 && !base.command_curve.is_on() {
+        let (terms, settings) = command_terms(&knots.command);
+        list.push(c("command static curve", "command", terms, settings));
+    }
+    if knots.channels[FORCE].len() >= 3 && free[FORCE] {
+        let terms = channel_terms(FORCE, &knots.channels[FORCE], "N");
+        list.push(c("force sensor static curve", "force_sensor", terms, vec![]));
+    }
+    if has_pressures {
+        let one = |ch: usize| {
+            (knots.channels[ch].len() >= 3 && free[ch]).then(|| channel_terms(ch, &knots.channels[ch], "Pa"))
+        };
+        if let Some(t) = one(P1) {
+            list.push(c(
+                "chamber 1 pressure sensor static curve",
+                "pressure_sensors",
+                t,
+                vec![],
+            ));
+        }
+        if let Some(t) = one(P2) {
+            list.push(c(
+                "chamber 2 pressure sensor static curve",
+                "pressure_sensors",
+                t,
+                vec![],
+            ));
+        }
+        if let (Some(mut a), Some(b)) = (one(P1), one(P2)) {
+            a.extend(b);
+            list.push(c("pressure sensor static curves", "pressure_sensors", a, vec![]));
+        }
+    }
+    list
+}
+
+/// Whether a candidate is a curve on a measured channel.
+pub fn is_channel_curve(candidate: &Candidate) -> bool {
+    candidate.terms.iter().any(|t| {
+        matches!(
+            t.mechanism,
+            Mechanism::Output {
+                regressor: Regressor::Segment { .. },
+                ..
+            }
+        )
+    })
+}
+
+/// The FMU parameters of a fitted channel curve, composed with the transducer the model
+/// has (an offset and a gain: the new reading c(o + g y) is a curve of y through the
+/// knots (x − o)/g); `None` when the transducer has more than that (a curve, a polynomial,
+/// a drift, a pick-up or a filter), which a curve could not carry exactly.
+pub fn channel_model_terms(
+    candidate: &Candidate,
+    values: &[f64],
+    base: &Parameters,
+) -> Option<Vec<(&'static str, f64)>> {
+    let mut set = vec![];
+    for channel in [FORCE, P1, P2] {
+        let mine: Vec<(&Term, f64)> = candidate
+            .terms
+            .iter()
+            .zip(values)
+            .filter(|(t, _)| matches!(t.mechanism, Mechanism::Output { channel: c, .. } if c == channel))
+            .map(|(t, &v)| (t, v))
+            .collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let mut offset = 0.0;
+        let mut knots: Vec<f64> = vec![];
+        let mut rises: Vec<f64> = vec![];
+        for (t, v) in &mine {
+            match t.mechanism {
+                Mechanism::Output {
+                    regressor: Regressor::One,
+                    ..
+                } => offset += v,
+                Mechanism::Output {
+                    regressor: Regressor::Segment { lo, hi, .. },
+                    ..
+                } => {
+                    if knots.is_empty() {
+                        knots.push(lo);
+                    }
+                    knots.push(hi);
+                    rises.push(hi - lo + v);
+                }
+                _ => return None,
+            }
+        }
+        if knots.len() < 2 || knots.len() > MAX_KNOTS {
+            return None;
+        }
+        let (o, g) = match channel {
+            FORCE => {
+                let p = base;
+                let plain = p.force_sensor_quadratic == 0.0
+                    && p.force_sensor_cubic == 0.0
+                    && p.force_sensor_drift == 0.0
+                    && p.force_sensor_ripple_sine == 0.0
+                    && p.force_sensor_ripple_cosine == 0.0
+                    && p.force_sensor_delay == 0.0
+                    && p.force_sensor_lag == 0.0
+                    && p.force_sensor_play == 0.0
+                    && !p.force_sensor_curve.is_on();
+                if !plain {
+                    return None;
+                }
+                (p.force_sensor_offset, p.force_sensor_gain)
+            }
+            P1 => {
+                let p = base;
+                if p.p1_sensor_drift != 0.0
+                    || p.p1_sensor_delay != 0.0
+                    || p.p1_sensor_lag != 0.0
+                    || p.p1_sensor_curve.is_on()
+                {
+                    return None;
+                }
+                (p.p1_sensor_offset, p.p1_sensor_gain)
+            }
+            _ => {
+                let p = base;
+                if p.p2_sensor_drift != 0.0
+                    || p.p2_sensor_delay != 0.0
+                    || p.p2_sensor_lag != 0.0
+                    || p.p2_sensor_curve.is_on()
+                {
+                    return None;
+                }
+                (p.p2_sensor_offset, p.p2_sensor_gain)
+            }
+        };
+        let prefix = channel_prefix(channel);
+        let (off_name, gain_name) = match channel {
+            FORCE => ("force_sensor_offset", "force_sensor_gain"),
+            P1 => ("p1_sensor_offset", "p1_sensor_gain"),
+            _ => ("p2_sensor_offset", "p2_sensor_gain"),
+        };
+        set.push((variable_name(off_name), 0.0));
+        set.push((variable_name(gain_name), 1.0));
+        set.push((variable_name(&format!("{prefix}_knots")), knots.len() as f64));
+        let mut y = knots[0] + offset;
+        for (k, &x) in knots.iter().enumerate() {
+            if k > 0 {
+                y += rises[k - 1];
+            }
+            set.push((variable_name(&format!("{prefix}_x_{}", k + 1)), (x - o) / g));
+            set.push((variable_name(&format!("{prefix}_y_{}", k + 1)), y));
+        }
+    }
+    (!set.is_empty()).then_some(set)
+}
+
+/// Make the command curve's knot values in `set` non-decreasing (a running maximum).
+pub fn monotone_command(set: &mut [(&'static str, f64)]) {
+    let mut highest = f64::NEG_INFINITY;
+    for k in 1..=MAX_KNOTS {
+        let name = format!("command_curve_y_{k}");
+        if let Some(entry) = set.iter_mut().find(|(n, _)| *n == name) {
+            highest = highest.max(entry.1);
+            entry.1 = highest;
+        }
+    }
+}
+
+/// The curves that `set` turns on: (prefix, curve).
+fn curves_in(set: &[(&'static str, f64)]) -> Vec<(&'static str, StaticCurve)> {
+    let mut out = vec![];
+    for prefix in [
+        "command_curve",
+        "force_sensor_curve",
+        "p1_sensor_curve",
+        "p2_sensor_curve",
+    ] {
+        let get = |name: String| set.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
+        let Some(n) = get(format!("{prefix}_knots")) else {
+            continue;
+        };
+        let n = (n as usize).min(MAX_KNOTS);
+        let x: Vec<f64> = (1..=n).map(|k| get(format!("{prefix}_x_{k}")).unwrap_or(0.0)).collect();
+        let y: Vec<f64> = (1..=n).map(|k| get(format!("{prefix}_y_{k}")).unwrap_or(0.0)).collect();
+        out.push((prefix, StaticCurve::through(&x, &y)));
+    }
+    out
+}
+
+/// The family of a discovered term: `limit` when a curve in `set` is flat at an end (a
+/// saturation), else the candidate's.
+pub fn family(candidate_family: &'static str, set: &[(&'static str, f64)]) -> &'static str {
+    let curves = curves_in(set);
+    if curves.is_empty() {
+        return candidate_family;
+    }
+    if curves.iter().any(|(_, c)| flat_end(c).is_some()) {
+        "limit"
+    } else {
+        "nonlinearity"
+    }
+}
+
+fn slope(c: &StaticCurve, j: usize) -> f64 {
+    (c.y[j + 1] - c.y[j]) / (c.x[j + 1] - c.x[j])
+}
+
+/// A flat end: (true for the upper end, the knot where it starts).
+fn flat_end(c: &StaticCurve) -> Option<(bool, usize)> {
+    let n = c.len();
+    if n < 3 {
+        return None;
+    }
+    if slope(c, n - 2).abs() < FLAT {
+        // The flat run may span several segments: its first knot.
+        let mut k = n - 2;
+        while k > 0 && slope(c, k - 1).abs() < FLAT {
+            k -= 1;
+        }
+        return Some((true, k));
+    }
+    if slope(c, 0).abs() < FLAT {
+        let mut k = 1;
+        while k + 1 < n && slope(c, k).abs() < FLAT {
+            k += 1;
+        }
+        return Some((false, k));
+    }
+    None
+}
+
+/// A sentence on what a curve is, in physical words.
+fn describe(prefix: &str, c: &StaticCurve) -> String {
+    let (place, quantity, unit, scale, shown) = match prefix {
+        "command_curve" => ("the command", "command", "V", 1.0, "V"),
+        "force_sensor_curve" => ("the force sensor", "force", "N", 1.0, "N"),
+        "p1_sensor_curve" => ("the chamber 1 pressure transducer", "pressure", "Pa", 1e-3, "kPa"),
+        _ => ("the chamber 2 pressure transducer", "pressure", "Pa", 1e-3, "kPa"),
+    };
+    let _ = unit;
+    let n = c.len();
+    if let Some((upper, k)) = flat_end(c) {
+        let level = c.y[k];
+        return if upper {
+            format!(
+                "{place} saturates at {:.2} {shown}: above a {quantity} of {:.2} {shown} it reads {:.2} {shown}",
+                scale * level,
+                scale * c.x[k],
+                scale * level
+            )
+        } else {
+            format!(
+                "{place} bottoms out at {:.2} {shown}: below a {quantity} of {:.2} {shown} it reads {:.2} {shown}",
+                scale * level,
+                scale * c.x[k],
+                scale * level
+            )
+        };
+    }
+    // A flat stretch inside: a dead zone.
+    let flat: Vec<usize> = (0..n - 1).filter(|&j| slope(c, j).abs() < FLAT).collect();
+    if let (Some(&a), Some(&b)) = (flat.first(), flat.last()) {
+        if flat.len() == b - a + 1 {
+            let (lo, hi) = (c.x[a], c.x[b + 1]);
+            let centre = 0.5 * (lo + hi);
+            let half = 0.5 * (hi - lo);
+            return if centre.abs() < 0.25 * half {
+                format!(
+                    "{place} has a dead zone of ±{:.2} {shown} (from {:.2} to {:.2} {shown}, where it gives {:.2} {shown})",
+                    scale * half,
+                    scale * lo,
+                    scale * hi,
+                    scale * c.y[a]
+                )
+            } else {
+                format!(
+                    "{place} has a dead zone from {:.2} to {:.2} {shown} of the {quantity}, where it gives {:.2} {shown}",
+                    scale * lo,
+                    scale * hi,
+                    scale * c.y[a]
+                )
+            };
+        }
+    }
+    // The largest departure from the identity at a knot.
+    let (k, d) = (0..n)
+        .map(|k| (k, c.y[k] - c.x[k]))
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .expect("a curve has knots");
+    format!(
+        "{place} departs most from the identity by {:+.3} {shown} at a {quantity} of {:.2} {shown} (slopes {})",
+        scale * d,
+        scale * c.x[k],
+        (0..n - 1)
+            .map(|j| format!("{:.3}", slope(c, j)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
+/// The reading of a discovered term whose parameters turn a curve on, or `None`.
+pub fn reading(set: &[(&'static str, f64)]) -> Option<String> {
+    let curves = curves_in(set);
+    if curves.is_empty() {
+        return None;
+    }
+    let parts: Vec<String> = curves
+        .iter()
+        .map(|(prefix, c)| {
+            let knots: Vec<String> = (0..c.len())
+                .map(|k| format!("({:.4e}, {:.4e})", c.x[k], c.y[k]))
+                .collect();
+            format!("{}; knots (x, y) in SI: {}", describe(prefix, c), knots.join(" "))
+        })
+        .collect();
+    Some(format!("A static curve: {}.", parts.join("; ")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn knots_placed_on_a_saturated_reading_put_one_on_its_corner() {
+        // A reading that follows its quantity to 85 and stays there; the quantity 0..100.
+        let x: Vec<f64> = (0..4000).map(|k| 100.0 * k as f64 / 3999.0).collect();
+        let y: Vec<f64> = x.iter().map(|v| v.min(85.0)).collect();
+        let knots = placed_knots(&x, &y, &vec![true; x.len()], SENSOR_KNOTS);
+        assert!(
+            knots.iter().any(|k| (k - 85.0).abs() < 0.2),
+            "no knot at the corner: {knots:?}"
+        );
+    }
+
+    #[test]
+    fn a_flat_upper_end_reads_as_a_saturation_and_a_flat_middle_as_a_dead_zone() {
+        let s = [
+            ("force_sensor_curve_knots", 3.0),
+            ("force_sensor_curve_x_1", 0.0),
+            ("force_sensor_curve_y_1", 0.0),
+            ("force_sensor_curve_x_2", 85.0),
+            ("force_sensor_curve_y_2", 85.0),
+            ("force_sensor_curve_x_3", 100.0),
+            ("force_sensor_curve_y_3", 85.1),
+        ];
+        assert_eq!(family("nonlinearity", &s), "limit");
+        let r = reading(&s).unwrap();
+        assert!(r.contains("the force sensor saturates at 85.00 N"), "{r}");
+        let d = [
+            ("command_curve_knots", 4.0),
+            ("command_curve_x_1", -8.0),
+            ("command_curve_y_1", -7.6),
+            ("command_curve_x_2", -0.4),
+            ("command_curve_y_2", 0.0),
+            ("command_curve_x_3", 0.4),
+            ("command_curve_y_3", 0.0),
+            ("command_curve_x_4", 8.0),
+            ("command_curve_y_4", 7.6),
+        ];
+        assert_eq!(family("nonlinearity", &d), "nonlinearity");
+        let r = reading(&d).unwrap();
+        assert!(r.contains("the command has a dead zone of ±0.40 V"), "{r}");
+    }
+}
