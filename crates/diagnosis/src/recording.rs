@@ -88,7 +88,7 @@ impl Recording {
         if n <= max_rows || n < 2 {
             return self.clone();
         }
-        let every = (n + max_rows - 1) / max_rows;
+        let every = n.div_ceil(max_rows);
         let t0 = self.time[0];
         let rows: Vec<usize> = (0..n)
             .filter(|&k| ((self.time[k] - t0) / FIT_STRETCH_SECONDS).floor() as usize % every == 0)
