@@ -197,6 +197,7 @@ mod tests {
             p1: pressures.map(|(a, _)| vec![a; n]),
             p2: pressures.map(|(_, b)| vec![b; n]),
             time,
+            full_rate: None,
         }
     }
 

@@ -474,7 +474,11 @@ pub fn diagnose(
 /// What every stage of a diagnosis reads: the recording, its training blocks and the
 /// channels' noise floors.
 struct Context<'a> {
+    /// The rows the fits work on: the whole recording, or stretches of a long one
+    /// ([`Recording::rows_for_fits`]).
     recording: &'a Recording,
+    /// Every sample: the noise floors and the errors reported are its.
+    full: &'a Recording,
     options: &'a Options,
     training: Vec<bool>,
     n: usize,
@@ -489,6 +493,7 @@ impl<'a> Context<'a> {
     /// Estimate the channels' noise floors (step 1); a force channel rounded coarser than
     /// its noise gets a line in `input_checks`.
     fn measure(
+        full: &'a Recording,
         recording: &'a Recording,
         options: &'a Options,
         input_checks: &mut Vec<String>,
@@ -496,15 +501,25 @@ impl<'a> Context<'a> {
     ) -> Self {
         let training = training_mask(&recording.time);
         let n = recording.len();
-        // A sharp line (a pick-up) is a departure to find, not noise.
-        let sample_rate = (n - 1) as f64 / (recording.time[n - 1] - recording.time[0]).max(1e-12);
+        // The noise floors from every sample. A sharp line (a pick-up) is a departure to
+        // find, not noise.
+        let sample_rate = full.sample_rate();
         let floor = |x: &[f64]| noise::noise_floor(&lines::without_lines(x, sample_rate, 3));
-        let noise = floor(&recording.force);
-        let pressure_noise = match (&recording.p1, &recording.p2) {
+        let noise = floor(&full.force);
+        let pressure_noise = match (&full.p1, &full.p2) {
             (Some(a), Some(b)) => Some([floor(a), floor(b)]),
             _ => None,
         };
-        if let Some(q) = noise::quantisation_step(&recording.force) {
+        if n < full.len() {
+            let message = format!(
+                "The fits use {n} of the {} samples: stretches of {} s spread over the whole recording. The noise floors and the errors reported are of every sample.",
+                full.len(),
+                recording::FIT_STRETCH_SECONDS
+            );
+            progress(&message);
+            input_checks.push(message);
+        }
+        if let Some(q) = noise::quantisation_step(&full.force) {
             if q > noise {
                 input_checks.push(format!(
                     "The force channel is quantised in steps of {q:.4} N, coarser than its noise {noise:.4} N: errors below a step cannot be told from rounding."
@@ -524,6 +539,7 @@ impl<'a> Context<'a> {
         }
         Self {
             recording,
+            full,
             options,
             training,
             n,
@@ -555,7 +571,8 @@ pub fn diagnose_with(
     // 1. The file's checks and the noise floors.
     let mut input_checks = checks::check_file(recording, base)?;
     let smoothed = recording.with_stopper_smoothed();
-    let cx = Context::measure(&smoothed, options, &mut input_checks, progress);
+    let fitted = smoothed.rows_for_fits(recording::MAX_FIT_ROWS);
+    let cx = Context::measure(&smoothed, &fitted, options, &mut input_checks, progress);
     let before_model = Actuator::new(base.clone())?;
     let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
     input_checks.extend(checks::check_against_model(
@@ -732,37 +749,54 @@ fn conclude(
     replays: usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
-    let (recording, n, noise, training) = (cx.recording, cx.n, cx.noise, &cx.training);
-    // The reported figures come from the accurate, error-controlled replay.
+    let (full, noise) = (cx.full, cx.noise);
+    // The reported figures come from the accurate, error-controlled replay of every sample.
     progress("final replays with the error-controlled integrator");
     let final_model = Actuator::new(found.params.clone())?;
+    let n = full.len();
     let (before, after) = std::thread::scope(|scope| {
-        let b = scope.spawn(|| replay(&before_model, recording, 1e-5, n));
-        let a = replay(&final_model, recording, 1e-5, n);
+        let b = scope.spawn(|| replay(&before_model, full, 1e-5, n));
+        let a = replay(&final_model, full, 1e-5, n);
         (b.join().unwrap_or_else(|_| Err("replay panicked".to_string())), a)
     });
     let (before, after) = (before?, after?);
-    let after_residual = difference(&recording.force, &after.force);
-    let after_errors = errors(&after, recording, training);
+    let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
+    let full_training = match thinned {
+        Some(_) => training_mask(&full.time),
+        None => cx.training.clone(),
+    };
+    let training = &full_training;
+    let after_errors = errors(&after, full, training);
     let split = cx
         .pressure_noise
-        .and_then(|pn| pressure_split(&final_model, recording, &after, noise, pn));
-    let chain = ChainSignals::new(&final_model, recording, &after);
-    let remainder = Signature::of(&recording.time, &after_residual, &chain, "N");
+        .and_then(|pn| pressure_split(&final_model, full, &after, noise, pn));
+    // What the remainder follows, on the fits' rows.
+    let after_at_rows = thinned.map(|rows| after.at_rows(rows));
+    let after_rows = after_at_rows.as_ref().unwrap_or(&after);
+    let recording = cx.recording;
+    let chain = ChainSignals::new(&final_model, recording, after_rows);
+    let remainder = Signature::of(
+        &recording.time,
+        &difference(&recording.force, &after_rows.force),
+        &chain,
+        "N",
+    );
     let unexplained = what_stays_unexplained(
         cx,
         &found.localization,
-        &after,
+        after_rows,
         &after_errors,
         split.as_ref(),
         &chain,
         &remainder,
     );
-    let heldout_residual: Vec<f64> = after_residual
+    let heldout_residual: Vec<f64> = full
+        .force
         .iter()
+        .zip(&after.force)
         .zip(training)
         .filter(|(_, &m)| !m)
-        .map(|(r, _)| *r)
+        .map(|((f, a), _)| f - a)
         .collect();
     let (ljung_box, lag1) = whiteness(&heldout_residual, 20);
     let residual_tests = json!({
@@ -774,7 +808,7 @@ fn conclude(
         noise_floor: noise,
         pressure_noise: cx.pressure_noise,
         input_checks,
-        before: errors(&before, recording, training),
+        before: errors(&before, full, training),
         after: after_errors,
         calibrated,
         effects: found.effects,

@@ -128,10 +128,15 @@ pub(crate) fn localize(
             .position(|(n, _)| *n == name)
             .and_then(|k| sensitivities[k].clone())
     };
-    let score = |fit: Fit| -> Scored {
+    let score = |mut fit: Fit| -> Scored {
         let explained = 1.0 - fit.heldout_total() / before_total;
         let residual = difference(&problem.recording.force, &fit.prediction[FORCE]);
         let force_heldout_rms = rms_where(&residual, problem.training, false);
+        // Only the force prediction is read once a candidate is scored (the remainder of a
+        // named effect that is added): the pressures' would hold two more series for every
+        // candidate until the diagnosis ends.
+        fit.prediction[1] = Vec::new();
+        fit.prediction[2] = Vec::new();
         Scored {
             fit,
             explained,

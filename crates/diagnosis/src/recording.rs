@@ -13,7 +13,27 @@ pub struct Recording {
     pub force: Vec<f64>,
     pub p1: Option<Vec<f64>>,
     pub p2: Option<Vec<f64>>,
+    /// For a recording that keeps only some rows of a longer one ([`Recording::rows_for_fits`]):
+    /// the inputs at every sample of the longer one, which the replays integrate, and which of
+    /// its samples the rows are. `None` for a recording as read.
+    pub full_rate: Option<std::sync::Arc<FullRateInputs>>,
 }
+
+/// The inputs of a recording at every sample, and the samples a thinned view keeps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FullRateInputs {
+    pub time: Vec<f64>,
+    pub v_da: Vec<f64>,
+    pub x_s: Vec<f64>,
+    /// The sample of each kept row, increasing.
+    pub rows: Vec<usize>,
+}
+
+/// The most rows the fits keep: a longer recording is fitted on whole stretches of it
+/// ([`Recording::rows_for_fits`]). 100,000 rows keep an 80 s recording at 1 kHz whole.
+pub const MAX_FIT_ROWS: usize = 100_000;
+/// The stretches a long recording's fits keep: one training and one held-out block.
+pub const FIT_STRETCH_SECONDS: f64 = 2.0 * crate::BLOCK_SECONDS;
 
 const REQUIRED: [&str; 4] = ["time_s", "v_da_V", "x_s_m", "force_N"];
 const OPTIONAL: [&str; 2] = ["p1_Pa", "p2_Pa"];
@@ -54,6 +74,47 @@ impl Recording {
             })
             .collect();
         Recording { x_s, ..self.clone() }
+    }
+
+    /// The rows the fits work on: the whole recording when it has at most `max_rows` samples;
+    /// otherwise every `m`-th stretch of [`FIT_STRETCH_SECONDS`] (a training block and the
+    /// held-out block after it), `m` the smallest that keeps at most about `max_rows` rows.
+    /// The stretches are spread over the whole recording, so slow changes stay visible, and
+    /// each is contiguous at the full rate, so lags, delays, rates and spectral lines are seen
+    /// as they are. The thinned recording carries the full-rate inputs: its replays integrate
+    /// every sample and keep the outputs at its rows.
+    pub fn rows_for_fits(&self, max_rows: usize) -> Recording {
+        let n = self.len();
+        if n <= max_rows || n < 2 {
+            return self.clone();
+        }
+        let every = n.div_ceil(max_rows);
+        let t0 = self.time[0];
+        let rows: Vec<usize> = (0..n)
+            .filter(|&k| ((self.time[k] - t0) / FIT_STRETCH_SECONDS).floor() as usize % every == 0)
+            .collect();
+        let pick = |x: &[f64]| -> Vec<f64> { rows.iter().map(|&k| x[k]).collect() };
+        Recording {
+            time: pick(&self.time),
+            v_da: pick(&self.v_da),
+            x_s: pick(&self.x_s),
+            force: pick(&self.force),
+            p1: self.p1.as_deref().map(pick),
+            p2: self.p2.as_deref().map(pick),
+            full_rate: Some(std::sync::Arc::new(FullRateInputs {
+                time: self.time.clone(),
+                v_da: self.v_da.clone(),
+                x_s: self.x_s.clone(),
+                rows,
+            })),
+        }
+    }
+
+    /// Samples per second: of the full-rate recording behind a thinned one.
+    pub fn sample_rate(&self) -> f64 {
+        let time = self.full_rate.as_ref().map_or(&self.time, |f| &f.time);
+        let n = time.len();
+        (n - 1) as f64 / (time[n - 1] - time[0]).max(1e-12)
     }
 
     /// Read and check a recording file.
@@ -190,6 +251,7 @@ impl Recording {
             force,
             p1: has_pressures.then_some(p1),
             p2: has_pressures.then_some(p2),
+            full_rate: None,
         })
     }
 }

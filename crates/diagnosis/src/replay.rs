@@ -1,5 +1,6 @@
 //! Replaying a recording's inputs through the model: the command held between samples,
-//! the stopper moving linearly between samples (docs/model.md, "CSV formats").
+//! the stopper moving linearly between samples (docs/model.md, "CSV formats"). A recording
+//! thinned for the fits is replayed at its full rate, its outputs kept at its rows.
 
 use crate::recording::Recording;
 use jetpipe_model::physics::actuator::{Actuator, Outputs};
@@ -32,6 +33,19 @@ impl Replay {
         }
     }
 
+    /// The outputs at the given samples.
+    pub fn at_rows(&self, rows: &[usize]) -> Replay {
+        let pick = |x: &[f64]| -> Vec<f64> { rows.iter().map(|&k| x[k]).collect() };
+        Replay {
+            force: pick(&self.force),
+            p1: pick(&self.p1),
+            p2: pick(&self.p2),
+            current: pick(&self.current),
+            x_jp: pick(&self.x_jp),
+            steps: self.steps,
+        }
+    }
+
     fn record(&mut self, y: &Outputs) {
         self.force.push(y.f_meas);
         self.p1.push(y.p1_meas);
@@ -41,30 +55,86 @@ impl Replay {
     }
 }
 
+/// The inputs a replay integrates, sample by sample, and which samples it keeps: every
+/// sample of a recording as read; of a thinned one ([`Recording::rows_for_fits`]), every
+/// sample of the full-rate recording behind it, the outputs kept at its rows.
+struct Drive<'a> {
+    time: &'a [f64],
+    v_da: &'a [f64],
+    x_s: &'a [f64],
+    rows: Option<&'a [usize]>,
+    /// The last sample to reach.
+    last: usize,
+}
+
+impl<'a> Drive<'a> {
+    /// The drive of rows `0..end` (at least one).
+    fn of(recording: &'a Recording, end: usize) -> Self {
+        let n = end.min(recording.len()).max(1);
+        match &recording.full_rate {
+            Some(full) => Drive {
+                time: &full.time,
+                v_da: &full.v_da,
+                x_s: &full.x_s,
+                rows: Some(&full.rows[..n]),
+                last: full.rows[n - 1],
+            },
+            None => Drive {
+                time: &recording.time,
+                v_da: &recording.v_da,
+                x_s: &recording.x_s,
+                rows: None,
+                last: n - 1,
+            },
+        }
+    }
+
+    fn rows(&self) -> usize {
+        self.rows.map_or(self.last + 1, |r| r.len())
+    }
+
+    /// Calls `keep(k)` at the samples whose outputs are kept, in order.
+    fn keeps(&self) -> impl FnMut(usize) -> bool + 'a {
+        let rows = self.rows;
+        let mut next = 0;
+        move |k| match rows {
+            None => true,
+            Some(rows) => {
+                if next < rows.len() && rows[next] == k {
+                    next += 1;
+                    true
+                } else {
+                    false
+                }
+            }
+        }
+    }
+}
+
 /// Simulate `recording` from the equilibrium of its first sample (the bench holds the
 /// first command before t = 0). Samples in `0..end` only.
 pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usize) -> Result<Replay, String> {
-    let n = end.min(recording.len());
-    let mut sim = Simulation::at_equilibrium(
-        model.clone(),
-        recording.v_da[0],
-        recording.x_s[0],
-        recording.time[0],
-        tolerance,
-    )?;
-    let mut out = Replay::with_capacity(n);
-    for k in 0..n {
-        let y = sim.outputs();
-        out.record(&y);
-        if k + 1 == n {
+    if end.min(recording.len()) == 0 {
+        return Ok(Replay::default());
+    }
+    let drive = Drive::of(recording, end);
+    let (time, v_da, x_s) = (drive.time, drive.v_da, drive.x_s);
+    let mut sim = Simulation::at_equilibrium(model.clone(), v_da[0], x_s[0], time[0], tolerance)?;
+    let mut out = Replay::with_capacity(drive.rows());
+    let mut keep = drive.keeps();
+    for k in 0..=drive.last {
+        if keep(k) {
+            out.record(&sim.outputs());
+        }
+        if k == drive.last {
             break;
         }
-        let dt = recording.time[k + 1] - recording.time[k];
-        sim.set_command(recording.v_da[k])?;
-        sim.set_stopper_rate((recording.x_s[k + 1] - recording.x_s[k]) / dt)?;
+        let dt = time[k + 1] - time[k];
+        sim.set_command(v_da[k])?;
+        sim.set_stopper_rate((x_s[k + 1] - x_s[k]) / dt)?;
         sim.step(dt).map_err(|e| describe(e, k + 1))?;
         // Land exactly on the recorded stopper position (no drift from rounding).
-        sim.land_stopper_at(recording.x_s[k + 1]);
+        sim.land_stopper_at(x_s[k + 1]);
     }
     out.steps = sim.statistics().steps;
     Ok(out)
@@ -83,22 +153,28 @@ pub const MAX_FAST_STEP: f64 = 1.05e-3;
 /// the accurate replay checks the final figures. Falls back to [`replay`] when the jet pipe
 /// has no modal form.
 pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Result<Replay, String> {
-    let n = end.min(recording.len());
-    let t = &recording.time;
-    let mut sim = match FixedStep::at_equilibrium(model.clone(), recording.v_da[0], recording.x_s[0], t[0])? {
+    if end.min(recording.len()) == 0 {
+        return Ok(Replay::default());
+    }
+    let drive = Drive::of(recording, end);
+    let (t, v_da, x_s) = (drive.time, drive.v_da, drive.x_s);
+    let mut sim = match FixedStep::at_equilibrium(model.clone(), v_da[0], x_s[0], t[0])? {
         Some(sim) => sim,
         None => return replay(model, recording, 1e-5, end),
     };
-    let mut out = Replay::with_capacity(n);
-    for k in 0..n {
-        out.record(&sim.outputs());
-        if k + 1 == n {
+    let mut out = Replay::with_capacity(drive.rows());
+    let mut keep = drive.keeps();
+    for k in 0..=drive.last {
+        if keep(k) {
+            out.record(&sim.outputs());
+        }
+        if k == drive.last {
             break;
         }
-        sim.set_command(recording.v_da[k])?;
+        sim.set_command(v_da[k])?;
         // the stopper moves linearly between samples
         let parts = ((t[k + 1] - t[k]) / MAX_FAST_STEP).ceil().max(1.0) as usize;
-        sim.step_to_in_parts(t[k + 1], recording.x_s[k + 1], parts)
+        sim.step_to_in_parts(t[k + 1], x_s[k + 1], parts)
             .map_err(|e| describe(e, k + 1))?;
     }
     out.steps = sim.simulation().statistics().steps;
@@ -120,7 +196,11 @@ mod tests {
 
     /// 3 s at 1 kHz: command steps and a sine, the stopper moving in and out.
     fn protocol() -> Recording {
-        let n = 3000;
+        protocol_of(3000)
+    }
+
+    /// `n` samples at 1 kHz of the same protocol.
+    fn protocol_of(n: usize) -> Recording {
         let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
         let v_da = time
             .iter()
@@ -140,11 +220,62 @@ mod tests {
             force: vec![0.0; n],
             p1: None,
             p2: None,
+            full_rate: None,
         }
     }
 
     fn rms_difference(a: &[f64], b: &[f64]) -> f64 {
         (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+    }
+
+    #[test]
+    fn a_thinned_recording_is_replayed_at_its_full_rate_and_gives_the_outputs_at_its_rows() {
+        // 24 s: six stretches of 4 s, of which every second is kept for at most 12,000 rows.
+        let recording = protocol_of(24_000);
+        let thinned = recording.rows_for_fits(12_000);
+        let rows = thinned.full_rate.as_ref().expect("thinned").rows.clone();
+        assert_eq!(thinned.len(), 12_000);
+        assert!(rows.windows(2).all(|w| w[0] < w[1]));
+        for (j, &k) in rows.iter().enumerate() {
+            assert_eq!(thinned.time[j], recording.time[k]);
+            // Stretches 0, 2 and 4: each a training block and the held-out block after it.
+            assert_eq!(
+                (recording.time[k] / 4.0).floor() as usize % 2,
+                0,
+                "row {j} at {} s",
+                recording.time[k]
+            );
+        }
+        let model = Actuator::new(Parameters {
+            force_sensor_lag: 0.01,
+            ..Parameters::default()
+        })
+        .unwrap();
+        let full = replay_fast(&model, &recording, recording.len()).unwrap();
+        let thin = replay_fast(&model, &thinned, thinned.len()).unwrap();
+        // The same outputs to the bit (the thinned replay stops at its last row).
+        let expected = full.at_rows(&rows);
+        assert_eq!(
+            [&thin.force, &thin.p1, &thin.p2, &thin.current, &thin.x_jp],
+            [
+                &expected.force,
+                &expected.p1,
+                &expected.p2,
+                &expected.current,
+                &expected.x_jp
+            ]
+        );
+        let full = replay(&model, &recording, 1e-6, recording.len()).unwrap();
+        let thin = replay(&model, &thinned, 1e-6, thinned.len()).unwrap();
+        assert_eq!(thin.force, full.at_rows(&rows).force);
+        // The stopper's velocity is the full-rate slope at each row.
+        let velocity = crate::signals::stopper_velocity(&recording);
+        let at_rows: Vec<f64> = rows.iter().map(|&k| velocity[k]).collect();
+        assert_eq!(crate::signals::stopper_velocity(&thinned), at_rows);
+        assert!((thinned.sample_rate() - 1000.0).abs() < 1e-6);
+        assert!((crate::signals::sample_rate(&thinned.time) - 1000.0).abs() < 1e-6);
+        // A recording within the limit is kept whole.
+        assert_eq!(recording.rows_for_fits(24_000), recording);
     }
 
     #[test]

@@ -165,7 +165,7 @@ fn replay_round(
         .then_some(line.peak_hz)
         .or_else(|| {
             let n = force_residual.len();
-            let sample_rate = (n - 1) as f64 / (recording.time[n - 1] - recording.time[0]).max(1e-12);
+            let sample_rate = recording.sample_rate();
             let inputs = [&recording.v_da[..n], &recording.x_s[..n]];
             lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n]).map(|l| l.hz)
         });

@@ -15,13 +15,42 @@ pub const CHANNELS: usize = 3;
 pub const CHANNEL_NAMES: [&str; CHANNELS] = ["force", "p1", "p2"];
 
 /// Stopper velocity as the replays see it at sample k: the slope of the interval that
-/// ends there (zero at the first sample).
+/// ends there (zero at the first sample). For a recording thinned for the fits, the
+/// interval of the full-rate recording that ends at the row.
 pub fn stopper_velocity(recording: &Recording) -> Vec<f64> {
-    let mut v = vec![0.0; recording.len()];
-    for k in 1..recording.len() {
-        v[k] = (recording.x_s[k] - recording.x_s[k - 1]) / (recording.time[k] - recording.time[k - 1]);
+    let slope = |time: &[f64], x: &[f64], k: usize| {
+        if k == 0 {
+            0.0
+        } else {
+            (x[k] - x[k - 1]) / (time[k] - time[k - 1])
+        }
+    };
+    match &recording.full_rate {
+        Some(full) => full.rows.iter().map(|&k| slope(&full.time, &full.x_s, k)).collect(),
+        None => (0..recording.len())
+            .map(|k| slope(&recording.time, &recording.x_s, k))
+            .collect(),
     }
-    v
+}
+
+/// Samples per second of a series sampled at `time`: from its span, or, when it has gaps
+/// (the stretches of a recording thinned for the fits), from its median interval.
+pub fn sample_rate(time: &[f64]) -> f64 {
+    let n = time.len();
+    if n < 2 {
+        return 1.0;
+    }
+    let span = (time[n - 1] - time[0]).max(1e-12);
+    let mean = span / (n - 1) as f64;
+    if time.windows(2).all(|w| w[1] - w[0] <= 2.0 * mean) {
+        return (n - 1) as f64 / span;
+    }
+    let mut intervals: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = intervals.len() / 2;
+    1.0 / intervals
+        .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
+        .1
+        .max(1e-12)
 }
 
 /// Centred difference quotient over ±`half` samples.

@@ -66,8 +66,12 @@ pub struct Spectrum {
 
 pub fn spectrum(time: &[f64], residual: &[f64]) -> Spectrum {
     let n = residual.len();
-    let span = time[n - 1] - time[0];
-    let sample_rate = (n - 1) as f64 / span.max(1e-12);
+    let sample_rate = crate::signals::sample_rate(&time[..n]);
+    // The length of the series as sampled: of its stretches, when it was thinned for the fits.
+    let mut span = time[n - 1] - time[0];
+    if span * sample_rate > n as f64 {
+        span = (n - 1) as f64 / sample_rate;
+    }
     let mean = residual.iter().sum::<f64>() / n as f64;
     let centred: Vec<f64> = residual.iter().map(|r| r - mean).collect();
     let lowest = (2.0 / span).max(0.02);

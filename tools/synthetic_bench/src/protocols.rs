@@ -1,6 +1,6 @@
 //! Protocols other than the bench's: the same plant and effects driven by random staircases,
 //! multisines, PRBS, slow sines, ramps or a force-tracking controller, with the stopper fixed,
-//! oscillating or moving between positions, sampled at 250 Hz–2 kHz for 20–120 s with chosen
+//! oscillating or moving between positions, sampled at 250 Hz–2 kHz for 20–3600 s with chosen
 //! noise, and logged with or without the pressure channels. A diagnosis developed on the bench
 //! protocol alone learns that protocol; these recordings are where it is tried on others.
 //!
@@ -77,7 +77,7 @@ pub const STOPPER_RANGE: (f64, f64) = (0.030, 0.090);
 /// Sampling rates a protocol may use (Hz).
 pub const SAMPLE_RATE_RANGE: (f64, f64) = (250.0, 2000.0);
 /// Lengths a protocol may have (s).
-pub const DURATION_RANGE: (f64, f64) = (20.0, 120.0);
+pub const DURATION_RANGE: (f64, f64) = (20.0, 3600.0);
 
 /// A recording's protocol: what drives the plant, how it is sampled and how noisy it is.
 #[derive(Clone, Debug, PartialEq)]

@@ -25,7 +25,7 @@ struct Cli {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Length of the recording, s: with the bench protocol at most 80 (it is truncated), with
-    /// --protocol 20–120.
+    /// --protocol 20–3600.
     #[arg(long, default_value_t = PROTOCOL_DURATION)]
     duration: f64,
     /// Another protocol than the bench's: staircase, multisine, prbs, sine, ramps or
