@@ -192,6 +192,15 @@ pub struct UndeclaredEffects {
     /// `force_sensor`/`limit`: the force reading saturates at ± this (N), after gain and
     /// offset, before noise and quantisation; 0 = none.
     pub force_sensor_saturation: f64,
+    /// `chambers`/`parameter_offset`: the logged stopper position is this much (m) beyond the
+    /// true one (a displacement transducer's zero, e.g. 1 mm); the plant moves with the true one.
+    pub stopper_position_offset: f64,
+    /// With `contact_stiffness`: the relaxation time (s) of the piston on its compliant mount
+    /// (mass and damping of the mount); 0 = the standard 0.5 ms.
+    pub contact_lag: f64,
+    /// `chambers`/`drift`: the gas temperature rises linearly by this (K) from the start to the
+    /// end of the recording (supply air warming up); the chamber walls follow it.
+    pub gas_temperature_drift: f64,
 }
 
 impl Default for BenchEffects {

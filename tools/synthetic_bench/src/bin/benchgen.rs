@@ -148,6 +148,16 @@ struct Cli {
     /// The force reading saturates at ± this, N (e.g. 85).
     #[arg(long)]
     force_sensor_saturation: Option<f64>,
+    /// The logged stopper position is this far beyond the true one, m (e.g. 1e-3).
+    #[arg(long, allow_hyphen_values = true)]
+    stopper_position_offset: Option<f64>,
+    /// With --contact-stiffness: the relaxation time of the piston on its compliant mount, s
+    /// (0.5 ms unless given; e.g. 1e-3).
+    #[arg(long)]
+    contact_lag: Option<f64>,
+    /// The gas temperature rises linearly by this over the recording, K (e.g. 20).
+    #[arg(long, allow_hyphen_values = true)]
+    gas_temperature_drift: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -205,6 +215,9 @@ fn main() -> ExitCode {
     );
     set(&mut und.command_dead_zone, cli.command_dead_zone);
     set(&mut und.force_sensor_saturation, cli.force_sensor_saturation);
+    set(&mut und.stopper_position_offset, cli.stopper_position_offset);
+    set(&mut und.contact_lag, cli.contact_lag);
+    set(&mut und.gas_temperature_drift, cli.gas_temperature_drift);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -222,6 +235,7 @@ fn main() -> ExitCode {
         und.force_sensor_pickup_frequency,
         und.command_dead_zone,
         und.force_sensor_saturation,
+        und.contact_lag,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -232,15 +246,19 @@ fn main() -> ExitCode {
             und.return_back_pressure,
             und.receiver_offset,
             und.force_sensor_pickup_amplitude,
+            und.stopper_position_offset,
+            und.gas_temperature_drift,
         ]
         .iter()
         .all(|x| x.is_finite());
+    let und_bad = und_bad || und.stopper_position_offset.abs() > 5e-3 || und.gas_temperature_drift.abs() > 100.0;
     let und_bad = und_bad || und.jet_pipe_curve_blend > 1.0 || und.return_area_reduction > 1.0;
     if und_bad {
         eprintln!(
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
              friction, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
-             blend and return area reduction in 0..1"
+             blend and return area reduction in 0..1; stopper position offset within ±5 mm, gas \
+             temperature drift within ±100 K"
         );
         return ExitCode::from(2);
     }
