@@ -3,7 +3,8 @@
 //! * `shared`: the project's shared bench recordings (`../shared/bench/`);
 //! * `synthetic`: the synthetic bench's recordings of the named effects;
 //! * `undeclared`: the synthetic bench's undeclared mechanisms;
-//! * `protocols`: the general discovery pieces on recordings under other protocols.
+//! * `protocols`: the general discovery pieces on recordings under other protocols;
+//! * `search`: compounds and mechanisms that a search locking in on its first choice missed.
 //!
 //! Why one binary and not three: cargo runs test binaries one after another and each
 //! harness runs its tests two at a time, so a binary's last, long test left a core idle
@@ -11,6 +12,7 @@
 //! diagnoses whenever one ends, and both cores stay busy until the last few.
 
 mod protocols;
+mod search;
 mod shared;
 mod synthetic;
 mod undeclared;
