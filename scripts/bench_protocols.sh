@@ -35,7 +35,14 @@ mechanisms=(
     "force_sensor_lag|force_sensor|dynamics|--undeclared force_sensor_lag"
     "command_dead_zone|command|nonlinearity|--command-dead-zone 0.4"
     "force_sensor_saturation|force_sensor|limit|--force-sensor-saturation 85"
+    "stopper_offset_1mm|chambers|parameter_offset|--stopper-position-offset 1e-3"
+    "mount_lag_1ms|mechanics|compliance|--contact-stiffness 2e4 --contact-lag 1e-3"
+    "gas_drift_20k|chambers|drift|--gas-temperature-drift 20"
+    "receiver_and_supply|jet_pipe+supply|parameter_offset|--undeclared receiver_offset --supply-pressure 622925"
+    "receiver_and_pickup|jet_pipe+force_sensor|parameter_offset+periodic|--undeclared receiver_offset --force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
 )
+# A compound's truth lists its places (and families) joined by "+": it is at the right place
+# when every one of them was found, in any order.
 
 chosen() { # NAME LIST: whether NAME is in the space-separated LIST (or LIST is empty)
     [ -z "$2" ] && return 0
@@ -71,6 +78,11 @@ if "unexplained" in d and d["unexplained"].get("channel", "force") == "force":
 found = "; ".join(f"{a}, {b}" for a, b in places) or "nothing"
 if loc == "none":
     right = "yes" if not d["discovered"] and not d["effects"] else "no"
+elif "+" in loc:
+    locs = loc.split("+")
+    fams = fam.split("+") if "+" in fam else [fam] * len(locs)
+    truth = list(zip(locs, fams))
+    right = "yes" if all(t in places for t in truth) else ("place" if all(l in [p[0] for p in places] for l in locs) else "no")
 else:
     right = "yes" if places and places[0] == (loc, fam) else ("place" if places and places[0][0] == loc else "no")
 ratio = d["heldout"]["after_rms_N"] / d["noise_floor_N"]

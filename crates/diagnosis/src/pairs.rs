@@ -289,6 +289,33 @@ pub(crate) fn best_pair(
     if !better {
         return Ok(None);
     }
+    // Each member must earn its own penalty: the other alone (as fitted alone, replayed)
+    // leaves more than the pair by more than this member's parameters' penalty. Otherwise
+    // one term with a passenger would be added where the single term does.
+    for (this, other, other_set) in [(a, b, &set_b), (b, a, &set_a)] {
+        let Some(alone) = found.candidates.iter().find(|s| s.fit.candidate.label == other.label) else {
+            return Ok(None);
+        };
+        let Some(set) = discover::model_terms(other, &alone.fit.values, params, problem) else {
+            return Ok(None);
+        };
+        let mut single = params.clone();
+        if set.iter().any(|(n, v)| set_parameter(&mut single, n, *v).is_err()) || single.validate().is_err() {
+            return Ok(None);
+        }
+        let (misfit_alone, _) = alternatives::judge(cx, problem, &single, replays)?;
+        let own = (used - other_set.len() as f64).max(1.0);
+        progress(&format!(
+            "  the {} alone leaves {misfit_alone:.0}: the {} earns {:.0} against its penalty {:.0}",
+            other.label,
+            this.label,
+            misfit_alone - misfit,
+            own * penalty
+        ));
+        if misfit_alone - misfit <= own * penalty {
+            return Ok(None);
+        }
+    }
     progress(&format!(
         "adding the {} at the {} and the {} at the {} together",
         a.label, a.location, b.label, b.location

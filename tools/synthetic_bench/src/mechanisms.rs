@@ -104,6 +104,16 @@
 //!   through an orifice of that C_d·A (same compressible law, inflow to the chamber at T).
 //!   Force 2.2 N rms / 6.9 N max.
 //!
+//! Beyond the table (flags of `benchgen`, fields of [`UndeclaredEffects`], no standard size):
+//!
+//! * `stopper_position_offset` (`chambers`/`parameter_offset`): the logged stopper position is
+//!   x_s + d (before quantisation); the plant moves with x_s.
+//! * `contact_lag` (with `contact_stiffness`): τ_c of the compliant contact above instead of
+//!   0.5 ms (a compliant stopper mount with its own mass and damping).
+//! * `gas_temperature_drift` (`chambers`/`drift`, ΔT): the gas temperature T of (2.6), the
+//!   supply's, the inflows' and (with heat exchange) the walls', is T + ΔT t / t_end, rising
+//!   linearly over the recording; the chambers start at T.
+//!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 
 /// Effects beyond the thesis model. `Default` switches every effect off.
