@@ -25,6 +25,8 @@ protocols=(
     "sine_250_p|--protocol sine --sample-rate 250"
 )
 # name|truth location|truth family|benchgen effect options
+# A compound's truth lists its places (and families) joined by "+": it is at the right place
+# when every one of them was found, in any order.
 mechanisms=(
     "clean|none|none|"
     "pickup_50hz|force_sensor|periodic|--force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
@@ -39,6 +41,11 @@ mechanisms=(
     "p1_sensor_saturation|pressure_sensors|limit|--pressure-sensor-saturation 450000"
     "p2_sensor_quadratic|pressure_sensors|nonlinearity|--pressure-sensor-quadratic 5e-8"
     "force_sensor_offset_gain|force_sensor|parameter_offset|--force-sensor-offset 0.7 --force-sensor-gain 1.02"
+    "stopper_offset_1mm|chambers|parameter_offset|--stopper-position-offset 1e-3"
+    "mount_lag_1ms|mechanics|compliance|--contact-stiffness 2e4 --contact-lag 1e-3"
+    "gas_drift_20k|chambers|drift|--gas-temperature-drift 20"
+    "receiver_and_supply|jet_pipe+supply|parameter_offset|--undeclared receiver_offset --supply-pressure 622925"
+    "receiver_and_pickup|jet_pipe+force_sensor|parameter_offset+periodic|--undeclared receiver_offset --force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
 )
 # Extra forces on the piston, which show only while the stopper moves: their own protocols.
 balance_protocols=(
@@ -94,6 +101,11 @@ if "unexplained" in d and d["unexplained"].get("channel", "force") == "force":
 found = "; ".join(f"{a}, {b}" for a, b in places) or "nothing"
 if loc == "none":
     right = "yes" if not d["discovered"] and not d["effects"] else "no"
+elif "+" in loc:
+    locs = loc.split("+")
+    fams = fam.split("+") if "+" in fam else [fam] * len(locs)
+    truth = list(zip(locs, fams))
+    right = "yes" if all(t in places for t in truth) else ("place" if all(l in [p[0] for p in places] for l in locs) else "no")
 else:
     right = "yes" if places and places[0] == (loc, fam) else ("place" if places and places[0][0] == loc else "no")
 ratio = f'{d["heldout"]["after_rms_N"] / d["noise_floor_N"]:.2f}'

@@ -1,8 +1,9 @@
-//! A search that does not lock in: after a named effect has earned its name at a place, the
-//! simpler terms at that place are tried again in the replayed model, and one that does
-//! better on the held-out blocks (its parameters' penalty counted) replaces it. A
-//! supply pressure set 30 kPa low is explained by the line resistance of the named
-//! `supply_pressure_drop` to within 10 noise floors, and by a plain `P_s` to the noise.
+//! A search that does not lock in: after anything has been added at a place (a named
+//! effect or a discovered term), the other terms at that place with no more parameters are
+//! tried again in the replayed model, and the simplest that is adequate on the held-out
+//! blocks (its parameters' penalty counted) takes its place. A supply pressure set 30 kPa
+//! low is explained by the line resistance of the named `supply_pressure_drop` to within 10
+//! noise floors, and by a plain `P_s` to the noise.
 
 use super::*;
 
@@ -19,54 +20,74 @@ pub(crate) struct Check<'a> {
 impl Check<'_> {
     /// The model with `params` replayed: its held-out misfit (all channels, in noise floors
     /// squared) and its held-out force RMS error.
-    fn judge(&self, params: &Parameters, replays: &mut usize) -> Result<(f64, f64), String> {
-        let with = replay_fast(&Actuator::new(params.clone())?, self.cx.recording, self.cx.n)?;
-        *replays += 1;
-        let (_, heldout) = self
-            .problem
-            .errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
-        let force = rms_where(
-            &difference(&self.cx.recording.force, &with.force),
-            &self.cx.training,
-            false,
-        );
-        Ok((heldout.iter().sum(), force))
+    pub(crate) fn judge(&self, params: &Parameters, replays: &mut usize) -> Result<(f64, f64), String> {
+        judge(self.cx, self.problem, params, replays)
     }
 }
 
-/// The simplest term at the named effect's place that, replayed, leaves a held-out misfit
-/// plus its parameters' penalty below the named effect's: that term, as discovered, with
-/// the parameters that carry it. Only terms with no more parameters than the named effect
-/// are tried, best first, at most [`DISCOVERY_TRIALS`].
-pub(crate) fn simpler_than_named(
+/// The model with `params` replayed: its held-out misfit (all channels, in noise floors
+/// squared, weighted as `problem` weighs them) and its held-out force RMS error, N.
+pub(crate) fn judge(
+    cx: &Context,
+    problem: &Problem,
+    params: &Parameters,
+    replays: &mut usize,
+) -> Result<(f64, f64), String> {
+    let with = replay_fast(&Actuator::new(params.clone())?, cx.recording, cx.n)?;
+    *replays += 1;
+    let (_, heldout) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
+    let force = rms_where(&difference(&cx.recording.force, &with.force), &cx.training, false);
+    Ok((heldout.iter().sum(), force))
+}
+
+/// What was added at a place, as the alternatives are judged against it.
+pub(crate) struct Added<'a> {
+    /// Its fitted candidate.
+    pub scored: &'a Scored,
+    /// The model with it.
+    pub with: &'a Parameters,
+    /// A named effect (its alternatives may have as many parameters as it) or a discovered
+    /// term (one with as many must do strictly better).
+    pub named: bool,
+}
+
+/// The simplest other term at the place of what was added that, replayed, leaves a
+/// held-out misfit plus its parameters' penalty no larger than the addition's, and a
+/// held-out force error no larger (within a twentieth of the noise floor when it has fewer
+/// parameters): that term, as discovered, with the parameters that carry it. The candidates
+/// with no more parameters than the addition are tried, best first by their penalised
+/// held-out misfit, at most [`DISCOVERY_TRIALS`]; among those adequate, the fewest
+/// parameters win, then the smaller penalised misfit.
+pub(crate) fn simpler_at_place(
     check: &Check,
     found: &Localization,
     params: &Parameters,
-    named: &Scored,
+    added: &Added,
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Option<(DiscoveredTerm, Parameters)>, String> {
-    let place = named.fit.candidate.location;
+    let scored = added.scored;
+    let place = scored.fit.candidate.location;
     let count = check.count;
     let penalty = discovery_penalty_per_term(count);
-    let named_terms = used_terms(named);
+    let added_terms = used_terms(scored);
     let mut alternatives: Vec<&Scored> = found
         .candidates
         .iter()
         .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
-        .filter(|s| s.explained >= LOCATED_SHARE && used_terms(s) <= named_terms)
+        .filter(|s| s.fit.candidate.label != scored.fit.candidate.label)
+        .filter(|s| s.explained >= LOCATED_SHARE && used_terms(s) <= added_terms && used_terms(s) > 0.0)
         .collect();
     if alternatives.is_empty() {
         return Ok(None);
     }
     alternatives.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
-    let name = named.fit.candidate.named.expect("a named candidate");
-    let mut with_named = params.clone();
-    if apply_named(&mut with_named, named).is_err() {
-        return Ok(None);
-    }
-    let (named_misfit, named_force) = check.judge(&with_named, replays)?;
-    let named_score = named_misfit + named_terms * penalty;
+    let name = scored.fit.candidate.named.unwrap_or(scored.fit.candidate.label);
+    let (added_misfit, added_force) = check.judge(added.with, replays)?;
+    let added_score = added_misfit + added_terms * penalty;
+    let noise = check.cx.noise;
+    // (terms, score, term, parameters) of each adequate alternative.
+    let mut adequate: Vec<(f64, f64, DiscoveredTerm, Parameters)> = vec![];
     for s in alternatives.into_iter().take(DISCOVERY_TRIALS) {
         let candidate = &s.fit.candidate;
         let Some(set) = discover::model_terms(candidate, &s.fit.values, params, check.problem) else {
@@ -77,30 +98,44 @@ pub(crate) fn simpler_than_named(
             continue;
         }
         let (misfit, force) = check.judge(&trial, replays)?;
-        let score = misfit + used_terms(s) * penalty;
+        let terms = used_terms(s);
+        let score = misfit + terms * penalty;
         progress(&format!(
-            "  instead of {name}: {} leaves {misfit:.0} held out against its {named_misfit:.0} (noise floors squared), force {force:.4} against {named_force:.4} N",
+            "  instead of {name}: {} leaves {misfit:.0} held out against its {added_misfit:.0} (noise floors squared), force {force:.4} against {added_force:.4} N",
             candidate.label
         ));
-        if score < named_score && force <= named_force {
-            progress(&format!(
-                "adding a {} at the {} instead of {name}",
-                candidate.label, place
-            ));
-            let before = check.force_before;
-            let term = DiscoveredTerm {
-                location: place,
-                family: crate::curves::family(candidate.family, &set),
-                candidate: candidate.label,
-                reading: discover::reading(candidate.label, place, candidate.family, &set, params),
-                parameters: set,
-                heldout_before: before,
-                heldout_after: force,
-                share: 1.0 - (force / before).powi(2),
-                pressures_heldout: None,
-            };
-            return Ok(Some((term, trial)));
+        let simpler = terms < added_terms;
+        let ok = if simpler {
+            score <= added_score && force <= added_force + 0.05 * noise
+        } else {
+            (added.named && score < added_score && force <= added_force)
+                || (!added.named && score < added_score - penalty && force <= added_force)
+        };
+        if !ok {
+            continue;
         }
+        let before = check.force_before;
+        let term = DiscoveredTerm {
+            location: place,
+            family: crate::curves::family(candidate.family, &set),
+            candidate: candidate.label,
+            reading: discover::reading(candidate.label, place, candidate.family, &set, params),
+            parameters: set,
+            heldout_before: before,
+            heldout_after: force,
+            share: 1.0 - (force / before).powi(2),
+            pressures_heldout: None,
+        };
+        adequate.push((terms, score, term, trial));
     }
-    Ok(None)
+    let best = adequate
+        .into_iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    Ok(best.map(|(_, _, term, trial)| {
+        progress(&format!(
+            "adding a {} at the {} instead of {name}",
+            term.candidate, place
+        ));
+        (term, trial)
+    }))
 }

@@ -24,10 +24,12 @@ pub mod checks;
 pub mod corrections;
 pub mod curves;
 mod discover;
+mod eliminate;
 pub mod lines;
 mod localize;
 mod named;
 pub mod noise;
+mod pairs;
 pub mod recording;
 pub mod replay;
 mod report;
@@ -712,6 +714,7 @@ pub(crate) fn refit_jointly(
 /// their refitted values.
 fn retire_switched_off(found: &mut rounds::Findings, progress: &mut dyn FnMut(&str)) {
     let params = &mut found.params;
+    let count = found.effects.len();
     found.effects.retain(|e| {
         let off = match e.name {
             "piston_friction" => params.friction_coulomb == 0.0,
@@ -725,6 +728,9 @@ fn retire_switched_off(found: &mut rounds::Findings, progress: &mut dyn FnMut(&s
         }
         !off
     });
+    if found.effects.len() != count && matches!(found.newest, Some((true, _))) {
+        found.newest = None;
+    }
     if params.friction_coulomb == 0.0 {
         params.friction_velocity = 0.0;
     }

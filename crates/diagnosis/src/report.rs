@@ -64,8 +64,8 @@ impl Diagnosis {
         for d in &self.discovered {
             lines.push(match d.pressures_heldout {
                 Some((before, after)) => format!(
-                    "+ discovered: {} It lowers the held-out pressure errors from {:.0} and {:.0} Pa to {:.0} and {:.0} Pa in the model; the force error stays at {:.4} N.",
-                    d.reading, before[0], before[1], after[0], after[1], d.heldout_after
+                    "+ discovered: {} It lowers the held-out pressure errors from {:.0} and {:.0} Pa to {:.0} and {:.0} Pa in the model; the held-out force error is {:.4} N before and {:.4} N after.",
+                    d.reading, before[0], before[1], after[0], after[1], d.heldout_before, d.heldout_after
                 ),
                 None => format!(
                     "+ discovered: {} It lowers the held-out force error from {:.4} N to {:.4} N in the model ({:.1} % of its mean square).",

@@ -15,6 +15,10 @@ pub(crate) struct Findings {
     pub localization: Option<Localization>,
     /// The held-out force error before and after the last joint refit that was kept.
     pub joint_refit: Option<(f64, f64)>,
+    /// The parameters before the rounds, to which a removed addition's go back.
+    pub start: Parameters,
+    /// The latest addition: a named effect (`true`) or a discovered term, by index.
+    pub newest: Option<(bool, usize)>,
 }
 
 /// One round's replay of the current model and how far it is from the recording.
@@ -33,8 +37,10 @@ struct Round {
 enum Addition {
     /// A named effect with its signature's sentence.
     Named(Scored, String),
-    /// A discovered term with the parameters that carry it.
-    Discovered(DiscoveredTerm, Box<Parameters>),
+    /// A discovered term with the parameters that carry it, and its fitted candidate.
+    Discovered(DiscoveredTerm, Box<Parameters>, Option<Box<Scored>>),
+    /// Two discovered terms at two places, fitted together (`pairs.rs`).
+    Pair(Vec<DiscoveredTerm>, Box<Parameters>),
 }
 
 pub(crate) fn run_rounds(
@@ -44,6 +50,8 @@ pub(crate) fn run_rounds(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Findings, String> {
     let mut f = Findings {
+        start: params.clone(),
+        newest: None,
         params,
         effects: vec![],
         discovered: vec![],
@@ -85,27 +93,56 @@ pub(crate) fn run_rounds(
         } else {
             None
         };
-        // A named effect is a hypothesis, not a lock: a simpler term at its place that does
+        // What was added is a hypothesis, not a lock: a simpler term at its place that does
         // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
         // not a line resistance).
+        let check = alternatives::Check {
+            cx,
+            problem: &problem,
+            count: r.count,
+            force_before: r.force_before,
+        };
         let added = match added {
             Some(Addition::Named(s, sentence)) => {
-                let check = alternatives::Check {
-                    cx,
-                    problem: &problem,
-                    count: r.count,
-                    force_before: r.force_before,
+                let mut with = f.params.clone();
+                let simpler = if apply_named(&mut with, &s).is_ok() {
+                    let a = alternatives::Added {
+                        scored: &s,
+                        with: &with,
+                        named: true,
+                    };
+                    alternatives::simpler_at_place(&check, &found, &f.params, &a, replays, progress)?
+                } else {
+                    None
                 };
-                match alternatives::simpler_than_named(&check, &found, &f.params, &s, replays, progress)? {
-                    Some((term, trial)) => Some(Addition::Discovered(term, Box::new(trial))),
+                match simpler {
+                    Some((term, trial)) => Some(Addition::Discovered(term, Box::new(trial), None)),
                     None => Some(Addition::Named(s, sentence)),
+                }
+            }
+            Some(Addition::Discovered(term, trial, Some(s))) => {
+                let a = alternatives::Added {
+                    scored: &s,
+                    with: &trial,
+                    named: false,
+                };
+                match alternatives::simpler_at_place(&check, &found, &f.params, &a, replays, progress)? {
+                    Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
+                    None => Some(Addition::Discovered(term, trial, Some(s))),
                 }
             }
             other => other,
         };
         match added {
-            Some(Addition::Discovered(term, trial)) => {
+            Some(Addition::Discovered(term, trial, _)) => {
                 f.discovered.push(term);
+                f.newest = Some((false, f.discovered.len() - 1));
+                f.params = *trial;
+                reusable = None;
+            }
+            Some(Addition::Pair(terms, trial)) => {
+                f.discovered.extend(terms);
+                f.newest = Some((false, f.discovered.len() - 1));
                 f.params = *trial;
                 reusable = None;
             }
@@ -115,6 +152,7 @@ pub(crate) fn run_rounds(
                 }
                 let effect = add_effect(cx, &mut f.params, &r, &found, s, sentence, progress)?;
                 f.effects.push(effect);
+                f.newest = Some((true, f.effects.len() - 1));
             }
             None => {
                 f.localization = Some(found);
@@ -130,7 +168,15 @@ pub(crate) fn run_rounds(
             f.joint_refit = Some(refit);
             reusable = None;
         }
+        // What a later addition has made redundant goes (`eliminate.rs`).
+        if crate::eliminate::drop_redundant(cx, &mut f, replays, progress)? {
+            reusable = None;
+            if let Some(refit) = crate::refit_jointly(cx, &mut f, replays, progress)? {
+                f.joint_refit = Some(refit);
+            }
+        }
     }
+    crate::eliminate::attribute_from_joint_fit(cx, &mut f, replays, progress)?;
     Ok(f)
 }
 
@@ -267,9 +313,22 @@ fn find_addition(
             return Ok(Some(Addition::Named(s, sentence)));
         }
     }
+    if let Some((terms, trial)) = crate::pairs::best_pair(
+        cx,
+        problem,
+        found,
+        &f.params,
+        &r.current,
+        &r.heldout,
+        r.force_before,
+        replays,
+        progress,
+    )? {
+        return Ok(Some(Addition::Pair(terms, Box::new(trial))));
+    }
     if place != "unknown" {
-        if let Some((term, trial)) = discover_term(cx, r, problem, found, &f.params, replays, progress)? {
-            return Ok(Some(Addition::Discovered(term, Box::new(trial))));
+        if let Some((term, trial, s)) = discover_term(cx, r, problem, found, &f.params, replays, progress)? {
+            return Ok(Some(Addition::Discovered(term, Box::new(trial), Some(Box::new(s)))));
         }
     }
     Ok(None)
@@ -413,7 +472,7 @@ fn discover_term(
     params: &Parameters,
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
-) -> Result<Option<(DiscoveredTerm, Parameters)>, String> {
+) -> Result<Option<(DiscoveredTerm, Parameters, Scored)>, String> {
     let (recording, count, force_before, noise) = (cx.recording, r.count, r.force_before, cx.noise);
     let mut at_place: Vec<&Scored> = found
         .candidates
@@ -454,12 +513,17 @@ fn discover_term(
         progress(&format!(
             "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
         ));
-        let pressures = if s.fit.candidate.location == "pressure_sensors" {
+        let force_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
+        // A term on the pressure transducers is judged on the pressures; so is one upstream
+        // of the piston whose departure shows in the pressures more than in the force (a
+        // stopper position 1 mm off leaves 2 noise floors in the force, 9 in the pressures).
+        let pressures = if s.fit.candidate.location == "pressure_sensors" || (!force_ok && cx.pressure_noise.is_some())
+        {
             pressures_judgement(cx, r, problem, &with, after, progress, label)
         } else {
             None
         };
-        if pressures.is_some() || (gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise) {
+        if pressures.is_some() || force_ok {
             let candidate = &s.fit.candidate;
             progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
             let term = DiscoveredTerm {
@@ -473,7 +537,7 @@ fn discover_term(
                 share: 1.0 - (after / force_before).powi(2),
                 pressures_heldout: pressures,
             };
-            return Ok(Some((term, trial)));
+            return Ok(Some((term, trial, s.clone())));
         }
     }
     Ok(None)

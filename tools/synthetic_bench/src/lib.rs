@@ -197,6 +197,10 @@ pub fn run(
         }
     };
 
+    // gas temperature: the thesis constant unless it drifts over the recording
+    let recording_span = (n_samples as f64 * sample).max(sample);
+    let tgas_at = |t: f64| params.temperature + und.gas_temperature_drift * (t / recording_span).clamp(0.0, 1.0);
+
     // initial state at the first command: static jet pipe, pressures at mid values
     let mut y: State = [0.0; NS];
     let i0 = params.k_cd * m.driver_input(cmds[0]) + params.i_offset;
@@ -238,24 +242,24 @@ pub fn run(
         // inputs evaluated inside the step (left/right limits at its ends)
         let inp = |t: f64| {
             let te = t.clamp(t_lo + eps, t_hi - eps);
-            (cmd_at(cmds, te), stop_at(te), stopv_at(te), psrc_at(te))
+            (cmd_at(cmds, te), stop_at(te), stopv_at(te), psrc_at(te), tgas_at(te))
         };
-        let (v, xs, xd, ps) = inp(t_lo);
-        m.rhs(y, v, xs, xd, ps, &mut k1);
-        let (v, xs, xd, ps) = inp(t_lo + 0.5 * H);
+        let (v, xs, xd, ps, tg) = inp(t_lo);
+        m.rhs(y, v, xs, xd, ps, tg, &mut k1);
+        let (v, xs, xd, ps, tg) = inp(t_lo + 0.5 * H);
         for j in 0..NS {
             tmp[j] = y[j] + 0.5 * H * k1[j];
         }
-        m.rhs(&tmp, v, xs, xd, ps, &mut k2);
+        m.rhs(&tmp, v, xs, xd, ps, tg, &mut k2);
         for j in 0..NS {
             tmp[j] = y[j] + 0.5 * H * k2[j];
         }
-        m.rhs(&tmp, v, xs, xd, ps, &mut k3);
-        let (v, xs, xd, ps) = inp(t_hi);
+        m.rhs(&tmp, v, xs, xd, ps, tg, &mut k3);
+        let (v, xs, xd, ps, tg) = inp(t_hi);
         for j in 0..NS {
             tmp[j] = y[j] + H * k3[j];
         }
-        m.rhs(&tmp, v, xs, xd, ps, &mut k4);
+        m.rhs(&tmp, v, xs, xd, ps, tg, &mut k4);
         for j in 0..NS {
             y[j] += H / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
         }
@@ -317,9 +321,9 @@ pub fn run(
             p1 += opts.pressure_noise * r.normal();
             p2 += opts.pressure_noise * r.normal();
         }
-        let mut row = [t, 0.0, xs, f, p1, p2];
+        let mut row = [t, 0.0, xs + und.stopper_position_offset, f, p1, p2];
         if opts.quantise {
-            row[2] = quantise_stopper(xs);
+            row[2] = quantise_stopper(row[2]);
             row[3] = quantise_force(f);
             row[4] = quantise_pressure(p1);
             row[5] = quantise_pressure(p2);

@@ -104,6 +104,16 @@
 //!   through an orifice of that C_d·A (same compressible law, inflow to the chamber at T).
 //!   Force 2.2 N rms / 6.9 N max.
 //!
+//! Beyond the table (flags of `benchgen`, fields of [`UndeclaredEffects`], no standard size):
+//!
+//! * `stopper_position_offset` (`chambers`/`parameter_offset`): the logged stopper position is
+//!   x_s + d (before quantisation); the plant moves with x_s.
+//! * `contact_lag` (with `contact_stiffness`): τ_c of the compliant contact above instead of
+//!   0.5 ms (a compliant stopper mount with its own mass and damping).
+//! * `gas_temperature_drift` (`chambers`/`drift`, ΔT): the gas temperature T of (2.6), the
+//!   supply's, the inflows' and (with heat exchange) the walls', is T + ΔT t / t_end, rising
+//!   linearly over the recording; the chambers start at T.
+//!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 
 /// Effects beyond the thesis model. `Default` switches every effect off.
@@ -209,6 +219,15 @@ pub struct UndeclaredEffects {
     /// `pressure_sensors`/`nonlinearity`: the chamber 2 transducer reads
     /// P2 + q (P2 − 101 325 Pa)² with q this (1/Pa), before noise and quantisation; 0 = none.
     pub pressure_sensor_quadratic_2: f64,
+    /// `chambers`/`parameter_offset`: the logged stopper position is this much (m) beyond the
+    /// true one (a displacement transducer's zero, e.g. 1 mm); the plant moves with the true one.
+    pub stopper_position_offset: f64,
+    /// With `contact_stiffness`: the relaxation time (s) of the piston on its compliant mount
+    /// (mass and damping of the mount); 0 = the standard 0.5 ms.
+    pub contact_lag: f64,
+    /// `chambers`/`drift`: the gas temperature rises linearly by this (K) from the start to the
+    /// end of the recording (supply air warming up); the chamber walls follow it.
+    pub gas_temperature_drift: f64,
 }
 
 impl Default for BenchEffects {

@@ -371,9 +371,11 @@ impl Model {
     /// Time derivatives.
     /// `p_src` is the supply pressure at the source (the thesis constant unless an undeclared
     /// supply drift or ripple is on).
-    pub(crate) fn rhs(&self, y: &State, v_cmd: f64, xs: f64, xs_dot: f64, p_src: f64, dy: &mut State) {
+    /// `t_gas` is the gas temperature (the thesis constant unless an undeclared drift is on).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn rhs(&self, y: &State, v_cmd: f64, xs: f64, xs_dot: f64, p_src: f64, t_gas: f64, dy: &mut State) {
         let p = &self.p;
-        let t0 = p.temperature;
+        let t0 = t_gas;
         let rt = p.r_gas * t0;
         // current driver (2.1)–(2.3)
         let i = y[S_I];
@@ -494,7 +496,12 @@ impl Model {
         // stopper, δ relaxing to F/k
         let (x_pist, x_pist_dot) = if self.contact {
             let f = self.force(y, xs, xs_dot);
-            let dd = (f / self.e.undeclared.contact_stiffness - y[S_DEL]) / TAU_CONTACT;
+            let tau = if self.e.undeclared.contact_lag > 0.0 {
+                self.e.undeclared.contact_lag
+            } else {
+                TAU_CONTACT
+            };
+            let dd = (f / self.e.undeclared.contact_stiffness - y[S_DEL]) / tau;
             dy[S_DEL] = dd;
             (xs + y[S_DEL], xs_dot + dd)
         } else {

@@ -301,3 +301,90 @@ fn the_force_tracking_controller_brings_the_logged_force_to_each_reference() {
     assert!(commands.iter().all(|v| v.abs() <= 10.0));
     assert!(commands.windows(2).filter(|w| w[0] != w[1]).count() > 1000);
 }
+
+fn with_undeclared(undeclared: synthetic_bench::UndeclaredEffects) -> BenchEffects {
+    BenchEffects {
+        undeclared,
+        ..BenchEffects::default()
+    }
+}
+
+#[test]
+fn a_stopper_position_offset_moves_the_logged_position_alone() {
+    let spec = ProtocolSpec {
+        duration: 20.0,
+        sample_rate: 500.0,
+        ..ProtocolSpec::default()
+    };
+    let clean = generate_protocol(&spec, &BenchEffects::default()).unwrap();
+    let offset = generate_protocol(
+        &spec,
+        &with_undeclared(synthetic_bench::UndeclaredEffects {
+            stopper_position_offset: 1e-3,
+            ..Default::default()
+        }),
+    )
+    .unwrap();
+    for (a, b) in clean.rows.iter().zip(&offset.rows) {
+        // The logged position is rounded to 1 µm.
+        assert!((b[2] - a[2] - 1e-3).abs() < 1.5e-6, "{} against {}", b[2], a[2]);
+        assert_eq!((a[0], a[1], a[3], a[4], a[5]), (b[0], b[1], b[3], b[4], b[5]));
+    }
+}
+
+#[test]
+fn a_warming_gas_moves_the_pressures_late_in_the_recording_more_than_at_its_start() {
+    let spec = ProtocolSpec {
+        duration: 20.0,
+        sample_rate: 500.0,
+        ..ProtocolSpec::default()
+    };
+    let clean = generate_protocol(&spec, &BenchEffects::default()).unwrap();
+    let warming = generate_protocol(
+        &spec,
+        &with_undeclared(synthetic_bench::UndeclaredEffects {
+            gas_temperature_drift: 20.0,
+            ..Default::default()
+        }),
+    )
+    .unwrap();
+    let rms_gap = |from: usize, to: usize| {
+        let rows = clean.rows[from..to].iter().zip(&warming.rows[from..to]);
+        (rows.map(|(a, b)| (a[4] - b[4]).powi(2)).sum::<f64>() / (to - from) as f64).sqrt()
+    };
+    let n = clean.rows.len();
+    let (early, late) = (rms_gap(0, n / 10), rms_gap(n - n / 10, n));
+    assert!(
+        late > 3.0 * early && late > 100.0,
+        "p1 apart by {early} Pa early, {late} Pa late"
+    );
+}
+
+#[test]
+fn a_slower_stopper_mount_changes_the_logged_force_of_a_moving_stopper() {
+    let spec = ProtocolSpec {
+        duration: 20.0,
+        sample_rate: 500.0,
+        stopper: StopperMotion::Moves { speed: 0.02 },
+        ..ProtocolSpec::default()
+    };
+    let mount = |lag: f64| {
+        generate_protocol(
+            &spec,
+            &with_undeclared(synthetic_bench::UndeclaredEffects {
+                contact_stiffness: 2e4,
+                contact_lag: lag,
+                ..Default::default()
+            }),
+        )
+        .unwrap()
+    };
+    let (standard, slow) = (mount(0.0), mount(2e-3));
+    let gap: Vec<f64> = standard
+        .rows
+        .iter()
+        .zip(&slow.rows)
+        .map(|(a, b)| (a[3] - b[3]).abs())
+        .collect();
+    assert!(gap.iter().cloned().fold(0.0, f64::max) > 0.1, "the lag changes nothing");
+}

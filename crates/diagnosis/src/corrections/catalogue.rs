@@ -421,6 +421,34 @@ pub fn catalogue(
                 offset("C_db_A_lpp", "m2", 2e-9, 0.0, 1e-6),
             ],
         ),
+        // The chamber volumes are those of the stopper position the model sees: a logged
+        // position off by a constant (a transducer's zero) moves both volumes by A_p times
+        // it, which is the support length L_sup changed by as much (§2.6, (2.31)–(2.32)).
+        c(
+            "stopper position offset",
+            "chambers",
+            "parameter_offset",
+            None,
+            vec![offset(
+                "L_sup",
+                "m",
+                1e-5,
+                (base.l_sup - 5e-3).max(0.0),
+                base.l_sup + 5e-3,
+            )],
+        ),
+        // The gas temperature of (2.6), a constant of the model, drifting over the recording
+        // (the supply air warming up): placed, not carried by the FMU.
+        c(
+            "gas temperature drift",
+            "chambers",
+            "drift",
+            None,
+            vec![
+                p("T", "K", 0.005, 200.0, 400.0),
+                modulated("T_drift", "K", "T", Modulation::Ramp, 1.0),
+            ],
+        ),
         c(
             "chamber leaks to the return",
             "chambers",

@@ -9,6 +9,66 @@ use super::*;
 /// it). The leaders' refinement and a discovered term's trial search to the finer bracket.
 const GOLDEN_STEPS: usize = 16;
 const COARSE_GOLDEN_STEPS: usize = 10;
+/// Points of the grid from which a golden-section search is started again when one of
+/// them does better than where the search over the whole range ended: the first pass's
+/// ranking and the shape searches, then the leaders' refinement.
+const COARSE_GRID: usize = 5;
+const FINE_GRID: usize = 9;
+
+/// Golden-section search of `steps` steps on [a, b]: the best point and its cost.
+fn golden(a: f64, b: f64, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
+    let phi = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (a, b);
+    let mut c = b - phi * (b - a);
+    let mut d = a + phi * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..steps {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - phi * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + phi * (b - a);
+            fd = f(d);
+        }
+    }
+    if fc < fd {
+        (c, fc)
+    } else {
+        (d, fd)
+    }
+}
+
+/// A golden-section search of a cost on u ∈ [0, 1] that may have more than one valley,
+/// started from several points: the search over the whole range, and the cost on a grid of
+/// `grid` points (the ends included); when a grid point does better than where the search
+/// ended (it followed another valley), the search again between that point's neighbours.
+/// The best u found and its cost: never worse than the single search.
+pub(crate) fn golden_from_several(grid: usize, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
+    let (mut best_u, mut best) = golden(0.0, 1.0, steps, f);
+    if grid >= 3 {
+        let h = 1.0 / (grid - 1) as f64;
+        let mut start = (best_u, best);
+        for i in 0..grid {
+            let u = i as f64 * h;
+            let cost = f(u);
+            if cost < start.1 {
+                start = (u, cost);
+            }
+        }
+        if start.1 < best {
+            let u0 = start.0;
+            let (u, cost) = golden((u0 - h).max(0.0), (u0 + h).min(1.0), steps, f);
+            (best_u, best) = if cost < start.1 { (u, cost) } else { start };
+        }
+    }
+    (best_u, best)
+}
 
 /// The fixed part of a fitting problem: the recording, the base model, the blocks and
 /// the channels' weights.
@@ -511,33 +571,9 @@ impl Problem<'_> {
         let none = |_: &'static str| None;
         let fit_at = |vc: f64, vs: f64| self.fit(&shaped(vc, vs), 1, base_replay, &none).ok();
         let cost = |fit: &Option<Fit>| fit.as_ref().map_or(f64::INFINITY, |f| f.train_total());
-        // The best u in [0, 1] of a unimodal cost, and its cost.
+        // The best u in [0, 1] of the cost, and its cost.
         let golden = |iterations: usize, f: &dyn Fn(f64) -> f64| -> (f64, f64) {
-            let phi = (5f64.sqrt() - 1.0) / 2.0;
-            let (mut a, mut b) = (0.0, 1.0);
-            let mut c = b - phi * (b - a);
-            let mut d = a + phi * (b - a);
-            let (mut fc, mut fd) = (f(c), f(d));
-            for _ in 0..iterations {
-                if fc < fd {
-                    b = d;
-                    d = c;
-                    fd = fc;
-                    c = b - phi * (b - a);
-                    fc = f(c);
-                } else {
-                    a = c;
-                    c = d;
-                    fc = fd;
-                    d = a + phi * (b - a);
-                    fd = f(d);
-                }
-            }
-            if fc < fd {
-                (c, fc)
-            } else {
-                (d, fd)
-            }
+            golden_from_several(COARSE_GRID, iterations, &mut |u| f(u))
         };
         let inner = |vs: f64| golden(14, &|u| cost(&fit_at(value_of(0, u), vs)));
         let (vc, vs) = if shapes.len() >= 2 {
@@ -671,27 +707,13 @@ impl Problem<'_> {
                 lower + (upper - lower) * u
             }
         };
-        let phi = (5f64.sqrt() - 1.0) / 2.0;
-        let (mut a, mut b) = (0.0, 1.0);
-        let mut c = b - phi * (b - a);
-        let mut d = a + phi * (b - a);
-        let (mut fc, mut fd) = (evaluate(to_value(c)).0, evaluate(to_value(d)).0);
-        for _ in 0..golden_steps {
-            if fc < fd {
-                b = d;
-                d = c;
-                fd = fc;
-                c = b - phi * (b - a);
-                fc = evaluate(to_value(c)).0;
-            } else {
-                a = c;
-                c = d;
-                fc = fd;
-                d = a + phi * (b - a);
-                fd = evaluate(to_value(d)).0;
-            }
-        }
-        let best = to_value(if fc < fd { c } else { d });
+        let grid = if golden_steps >= GOLDEN_STEPS {
+            FINE_GRID
+        } else {
+            COARSE_GRID
+        };
+        let (u, _) = golden_from_several(grid, golden_steps, &mut |u| evaluate(to_value(u)).0);
+        let best = to_value(u);
         let (cost, prediction) = evaluate(best);
         let (values, prediction) = match prediction {
             Some(y) if cost < self.errors(&base).0.iter().sum::<f64>() => (vec![best], y),

@@ -5,7 +5,8 @@
 //! * `undeclared`: the synthetic bench's undeclared mechanisms;
 //! * `protocols`: the general discovery pieces on recordings under other protocols;
 //! * `balance`: an extra force in the piston's balance picked from a library of local signals;
-//! * `curves`: the static-curve class at the command and the transducers.
+//! * `curves`: the static-curve class at the command and the transducers;
+//! * `search`: compounds and mechanisms that a search locking in on its first choice missed.
 //!
 //! Why one binary and not three: cargo runs test binaries one after another and each
 //! harness runs its tests two at a time, so a binary's last, long test left a core idle
@@ -15,6 +16,7 @@
 mod balance;
 mod curves;
 mod protocols;
+mod search;
 mod shared;
 mod synthetic;
 mod undeclared;

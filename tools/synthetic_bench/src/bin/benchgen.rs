@@ -165,6 +165,16 @@ struct Cli {
     /// The chamber 2 transducer reads P2 + q (P2 − 101 325 Pa)²: q, 1/Pa (e.g. 2e-7).
     #[arg(long)]
     pressure_sensor_quadratic: Option<f64>,
+    /// The logged stopper position is this far beyond the true one, m (e.g. 1e-3).
+    #[arg(long, allow_hyphen_values = true)]
+    stopper_position_offset: Option<f64>,
+    /// With --contact-stiffness: the relaxation time of the piston on its compliant mount, s
+    /// (0.5 ms unless given; e.g. 1e-3).
+    #[arg(long)]
+    contact_lag: Option<f64>,
+    /// The gas temperature rises linearly by this over the recording, K (e.g. 20).
+    #[arg(long, allow_hyphen_values = true)]
+    gas_temperature_drift: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -227,6 +237,9 @@ fn main() -> ExitCode {
     set(&mut und.quadratic_damping, cli.quadratic_damping);
     set(&mut und.pressure_sensor_saturation_1, cli.pressure_sensor_saturation);
     set(&mut und.pressure_sensor_quadratic_2, cli.pressure_sensor_quadratic);
+    set(&mut und.stopper_position_offset, cli.stopper_position_offset);
+    set(&mut und.contact_lag, cli.contact_lag);
+    set(&mut und.gas_temperature_drift, cli.gas_temperature_drift);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -248,6 +261,7 @@ fn main() -> ExitCode {
         und.seal_pressure_friction,
         und.quadratic_damping,
         und.pressure_sensor_saturation_1,
+        und.contact_lag,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -259,15 +273,19 @@ fn main() -> ExitCode {
             und.receiver_offset,
             und.force_sensor_pickup_amplitude,
             und.pressure_sensor_quadratic_2,
+            und.stopper_position_offset,
+            und.gas_temperature_drift,
         ]
         .iter()
         .all(|x| x.is_finite());
+    let und_bad = und_bad || und.stopper_position_offset.abs() > 5e-3 || und.gas_temperature_drift.abs() > 100.0;
     let und_bad = und_bad || und.jet_pipe_curve_blend > 1.0 || und.return_area_reduction > 1.0;
     if und_bad {
         eprintln!(
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
              friction, moving mass, seal friction, damping, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
-             blend and return area reduction in 0..1"
+             blend and return area reduction in 0..1; stopper position offset within ±5 mm, gas \
+             temperature drift within ±100 K"
         );
         return ExitCode::from(2);
     }

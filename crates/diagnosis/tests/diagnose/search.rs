@@ -1,0 +1,249 @@
+//! A search that does not lock in (`alternatives.rs`, `pairs.rs`, `eliminate.rs`), on
+//! mechanisms the synthetic bench writes with its own integrator: a compound of two
+//! departures at two places, a stopper position logged 1 mm off, a compliant stopper mount
+//! with a 1 ms lag and a gas temperature drifting 20 K. Short recordings (20 s at 250 or
+//! 500 Hz), two protocols each, with and without pressures.
+
+use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_model::physics::parameters::Parameters;
+use synthetic_bench::{
+    generate_protocol_with, BenchEffects, BenchParams, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
+};
+
+use super::{names, value_reference};
+
+fn diagnosed(label: &str, spec: &ProtocolSpec, undeclared: UndeclaredEffects) -> Diagnosis {
+    diagnosed_with(label, &BenchParams::default(), spec, undeclared)
+}
+
+fn diagnosed_with(label: &str, plant: &BenchParams, spec: &ProtocolSpec, undeclared: UndeclaredEffects) -> Diagnosis {
+    let effects = BenchEffects {
+        undeclared,
+        ..BenchEffects::default()
+    };
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{label}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("recording.csv");
+    generate_protocol_with(plant, spec, &effects)
+        .unwrap()
+        .write_csv(&path)
+        .unwrap();
+    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let started = std::time::Instant::now();
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    println!(
+        "{label} ({}): {} in {:.1} s; {}",
+        spec.label(),
+        d.verdict(),
+        started.elapsed().as_secs_f64(),
+        d.summary().join(" | ")
+    );
+    d
+}
+
+fn spec(command: CommandProtocol, stopper: StopperMotion, sample_rate: f64, pressures: bool) -> ProtocolSpec {
+    ProtocolSpec {
+        command,
+        stopper,
+        sample_rate,
+        duration: 20.0,
+        pressures,
+        seed: 5,
+        ..ProtocolSpec::default()
+    }
+}
+
+fn moves() -> StopperMotion {
+    StopperMotion::Moves { speed: 0.02 }
+}
+
+fn fixed() -> StopperMotion {
+    StopperMotion::Fixed { position: 0.054 }
+}
+
+fn get(d: &Diagnosis, name: &str) -> f64 {
+    d.parameters.get(value_reference(name)).unwrap()
+}
+
+/// The receivers 0.1 mm off the jet pipe's null and a supply set 30 kPa low: found as both,
+/// each at its place, not as one term elsewhere that stands in for the two.
+fn compound_found(label: &str, spec: &ProtocolSpec) {
+    let truth = BenchParams::default().p_supply - 30e3;
+    let plant = BenchParams {
+        p_supply: truth,
+        ..BenchParams::default()
+    };
+    let d = diagnosed_with(
+        label,
+        &plant,
+        spec,
+        UndeclaredEffects {
+            receiver_offset: 1e-5,
+            ..UndeclaredEffects::default()
+        },
+    );
+    assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
+    let places: Vec<(&str, &str)> = d.discovered.iter().map(|t| (t.location, t.family)).collect();
+    assert!(
+        places.contains(&("supply", "parameter_offset")) && places.contains(&("jet_pipe", "parameter_offset")),
+        "{label}: {places:?}"
+    );
+    let supply = get(&d, "P_s");
+    assert!((supply - truth).abs() < 3e3, "{label}: P_s = {supply} against {truth}");
+    let null = get(&d, "x_jp_offset") - Parameters::default().x_jp_offset;
+    assert!((null - 1e-5).abs() < 0.2e-5, "{label}: x_jp_offset moved by {null}");
+    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
+}
+
+#[test]
+fn a_supply_set_low_with_the_receivers_off_the_null_is_found_as_both_under_ramps_at_500_hz_without_pressures() {
+    compound_found("compound-ramps", &spec(CommandProtocol::Ramps, moves(), 500.0, false));
+}
+
+#[test]
+#[ignore = "the slowest of the compound's cases (65 s wall under load); scripts/bench_protocols.sh runs the compound under every protocol"]
+fn a_supply_set_low_with_the_receivers_off_the_null_is_found_as_both_under_a_staircase_at_250_hz_with_pressures() {
+    compound_found(
+        "compound-staircase",
+        &spec(CommandProtocol::Staircase, fixed(), 250.0, true),
+    );
+}
+
+/// The logged stopper position 1 mm beyond the true one: at the chambers, as the support
+/// length L_sup 1 mm longer (within 20 %), the force explained.
+fn stopper_offset_found(label: &str, spec: &ProtocolSpec) {
+    let d = diagnosed(
+        label,
+        spec,
+        UndeclaredEffects {
+            stopper_position_offset: 1e-3,
+            ..UndeclaredEffects::default()
+        },
+    );
+    assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
+    let first = d
+        .discovered
+        .first()
+        .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
+    assert_eq!(
+        (first.location, first.family),
+        ("chambers", "parameter_offset"),
+        "{}",
+        first.reading
+    );
+    let shift = get(&d, "L_sup") - Parameters::default().l_sup;
+    assert!((shift - 1e-3).abs() < 0.2e-3, "{label}: L_sup moved by {shift} m");
+    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
+}
+
+#[test]
+fn a_stopper_position_logged_one_millimetre_off_is_placed_at_the_chambers_under_a_staircase_at_500_hz_with_pressures() {
+    stopper_offset_found(
+        "stopper-offset-staircase",
+        &spec(CommandProtocol::Staircase, fixed(), 500.0, true),
+    );
+}
+
+#[test]
+fn a_stopper_position_logged_one_millimetre_off_is_placed_at_the_chambers_under_ramps_at_250_hz_without_pressures() {
+    stopper_offset_found(
+        "stopper-offset-ramps",
+        &spec(CommandProtocol::Ramps, moves(), 250.0, false),
+    );
+}
+
+/// A compliant stopper mount (2e4 N/m) with a 1 ms lag: at the mechanics as a compliance,
+/// the compliance within 30 % of 1/k, most of the force error gone. The model has no lag of
+/// the mount, so what the lag leaves may stay.
+fn compliant_mount_found(label: &str, spec: &ProtocolSpec) {
+    let d = diagnosed(
+        label,
+        spec,
+        UndeclaredEffects {
+            contact_stiffness: 2e4,
+            contact_lag: 1e-3,
+            ..UndeclaredEffects::default()
+        },
+    );
+    assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
+    let first = d
+        .discovered
+        .first()
+        .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
+    assert_eq!(
+        (first.location, first.family),
+        ("mechanics", "compliance"),
+        "{}",
+        first.reading
+    );
+    let compliance = get(&d, "stopper_compliance");
+    assert!(
+        (compliance - 5e-5).abs() < 0.3 * 5e-5,
+        "{label}: compliance {compliance}"
+    );
+    assert!(
+        d.after.heldout_rms < 0.25 * d.before.heldout_rms,
+        "{label}: {} -> {}",
+        d.before.heldout_rms,
+        d.after.heldout_rms
+    );
+}
+
+#[test]
+#[ignore = "the slowest of the mount's cases (74 s wall under load); scripts/bench_protocols.sh runs the mount under every protocol"]
+fn a_compliant_stopper_mount_with_a_one_millisecond_lag_is_placed_at_the_mechanics_under_a_shaken_stopper_at_500_hz() {
+    compliant_mount_found(
+        "mount-shaken",
+        &spec(
+            CommandProtocol::Staircase,
+            StopperMotion::Sine {
+                centre: 0.054,
+                amplitude: 0.004,
+                frequency: 2.5,
+            },
+            500.0,
+            true,
+        ),
+    );
+}
+
+#[test]
+fn a_compliant_stopper_mount_with_a_one_millisecond_lag_is_placed_at_the_mechanics_under_ramps_at_250_hz_without_pressures(
+) {
+    compliant_mount_found("mount-ramps", &spec(CommandProtocol::Ramps, moves(), 250.0, false));
+}
+
+/// The gas temperature rising 20 K over the recording: the model has no drift of it, so it
+/// is placed, at the chambers as a drift, and nothing is named.
+fn temperature_drift_placed(label: &str, spec: &ProtocolSpec) {
+    let d = diagnosed(
+        label,
+        spec,
+        UndeclaredEffects {
+            gas_temperature_drift: 20.0,
+            ..UndeclaredEffects::default()
+        },
+    );
+    assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
+    let placed = d
+        .discovered
+        .first()
+        .map(|t| (t.location, t.family))
+        .or_else(|| d.unexplained.as_ref().map(|u| (u.location, u.family)));
+    assert_eq!(placed, Some(("chambers", "drift")), "{label}: {}", d.summary()[0]);
+}
+
+#[test]
+fn a_gas_temperature_drifting_twenty_kelvin_is_placed_at_the_chambers_under_a_staircase_at_500_hz() {
+    temperature_drift_placed(
+        "gas-drift-staircase",
+        &spec(CommandProtocol::Staircase, fixed(), 500.0, true),
+    );
+}
+
+#[test]
+fn a_gas_temperature_drifting_twenty_kelvin_is_placed_at_the_chambers_under_a_slow_sine_at_250_hz() {
+    temperature_drift_placed("gas-drift-sine", &spec(CommandProtocol::Sine, fixed(), 250.0, true));
+}
