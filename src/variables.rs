@@ -282,6 +282,9 @@ const fn variables_of(rows: &[Row]) -> [Variable; N_VARIABLES] {
     out
 }
 
+// A const, not a static, so that `VARIABLES` below stays a const slice; it is built at compile
+// time once.
+#[allow(clippy::large_const_arrays)]
 const VARIABLE_ARRAY: [Variable; N_VARIABLES] = variables_of(TABLE);
 
 /// The FMI variables of the table, in its order: what the model description, the getters and

@@ -108,8 +108,9 @@ pub(crate) fn simpler_at_place(
         let ok = if simpler {
             score <= added_score && force <= added_force + 0.05 * noise
         } else {
-            (added.named && score < added_score && force <= added_force)
-                || (!added.named && score < added_score - penalty && force <= added_force)
+            // a discovered term must be beaten by its penalty, a named effect by any margin
+            let margin = if added.named { 0.0 } else { penalty };
+            score < added_score - margin && force <= added_force
         };
         if !ok {
             continue;

@@ -862,7 +862,7 @@ pub const TABLE: &[Row] = &[
         .cite("(2.29)")
         .because(DEAD_VOLUME),
     parameter("command_curve_knots", vr::COMMAND_CURVE_KNOTS, "1", 0.0, "command static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
-    parameter("command_curve_x_1", vr::COMMAND_CURVE_X + 0, "V", 0.0, "command static curve: knot 1, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_x_1", vr::COMMAND_CURVE_X, "V", 0.0, "command static curve: knot 1, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_x_2", vr::COMMAND_CURVE_X + 1, "V", 0.0, "command static curve: knot 2, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_x_3", vr::COMMAND_CURVE_X + 2, "V", 0.0, "command static curve: knot 3, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_x_4", vr::COMMAND_CURVE_X + 3, "V", 0.0, "command static curve: knot 4, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
@@ -870,7 +870,7 @@ pub const TABLE: &[Row] = &[
     parameter("command_curve_x_6", vr::COMMAND_CURVE_X + 5, "V", 0.0, "command static curve: knot 6, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_x_7", vr::COMMAND_CURVE_X + 6, "V", 0.0, "command static curve: knot 7, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_x_8", vr::COMMAND_CURVE_X + 7, "V", 0.0, "command static curve: knot 8, the logged command v_DA").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
-    parameter("command_curve_y_1", vr::COMMAND_CURVE_Y + 0, "V", 0.0, "command static curve: knot 1, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
+    parameter("command_curve_y_1", vr::COMMAND_CURVE_Y, "V", 0.0, "command static curve: knot 1, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_y_2", vr::COMMAND_CURVE_Y + 1, "V", 0.0, "command static curve: knot 2, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_y_3", vr::COMMAND_CURVE_Y + 2, "V", 0.0, "command static curve: knot 3, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_y_4", vr::COMMAND_CURVE_Y + 3, "V", 0.0, "command static curve: knot 4, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
@@ -879,7 +879,7 @@ pub const TABLE: &[Row] = &[
     parameter("command_curve_y_7", vr::COMMAND_CURVE_Y + 6, "V", 0.0, "command static curve: knot 7, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("command_curve_y_8", vr::COMMAND_CURVE_Y + 7, "V", 0.0, "command static curve: knot 8, the command the current driver sees there").at_least(-100.0).at_most(100.0).because(CURVE_COMMAND),
     parameter("force_sensor_curve_knots", vr::FORCE_SENSOR_CURVE_KNOTS, "1", 0.0, "force sensor static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
-    parameter("force_sensor_curve_x_1", vr::FORCE_SENSOR_CURVE_X + 0, "N", 0.0, "force sensor static curve: knot 1, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_x_1", vr::FORCE_SENSOR_CURVE_X, "N", 0.0, "force sensor static curve: knot 1, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_x_2", vr::FORCE_SENSOR_CURVE_X + 1, "N", 0.0, "force sensor static curve: knot 2, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_x_3", vr::FORCE_SENSOR_CURVE_X + 2, "N", 0.0, "force sensor static curve: knot 3, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_x_4", vr::FORCE_SENSOR_CURVE_X + 3, "N", 0.0, "force sensor static curve: knot 4, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
@@ -887,7 +887,7 @@ pub const TABLE: &[Row] = &[
     parameter("force_sensor_curve_x_6", vr::FORCE_SENSOR_CURVE_X + 5, "N", 0.0, "force sensor static curve: knot 6, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_x_7", vr::FORCE_SENSOR_CURVE_X + 6, "N", 0.0, "force sensor static curve: knot 7, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_x_8", vr::FORCE_SENSOR_CURVE_X + 7, "N", 0.0, "force sensor static curve: knot 8, the force F_act").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
-    parameter("force_sensor_curve_y_1", vr::FORCE_SENSOR_CURVE_Y + 0, "N", 0.0, "force sensor static curve: knot 1, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
+    parameter("force_sensor_curve_y_1", vr::FORCE_SENSOR_CURVE_Y, "N", 0.0, "force sensor static curve: knot 1, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_y_2", vr::FORCE_SENSOR_CURVE_Y + 1, "N", 0.0, "force sensor static curve: knot 2, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_y_3", vr::FORCE_SENSOR_CURVE_Y + 2, "N", 0.0, "force sensor static curve: knot 3, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_y_4", vr::FORCE_SENSOR_CURVE_Y + 3, "N", 0.0, "force sensor static curve: knot 4, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
@@ -896,7 +896,7 @@ pub const TABLE: &[Row] = &[
     parameter("force_sensor_curve_y_7", vr::FORCE_SENSOR_CURVE_Y + 6, "N", 0.0, "force sensor static curve: knot 7, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("force_sensor_curve_y_8", vr::FORCE_SENSOR_CURVE_Y + 7, "N", 0.0, "force sensor static curve: knot 8, its reading there").at_least(-1000.0).at_most(1000.0).because(CURVE_FORCE),
     parameter("p1_sensor_curve_knots", vr::P1_SENSOR_CURVE_KNOTS, "1", 0.0, "pressure transducer 1 static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
-    parameter("p1_sensor_curve_x_1", vr::P1_SENSOR_CURVE_X + 0, "Pa", 0.0, "pressure transducer 1 static curve: knot 1, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_x_1", vr::P1_SENSOR_CURVE_X, "Pa", 0.0, "pressure transducer 1 static curve: knot 1, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_x_2", vr::P1_SENSOR_CURVE_X + 1, "Pa", 0.0, "pressure transducer 1 static curve: knot 2, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_x_3", vr::P1_SENSOR_CURVE_X + 2, "Pa", 0.0, "pressure transducer 1 static curve: knot 3, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_x_4", vr::P1_SENSOR_CURVE_X + 3, "Pa", 0.0, "pressure transducer 1 static curve: knot 4, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
@@ -904,7 +904,7 @@ pub const TABLE: &[Row] = &[
     parameter("p1_sensor_curve_x_6", vr::P1_SENSOR_CURVE_X + 5, "Pa", 0.0, "pressure transducer 1 static curve: knot 6, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_x_7", vr::P1_SENSOR_CURVE_X + 6, "Pa", 0.0, "pressure transducer 1 static curve: knot 7, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_x_8", vr::P1_SENSOR_CURVE_X + 7, "Pa", 0.0, "pressure transducer 1 static curve: knot 8, the pressure P1").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
-    parameter("p1_sensor_curve_y_1", vr::P1_SENSOR_CURVE_Y + 0, "Pa", 0.0, "pressure transducer 1 static curve: knot 1, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p1_sensor_curve_y_1", vr::P1_SENSOR_CURVE_Y, "Pa", 0.0, "pressure transducer 1 static curve: knot 1, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_y_2", vr::P1_SENSOR_CURVE_Y + 1, "Pa", 0.0, "pressure transducer 1 static curve: knot 2, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_y_3", vr::P1_SENSOR_CURVE_Y + 2, "Pa", 0.0, "pressure transducer 1 static curve: knot 3, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_y_4", vr::P1_SENSOR_CURVE_Y + 3, "Pa", 0.0, "pressure transducer 1 static curve: knot 4, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
@@ -913,7 +913,7 @@ pub const TABLE: &[Row] = &[
     parameter("p1_sensor_curve_y_7", vr::P1_SENSOR_CURVE_Y + 6, "Pa", 0.0, "pressure transducer 1 static curve: knot 7, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p1_sensor_curve_y_8", vr::P1_SENSOR_CURVE_Y + 7, "Pa", 0.0, "pressure transducer 1 static curve: knot 8, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_knots", vr::P2_SENSOR_CURVE_KNOTS, "1", 0.0, "pressure transducer 2 static curve: the number of knots in use, piecewise linear between them and along the end segments beyond (0 = off; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
-    parameter("p2_sensor_curve_x_1", vr::P2_SENSOR_CURVE_X + 0, "Pa", 0.0, "pressure transducer 2 static curve: knot 1, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_x_1", vr::P2_SENSOR_CURVE_X, "Pa", 0.0, "pressure transducer 2 static curve: knot 1, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_x_2", vr::P2_SENSOR_CURVE_X + 1, "Pa", 0.0, "pressure transducer 2 static curve: knot 2, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_x_3", vr::P2_SENSOR_CURVE_X + 2, "Pa", 0.0, "pressure transducer 2 static curve: knot 3, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_x_4", vr::P2_SENSOR_CURVE_X + 3, "Pa", 0.0, "pressure transducer 2 static curve: knot 4, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
@@ -921,7 +921,7 @@ pub const TABLE: &[Row] = &[
     parameter("p2_sensor_curve_x_6", vr::P2_SENSOR_CURVE_X + 5, "Pa", 0.0, "pressure transducer 2 static curve: knot 6, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_x_7", vr::P2_SENSOR_CURVE_X + 6, "Pa", 0.0, "pressure transducer 2 static curve: knot 7, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_x_8", vr::P2_SENSOR_CURVE_X + 7, "Pa", 0.0, "pressure transducer 2 static curve: knot 8, the pressure P2").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
-    parameter("p2_sensor_curve_y_1", vr::P2_SENSOR_CURVE_Y + 0, "Pa", 0.0, "pressure transducer 2 static curve: knot 1, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("p2_sensor_curve_y_1", vr::P2_SENSOR_CURVE_Y, "Pa", 0.0, "pressure transducer 2 static curve: knot 1, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_y_2", vr::P2_SENSOR_CURVE_Y + 1, "Pa", 0.0, "pressure transducer 2 static curve: knot 2, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_y_3", vr::P2_SENSOR_CURVE_Y + 2, "Pa", 0.0, "pressure transducer 2 static curve: knot 3, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_y_4", vr::P2_SENSOR_CURVE_Y + 3, "Pa", 0.0, "pressure transducer 2 static curve: knot 4, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
@@ -943,6 +943,9 @@ const fn variables_of(rows: &[Row]) -> [Variable; N_VARIABLES] {
     out
 }
 
+// A const, not a static, so that `VARIABLES` below stays a const slice; it is built at compile
+// time once.
+#[allow(clippy::large_const_arrays)]
 const VARIABLE_ARRAY: [Variable; N_VARIABLES] = variables_of(TABLE);
 
 /// The variables of [`TABLE`], in its order (the FMU crate's `variables::VARIABLES` are these

@@ -52,7 +52,7 @@ fn spec(command: CommandProtocol, sample_rate: f64, pressures: bool) -> Protocol
 
 /// The one discovered term, nothing named, at `location` in `family`.
 fn only_term<'a>(label: &str, d: &'a Diagnosis, location: &str, family: &str) -> &'a DiscoveredTerm {
-    assert!(names(&d).is_empty(), "{label}: named {:?}", names(d));
+    assert!(names(d).is_empty(), "{label}: named {:?}", names(d));
     assert_eq!(d.discovered.len(), 1, "{label}: {}", d.summary().join(" | "));
     let term = &d.discovered[0];
     assert_eq!(
@@ -140,7 +140,8 @@ fn an_offset_and_a_gain_of_the_force_sensor_stay_an_offset_and_a_gain_not_a_curv
         ..BenchEffects::default()
     };
     // (Without pressures too in scripts/bench_protocols.sh: 36 s here, over this file's budget.)
-    for (label, spec) in [("offset-gain-staircase", spec(CommandProtocol::Staircase, 1000.0, true))] {
+    let (label, spec) = ("offset-gain-staircase", spec(CommandProtocol::Staircase, 1000.0, true));
+    {
         let d = diagnosed(label, &spec, &effects);
         assert_eq!(
             names(&d),

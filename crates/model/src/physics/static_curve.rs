@@ -55,6 +55,11 @@ impl StaticCurve {
         }
     }
 
+    /// Whether no knot is in use (the curve is off).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// Whether the curve is on (two knots or more).
     pub fn is_on(&self) -> bool {
         self.len() >= 2
