@@ -293,7 +293,7 @@ impl CoSimModel for ActuatorFmu {
 
     /// The inputs and outputs of a simulation at once (an importer reads them every step);
     /// everything else, and everything before initialisation ends, from
-    /// [`ActuatorFmu::get_real_otherwise`].
+    /// `ActuatorFmu::get_real_otherwise`.
     #[inline]
     fn get_real(&self, value_reference: u32) -> Result<f64, String> {
         let simulation = match &self.simulation {
