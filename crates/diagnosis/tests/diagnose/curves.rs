@@ -5,20 +5,15 @@
 //! or more sampling rates, with and without pressures; broader sweeps are rows of
 //! `scripts/bench_protocols.sh`.
 
-use jetpipe_diagnosis::recording::Recording;
 use jetpipe_diagnosis::{diagnose, Diagnosis, DiscoveredTerm};
 use jetpipe_model::physics::parameters::Parameters;
-use synthetic_bench::{generate_protocol, BenchEffects, CommandProtocol, ProtocolSpec, UndeclaredEffects};
+use synthetic_bench::{BenchEffects, CommandProtocol, ProtocolSpec, UndeclaredEffects};
 
 use super::names;
+use super::protocols::recorded;
 
 fn diagnosed(label: &str, spec: &ProtocolSpec, effects: &BenchEffects) -> Diagnosis {
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{label}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    generate_protocol(spec, effects).unwrap().write_csv(&path).unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
+    let recording = recorded(label, spec, effects);
     let started = std::time::Instant::now();
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
     println!(

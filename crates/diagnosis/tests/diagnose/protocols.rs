@@ -13,7 +13,7 @@ use synthetic_bench::{
 use super::{names, value_reference};
 
 /// The recording of `effects` under `spec`, through the CSV file the generator writes.
-fn recorded(label: &str, spec: &ProtocolSpec, effects: &BenchEffects) -> Recording {
+pub(crate) fn recorded(label: &str, spec: &ProtocolSpec, effects: &BenchEffects) -> Recording {
     let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{label}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("recording.csv");
