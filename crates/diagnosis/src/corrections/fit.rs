@@ -653,13 +653,27 @@ impl Problem<'_> {
             step: 0.02 * found.values[0],
             ..first.clone()
         };
-        let start: Vec<f64> = refined.terms.iter().map(|t| t.neutral).collect();
-        let start_replay = self.replay(&refined, &start)?;
+        // A searched model parameter's prediction at what the search found is the replay
+        // with the other terms at their starts: the refinement's first point. (A filter on
+        // an output is searched on the base replay, not through the model.)
+        let (start_replay, replayed) = if matches!(first.mechanism, Mechanism::OutputFilter { .. }) {
+            let start: Vec<f64> = refined.terms.iter().map(|t| t.neutral).collect();
+            (self.replay(&refined, &start)?, 1)
+        } else {
+            let [force, p1, p2] = found.prediction;
+            let searched = Replay {
+                force,
+                p1,
+                p2,
+                ..Replay::default()
+            };
+            (searched, 0)
+        };
         let none = |_: &'static str| None;
         let fit = self.fit(&refined, iterations, &start_replay, &none)?;
         Ok(Fit {
             candidate: candidate.clone(),
-            replays: fit.replays + found.replays + 1,
+            replays: fit.replays + found.replays + replayed,
             ..fit
         })
     }
@@ -683,7 +697,15 @@ impl Problem<'_> {
         };
         let base = Prediction::of_replay(base_replay);
         let mut replays = 0;
+        // The prediction at the lowest cost so far: the search ends on it, and it is not
+        // replayed again.
+        let mut lowest: Option<(f64, f64, [Vec<f64>; CHANNELS])> = None;
         let mut evaluate = |value: f64| -> (f64, Option<[Vec<f64>; CHANNELS]>) {
+            if let Some((at, cost, y)) = &lowest {
+                if *at == value {
+                    return (*cost, Some(y.clone()));
+                }
+            }
             let prediction = match term.mechanism {
                 Mechanism::OutputFilter { channel, filter } => {
                     let mut out = base.clone();
@@ -696,7 +718,13 @@ impl Problem<'_> {
                 }
             };
             match prediction {
-                Some(y) => (self.errors(&y).0.iter().sum(), Some(y)),
+                Some(y) => {
+                    let cost: f64 = self.errors(&y).0.iter().sum();
+                    if lowest.as_ref().map_or(true, |(_, c, _)| cost < *c) {
+                        lowest = Some((value, cost, y.clone()));
+                    }
+                    (cost, Some(y))
+                }
                 None => (f64::INFINITY, None),
             }
         };
