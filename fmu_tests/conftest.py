@@ -19,6 +19,20 @@ import jetpipe_fmu  # noqa: E402
 from jetpipe_fmu import initialize, make_slave, release, vr_map  # noqa: E402
 
 
+def pytest_configure(config):
+    config.addinivalue_line("markers", "broad: a case of a broad sweep, run by scripts/bench_cases.sh "
+                            "(JETPIPE_BROAD=1), not by the test command")
+
+
+def pytest_collection_modifyitems(config, items):
+    if os.environ.get("JETPIPE_BROAD") == "1":
+        return
+    skip = pytest.mark.skip(reason="a broad case: scripts/bench_cases.sh runs every case (JETPIPE_BROAD=1)")
+    for item in items:
+        if "broad" in item.keywords:
+            item.add_marker(skip)
+
+
 @pytest.fixture(scope="session")
 def fmu_path() -> Path:
     env = os.environ.get("JETPIPE_FMU")

@@ -81,7 +81,8 @@ def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description,
 # force sensor (a lag of its reading) and a port line's volume behind an orifice (a pressure
 # state of its own): each has a memory the FMU keeps between steps.
 @needs_binaries
-@pytest.mark.parametrize("mechanism,parameter,duration", [("current_slew_limit", "current_slew_limit", 80),
+@pytest.mark.parametrize("mechanism,parameter,duration", [pytest.param("current_slew_limit", "current_slew_limit", 80,
+                                                                       marks=pytest.mark.broad),
                                                           ("force_sensor_lag", "force_sensor_lag", 80),
                                                           ("port_1_restriction", "port_line_volume_1", 40)])
 def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
@@ -124,7 +125,8 @@ def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
 # after must come back through the FMU's transducer outputs, a delay's memory included.
 @needs_binaries
 @pytest.mark.parametrize("mechanism,parameter", [("p1_sensor_offset", "p1_sensor_offset"),
-                                                 ("p2_sensor_delay", "p2_sensor_delay")])
+                                                 pytest.param("p2_sensor_delay", "p2_sensor_delay",
+                                                              marks=pytest.mark.broad)])
 def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors_after(
         unzipdir, model_description, vrs, tmp_path, mechanism, parameter):
     recording, report = generated_and_diagnosed(tmp_path, mechanism, "--seed", "43", "--duration", "40",

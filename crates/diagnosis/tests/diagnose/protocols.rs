@@ -86,6 +86,7 @@ fn pickup_found(label: &str, spec: &ProtocolSpec, amplitude: f64, frequency: f64
 }
 
 #[test]
+#[ignore = "a broad case (about 29 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_fifty_hertz_pickup_under_a_multisine_at_one_kilohertz_without_pressures_is_discovered() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Multisine,

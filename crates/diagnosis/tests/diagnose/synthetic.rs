@@ -115,6 +115,7 @@ fn sensor_offset_and_gain() {
 }
 
 #[test]
+#[ignore = "a broad case (about 57 s of CPU); scripts/bench_cases.sh runs every case"]
 fn command_delay() {
     single(
         "delay",
@@ -143,6 +144,7 @@ fn piston_friction_with_a_stribeck_curve() {
 }
 
 #[test]
+#[ignore = "a broad case (about 62 s of CPU); scripts/bench_cases.sh runs every case"]
 fn smooth_jet_pipe_hysteresis_is_found_with_the_generators_bouc_wen_constants() {
     if !selected("hysteresis") {
         return;
@@ -180,6 +182,7 @@ fn smooth_jet_pipe_hysteresis_is_found_with_the_generators_bouc_wen_constants() 
 }
 
 #[test]
+#[ignore = "a broad case (about 43 s of CPU); scripts/bench_cases.sh runs every case"]
 fn dead_volume_as_line_volumes() {
     let effects = BenchEffects {
         dead_volume_1: 5e-6,
@@ -204,6 +207,7 @@ fn supply_pressure_drop_through_a_plenum() {
 }
 
 #[test]
+#[ignore = "a broad case (about 34 s of CPU); scripts/bench_cases.sh runs every case"]
 fn heat_transfer_with_chamber_temperatures() {
     single(
         "heat",
@@ -218,6 +222,7 @@ fn heat_transfer_with_chamber_temperatures() {
 }
 
 #[test]
+#[ignore = "a broad case (about 107 s of CPU); scripts/bench_cases.sh runs every case"]
 fn two_effects_at_once() {
     if !selected("two") {
         return;

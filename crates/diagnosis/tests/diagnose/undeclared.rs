@@ -6,7 +6,9 @@
 //! explained; elsewhere the departure placed where the truth is, in the truth's family.
 //!
 //! Each mechanism is a test of its own; set JETPIPE_UNDECLARED to a comma list of names to
-//! run a subset.
+//! run a subset. The test command runs one mechanism at each of five places (the force
+//! sensor twice, for two families; the supply's named restriction and its plain pressure
+//! are cases of `synthetic` and `protocols`); `scripts/bench_cases.sh` runs them all.
 
 use jetpipe_diagnosis::{diagnose, Diagnosis};
 use jetpipe_model::physics::parameters::Parameters;
@@ -95,41 +97,49 @@ fn placed(name: &str, seed: u64) {
 }
 
 #[test]
+#[ignore = "a broad case (about 53 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_pressure_transducer_offset_is_found_at_the_pressure_sensors() {
     placed("p1_sensor_offset", 301);
 }
 
 #[test]
+#[ignore = "a broad case (about 62 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_late_pressure_transducer_is_found_at_the_pressure_sensors_as_a_delay() {
     placed("p2_sensor_delay", 302);
 }
 
 #[test]
+#[ignore = "a broad case (about 41 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_drifting_supply_is_found_at_the_supply_as_a_drift() {
     placed("supply_drift", 303);
 }
 
 #[test]
+#[ignore = "a broad case (about 41 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_supply_ripple_is_found_at_the_supply_as_periodic() {
     placed("supply_ripple", 304);
 }
 
 #[test]
+#[ignore = "a broad case (about 54 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_saturating_command_is_found_at_the_command_as_a_limit() {
     placed("command_limit", 305);
 }
 
 #[test]
+#[ignore = "a broad case (about 50 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_slew_limited_current_is_found_at_the_current_driver_as_a_limit() {
     placed("current_slew_limit", 306);
 }
 
 #[test]
+#[ignore = "a broad case (about 52 s of CPU); scripts/bench_cases.sh runs every case"]
 fn an_extra_jet_pipe_lag_is_found_at_the_jet_pipe_as_dynamics() {
     placed("jet_pipe_lag", 307);
 }
 
 #[test]
+#[ignore = "a broad case (about 48 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_reshaped_jet_pipe_curve_is_found_at_the_jet_pipe_as_a_nonlinearity() {
     placed("jet_pipe_curve", 308);
 }
@@ -145,11 +155,13 @@ fn smaller_return_areas_are_found_at_the_valve_as_an_asymmetry() {
 }
 
 #[test]
+#[ignore = "a broad case (about 64 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_restricted_port_line_is_found_at_the_valve_as_a_restriction() {
     placed("port_1_restriction", 311);
 }
 
 #[test]
+#[ignore = "a broad case (about 66 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_back_pressure_on_the_exhaust_is_found_at_the_return() {
     placed("return_back_pressure", 312);
 }
@@ -165,6 +177,7 @@ fn viscous_friction_is_found_at_the_mechanics_and_not_named_piston_friction() {
 }
 
 #[test]
+#[ignore = "a broad case (about 92 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_compliant_stopper_is_found_at_the_mechanics_and_not_named_dead_volume() {
     placed("contact_compliance", 315);
 }
@@ -192,6 +205,7 @@ fn every_mechanism_of_the_table_has_a_test_here() {
 }
 
 #[test]
+#[ignore = "a broad case (about 72 s of CPU); scripts/bench_cases.sh runs every case"]
 fn an_undeclared_back_pressure_and_named_friction_are_both_found() {
     if std::env::var("JETPIPE_UNDECLARED").is_ok() {
         return;
@@ -219,6 +233,7 @@ fn an_undeclared_back_pressure_and_named_friction_are_both_found() {
 /// the orifice and its line found at their own size beside the named effect, not at the
 /// standard mechanism's values.
 #[test]
+#[ignore = "a broad case (about 128 s of CPU); scripts/bench_cases.sh runs every case"]
 fn a_wider_port_restriction_with_named_friction_is_found_at_its_own_size() {
     if std::env::var("JETPIPE_UNDECLARED").is_ok() {
         return;
