@@ -5,8 +5,8 @@
 //! Terms that the fit applies on a measured channel (a transducer's offset, gain, curve or
 //! drift, a force on the piston) are composed with what the model already reads there;
 //! terms the FMU cannot carry (a constant modulated in time other than the supply's, the
-//! jet pipe null's and the gas temperature's) and compositions that would not be exact give `None`, and the candidate
-//! stays a located departure.
+//! jet pipe null's and the gas temperature's) and compositions that would not be exact give
+//! `None`, and the candidate stays a located departure.
 
 use super::corrections::{parameter_value, Candidate, Mechanism, Modulation, Problem, Regressor};
 use super::signals::{FORCE, P1, P2};
