@@ -422,3 +422,19 @@ fn a_drifting_gas_temperature_runs_the_chambers_on_the_clock_of_the_square_root_
     assert_eq!(warm.model.params, drifting.params);
     assert_eq!(warm.model.flow, drifting.flow);
 }
+
+#[test]
+fn a_step_that_would_take_the_drifting_gas_temperature_below_zero_kelvin_is_refused_by_name() {
+    // T = 293.15 K − 10 K/s · t: 3.15 K at t = 29 s, −1.85 K at the next step's middle.
+    let model = with(|p| p.t_drift = -10.0);
+    let mut sim = Simulation::at_equilibrium(model, 2.5, 0.054, 29.0, 1e-6).unwrap();
+    match sim.step(1.0) {
+        Err(StepFailure::InvalidRequest(e)) => {
+            assert!(
+                e.contains("T_drift = -10 K/s") && e.contains("must be in (0, 1000] K"),
+                "{e}"
+            )
+        }
+        other => panic!("a gas temperature of -1.85 K was not refused: {other:?}"),
+    }
+}
