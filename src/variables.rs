@@ -194,6 +194,14 @@ pub const UNITS: &[UnitDefinition] = &[
         k: 0,
     },
     UnitDefinition {
+        name: "K/s",
+        kg: 0,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 1,
+    },
+    UnitDefinition {
         name: "m/s",
         kg: 0,
         m: 1,

@@ -4,9 +4,9 @@
 //!
 //! Terms that the fit applies on a measured channel (a transducer's offset, gain, curve or
 //! drift, a force on the piston) are composed with what the model already reads there;
-//! terms the FMU cannot carry (a constant modulated in time other than the supply's and the
-//! jet pipe null's) and compositions that would not be exact give `None`, and the candidate
-//! stays a located departure.
+//! terms the FMU cannot carry (a constant modulated in time other than the supply's, the
+//! jet pipe null's and the gas temperature's) and compositions that would not be exact give
+//! `None`, and the candidate stays a located departure.
 
 use super::corrections::{parameter_value, Candidate, Mechanism, Modulation, Problem, Regressor};
 use super::signals::{FORCE, P1, P2};
@@ -124,6 +124,7 @@ pub fn model_terms(
         let (drift, ripple) = match parameter {
             "P_s" => ("supply_drift", true),
             "x_jp_offset" => ("x_jp_offset_drift", false),
+            "T" => ("T_drift", false),
             _ => return None,
         };
         if ramp != 0.0 {

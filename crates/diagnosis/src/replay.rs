@@ -373,6 +373,13 @@ mod tests {
                     ..Parameters::default()
                 },
             ),
+            (
+                "gas temperature drift",
+                Parameters {
+                    t_drift: 10.0,
+                    ..Parameters::default()
+                },
+            ),
         ];
         let thesis_model = Actuator::new(Parameters::default()).unwrap();
         let thesis = replay(&thesis_model, &recording, 1e-6, recording.len()).unwrap();

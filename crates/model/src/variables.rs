@@ -108,6 +108,7 @@ pub mod vr {
     pub const SUPPLY_RIPPLE_FREQUENCY: u32 = 492;
     pub const SUPPLY_RIPPLE_COSINE: u32 = 493;
     pub const X_JP_OFFSET_DRIFT: u32 = 494;
+    pub const T_DRIFT: u32 = 495;
     pub const P1_SENSOR_OFFSET: u32 = 500;
     pub const P1_SENSOR_GAIN: u32 = 501;
     pub const P1_SENSOR_DRIFT: u32 = 502;
@@ -793,6 +794,10 @@ pub const TABLE: &[Row] = &[
         .at_least(-0.01).at_most(0.01)
         .cite("(2.7)")
         .because("10 mm/s: the whole receiver travel in a third of a second"),
+    parameter("T_drift", vr::T_DRIFT, "K/s", 0.0, "gas temperature drift: the gas temperature T of (2.6) is T plus this times the time, in the chambers and the orifice flows, held over each communication step at its mid-step value (0 = off)")
+        .at_least(-10.0).at_most(10.0)
+        .cite("§2.6, (2.20)-(2.21), (2.29)")
+        .because("10 K/s: the gas warms by its own absolute temperature in half a minute"),
     parameter("p1_sensor_offset", vr::P1_SENSOR_OFFSET, "Pa", 0.0, "pressure transducer 1: offset of P1_meas (0 = off)")
         .at_least(-1e6).at_most(1e6)
         .cite("")

@@ -438,7 +438,7 @@ pub fn catalogue(
             )],
         ),
         // The gas temperature of (2.6), a constant of the model, drifting over the recording
-        // (the supply air warming up): placed, not carried by the FMU.
+        // (the supply air warming up): the FMU carries the ramp as T_drift.
         c(
             "gas temperature drift",
             "chambers",

@@ -383,3 +383,58 @@ fn a_static_curve_off_leaves_every_output_bit_identical_and_on_reads_through_its
     assert_eq!(at(&dead, 0.4), at(&thesis, 0.0));
     assert!((at(&dead, 3.0) - at(&thesis, 2.5)).abs() < 1e-9);
 }
+
+/// The chambers of a held stopper under a held command, the current and the jet pipe at rest
+/// from the start: only the pressures move, and by (2.20)–(2.21) every mass flow scales as
+/// 1/√T and (2.29)'s R T ṁ as √T. A gas temperature T(t) so runs the constant-T trajectory on
+/// the clock τ = ∫ √(T(s)/T) ds. A simulation with T_drift holds T at its mid-step value over
+/// each step h, so after each step it must be where the thesis model is after steps of
+/// h √(T(t + h/2)/T): an independent account of the drift, from the scaling alone.
+#[test]
+fn a_drifting_gas_temperature_runs_the_chambers_on_the_clock_of_the_square_root_of_the_temperature() {
+    let (drift, t0, h, v, x_s) = (3.0, 10.0, 1e-3, 2.5, 0.054);
+    let thesis = thesis_model();
+    let drifting = with(|p| p.t_drift = drift);
+    let started = |model: &Actuator, time: f64| {
+        // The pressures half-way between P_r and P_s, far from their balance.
+        let state = equilibrium_of_electromechanics(model, v);
+        Simulation::from_state(model.clone(), state, v, x_s, time, 1e-10)
+    };
+    let t_gas = thesis.params.temperature;
+    let mut warm = started(&drifting, t0);
+    let mut scaled = started(&thesis, 0.0);
+    let mut plain = started(&thesis, 0.0);
+    let (mut worst, mut apart) = (0.0_f64, 0.0_f64);
+    for k in 0..150 {
+        let mid = t0 + (k as f64 + 0.5) * h;
+        warm.step(h).unwrap();
+        scaled.step(h * ((t_gas + drift * mid) / t_gas).sqrt()).unwrap();
+        plain.step(h).unwrap();
+        for i in [index::P1, index::P2] {
+            worst = worst.max((warm.state[i] - scaled.state[i]).abs());
+            apart = apart.max((warm.state[i] - plain.state[i]).abs());
+        }
+    }
+    println!("warm against the rescaled thesis run: {worst} Pa; against the plain one: {apart} Pa");
+    // 30 K warmer by t0: the chambers run 5 % faster than the thesis's, by kPa in the transient.
+    assert!(apart > 1e3, "the drift moved the pressures by {apart} Pa at most");
+    assert!(worst < 0.01, "{worst} Pa from the rescaled clock");
+    assert_eq!(warm.model.params, drifting.params);
+    assert_eq!(warm.model.flow, drifting.flow);
+}
+
+#[test]
+fn a_step_that_would_take_the_drifting_gas_temperature_below_zero_kelvin_is_refused_by_name() {
+    // T = 293.15 K − 10 K/s · t: 3.15 K at t = 29 s, −1.85 K at the next step's middle.
+    let model = with(|p| p.t_drift = -10.0);
+    let mut sim = Simulation::at_equilibrium(model, 2.5, 0.054, 29.0, 1e-6).unwrap();
+    match sim.step(1.0) {
+        Err(StepFailure::InvalidRequest(e)) => {
+            assert!(
+                e.contains("T_drift = -10 K/s") && e.contains("must be in (0, 1000] K"),
+                "{e}"
+            )
+        }
+        other => panic!("a gas temperature of -1.85 K was not refused: {other:?}"),
+    }
+}

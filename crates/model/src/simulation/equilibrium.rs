@@ -29,7 +29,7 @@ pub fn equilibrium_at(model: &Actuator, v_da: f64, x_s: f64, time: f64) -> Resul
         return equilibrium(model, v_da, x_s);
     }
     let mut at = model.clone();
-    time_varying::set_at(&mut at.params, &model.params, time)?;
+    time_varying::set_model_at(&mut at, &model.params, time)?;
     equilibrium(&at, v_da, x_s)
 }
 
@@ -133,7 +133,7 @@ pub fn balance_with_volumes(
     let held;
     let model = if time_varying::varies(&model.params) {
         let mut at = model.clone();
-        time_varying::set_at(&mut at.params, &model.params, time)?;
+        time_varying::set_model_at(&mut at, &model.params, time)?;
         held = at;
         &held
     } else {

@@ -118,7 +118,7 @@ impl FixedStep {
         let rate = (x_s - self.simulation.x_s) / step;
         if let Some(nominal) = &self.nominal {
             // Held at mid-interval over the step, as `Simulation::step` holds them.
-            time_varying::set_at(&mut self.simulation.model.params, nominal, 0.5 * (t0 + time))
+            time_varying::set_model_at(&mut self.simulation.model, nominal, 0.5 * (t0 + time))
                 .map_err(StepFailure::InvalidRequest)?;
         }
         let result = if self.simulation.model.restrictions.has_volumes() {
@@ -127,7 +127,7 @@ impl FixedStep {
             advance(&mut self.simulation, &mut self.chambers, step, rate)
         };
         if let Some(nominal) = &self.nominal {
-            time_varying::reset(&mut self.simulation.model.params, nominal);
+            time_varying::reset_model(&mut self.simulation.model, nominal);
         }
         let (state, pressures, work) = result?;
         let sim = &mut self.simulation;

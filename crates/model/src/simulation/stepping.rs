@@ -78,11 +78,12 @@ impl Simulation {
         // from the last step were for the old values.
         let nominal = self.model.params.clone();
         if step.is_finite() && step > 0.0 {
-            time_varying::set_at(&mut self.model.params, &nominal, self.time + 0.5 * step)
+            time_varying::set_model_at(&mut self.model, &nominal, self.time + 0.5 * step)
                 .map_err(StepFailure::InvalidRequest)?;
         }
         self.chamber_rates_at_end = None;
         let result = self.step_with_constants_held(step);
+        time_varying::reset_model(&mut self.model, &nominal);
         self.model.params = nominal;
         self.chamber_rates_at_end = None;
         result
