@@ -144,10 +144,12 @@ pub(crate) fn localize(
         }
     };
     progress(&format!("fitting {} candidate corrections", candidates.len()));
-    let first: Vec<Option<Fit>> = parallel_map_shown("candidates", bars, candidates, jobs, |c| {
-        problem.fit(c, 1, base_replay, &shared).ok()
+    // Scored as each fit ends: the pressures' predictions of every candidate at once were
+    // the diagnosis's peak of memory (62 candidates, 119 MB of an 80 s recording's 292).
+    let first: Vec<Option<Scored>> = parallel_map_shown("candidates", bars, candidates, jobs, |c| {
+        problem.fit(c, 1, base_replay, &shared).ok().map(score)
     });
-    let mut scored: Vec<Scored> = first.into_iter().flatten().map(score).collect();
+    let mut scored: Vec<Scored> = first.into_iter().flatten().collect();
     replays += scored.iter().map(|s| s.fit.replays).sum::<usize>();
     scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
     // Refine the leaders (and every named effect near them) with more iterations.
@@ -176,13 +178,12 @@ pub(crate) fn localize(
     // Fewer leaders than threads, and one of them may take most of the time (a smooth
     // hysteresis law): its finite differences share the threads too.
     problem.set_jobs(jobs);
-    let refined: Vec<Option<Fit>> = parallel_map_shown("refining", bars, &leaders, jobs, |c| {
-        problem.fit(c, REFINE_ITERATIONS, base_replay, &shared).ok()
+    let refined: Vec<Option<Scored>> = parallel_map_shown("refining", bars, &leaders, jobs, |c| {
+        problem.fit(c, REFINE_ITERATIONS, base_replay, &shared).ok().map(score)
     });
     problem.set_jobs(1);
-    for fit in refined.into_iter().flatten() {
-        replays += fit.replays;
-        let better = score(fit);
+    for better in refined.into_iter().flatten() {
+        replays += better.fit.replays;
         if let Some(s) = scored.iter_mut().find(|s| s.fit.candidate == better.fit.candidate) {
             if better.explained > s.explained {
                 *s = better;
