@@ -132,11 +132,16 @@ pub(crate) fn localize(
         let explained = 1.0 - fit.heldout_total() / before_total;
         let residual = difference(&problem.recording.force, &fit.prediction[FORCE]);
         let force_heldout_rms = rms_where(&residual, problem.training, false);
-        // Only the force prediction is read once a candidate is scored (the remainder of a
-        // named effect that is added): the pressures' would hold two more series for every
-        // candidate until the diagnosis ends.
+        // Only a named effect's force prediction is read once a candidate is scored (its
+        // remainder, when it is added): the other series would be held for every candidate
+        // until the diagnosis ends.
         fit.prediction[1] = Vec::new();
         fit.prediction[2] = Vec::new();
+        // A discovered term is added through a fit of its own; only a named effect's
+        // remainder is read from its scored prediction.
+        if fit.candidate.named.is_none() {
+            fit.prediction[FORCE] = Vec::new();
+        }
         Scored {
             fit,
             explained,
