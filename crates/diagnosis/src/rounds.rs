@@ -493,10 +493,13 @@ fn discover_term(
             ));
             continue;
         }
-        let Some(set) = discover::model_terms(&s.fit.candidate, &s.fit.values, params, problem) else {
+        let Some(mut set) = discover::model_terms(&s.fit.candidate, &s.fit.values, params, problem) else {
             progress(&format!("  {label}: the FMU has no parameters for it"));
             continue;
         };
+        if crate::curves::is_command_curve(&s.fit.candidate) {
+            set = command_curve_knots_freed(cx, problem, params, set, replays, progress)?;
+        }
         let mut trial = params.clone();
         if set
             .iter()
@@ -541,6 +544,52 @@ fn discover_term(
         }
     }
     Ok(None)
+}
+
+/// The command's curve `set` refitted with its interior knots free
+/// (`curves::command_curve_with_free_knots`), made non-decreasing again, kept when the
+/// model with it fits the training samples better than with `set`.
+fn command_curve_knots_freed(
+    cx: &Context,
+    problem: &Problem,
+    params: &Parameters,
+    set: Vec<(&'static str, f64)>,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<(&'static str, f64)>, String> {
+    let Some(free) = crate::curves::command_curve_with_free_knots(&set) else {
+        return Ok(set);
+    };
+    let replayed = |values: &[(&'static str, f64)]| -> Result<Replay, String> {
+        let mut p = params.clone();
+        for &(name, value) in values {
+            set_parameter(&mut p, name, value)?;
+        }
+        replay_fast(&Actuator::new(p)?, cx.recording, cx.n)
+    };
+    let training_rms = |r: &Replay| rms_where(&difference(&cx.recording.force, &r.force), &cx.training, true);
+    let start = replayed(&set)?;
+    *replays += 1;
+    let Ok(fit) = problem.fit_damped(&free, REFINE_ITERATIONS, &start) else {
+        return Ok(set);
+    };
+    *replays += fit.replays;
+    let mut freed = set.clone();
+    for (term, &value) in free.terms.iter().zip(&fit.values) {
+        if let Some(entry) = freed.iter_mut().find(|(n, _)| *n == term.name) {
+            entry.1 = value;
+        }
+    }
+    crate::curves::monotone_command(&mut freed);
+    let Ok(with) = replayed(&freed) else {
+        return Ok(set);
+    };
+    *replays += 1;
+    let (before, after) = (training_rms(&start), training_rms(&with));
+    progress(&format!(
+        "  command static curve, its knots freed: force on the training blocks {before:.4} -> {after:.4} N"
+    ));
+    Ok(if after < before { freed } else { set })
 }
 
 /// A pressure transducer's term leaves the force as it is: it is judged on the pressures,

@@ -14,6 +14,9 @@ const COARSE_GOLDEN_STEPS: usize = 10;
 /// ranking and the shape searches, then the leaders' refinement.
 const COARSE_GRID: usize = 5;
 const FINE_GRID: usize = 9;
+/// The dampings λ a damped fit tries, in turn, when no step along the Gauss–Newton
+/// direction lowers the misfit.
+const MARQUARDT_DAMPINGS: [f64; 4] = [0.01, 0.1, 1.0, 100.0];
 
 /// Golden-section search of `steps` steps on [a, b]: the best point and its cost.
 fn golden(a: f64, b: f64, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
@@ -323,6 +326,26 @@ impl Problem<'_> {
         base_replay: &Replay,
         shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
     ) -> Result<Fit, String> {
+        self.fit_with(candidate, iterations, base_replay, shared, false)
+    }
+
+    /// [`Problem::fit`] for a candidate whose Gauss–Newton step may overshoot far from its
+    /// start (a curve's knot abscissae, whose sensitivities change where a corner crosses the
+    /// data): when no step along the Gauss–Newton direction lowers the misfit, steps damped in
+    /// Marquardt's way (the normal matrix's diagonal scaled by 1 + λ, λ from 0.01 to 100) are
+    /// tried from the same columns, one replay each, before the fit stops.
+    pub fn fit_damped(&self, candidate: &Candidate, iterations: usize, base_replay: &Replay) -> Result<Fit, String> {
+        self.fit_with(candidate, iterations, base_replay, &|_| None, true)
+    }
+
+    fn fit_with(
+        &self,
+        candidate: &Candidate,
+        iterations: usize,
+        base_replay: &Replay,
+        shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
+        damped: bool,
+    ) -> Result<Fit, String> {
         let terms = &candidate.terms;
         if terms.iter().any(|t| t.mechanism == Mechanism::Shape) {
             return self.fit_shape(candidate, base_replay);
@@ -428,11 +451,17 @@ impl Problem<'_> {
                 };
                 columns.push(column.unwrap_or_else(|| [vec![], vec![], vec![]]));
             }
-            let step = self.solve(terms, &point.values, &columns, &prediction);
-            // Line search on the true model.
+            let step = self.solve(terms, &point.values, &columns, &prediction, 0.0);
+            // Line search on the true model; then, for a damped fit, Marquardt's steps.
             let mut accepted = false;
             let mut alpha = 1.0;
-            for _ in 0..4 {
+            let mut step = step;
+            let tries = if damped { 4 + MARQUARDT_DAMPINGS.len() } else { 4 };
+            for attempt in 0..tries {
+                if attempt >= 4 {
+                    step = self.solve(terms, &point.values, &columns, &prediction, MARQUARDT_DAMPINGS[attempt - 4]);
+                    alpha = 1.0;
+                }
                 let values: Vec<f64> = point
                     .values
                     .iter()
@@ -490,6 +519,7 @@ impl Problem<'_> {
         values: &[f64],
         columns: &[Sensitivity],
         prediction: &[Vec<f64>; CHANNELS],
+        damping: f64,
     ) -> Vec<f64> {
         let m = terms.len();
         let usable: Vec<bool> = columns.iter().map(|c| c.iter().any(|ch| !ch.is_empty())).collect();
@@ -530,7 +560,11 @@ impl Problem<'_> {
             for b in 0..a {
                 ata[a][b] = ata[b][a];
             }
+            ata[a][a] *= 1.0 + damping;
         }
+        // A term that moves nothing on the training samples (a knot inside a flat stretch of
+        // its curve) gets no step: its column of zeros would make the system singular.
+        let usable: Vec<bool> = usable.iter().enumerate().map(|(a, &u)| u && ata[a][a] > 0.0).collect();
         let lower: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.lower - v).collect();
         let upper: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.upper - v).collect();
         bounded_least_squares(&ata, &atb, &usable, &lower, &upper)
