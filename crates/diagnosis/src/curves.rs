@@ -578,10 +578,7 @@ pub fn pooled_non_decreasing(values: &[f64]) -> Vec<f64> {
         }
         blocks.push(block);
     }
-    blocks
-        .into_iter()
-        .flat_map(|(mean, count)| std::iter::repeat(mean).take(count))
-        .collect()
+    blocks.into_iter().flat_map(|(mean, count)| vec![mean; count]).collect()
 }
 
 /// The command's fitted curve in `set` as a candidate whose knot abscissae are free as well

@@ -146,7 +146,10 @@ pub(crate) fn best_pair(
     // Every pair from the shared sensitivities, the leading pairs again with fresh ones.
     let first: Vec<Option<Fit>> = parallel_map(&pairs, jobs, |&(i, j)| {
         let pair = joined(&members[i].fit.candidate, &members[j].fit.candidate);
-        problem.fit(&pair, 1, current, &shared).ok()
+        problem
+            .fit(&pair, 1, current, &shared)
+            .ok()
+            .map(Fit::without_prediction)
     });
     *replays += first.iter().flatten().map(|f| f.replays).sum::<usize>();
     let score = |f: &Fit| {
@@ -164,7 +167,10 @@ pub(crate) fn best_pair(
     let again: Vec<Option<Fit>> = parallel_map(&order, jobs, |&k| {
         let (i, j) = pairs[k];
         let pair = joined(&members[i].fit.candidate, &members[j].fit.candidate);
-        problem.fit(&pair, PAIR_ITERATIONS, current, &shared).ok()
+        problem
+            .fit(&pair, PAIR_ITERATIONS, current, &shared)
+            .ok()
+            .map(Fit::without_prediction)
     });
     *replays += again.iter().flatten().map(|f| f.replays).sum::<usize>();
     let mut fits: Vec<Option<Fit>> = vec![None; pairs.len()];
@@ -210,7 +216,10 @@ pub(crate) fn best_pair(
             .collect();
         for c in simpler {
             let pair = if side == 0 { joined(c, other) } else { joined(other, c) };
-            let Ok(f) = problem.fit(&pair, PAIR_ITERATIONS, current, &shared) else {
+            let Ok(f) = problem
+                .fit(&pair, PAIR_ITERATIONS, current, &shared)
+                .map(Fit::without_prediction)
+            else {
                 continue;
             };
             *replays += f.replays;
@@ -238,7 +247,9 @@ pub(crate) fn best_pair(
         score(&best_fit)
     ));
     problem.set_jobs(jobs);
-    let refined = problem.fit(&joined(a, b), PAIR_REFINE_ITERATIONS, current, &shared);
+    let refined = problem
+        .fit(&joined(a, b), PAIR_REFINE_ITERATIONS, current, &shared)
+        .map(Fit::without_prediction);
     problem.set_jobs(1);
     let fit = match (refined, Some(best_fit)) {
         (Ok(r), Some(f)) if r.train_total() < f.train_total() => r,

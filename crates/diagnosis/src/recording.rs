@@ -169,7 +169,15 @@ impl Recording {
             return Err("row 1: give both p1_Pa and p2_Pa, or neither".to_string());
         }
         let has_pressures = columns[4] != usize::MAX;
+        // Reserved for every line, so a long recording's columns are not left at up to twice
+        // their length by the doubling of a growing vector (48 MB for 29 at 600 s and 1 kHz).
+        let rows = text.bytes().filter(|&b| b == b'\n').count() + 1;
         let mut data: [Vec<f64>; 6] = Default::default();
+        for (slot, &position) in columns.iter().enumerate() {
+            if position != usize::MAX {
+                data[slot] = Vec::with_capacity(rows);
+            }
+        }
         for (index, line) in lines {
             let row = index + 1;
             let cells: Vec<&str> = line.split(',').map(str::trim).collect();

@@ -267,7 +267,7 @@ fn curve_knots(cx: &Context, problem: &Problem, current: &Replay) -> crate::curv
     }
     let k_cd = problem.base.k_cd;
     if let Some(s) = problem.sensitivity("i_offset", 1e-3, current) {
-        let per_volt: Vec<f64> = s[FORCE].iter().map(|x| x * k_cd).collect();
+        let per_volt: Vec<f64> = s[FORCE].iter().map(|&x| f64::from(x) * k_cd).collect();
         let residual = difference(&cx.recording.force, &current.force);
         knots.command = crate::curves::placed_command_knots(
             &cx.recording.v_da[..cx.n],

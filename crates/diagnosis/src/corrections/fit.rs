@@ -209,6 +209,13 @@ pub struct Fit {
 }
 
 impl Fit {
+    /// The fit without its predicted series, for a caller that keeps only its values and
+    /// misfits (a pair among fifty held at once: 2.4 MB each at 100,000 rows).
+    pub fn without_prediction(mut self) -> Fit {
+        self.prediction = [Vec::new(), Vec::new(), Vec::new()];
+        self
+    }
+
     pub fn train_total(&self) -> f64 {
         self.train.iter().sum()
     }
@@ -218,8 +225,16 @@ impl Fit {
 }
 
 /// Sensitivities of the model's outputs to the nonlinear terms, shared by candidates that
-/// start from the same point.
-pub type Sensitivity = [Vec<f64>; CHANNELS];
+/// start from the same point. Single precision: a finite difference of two replays carries
+/// the integrator's relative error (1e-6 and more) in its lowest digits, so 24 bits lose
+/// nothing a Gauss–Newton step can use, and the thirty-odd shared columns of a long
+/// recording take half the memory (72 MB → 36 MB at 100,000 rows).
+pub type Sensitivity = [Vec<f32>; CHANNELS];
+
+/// A column of a [`Sensitivity`] from one in double precision.
+fn single(column: Vec<f64>) -> Vec<f32> {
+    column.into_iter().map(|v| v as f32).collect()
+}
 
 /// Everything needed at one point of a candidate's terms.
 struct Point {
@@ -255,7 +270,7 @@ impl Problem<'_> {
                             }
                             for k in 0..n {
                                 let m = modulation_at(modulation, self.recording.time[k], self.t_mid, self.t_span);
-                                out[c][k] += value * s[c][k] * m;
+                                out[c][k] += value * f64::from(s[c][k]) * m;
                             }
                         }
                     }
@@ -312,7 +327,7 @@ impl Problem<'_> {
         set_parameter(&mut p, name, value + step).ok()?;
         let model = Actuator::new(p).ok()?;
         let moved = replay_fast(&model, self.recording, self.recording.len()).ok()?;
-        let d = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| (x - y) / step).collect() };
+        let d = |a: &[f64], b: &[f64]| -> Vec<f32> { a.iter().zip(b).map(|(x, y)| ((x - y) / step) as f32).collect() };
         Some([d(&moved.force, &at.force), d(&moved.p1, &at.p1), d(&moved.p2, &at.p2)])
     }
 
@@ -411,8 +426,9 @@ impl Problem<'_> {
                 let mut moved = point.values.clone();
                 moved[j] += step;
                 self.replay(candidate, &moved).ok().map(|r| {
-                    let d =
-                        |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| (x - y) / step).collect() };
+                    let d = |a: &[f64], b: &[f64]| -> Vec<f32> {
+                        a.iter().zip(b).map(|(x, y)| ((x - y) / step) as f32).collect()
+                    };
                     [
                         d(&r.force, &point.replay.force),
                         d(&r.p1, &point.replay.p1),
@@ -442,9 +458,9 @@ impl Problem<'_> {
                         };
                         let with = self.predict(terms, &only, &modulated);
                         Some([
-                            difference(&with[0], &point.replay.force),
-                            difference(&with[1], &point.replay.p1),
-                            difference(&with[2], &point.replay.p2),
+                            single(difference(&with[0], &point.replay.force)),
+                            single(difference(&with[1], &point.replay.p1)),
+                            single(difference(&with[2], &point.replay.p2)),
                         ])
                     }
                     _ => None,
@@ -459,7 +475,13 @@ impl Problem<'_> {
             let tries = if damped { 4 + MARQUARDT_DAMPINGS.len() } else { 4 };
             for attempt in 0..tries {
                 if attempt >= 4 {
-                    step = self.solve(terms, &point.values, &columns, &prediction, MARQUARDT_DAMPINGS[attempt - 4]);
+                    step = self.solve(
+                        terms,
+                        &point.values,
+                        &columns,
+                        &prediction,
+                        MARQUARDT_DAMPINGS[attempt - 4],
+                    );
                     alpha = 1.0;
                 }
                 let values: Vec<f64> = point
@@ -537,7 +559,7 @@ impl Problem<'_> {
                 let r = self.measured[c][k] - prediction[c][k];
                 for a in 0..m {
                     let ja = if usable[a] && !columns[a][c].is_empty() {
-                        columns[a][c][k]
+                        f64::from(columns[a][c][k])
                     } else {
                         0.0
                     };
@@ -547,7 +569,7 @@ impl Problem<'_> {
                     atb[a] += w2 * ja * r;
                     for b in a..m {
                         let jb = if usable[b] && !columns[b][c].is_empty() {
-                            columns[b][c][k]
+                            f64::from(columns[b][c][k])
                         } else {
                             0.0
                         };
