@@ -140,7 +140,23 @@ enum Command {
     },
 }
 
+/// Allocations of 1 MiB and more get pages of their own, returned to the system when freed.
+///
+/// The diagnosis allocates and frees thousands of series of a few MB (a replay's outputs, a
+/// sensitivity, a Gauss–Newton column) from several threads. glibc's default threshold grows
+/// to the largest block freed (up to 32 MiB), after which such series come from the threads'
+/// heaps, where freed space stays resident: a 600 s recording at 1 kHz peaked at 287 MB of
+/// resident memory for about 190 MB in use; with the threshold fixed at 1 MiB, 196 MB.
+fn keep_large_allocations_apart() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt only sets an allocator parameter; it is called before any thread starts.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 1 << 20);
+    }
+}
+
 fn main() -> ExitCode {
+    keep_large_allocations_apart();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
