@@ -498,7 +498,7 @@ fn discover_term(
             continue;
         };
         if crate::curves::is_command_curve(&s.fit.candidate) {
-            set = command_curve_knots_freed(cx, problem, params, set, replays, progress)?;
+            set = command_curve_knots_freed(cx, problem, params, set, replays, progress);
         }
         let mut trial = params.clone();
         if set
@@ -556,9 +556,9 @@ fn command_curve_knots_freed(
     set: Vec<(&'static str, f64)>,
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
-) -> Result<Vec<(&'static str, f64)>, String> {
+) -> Vec<(&'static str, f64)> {
     let Some(free) = crate::curves::command_curve_with_free_knots(&set) else {
-        return Ok(set);
+        return set;
     };
     let replayed = |values: &[(&'static str, f64)]| -> Result<Replay, String> {
         let mut p = params.clone();
@@ -568,10 +568,13 @@ fn command_curve_knots_freed(
         replay_fast(&Actuator::new(p)?, cx.recording, cx.n)
     };
     let training_rms = |r: &Replay| rms_where(&difference(&cx.recording.force, &r.force), &cx.training, true);
-    let start = replayed(&set)?;
+    // A set the model refuses is left for the caller's checks to turn down.
+    let Ok(start) = replayed(&set) else {
+        return set;
+    };
     *replays += 1;
     let Ok(fit) = problem.fit_damped(&free, REFINE_ITERATIONS, &start) else {
-        return Ok(set);
+        return set;
     };
     *replays += fit.replays;
     let mut freed = set.clone();
@@ -582,14 +585,18 @@ fn command_curve_knots_freed(
     }
     crate::curves::monotone_command(&mut freed);
     let Ok(with) = replayed(&freed) else {
-        return Ok(set);
+        return set;
     };
     *replays += 1;
     let (before, after) = (training_rms(&start), training_rms(&with));
     progress(&format!(
         "  command static curve, its knots freed: force on the training blocks {before:.4} -> {after:.4} N"
     ));
-    Ok(if after < before { freed } else { set })
+    if after < before {
+        freed
+    } else {
+        set
+    }
 }
 
 /// A pressure transducer's term leaves the force as it is: it is judged on the pressures,
