@@ -146,7 +146,7 @@ enum Command {
 /// sensitivity, a Gauss–Newton column) from several threads. glibc's default threshold grows
 /// to the largest block freed (up to 32 MiB), after which such series come from the threads'
 /// heaps, where freed space stays resident: a 600 s recording at 1 kHz peaked at 287 MB of
-/// resident memory for about 190 MB in use; with the threshold fixed at 1 MiB, 196 MB.
+/// resident memory; with the threshold fixed at 1 MiB, at 196–215 MB (two runs).
 fn keep_large_allocations_apart() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: mallopt only sets an allocator parameter; it is called before any thread starts.
