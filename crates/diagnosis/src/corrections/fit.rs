@@ -228,7 +228,7 @@ impl Fit {
 /// start from the same point. Single precision: a finite difference of two replays carries
 /// the integrator's relative error (1e-6 and more) in its lowest digits, so 24 bits lose
 /// nothing a Gauss–Newton step can use, and the thirty-odd shared columns of a long
-/// recording take half the memory (72 MB → 36 MB at 100,000 rows).
+/// recording take half the memory (72 MB in double precision at 100,000 rows).
 pub type Sensitivity = [Vec<f32>; CHANNELS];
 
 /// A column of a [`Sensitivity`] from one in double precision.
