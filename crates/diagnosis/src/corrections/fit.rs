@@ -584,9 +584,6 @@ impl Problem<'_> {
             }
             ata[a][a] *= 1.0 + damping;
         }
-        // A term that moves nothing on the training samples (a knot inside a flat stretch of
-        // its curve) gets no step: its column of zeros would make the system singular.
-        let usable: Vec<bool> = usable.iter().enumerate().map(|(a, &u)| u && ata[a][a] > 0.0).collect();
         let lower: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.lower - v).collect();
         let upper: Vec<f64> = terms.iter().zip(values).map(|(t, v)| t.upper - v).collect();
         bounded_least_squares(&ata, &atb, &usable, &lower, &upper)
@@ -829,7 +826,14 @@ impl Prediction {
 fn bounded_least_squares(ata: &[Vec<f64>], atb: &[f64], usable: &[bool], lower: &[f64], upper: &[f64]) -> Vec<f64> {
     let m = atb.len();
     let mut x = vec![0.0; m];
-    let mut fixed: Vec<bool> = usable.iter().map(|u| !u).collect();
+    // A term that moves nothing on the training samples (a knot inside a flat stretch of its
+    // curve) gets no step: its column of zeros would make the system singular, and the solve
+    // would give every term a NaN.
+    let mut fixed: Vec<bool> = usable
+        .iter()
+        .enumerate()
+        .map(|(a, &u)| !u || ata[a][a] <= 0.0)
+        .collect();
     for _ in 0..=m {
         let free: Vec<usize> = (0..m).filter(|&j| !fixed[j]).collect();
         if free.is_empty() {
@@ -860,4 +864,34 @@ fn bounded_least_squares(ata: &[Vec<f64>], atb: &[f64], usable: &[bool], lower: 
         }
     }
     x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bounded_least_squares;
+
+    #[test]
+    fn a_term_whose_column_is_all_zeros_gets_no_step_and_the_others_their_least_squares_step() {
+        // Normal equations of two coupled terms (steps 2 and −1) and, between them, a term that
+        // moves nothing: its row and column of zeros.
+        let ata = vec![vec![4.0, 0.0, 2.0], vec![0.0, 0.0, 0.0], vec![2.0, 0.0, 2.0]];
+        let atb = vec![6.0, 0.0, 2.0];
+        let unbounded = [f64::NEG_INFINITY; 3];
+        let step = bounded_least_squares(&ata, &atb, &[true; 3], &unbounded, &[f64::INFINITY; 3]);
+        assert_eq!(step[1], 0.0, "{step:?}");
+        assert!((step[0] - 2.0).abs() < 1e-9 && (step[2] + 1.0).abs() < 1e-9, "{step:?}");
+    }
+
+    #[test]
+    fn a_step_past_a_bound_stops_at_the_bound_and_the_rest_is_solved_again() {
+        // Coupled terms: unbounded, the steps are (1, 1); with the first held at most 0.5 the
+        // second solves 0.5 + 2 x1 = 3, so x1 = 1.25.
+        let ata = vec![vec![2.0, 1.0], vec![1.0, 2.0]];
+        let atb = vec![3.0, 3.0];
+        let step = bounded_least_squares(&ata, &atb, &[true; 2], &[f64::NEG_INFINITY; 2], &[0.5, f64::INFINITY]);
+        assert!(
+            (step[0] - 0.5).abs() < 1e-12 && (step[1] - 1.25).abs() < 1e-9,
+            "{step:?}"
+        );
+    }
 }
