@@ -356,17 +356,23 @@ fn command_terms(x: &[f64]) -> (Vec<Term>, Vec<(&'static str, f64)>) {
         let yn = variable_name(&format!("command_curve_y_{}", k + 1));
         settings.push((xn, x[k]));
         settings.push((yn, x[k]));
-        terms.push(Term {
-            name: yn,
-            unit: "V",
-            mechanism: Mechanism::Parameter(yn),
-            neutral: x[k],
-            step: 0.02,
-            lower: -100.0,
-            upper: 100.0,
-        });
+        terms.push(command_value_term(k, x[k]));
     }
     (terms, settings)
+}
+
+/// The term of the command curve's knot `k` (from 0) value, starting at `start`.
+fn command_value_term(k: usize, start: f64) -> Term {
+    let name = variable_name(&format!("command_curve_y_{}", k + 1));
+    Term {
+        name,
+        unit: "V",
+        mechanism: Mechanism::Parameter(name),
+        neutral: start,
+        step: 0.02,
+        lower: -100.0,
+        upper: 100.0,
+    }
 }
 
 /// Whether a candidate is the command's curve.
@@ -600,19 +606,7 @@ pub fn command_curve_with_free_knots(set: &[(&'static str, f64)]) -> Option<Cand
         x.push(get(&format!("command_curve_x_{k}"))?);
         y.push(get(&format!("command_curve_y_{k}"))?);
     }
-    let mut terms = vec![];
-    for k in 0..n {
-        let name = variable_name(&format!("command_curve_y_{}", k + 1));
-        terms.push(Term {
-            name,
-            unit: "V",
-            mechanism: Mechanism::Parameter(name),
-            neutral: y[k],
-            step: 0.02,
-            lower: -100.0,
-            upper: 100.0,
-        });
-    }
+    let mut terms: Vec<Term> = (0..n).map(|k| command_value_term(k, y[k])).collect();
     for k in 1..n - 1 {
         let name = variable_name(&format!("command_curve_x_{}", k + 1));
         let (below, above) = (x[k] - x[k - 1], x[k + 1] - x[k]);

@@ -14,6 +14,8 @@ const COARSE_GOLDEN_STEPS: usize = 10;
 /// ranking and the shape searches, then the leaders' refinement.
 const COARSE_GRID: usize = 5;
 const FINE_GRID: usize = 9;
+/// Steps along a Gauss–Newton direction tried on the true model, each half the last.
+const LINE_SEARCH_STEPS: usize = 4;
 /// The dampings λ a damped fit tries, in turn, when no step along the Gauss–Newton
 /// direction lowers the misfit.
 const MARQUARDT_DAMPINGS: [f64; 4] = [0.01, 0.1, 1.0, 100.0];
@@ -236,6 +238,11 @@ fn single(column: Vec<f64>) -> Vec<f32> {
     column.into_iter().map(|v| v as f32).collect()
 }
 
+/// A column of a [`Sensitivity`] by finite difference: (`moved` − `at`) / `step`.
+fn divided_difference(moved: &[f64], at: &[f64], step: f64) -> Vec<f32> {
+    moved.iter().zip(at).map(|(x, y)| ((x - y) / step) as f32).collect()
+}
+
 /// Everything needed at one point of a candidate's terms.
 struct Point {
     values: Vec<f64>,
@@ -327,8 +334,11 @@ impl Problem<'_> {
         set_parameter(&mut p, name, value + step).ok()?;
         let model = Actuator::new(p).ok()?;
         let moved = replay_fast(&model, self.recording, self.recording.len()).ok()?;
-        let d = |a: &[f64], b: &[f64]| -> Vec<f32> { a.iter().zip(b).map(|(x, y)| ((x - y) / step) as f32).collect() };
-        Some([d(&moved.force, &at.force), d(&moved.p1, &at.p1), d(&moved.p2, &at.p2)])
+        Some([
+            divided_difference(&moved.force, &at.force, step),
+            divided_difference(&moved.p1, &at.p1, step),
+            divided_difference(&moved.p2, &at.p2, step),
+        ])
     }
 
     /// Fit a candidate: bounded Gauss–Newton from its neutral values, at most `iterations`
@@ -426,13 +436,10 @@ impl Problem<'_> {
                 let mut moved = point.values.clone();
                 moved[j] += step;
                 self.replay(candidate, &moved).ok().map(|r| {
-                    let d = |a: &[f64], b: &[f64]| -> Vec<f32> {
-                        a.iter().zip(b).map(|(x, y)| ((x - y) / step) as f32).collect()
-                    };
                     [
-                        d(&r.force, &point.replay.force),
-                        d(&r.p1, &point.replay.p1),
-                        d(&r.p2, &point.replay.p2),
+                        divided_difference(&r.force, &point.replay.force, step),
+                        divided_difference(&r.p1, &point.replay.p1, step),
+                        divided_difference(&r.p2, &point.replay.p2, step),
                     ]
                 })
             });
@@ -472,15 +479,19 @@ impl Problem<'_> {
             let mut accepted = false;
             let mut alpha = 1.0;
             let mut step = step;
-            let tries = if damped { 4 + MARQUARDT_DAMPINGS.len() } else { 4 };
+            let tries = if damped {
+                LINE_SEARCH_STEPS + MARQUARDT_DAMPINGS.len()
+            } else {
+                LINE_SEARCH_STEPS
+            };
             for attempt in 0..tries {
-                if attempt >= 4 {
+                if attempt >= LINE_SEARCH_STEPS {
                     step = self.solve(
                         terms,
                         &point.values,
                         &columns,
                         &prediction,
-                        MARQUARDT_DAMPINGS[attempt - 4],
+                        MARQUARDT_DAMPINGS[attempt - LINE_SEARCH_STEPS],
                     );
                     alpha = 1.0;
                 }
