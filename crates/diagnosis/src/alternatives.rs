@@ -36,7 +36,11 @@ pub(crate) fn judge(
     let with = replay_fast(&Actuator::new(params.clone())?, cx.recording, cx.n)?;
     *replays += 1;
     let (_, heldout) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
-    let force = rms_where(&difference(&cx.recording.force, &with.force), &cx.training, false);
+    let force = rms_where(
+        &difference(&cx.recording.force, &with.force),
+        &cx.blocks,
+        Block::HeldOut,
+    );
     Ok((heldout.iter().sum(), force))
 }
 

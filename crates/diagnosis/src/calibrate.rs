@@ -11,6 +11,7 @@ use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
 use super::corrections::{parameter_value, set_parameter};
+use crate::blocks::Block;
 
 pub const NAMES: [&str; 4] = ["x_jp_offset", "C_d", "C_dm_A_lpp", "C_db_A_lpp"];
 const SCALES: [f64; 4] = [1e-4, 0.1, 0.05e-6, 0.05e-6];
@@ -99,16 +100,18 @@ fn fit(recording: &Recording, base: &Parameters, rows: &[bool]) -> [f64; 4] {
 }
 
 /// Calibrate on the training blocks; check the values on halves of them.
-pub fn calibrate(recording: &Recording, base: &Parameters, training: &[bool]) -> (Parameters, Vec<Calibrated>) {
+pub fn calibrate(recording: &Recording, base: &Parameters, blocks: &[Block]) -> (Parameters, Vec<Calibrated>) {
     let thesis = Parameters::default();
     let n = recording.len();
     let mid_time = 0.5 * (recording.time[0] + recording.time[n - 1]);
     let mut commands = recording.v_da.clone();
     let mid = commands.len() / 2;
     let median_command = *commands.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
-    let subset = |keep: &dyn Fn(usize) -> bool| -> Vec<bool> { (0..n).map(|k| training[k] && keep(k)).collect() };
+    let subset = |keep: &dyn Fn(usize) -> bool| -> Vec<bool> {
+        (0..n).map(|k| blocks[k] == Block::Training && keep(k)).collect()
+    };
     let rows = [
-        training.to_vec(),
+        subset(&|_| true),
         subset(&|k| recording.time[k] < mid_time),
         subset(&|k| recording.time[k] >= mid_time),
         subset(&|k| recording.v_da[k] < median_command),

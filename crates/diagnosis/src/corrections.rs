@@ -128,8 +128,8 @@ pub enum Mechanism {
     /// An FMU parameter of the model.
     Parameter(&'static str),
     /// An FMU parameter whose effect is not smooth from its neutral value (an orifice that
-    /// is off at 0 area and at an infinite one): found by a search over its range on a
-    /// logarithmic scale.
+    /// is off at 0 area and at an infinite one), or nearly flat there (a corner frequency far
+    /// above the signals'): found by a search over its range on a logarithmic scale.
     Searched(&'static str),
     /// A first-order lag (time constant, s) on the command the current driver sees.
     CommandLag,

@@ -31,6 +31,7 @@
 //!   flat stretch inside a dead zone, otherwise the largest departure from the identity and
 //!   where it is.
 
+use crate::blocks::Block;
 use crate::corrections::{Candidate, Mechanism, Regressor, Term};
 use crate::signals::{CHANNELS, FORCE, P1, P2};
 use jetpipe_model::physics::parameters::Parameters;
@@ -195,9 +196,9 @@ fn misfit(knots: &[f64], x: &[f64], y: &[f64], scale: &[f64]) -> f64 {
 /// its 1/64 quantiles lowers the least-squares misfit most, then each interior knot moved
 /// between its neighbours to where the curve fits best (two sweeps). At most 5000 samples
 /// are used, evenly spread.
-pub fn placed_knots(own: &[f64], measured: &[f64], training: &[bool], n: usize) -> Vec<f64> {
+pub fn placed_knots(own: &[f64], measured: &[f64], blocks: &[Block], n: usize) -> Vec<f64> {
     let ones = vec![1.0; own.len()];
-    placed(own, measured, &ones, training, n)
+    placed(own, measured, &ones, blocks, n)
 }
 
 /// Knots for the command's curve: `residual` (the measured force minus the model's) taken
@@ -207,15 +208,17 @@ pub fn placed_command_knots(
     v_da: &[f64],
     residual: &[f64],
     sensitivity: &[f64],
-    training: &[bool],
+    blocks: &[Block],
     n: usize,
 ) -> Vec<f64> {
-    placed(v_da, residual, sensitivity, training, n)
+    placed(v_da, residual, sensitivity, blocks, n)
 }
 
-fn placed(x_all: &[f64], y_all: &[f64], s_all: &[f64], training: &[bool], n: usize) -> Vec<f64> {
+fn placed(x_all: &[f64], y_all: &[f64], s_all: &[f64], blocks: &[Block], n: usize) -> Vec<f64> {
     let picked: Vec<usize> = (0..x_all.len().min(y_all.len()).min(s_all.len()))
-        .filter(|&k| training[k] && x_all[k].is_finite() && y_all[k].is_finite() && s_all[k].is_finite())
+        .filter(|&k| {
+            blocks[k] == Block::Training && x_all[k].is_finite() && y_all[k].is_finite() && s_all[k].is_finite()
+        })
         .collect();
     let stride = (picked.len() / 5000).max(1);
     let x: Vec<f64> = picked.iter().step_by(stride).map(|&k| x_all[k]).collect();
@@ -789,7 +792,7 @@ mod tests {
         // A reading that follows its quantity to 85 and stays there; the quantity 0..100.
         let x: Vec<f64> = (0..4000).map(|k| 100.0 * k as f64 / 3999.0).collect();
         let y: Vec<f64> = x.iter().map(|v| v.min(85.0)).collect();
-        let knots = placed_knots(&x, &y, &vec![true; x.len()], SENSOR_KNOTS);
+        let knots = placed_knots(&x, &y, &vec![Block::Training; x.len()], SENSOR_KNOTS);
         assert!(
             knots.iter().any(|k| (k - 85.0).abs() < 0.2),
             "no knot at the corner: {knots:?}"

@@ -79,8 +79,8 @@ pub(crate) fn drop_redundant(
         if all.len() < 2 {
             return Ok(removed_any);
         }
-        let problem = Problem::new(cx.recording, &f.params, &cx.training, cx.channel_noise);
-        let count = heldout_count(&cx.training) as f64;
+        let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
+        let count = heldout_count(&cx.blocks) as f64;
         let penalty = discovery_penalty_per_term(count);
         let (misfit, force) = alternatives::judge(cx, &problem, &f.params, replays)?;
         // The newest addition has just earned its place.
@@ -144,7 +144,7 @@ pub(crate) fn attribute_from_joint_fit(
     if all.len() < 2 {
         return Ok(());
     }
-    let problem = Problem::new(cx.recording, &f.params, &cx.training, cx.channel_noise);
+    let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
     let (_, after) = alternatives::judge(cx, &problem, &f.params, replays)?;
     progress("each addition's share, from the joint fit");
     for which in all {

@@ -19,6 +19,7 @@
 //! through the model (crate `jetpipe-model`).
 
 mod alternatives;
+pub mod blocks;
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;
@@ -44,6 +45,7 @@ use crate::replay::{replay, replay_fast, Replay};
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
+use blocks::{count, Block};
 use calibrate::Calibrated;
 use corrections::{catalogue, parameter_value, set_parameter, Candidate, Fit, Mechanism, Problem, Sensitivity, Term};
 use signals::{difference, force_from_pressures, rms, rms_where, ChainSignals, CHANNELS, CHANNEL_NAMES, FORCE};
@@ -93,15 +95,7 @@ pub struct Errors {
     pub pressure_rms: Option<[f64; 2]>,
 }
 
-/// Training samples: those in even-numbered blocks.
-pub fn training_mask(time: &[f64]) -> Vec<bool> {
-    let t0 = time.first().copied().unwrap_or(0.0);
-    time.iter()
-        .map(|t| ((t - t0) / BLOCK_SECONDS).floor() as i64 % 2 == 0)
-        .collect()
-}
-
-fn errors(model: &Replay, recording: &Recording, mask: &[bool]) -> Errors {
+fn errors(model: &Replay, recording: &Recording, blocks: &[Block]) -> Errors {
     let residual = difference(&recording.force, &model.force);
     let (lo, hi) = recording
         .force
@@ -111,8 +105,8 @@ fn errors(model: &Replay, recording: &Recording, mask: &[bool]) -> Errors {
     Errors {
         rms: total,
         nrmse: if hi > lo { total / (hi - lo) } else { 0.0 },
-        train_rms: rms_where(&residual, mask, true),
-        heldout_rms: rms_where(&residual, mask, false),
+        train_rms: rms_where(&residual, blocks, Block::Training),
+        heldout_rms: rms_where(&residual, blocks, Block::HeldOut),
         pressure_rms: match (&recording.p1, &recording.p2) {
             (Some(p1), Some(p2)) => Some([rms(&difference(p1, &model.p1)), rms(&difference(p2, &model.p2))]),
             _ => None,
@@ -294,6 +288,9 @@ pub struct Diagnosis {
     pub input_checks: Vec<String>,
     pub before: Errors,
     pub after: Errors,
+    /// The seconds at the start in which the model's starting state still shows: neither
+    /// fitted nor scored ([`blocks`]).
+    pub settling: f64,
     pub calibrated: Vec<Calibrated>,
     pub effects: Vec<AddedEffect>,
     pub discovered: Vec<DiscoveredTerm>,
@@ -334,9 +331,20 @@ fn pressure_split(
     replay: &Replay,
     noise: f64,
     pressure_noise: [f64; 2],
+    blocks: &[Block],
 ) -> Option<PressureSplit> {
     let from_pressures = force_from_pressures(model, recording)?;
     let (p1, p2) = (recording.p1.as_ref()?, recording.p2.as_ref()?);
+    // Over the samples after the start, where the model's starting state has faded.
+    let rms = |x: &[f64]| {
+        let kept: Vec<f64> = x
+            .iter()
+            .zip(blocks)
+            .filter(|(_, &b)| b != Block::Settling)
+            .map(|(v, _)| *v)
+            .collect();
+        rms(&kept)
+    };
     let mechanical = rms(&difference(&recording.force, &from_pressures));
     let area = model.piston_area;
     let mechanical_noise =
@@ -437,7 +445,7 @@ fn named_signature(
     recording: &Recording,
     model: &Actuator,
     replay: &Replay,
-    training: &[bool],
+    blocks: &[Block],
     noise: f64,
     mechanical_noise: f64,
 ) -> named::SignatureTest {
@@ -449,7 +457,7 @@ fn named_signature(
         None => (force_residual.clone(), replay.force.clone(), noise),
     };
     match name {
-        "sensor_offset_gain" => named::sensor_is_affine(&residual, &reference, training, judged_noise),
+        "sensor_offset_gain" => named::sensor_is_affine(&residual, &reference, blocks, judged_noise),
         "piston_friction" => named::friction_changes_sign(&residual, recording, judged_noise),
         "jet_pipe_hysteresis" => named::loop_with_command_direction(&force_residual, recording, noise),
         _ => named::SignatureTest {
@@ -482,7 +490,10 @@ struct Context<'a> {
     /// Every sample: the noise floors and the errors reported are its.
     full: &'a Recording,
     options: &'a Options,
-    training: Vec<bool>,
+    /// What each of the fits' rows is for.
+    blocks: Vec<Block>,
+    /// From when (s) the model's starting state no longer shows.
+    settled_from: f64,
     n: usize,
     noise: f64,
     pressure_noise: Option<[f64; 2]>,
@@ -492,16 +503,16 @@ struct Context<'a> {
 }
 
 impl<'a> Context<'a> {
-    /// Estimate the channels' noise floors (step 1); a force channel rounded coarser than
-    /// its noise gets a line in `input_checks`.
+    /// Estimate the channels' noise floors (step 1), and how long `model`'s starting state
+    /// shows; a force channel rounded coarser than its noise gets a line in `input_checks`.
     fn measure(
         full: &'a Recording,
         recording: &'a Recording,
+        model: &Actuator,
         options: &'a Options,
         input_checks: &mut Vec<String>,
         progress: &mut dyn FnMut(&str),
-    ) -> Self {
-        let training = training_mask(&recording.time);
+    ) -> Result<Self, String> {
         let n = recording.len();
         // The noise floors from every sample. A sharp line (a pick-up) is a departure to
         // find, not noise.
@@ -539,17 +550,26 @@ impl<'a> Context<'a> {
             channel_noise[1] = p[0];
             channel_noise[2] = p[1];
         }
-        Self {
+        let settled_from = blocks::settling_time(model, recording, channel_noise)?;
+        let t0 = recording.time[0];
+        if settled_from > t0 {
+            progress(&format!(
+                "the model's starting state shows until {:.2} s: the samples before are neither fitted nor scored",
+                settled_from - t0
+            ));
+        }
+        Ok(Self {
             recording,
             full,
             options,
-            training,
+            blocks: blocks::blocks(&recording.time, settled_from),
+            settled_from,
             n,
             noise,
             pressure_noise,
             channel_noise,
             mechanical_noise: noise,
-        }
+        })
     }
 
     /// The force against the pressures carries the pressures' noise through the piston area.
@@ -574,8 +594,8 @@ pub fn diagnose_with(
     let mut input_checks = checks::check_file(recording, base)?;
     let smoothed = recording.with_stopper_smoothed();
     let fitted = smoothed.rows_for_fits(recording::MAX_FIT_ROWS);
-    let cx = Context::measure(&smoothed, &fitted, options, &mut input_checks, progress);
     let before_model = Actuator::new(base.clone())?;
+    let cx = Context::measure(&smoothed, &fitted, &before_model, options, &mut input_checks, progress)?;
     let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
     input_checks.extend(checks::check_against_model(
         cx.recording,
@@ -610,7 +630,7 @@ pub fn diagnose_with(
 /// Re-identify what the thesis identified from static loops (§3.3.1).
 fn calibrate_static(cx: &Context, base: &Parameters, progress: &mut dyn FnMut(&str)) -> (Parameters, Vec<Calibrated>) {
     progress("calibration: x_jp_offset, C_d and the leakage (§3.3.1), on the whole and on halves");
-    let (params, calibrated) = calibrate::calibrate(cx.recording, base, &cx.training);
+    let (params, calibrated) = calibrate::calibrate(cx.recording, base, &cx.blocks);
     for c in &calibrated {
         progress(&format!(
             "  {} = {:.4e} (thesis {:.4e}){}",
@@ -675,11 +695,15 @@ pub(crate) fn refit_jointly(
         .filter(|name| !name.ends_with("_curve_knots") && !name.contains("_curve_x_"))
         .collect();
     progress(&format!("joint refit of the {} parameters added", names.len()));
-    let problem = Problem::new(recording, params, &cx.training, cx.channel_noise);
+    let problem = Problem::new(recording, params, &cx.blocks, cx.channel_noise);
     problem.set_jobs(cx.options.jobs);
     let candidate = joint_candidate(params, &names);
     let current = replay_fast(&Actuator::new(params.clone())?, recording, n)?;
-    let before_joint = rms_where(&difference(&recording.force, &current.force), &cx.training, false);
+    let before_joint = rms_where(
+        &difference(&recording.force, &current.force),
+        &cx.blocks,
+        Block::HeldOut,
+    );
     let step_of = |name: &'static str| candidate.terms.iter().find(|t| t.name == name).map_or(0.0, |t| t.step);
     let sensitivities = |name: &'static str| problem.sensitivity(name, step_of(name), &current);
     let Ok(fit) = problem.fit(&candidate, 3, &current, &sensitivities) else {
@@ -697,7 +721,7 @@ pub(crate) fn refit_jointly(
     }
     let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
     *replays += 1;
-    let after_joint = rms_where(&difference(&recording.force, &with.force), &cx.training, false);
+    let after_joint = rms_where(&difference(&recording.force, &with.force), &cx.blocks, Block::HeldOut);
     progress(&format!(
         "  held-out force error {before_joint:.4} -> {after_joint:.4} N"
     ));
@@ -767,15 +791,15 @@ fn conclude(
     });
     let (before, after) = (before?, after?);
     let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
-    let full_training = match thinned {
-        Some(_) => training_mask(&full.time),
-        None => cx.training.clone(),
+    let full_blocks = match thinned {
+        Some(_) => blocks::blocks(&full.time, cx.settled_from),
+        None => cx.blocks.clone(),
     };
-    let training = &full_training;
-    let after_errors = errors(&after, full, training);
+    let blocks = &full_blocks;
+    let after_errors = errors(&after, full, blocks);
     let split = cx
         .pressure_noise
-        .and_then(|pn| pressure_split(&final_model, full, &after, noise, pn));
+        .and_then(|pn| pressure_split(&final_model, full, &after, noise, pn, blocks));
     // What the remainder follows, on the fits' rows.
     let after_at_rows = thinned.map(|rows| after.at_rows(rows));
     let after_rows = after_at_rows.as_ref().unwrap_or(&after);
@@ -800,8 +824,8 @@ fn conclude(
         .force
         .iter()
         .zip(&after.force)
-        .zip(training)
-        .filter(|(_, &m)| !m)
+        .zip(blocks)
+        .filter(|(_, &b)| b == Block::HeldOut)
         .map(|((f, a), _)| f - a)
         .collect();
     let (ljung_box, lag1) = whiteness(&heldout_residual, 20);
@@ -814,8 +838,9 @@ fn conclude(
         noise_floor: noise,
         pressure_noise: cx.pressure_noise,
         input_checks,
-        before: errors(&before, full, training),
+        before: errors(&before, full, blocks),
         after: after_errors,
+        settling: cx.settled_from - full.time[0],
         calibrated,
         effects: found.effects,
         discovered: found.discovered,

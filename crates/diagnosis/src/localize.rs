@@ -71,8 +71,8 @@ pub(crate) fn parallel_map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl F
     out.into_iter().map(|(_, r)| r).collect()
 }
 
-pub(crate) fn heldout_count(training: &[bool]) -> usize {
-    training.iter().filter(|t| !**t).count().max(1)
+pub(crate) fn heldout_count(blocks: &[Block]) -> usize {
+    count(blocks, Block::HeldOut).max(1)
 }
 
 /// Fit every candidate and rank the places of the chain.
@@ -131,7 +131,7 @@ pub(crate) fn localize(
     let score = |mut fit: Fit| -> Scored {
         let explained = 1.0 - fit.heldout_total() / before_total;
         let residual = difference(&problem.recording.force, &fit.prediction[FORCE]);
-        let force_heldout_rms = rms_where(&residual, problem.training, false);
+        let force_heldout_rms = rms_where(&residual, problem.blocks, Block::HeldOut);
         // Only a named effect's force prediction is read once a candidate is scored (its
         // remainder, when it is added): the other series would be held for every candidate
         // until the diagnosis ends.

@@ -4,6 +4,7 @@
 
 use super::signals::{command_direction, stopper_velocity};
 use super::signature::BINS;
+use crate::blocks::Block;
 use crate::recording::Recording;
 
 /// What a signature test found.
@@ -13,12 +14,12 @@ pub struct SignatureTest {
 }
 
 /// Held-out RMS of `residual − fit` for least squares on `columns` over the training samples.
-fn heldout_rms_after(residual: &[f64], columns: &[Vec<f64>], training: &[bool]) -> f64 {
+fn heldout_rms_after(residual: &[f64], columns: &[Vec<f64>], blocks: &[Block]) -> f64 {
     let m = columns.len();
     let mut ata = nalgebra::DMatrix::<f64>::zeros(m, m);
     let mut atb = nalgebra::DVector::<f64>::zeros(m);
     for k in 0..residual.len() {
-        if !training[k] {
+        if blocks[k] != Block::Training {
             continue;
         }
         for a in 0..m {
@@ -31,7 +32,7 @@ fn heldout_rms_after(residual: &[f64], columns: &[Vec<f64>], training: &[bool]) 
     let x = ata.lu().solve(&atb).unwrap_or_else(|| nalgebra::DVector::zeros(m));
     let (mut sum, mut n) = (0.0, 0usize);
     for k in 0..residual.len() {
-        if training[k] {
+        if blocks[k] != Block::HeldOut {
             continue;
         }
         let fit: f64 = (0..m).map(|a| x[a] * columns[a][k]).sum();
@@ -43,12 +44,12 @@ fn heldout_rms_after(residual: &[f64], columns: &[Vec<f64>], training: &[bool]) 
 
 /// A sensor offset and gain leave the force and what the pressures (or, without them,
 /// the model) say disagreeing as an affine map: a smooth curve must not do much better.
-pub fn sensor_is_affine(residual: &[f64], reference: &[f64], training: &[bool], noise: f64) -> SignatureTest {
+pub fn sensor_is_affine(residual: &[f64], reference: &[f64], blocks: &[Block], noise: f64) -> SignatureTest {
     let ones = vec![1.0; reference.len()];
     let squares: Vec<f64> = reference.iter().map(|f| f * f).collect();
     let cubes: Vec<f64> = reference.iter().map(|f| f * f * f).collect();
-    let affine = heldout_rms_after(residual, &[ones.clone(), reference.to_vec()], training);
-    let curve = heldout_rms_after(residual, &[ones, reference.to_vec(), squares, cubes], training);
+    let affine = heldout_rms_after(residual, &[ones.clone(), reference.to_vec()], blocks);
+    let curve = heldout_rms_after(residual, &[ones, reference.to_vec(), squares, cubes], blocks);
     let present = affine <= 2.0 * noise || affine - curve <= noise;
     SignatureTest {
         present,

@@ -58,7 +58,7 @@ pub(crate) fn best_pair(
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Option<(Vec<DiscoveredTerm>, Parameters)>, String> {
-    let count = heldout_count(&cx.training) as f64;
+    let count = heldout_count(&cx.blocks) as f64;
     let penalty = discovery_penalty_per_term(count);
     let Some(single) = found.candidates.first() else {
         return Ok(None);
@@ -283,7 +283,11 @@ pub(crate) fn best_pair(
     let (_, heldout) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
     let misfit: f64 = heldout.iter().sum();
     let used = (set_a.len() + set_b.len()).min(a.terms.len() + b.terms.len()) as f64;
-    let after = rms_where(&difference(&cx.recording.force, &with.force), &cx.training, false);
+    let after = rms_where(
+        &difference(&cx.recording.force, &with.force),
+        &cx.blocks,
+        Block::HeldOut,
+    );
     let gain = force_before - after;
     let worse_pressures =
         (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && heldout[c] > 1.05 * heldout_before[c] + count * 0.01);

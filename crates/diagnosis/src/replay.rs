@@ -114,12 +114,26 @@ impl<'a> Drive<'a> {
 /// Simulate `recording` from the equilibrium of its first sample (the bench holds the
 /// first command before t = 0). Samples in `0..end` only.
 pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usize) -> Result<Replay, String> {
+    match recording.v_da.first() {
+        Some(&first) => replay_from(model, recording, tolerance, end, first),
+        None => Ok(Replay::default()),
+    }
+}
+
+/// [`replay`] from the equilibrium of `held`, the command held before the recording.
+fn replay_from(
+    model: &Actuator,
+    recording: &Recording,
+    tolerance: f64,
+    end: usize,
+    held: f64,
+) -> Result<Replay, String> {
     if end.min(recording.len()) == 0 {
         return Ok(Replay::default());
     }
     let drive = Drive::of(recording, end);
     let (time, v_da, x_s) = (drive.time, drive.v_da, drive.x_s);
-    let mut sim = Simulation::at_equilibrium(model.clone(), v_da[0], x_s[0], time[0], tolerance)?;
+    let mut sim = Simulation::at_equilibrium(model.clone(), held, x_s[0], time[0], tolerance)?;
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();
     for k in 0..=drive.last {
@@ -153,14 +167,22 @@ pub const MAX_FAST_STEP: f64 = 1.05e-3;
 /// the accurate replay checks the final figures. Falls back to [`replay`] when the jet pipe
 /// has no modal form.
 pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Result<Replay, String> {
+    match recording.v_da.first() {
+        Some(&first) => replay_fast_from(model, recording, end, first),
+        None => Ok(Replay::default()),
+    }
+}
+
+/// [`replay_fast`] from the equilibrium of `held`, the command held before the recording.
+pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, held: f64) -> Result<Replay, String> {
     if end.min(recording.len()) == 0 {
         return Ok(Replay::default());
     }
     let drive = Drive::of(recording, end);
     let (t, v_da, x_s) = (drive.time, drive.v_da, drive.x_s);
-    let mut sim = match FixedStep::at_equilibrium(model.clone(), v_da[0], x_s[0], t[0])? {
+    let mut sim = match FixedStep::at_equilibrium(model.clone(), held, x_s[0], t[0])? {
         Some(sim) => sim,
-        None => return replay(model, recording, 1e-5, end),
+        None => return replay_from(model, recording, 1e-5, end, held),
     };
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();

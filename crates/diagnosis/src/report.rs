@@ -124,7 +124,11 @@ impl Diagnosis {
             "input_checks": self.input_checks,
             "before": err(&self.before),
             "after": err(&self.after),
-            "heldout": {"before_rms_N": self.before.heldout_rms, "after_rms_N": self.after.heldout_rms},
+            "heldout": {
+                "before_rms_N": self.before.heldout_rms,
+                "after_rms_N": self.after.heldout_rms,
+                "settling_s": self.settling,
+            },
             "effects": self.effects.iter().map(|e| json!({
                 "name": e.name,
                 "location": e.location,

@@ -63,7 +63,7 @@ pub(crate) fn run_rounds(
     // upstream places' scores, as they were.
     let mut reusable: Option<Localization> = None;
     for round in 0..=MAX_EFFECTS {
-        let problem = Problem::new(cx.recording, &f.params, &cx.training, cx.channel_noise);
+        let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
         let Some(r) = replay_round(cx, &problem, &f, round, replays, progress)? else {
             progress("every channel is within its noise on the held-out blocks");
             f.localization = None;
@@ -195,7 +195,7 @@ fn replay_round(
     *replays += 1;
     let prediction = [current.force.clone(), current.p1.clone(), current.p2.clone()];
     let (_, heldout) = problem.errors(&prediction);
-    let count = heldout_count(&cx.training) as f64;
+    let count = heldout_count(&cx.blocks) as f64;
     let misfit: Vec<f64> = (0..CHANNELS)
         .filter(|&c| problem.weights[c] > 0.0)
         .map(|c| (heldout[c] / count).sqrt())
@@ -236,7 +236,7 @@ fn replay_round(
             .collect::<Vec<_>>()
             .join(", ")
     ));
-    let force_before = rms_where(&force_residual, &cx.training, false);
+    let force_before = rms_where(&force_residual, &cx.blocks, Block::HeldOut);
     Ok(Some(Round {
         model,
         current,
@@ -260,7 +260,7 @@ fn curve_knots(cx: &Context, problem: &Problem, current: &Replay) -> crate::curv
             knots.channels[c] = crate::curves::placed_knots(
                 modelled[c],
                 problem.measured[c],
-                &cx.training,
+                &cx.blocks,
                 crate::curves::SENSOR_KNOTS,
             );
         }
@@ -273,7 +273,7 @@ fn curve_knots(cx: &Context, problem: &Problem, current: &Replay) -> crate::curv
             &cx.recording.v_da[..cx.n],
             &residual,
             &per_volt,
-            &cx.training,
+            &cx.blocks,
             crate::curves::COMMAND_KNOTS,
         );
     }
@@ -365,7 +365,7 @@ fn named_at_place(
             cx.recording,
             &r.model,
             &r.current,
-            &cx.training,
+            &cx.blocks,
             noise,
             cx.mechanical_noise,
         );
@@ -402,7 +402,7 @@ fn named_downstream(
     let Some(through) = force_through_mechanics(&r.model, recording) else {
         return Ok(None);
     };
-    let downstream = Problem::new(recording, params, &cx.training, [cx.mechanical_noise, 0.0, 0.0]);
+    let downstream = Problem::new(recording, params, &cx.blocks, [cx.mechanical_noise, 0.0, 0.0]);
     let (_, misfit) = downstream.errors(&[through.force.clone(), vec![], vec![]]);
     if (misfit[FORCE] / count).sqrt() <= EXPLAINED_WITHIN_NOISE {
         return Ok(None);
@@ -432,7 +432,7 @@ fn named_downstream(
         }
         let with = replay_fast(&Actuator::new(trial)?, recording, cx.n)?;
         *replays += 1;
-        let after = rms_where(&difference(&recording.force, &with.force), &cx.training, false);
+        let after = rms_where(&difference(&recording.force, &with.force), &cx.blocks, Block::HeldOut);
         let gain = force_before - after;
         let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * side_share && s.explained >= NAMED_MIN_SHARE;
         let gain_ok = gain >= MIN_RELATIVE_GAIN * force_before && gain >= MIN_GAIN_IN_NOISE * noise;
@@ -441,7 +441,7 @@ fn named_downstream(
             recording,
             &r.model,
             &r.current,
-            &cx.training,
+            &cx.blocks,
             noise,
             cx.mechanical_noise,
         );
@@ -511,7 +511,7 @@ fn discover_term(
         let with = replay_fast(&Actuator::new(trial.clone())?, recording, cx.n)?;
         *replays += 1;
         let residual = difference(&recording.force, &with.force);
-        let after = rms_where(&residual, &cx.training, false);
+        let after = rms_where(&residual, &cx.blocks, Block::HeldOut);
         let gain = force_before - after;
         progress(&format!(
             "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
@@ -567,7 +567,7 @@ fn command_curve_knots_freed(
         }
         replay_fast(&Actuator::new(p)?, cx.recording, cx.n)
     };
-    let training_rms = |r: &Replay| rms_where(&difference(&cx.recording.force, &r.force), &cx.training, true);
+    let training_rms = |r: &Replay| rms_where(&difference(&cx.recording.force, &r.force), &cx.blocks, Block::Training);
     // A set the model refuses is left for the caller's checks to turn down.
     let Ok(start) = replayed(&set) else {
         return set;
@@ -620,7 +620,11 @@ fn pressures_judgement(
     ));
     let rms_pa = |series: [&[f64]; 2]| {
         let measured = [recording.p1.as_deref(), recording.p2.as_deref()];
-        [0, 1].map(|c| measured[c].map_or(0.0, |m| rms_where(&difference(m, series[c]), &cx.training, false)))
+        [0, 1].map(|c| {
+            measured[c].map_or(0.0, |m| {
+                rms_where(&difference(m, series[c]), &cx.blocks, Block::HeldOut)
+            })
+        })
     };
     let better = was - now >= MIN_RELATIVE_GAIN * was
         && was - now >= MIN_GAIN_IN_NOISE

@@ -1,6 +1,7 @@
 //! The recording's channels and the model's, sample by sample: the residuals the
 //! diagnosis works on and the signals along the chain that a residual may follow.
 
+use crate::blocks::Block;
 use crate::recording::Recording;
 use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
@@ -160,11 +161,11 @@ impl ChainSignals {
     }
 }
 
-/// RMS of `x` over the samples where `mask` equals `want`.
-pub fn rms_where(x: &[f64], mask: &[bool], want: bool) -> f64 {
+/// RMS of `x` over the samples of `blocks` that are `which`.
+pub fn rms_where(x: &[f64], blocks: &[Block], which: Block) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
-    for (v, &m) in x.iter().zip(mask) {
-        if m == want {
+    for (v, &b) in x.iter().zip(blocks) {
+        if b == which {
             sum += v * v;
             n += 1;
         }

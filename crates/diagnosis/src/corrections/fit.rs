@@ -2,6 +2,7 @@
 //! sensitivities, golden-section searches for the terms with none, held-out scores.
 
 use super::*;
+use crate::blocks::Block;
 
 /// Golden-section steps of a searched term: its bracket shrinks to 0.618^16 = 5e-4 of its
 /// range (a thousandth of a decade over three), or, for the first pass's ranking, to
@@ -80,8 +81,8 @@ pub(crate) fn golden_from_several(grid: usize, steps: usize, f: &mut dyn FnMut(f
 pub struct Problem<'a> {
     pub recording: &'a Recording,
     pub base: &'a Parameters,
-    /// Training samples (the others are held out).
-    pub training: &'a [bool],
+    /// Which samples are fitted and which held out.
+    pub blocks: &'a [Block],
     /// 1/noise floor of each channel (0 for a channel the recording lacks).
     pub weights: [f64; CHANNELS],
     pub measured: [&'a [f64]; CHANNELS],
@@ -99,7 +100,7 @@ pub struct Problem<'a> {
 }
 
 impl<'a> Problem<'a> {
-    pub fn new(recording: &'a Recording, base: &'a Parameters, training: &'a [bool], noise: [f64; CHANNELS]) -> Self {
+    pub fn new(recording: &'a Recording, base: &'a Parameters, blocks: &'a [Block], noise: [f64; CHANNELS]) -> Self {
         let empty: &[f64] = &[];
         let measured = [
             recording.force.as_slice(),
@@ -117,7 +118,7 @@ impl<'a> Problem<'a> {
         Self {
             recording,
             base,
-            training,
+            blocks,
             weights,
             measured,
             velocity: stopper_velocity(recording),
@@ -317,10 +318,10 @@ impl Problem<'_> {
             }
             for (k, (&m, &y)) in self.measured[c].iter().zip(&prediction[c]).enumerate() {
                 let e = w * (m - y);
-                if self.training[k] {
-                    train[c] += e * e;
-                } else {
-                    heldout[c] += e * e;
+                match self.blocks[k] {
+                    Block::Training => train[c] += e * e,
+                    Block::HeldOut => heldout[c] += e * e,
+                    Block::Settling => {}
                 }
             }
         }
@@ -564,7 +565,7 @@ impl Problem<'_> {
                 continue;
             }
             for k in 0..self.recording.len() {
-                if !self.training[k] {
+                if self.blocks[k] != Block::Training {
                     continue;
                 }
                 let r = self.measured[c][k] - prediction[c][k];

@@ -244,3 +244,105 @@ fn a_fifty_hertz_pickup_under_force_tracking_that_feeds_it_back_into_the_command
     };
     pickup_found("pickup-tracking", &spec, 0.2, 50.0);
 }
+
+/// Under force tracking the controller starts from 2.5 V and the first command logged is
+/// another, so the bench does not start where a replay does: the stretch in which that
+/// shows is neither fitted nor scored. Trained on it, an offset and gain of the force sensor
+/// came out at 1.029 for 1.02 and a 10 ms lag was not found (4.4 and 6.4 noise floors left).
+#[test]
+fn under_force_tracking_the_start_is_left_out_and_a_force_sensors_offset_gain_and_lag_are_found_with_their_values() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::ForceTracking,
+        sample_rate: 500.0,
+        duration: 20.0,
+        force_noise: 0.08,
+        seed: 6,
+        ..ProtocolSpec::default()
+    };
+    let offset_gain = BenchEffects {
+        force_sensor_offset: 0.7,
+        force_sensor_gain: 1.02,
+        ..BenchEffects::default()
+    };
+    let d = diagnosed("tracking-offset-gain", &spec, &offset_gain);
+    assert!(
+        d.settling > 0.5 && d.settling <= 5.0,
+        "settling {} s of a 20 s recording",
+        d.settling
+    );
+    assert_eq!(names(&d), ["sensor_offset_gain"], "{}", d.summary().join(" | "));
+    let get = |name: &str| d.parameters.get(value_reference(name)).unwrap();
+    assert!(
+        (get("force_sensor_offset") - 0.7).abs() < 0.05,
+        "offset {}",
+        get("force_sensor_offset")
+    );
+    assert!(
+        (get("force_sensor_gain") - 1.02).abs() < 0.003,
+        "gain {}",
+        get("force_sensor_gain")
+    );
+    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+
+    let lag = BenchEffects {
+        undeclared: UndeclaredEffects {
+            force_sensor_lag: 0.01,
+            ..UndeclaredEffects::default()
+        },
+        ..BenchEffects::default()
+    };
+    let d = diagnosed("tracking-sensor-lag", &spec, &lag);
+    let found = d
+        .discovered
+        .first()
+        .unwrap_or_else(|| panic!("nothing discovered: {}", d.summary()[0]));
+    assert_eq!(
+        (found.location, found.family),
+        ("force_sensor", "dynamics"),
+        "{}",
+        found.reading
+    );
+    let fitted = d.parameters.get(value_reference("force_sensor_lag")).unwrap();
+    assert!((fitted - 0.01).abs() < 0.001, "lag {fitted} s");
+    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+}
+
+/// An extra 15 ms lag after the jet pipe's static curve, in series with its 1.03 ms corner
+/// (974 rad/s): one lag of their summed time constants, 16.0 ms, is 62.4 rad/s. The corner
+/// is searched on a logarithmic scale; one Gauss–Newton step from 974 rad/s, where the
+/// force barely moves with it, left it behind a current slew limit (7.3 noise floors).
+#[test]
+fn a_fifteen_millisecond_jet_pipe_lag_under_a_staircase_is_found_as_the_jet_pipes_corner_at_the_summed_time_constant() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Staircase,
+        sample_rate: 1000.0,
+        duration: 20.0,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let lag = BenchEffects {
+        undeclared: UndeclaredEffects {
+            jet_pipe_lag: 15e-3,
+            ..UndeclaredEffects::default()
+        },
+        ..BenchEffects::default()
+    };
+    let d = diagnosed("staircase-jet-pipe-lag", &spec, &lag);
+    let found = d
+        .discovered
+        .first()
+        .unwrap_or_else(|| panic!("nothing discovered: {}", d.summary()[0]));
+    assert_eq!(
+        (found.location, found.family),
+        ("jet_pipe", "dynamics"),
+        "{}",
+        found.reading
+    );
+    let corner = d.parameters.get(value_reference("omega_1")).unwrap();
+    let summed = 1.0 / (15e-3 + 1.0 / 973.9);
+    assert!(
+        (corner / summed - 1.0).abs() < 0.1,
+        "omega_1 {corner} rad/s against {summed}"
+    );
+    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+}
