@@ -1,5 +1,5 @@
 //! Which samples the fits train on and which score them: alternate blocks of
-//! [`BLOCK_SECONDS`](crate::BLOCK_SECONDS), after a first stretch in which the model's
+//! [`BLOCK_SECONDS`], after a first stretch in which the model's
 //! unknown starting state still shows.
 //!
 //! A replay starts from the equilibrium of the first recorded command, as if the bench had
@@ -56,11 +56,11 @@ pub fn count(blocks: &[Block], which: Block) -> usize {
 /// mean square, 5 % to its RMS. (A tenth of the floor would cost a 20 s recording under
 /// force tracking a quarter of its samples: the chambers' common pressure forgets its start
 /// slowly, 0.3 of the floor about 3.7 s after the start and 0.1 of it after 5 s.)
-const SETTLED_WITHIN_NOISE: f64 = 0.3;
+pub const SETTLED_WITHIN_NOISE: f64 = 0.3;
 /// The settling stretch is looked for in at most this share of the recording…
-const MOST_OF_THE_SPAN: f64 = 0.25;
+pub const MOST_OF_THE_SPAN: f64 = 0.25;
 /// …and in at most this many seconds.
-const LONGEST_SETTLING: f64 = 10.0;
+pub const LONGEST_SETTLING: f64 = 10.0;
 
 /// The time (s) from which `model`'s starting state no longer shows in its outputs on
 /// `recording`, to within [`SETTLED_WITHIN_NOISE`] of each channel's floor in `noise`
