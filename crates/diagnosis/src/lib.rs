@@ -208,6 +208,31 @@ impl Localization {
             .max_by(|a, b| a.explained.total_cmp(&b.explained))
     }
 
+    /// A clause naming the places that explain nearly as much as the located one
+    /// ([`Localization::alternatives`]), with their shares, for a term added at the located
+    /// place; `None` when there are none. What the recording cannot tell apart is said
+    /// beside what was added.
+    pub fn undecided_beside(&self, has_pressures: bool) -> Option<String> {
+        let others: Vec<String> = self
+            .alternatives()
+            .into_iter()
+            .filter_map(|l| self.by_location.iter().find(|(at, _, _)| *at == l))
+            .map(|(l, e, _)| format!("the {l} ({:.1} %)", 100.0 * e))
+            .collect();
+        if others.is_empty() {
+            return None;
+        }
+        Some(format!(
+            "a correction at {} explains nearly as much, which this recording does not tell apart{}",
+            others.join(" or at "),
+            if has_pressures {
+                ""
+            } else {
+                " (pressure channels would split the chain at the piston)"
+            }
+        ))
+    }
+
     /// Places that explain nearly as much as the best (within 10 % of its share).
     pub fn alternatives(&self) -> Vec<&'static str> {
         let Some(&(_, top, _)) = self.by_location.first() else {

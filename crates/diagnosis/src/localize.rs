@@ -230,3 +230,40 @@ pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
         candidates: scored.to_vec(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::Localization;
+
+    fn located(by_location: Vec<(&'static str, f64, &'static str)>) -> Localization {
+        Localization {
+            location: by_location[0].0,
+            family: "parameter_offset",
+            by_location,
+            candidates: vec![],
+        }
+    }
+
+    #[test]
+    fn places_that_explain_nearly_as_much_are_named_beside_the_term_added() {
+        let l = located(vec![
+            ("force_sensor", 1.0, "force sensor offset and gain"),
+            ("supply", 0.995, "supply pressure"),
+            ("mechanics", 0.5, "viscous friction"),
+        ]);
+        let clause = l.undecided_beside(false).expect("the supply explains as much");
+        assert!(clause.contains("the supply (99.5 %)"), "{clause}");
+        assert!(!clause.contains("mechanics"), "{clause}");
+        assert!(clause.contains("pressure channels"), "{clause}");
+        assert!(!l.undecided_beside(true).unwrap().contains("pressure channels"));
+    }
+
+    #[test]
+    fn a_place_well_ahead_of_the_others_is_added_without_a_doubt() {
+        let l = located(vec![
+            ("force_sensor", 1.0, "force sensor lag"),
+            ("jet_pipe", 0.8, "jet pipe lag"),
+        ]);
+        assert_eq!(l.undecided_beside(true), None);
+    }
+}

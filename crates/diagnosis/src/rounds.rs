@@ -533,7 +533,10 @@ fn discover_term(
                 location: candidate.location,
                 family: crate::curves::family(candidate.family, &set),
                 candidate: candidate.label,
-                reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+                reading: with_undecided(
+                    discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+                    found.undecided_beside(cx.pressure_noise.is_some()),
+                ),
                 parameters: set,
                 heldout_before: force_before,
                 heldout_after: after,
@@ -544,6 +547,14 @@ fn discover_term(
         }
     }
     Ok(None)
+}
+
+/// A discovered term's `reading` (one sentence) with the places it cannot be told apart from.
+fn with_undecided(reading: String, undecided: Option<String>) -> String {
+    match undecided {
+        Some(clause) => format!("{}; {clause}.", reading.trim_end_matches('.')),
+        None => reading,
+    }
 }
 
 /// The command's curve `set` refitted with its interior knots free
@@ -672,6 +683,10 @@ fn add_effect(
         s.force_heldout_rms,
         100.0 * share
     );
+    let evidence = match found.undecided_beside(cx.pressure_noise.is_some()) {
+        Some(clause) if !downstream => format!("{evidence} Beside it, {clause}."),
+        _ => evidence,
+    };
     progress(&format!("adding {name}"));
     Ok(AddedEffect {
         name,
