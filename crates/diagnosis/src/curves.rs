@@ -22,6 +22,10 @@
 //!   where the model needs them (a ±0.4 V dead zone under a sine at 500 Hz: 1.36 N of force
 //!   left on the training blocks with the proxy's knots, 0.049 N with them freed, the noise
 //!   floor 0.049 N).
+//! * **Unvisited stretches.** Where the training samples cover less than half of the
+//!   stretch between two knots of a channel's curve, the stretch's upper knot moves to where
+//!   its neighbours' lines meet, unless the held-out samples there fit the chord better
+//!   ([`corners_across_unvisited`]).
 //! * **Monotone.** A transducer's reading and the command the driver sees do not fall as
 //!   their input rises: on a channel the curve is fitted as an offset and non-negative
 //!   increments over the segments (bounded least squares); the command's knot values are
@@ -556,6 +560,133 @@ pub fn channel_model_terms(
     (!set.is_empty()).then_some(set)
 }
 
+/// A stretch between two knots of a channel's curve that the training samples visit over
+/// less than this share of its width is decided by its ends alone: the chord between them is
+/// a slope that no sample supports.
+pub const VISITED_SHARE: f64 = 0.5;
+
+/// Each channel curve in `set` with its chords across stretches the training samples leave
+/// unvisited ([`VISITED_SHARE`]) replaced by the corner where the lines of the stretches on
+/// either side meet: the curve keeps the shape the data show on each side up to where they
+/// cross, instead of a slope of its own. A transducer saturating at 450 kPa under force
+/// tracking, whose training blocks hold the model's P1 up to 437 kPa and then only above
+/// 470 kPa, got a chord from 431 to 470 kPa that read the held-out blocks' rise into the
+/// saturation 14 noise floors off. Each side's line is the secant over up to two segments
+/// (one short segment's slope is noisy). The held-out samples over the stretch and the next
+/// one choose between the corner and the chord (the corner when none lie there).
+///
+/// `quantities` holds the model's reading of each channel in the curve's coordinates, at
+/// every sample; `measured`, the recording's (empty for a channel it lacks).
+pub fn corners_across_unvisited(
+    set: &mut Vec<(&'static str, f64)>,
+    quantities: [&[f64]; CHANNELS],
+    measured: [&[f64]; CHANNELS],
+    blocks: &[Block],
+) {
+    for channel in [FORCE, P1, P2] {
+        let prefix = channel_prefix(channel);
+        let get = |set: &[(&'static str, f64)], name: &str| set.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
+        let Some(n) = get(set, &format!("{prefix}_knots")) else {
+            continue;
+        };
+        let n = n as usize;
+        let (q, m) = (quantities[channel], measured[channel]);
+        if n < 4 || q.is_empty() || m.len() != q.len() {
+            continue;
+        }
+        let (Some(x), Some(y)): (Option<Vec<f64>>, Option<Vec<f64>>) = (
+            (1..=n).map(|k| get(set, &format!("{prefix}_x_{k}"))).collect(),
+            (1..=n).map(|k| get(set, &format!("{prefix}_y_{k}"))).collect(),
+        ) else {
+            continue;
+        };
+        let samples = |which: Block| -> Vec<(f64, f64)> {
+            (0..q.len())
+                .filter(|&k| blocks[k] == which && q[k].is_finite() && m[k].is_finite())
+                .map(|k| (q[k], m[k]))
+                .collect()
+        };
+        let (x, y, changed) = cornered(x, y, &samples(Block::Training), &samples(Block::HeldOut));
+        if !changed {
+            continue;
+        }
+        set.retain(|(name, _)| {
+            !name.starts_with(&format!("{prefix}_x_")) && !name.starts_with(&format!("{prefix}_y_"))
+        });
+        for (name, value) in set.iter_mut() {
+            if *name == format!("{prefix}_knots") {
+                *value = x.len() as f64;
+            }
+        }
+        for (k, (&xk, &yk)) in x.iter().zip(&y).enumerate() {
+            set.push((variable_name(&format!("{prefix}_x_{}", k + 1)), xk));
+            set.push((variable_name(&format!("{prefix}_y_{}", k + 1)), yk));
+        }
+    }
+}
+
+/// The knots `x`, `y` with every chord across a stretch that `training` (quantity,
+/// measured) visits over less than [`VISITED_SHARE`] of its width replaced by its
+/// neighbours' corner (the stretch's upper knot moved there), unless `held_out` fits the
+/// chord better; and whether any was.
+fn cornered(
+    mut x: Vec<f64>,
+    mut y: Vec<f64>,
+    training: &[(f64, f64)],
+    held_out: &[(f64, f64)],
+) -> (Vec<f64>, Vec<f64>, bool) {
+    let mut changed = false;
+    let mut j = 1;
+    while j + 2 < x.len() {
+        let inside: Vec<(f64, f64)> = training
+            .iter()
+            .copied()
+            .filter(|&(q, _)| q >= x[j] && q <= x[j + 1])
+            .collect();
+        let (lo, hi) = inside
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &(q, _)| {
+                (a.min(q), b.max(q))
+            });
+        let seen = if inside.is_empty() { 0.0 } else { hi - lo };
+        if seen >= VISITED_SHARE * (x[j + 1] - x[j]) {
+            j += 1;
+            continue;
+        }
+        let back = j.saturating_sub(2);
+        let ahead = (j + 3).min(x.len() - 1);
+        let left = (y[j] - y[back]) / (x[j] - x[back]);
+        let right = (y[ahead] - y[j + 1]) / (x[ahead] - x[j + 1]);
+        let corner = (y[j + 1] - y[j] + left * x[j] - right * x[j + 1]) / (left - right);
+        if !(corner > x[j] && corner < x[j + 1]) {
+            j += 1;
+            continue;
+        }
+        let at_corner = y[j] + left * (corner - x[j]);
+        let chord = StaticCurve::through(&x, &y);
+        let mut cx = x.clone();
+        let mut cy = y.clone();
+        cx[j + 1] = corner;
+        cy[j + 1] = at_corner;
+        let bent = StaticCurve::through(&cx, &cy);
+        let (from, to) = (x[j], x[j + 2]);
+        let misfit = |c: &StaticCurve| {
+            held_out
+                .iter()
+                .filter(|&&(q, _)| q >= from && q <= to)
+                .map(|&(q, m)| (m - c.at(q)).powi(2))
+                .sum::<f64>()
+        };
+        if misfit(&bent) <= misfit(&chord) {
+            x = cx;
+            y = cy;
+            changed = true;
+        }
+        j += 1;
+    }
+    (x, y, changed)
+}
+
 /// Make the command curve's knot values in `set` non-decreasing: adjacent knots that fall
 /// are pooled to their mean (pool-adjacent-violators), the least-squares non-decreasing
 /// sequence, where a running maximum would lift a whole stretch to one noisy high knot.
@@ -786,6 +917,72 @@ pub fn reading(set: &[(&'static str, f64)]) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A reading that follows its quantity to 40 and stays there, fitted with a chord from
+    /// (26, 26) to (41.5, 40) because no training sample lies between 27 and 85.
+    fn chord_across_a_saturation() -> (Vec<f64>, Vec<f64>, Vec<(f64, f64)>) {
+        let x = vec![8.0, 17.0, 26.0, 41.5, 90.0];
+        let y = vec![8.0, 17.0, 26.0, 40.0, 40.0];
+        let training: Vec<(f64, f64)> = (0..400)
+            .map(|k| {
+                let q = if k < 200 {
+                    8.0 + 19.0 * k as f64 / 199.0
+                } else {
+                    85.0 + 5.0 * (k - 200) as f64 / 199.0
+                };
+                (q, q.min(40.0))
+            })
+            .collect();
+        (x, y, training)
+    }
+
+    #[test]
+    fn a_chord_across_a_stretch_no_training_sample_visits_becomes_its_neighbours_corner_when_the_held_out_samples_agree(
+    ) {
+        let (x, y, training) = chord_across_a_saturation();
+        let held_out: Vec<(f64, f64)> = (0..100)
+            .map(|k| 27.0 + 0.2 * k as f64)
+            .map(|q| (q, q.min(40.0)))
+            .collect();
+        let (x2, y2, changed) = cornered(x, y, &training, &held_out);
+        assert!(changed);
+        let curve = StaticCurve::through(&x2, &y2);
+        // The identity up to the corner at 40, flat beyond it.
+        for q in [30.0, 35.0, 39.5, 45.0, 60.0] {
+            assert!(
+                (curve.at(q) - q.min(40.0)).abs() < 0.05,
+                "{q}: {} ({x2:?}, {y2:?})",
+                curve.at(q)
+            );
+        }
+    }
+
+    #[test]
+    fn held_out_samples_that_follow_the_chord_keep_it() {
+        let (x, y, training) = chord_across_a_saturation();
+        let chord = StaticCurve::through(&x, &y);
+        let held_out: Vec<(f64, f64)> = (0..100)
+            .map(|k| 27.0 + 0.2 * k as f64)
+            .map(|q| (q, chord.at(q)))
+            .collect();
+        let (x2, y2, changed) = cornered(x.clone(), y.clone(), &training, &held_out);
+        assert!(!changed);
+        assert_eq!((x2, y2), (x, y));
+    }
+
+    #[test]
+    fn a_stretch_the_training_samples_cover_keeps_its_chord() {
+        let (x, y, _) = chord_across_a_saturation();
+        let training: Vec<(f64, f64)> = (0..400)
+            .map(|k| 8.0 + 82.0 * k as f64 / 399.0)
+            .map(|q| (q, q.min(40.0)))
+            .collect();
+        let held_out: Vec<(f64, f64)> = (0..100)
+            .map(|k| 27.0 + 0.2 * k as f64)
+            .map(|q| (q, q.min(40.0)))
+            .collect();
+        assert!(!cornered(x, y, &training, &held_out).2);
+    }
 
     #[test]
     fn knots_placed_on_a_saturated_reading_put_one_on_its_corner() {

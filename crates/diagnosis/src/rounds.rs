@@ -500,6 +500,24 @@ fn discover_term(
         if crate::curves::is_command_curve(&s.fit.candidate) {
             set = command_curve_knots_freed(cx, problem, params, set, replays, progress);
         }
+        if crate::curves::is_channel_curve(&s.fit.candidate) {
+            // The curve's coordinates are the quantity the transducer reads: its reading
+            // with the transducer's offset and gain taken off.
+            let p = params;
+            let unread =
+                |reading: &[f64], o: f64, g: f64| -> Vec<f64> { reading.iter().map(|v| (v - o) / g).collect() };
+            let quantities = [
+                unread(&r.current.force, p.force_sensor_offset, p.force_sensor_gain),
+                unread(&r.current.p1, p.p1_sensor_offset, p.p1_sensor_gain),
+                unread(&r.current.p2, p.p2_sensor_offset, p.p2_sensor_gain),
+            ];
+            crate::curves::corners_across_unvisited(
+                &mut set,
+                [&quantities[0], &quantities[1], &quantities[2]],
+                problem.measured,
+                &cx.blocks,
+            );
+        }
         let mut trial = params.clone();
         if set
             .iter()

@@ -247,3 +247,41 @@ fn a_dead_zone_in_the_command_under_a_sine_at_500_hertz_is_a_static_curve_at_the
 fn a_dead_zone_in_the_command_under_a_multisine_at_250_hertz_without_pressures_is_a_static_curve_at_the_command() {
     dead_zone_found("dead-zone-multisine", &spec(CommandProtocol::Multisine, 250.0, false));
 }
+
+/// Under force tracking the controller winds up against a sensor that reads at most 40 N
+/// and the chamber 1 transducer whose range ends at 450 kPa: the training blocks hold the
+/// model's reading below the corner and well beyond it, the held-out blocks the rise between.
+/// The curve's stretch across the corner is its neighbours' corner, not a chord (1.79 noise
+/// floors of force and 14 of P1 were left with the chord).
+#[test]
+fn saturations_whose_corner_only_the_held_out_blocks_cross_under_force_tracking_are_cornered_where_the_reading_meets_the_limit(
+) {
+    let tracking = ProtocolSpec {
+        command: CommandProtocol::ForceTracking,
+        sample_rate: 500.0,
+        duration: 20.0,
+        force_noise: 0.08,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    force_saturation_found("saturation-tracking", &tracking, 40.0);
+    let label = "p1-saturation-tracking";
+    let d = diagnosed(
+        label,
+        &tracking,
+        &undeclared(UndeclaredEffects {
+            pressure_sensor_saturation_1: 450e3,
+            ..UndeclaredEffects::default()
+        }),
+    );
+    let term = only_term(label, &d, "pressure_sensors", "limit");
+    let curve = &d.parameters.p1_sensor_curve;
+    for p in [440e3, 445e3, 455e3, 500e3] {
+        assert!(
+            (curve.at(p) - p.min(450e3)).abs() < 1e3,
+            "{label}: {p} reads {}",
+            curve.at(p)
+        );
+    }
+    pressures_explained(label, &d, term);
+}
