@@ -284,27 +284,41 @@ fn under_force_tracking_the_start_is_left_out_and_a_force_sensors_offset_gain_an
     );
     assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
 
-    let lag = BenchEffects {
-        undeclared: UndeclaredEffects {
-            force_sensor_lag: 0.01,
-            ..UndeclaredEffects::default()
-        },
+    let lag = UndeclaredEffects {
+        force_sensor_lag: 0.01,
+        ..UndeclaredEffects::default()
+    };
+    let fitted = discovered_and_explained(
+        "tracking-sensor-lag",
+        &spec,
+        lag,
+        ("force_sensor", "dynamics"),
+        "force_sensor_lag",
+    );
+    assert!((fitted - 0.01).abs() < 0.001, "lag {fitted} s");
+}
+
+/// Diagnose `undeclared` under `spec`: the first term discovered is at `place` (location,
+/// family), the force is explained; the fitted value of `parameter`.
+fn discovered_and_explained(
+    label: &str,
+    spec: &ProtocolSpec,
+    undeclared: UndeclaredEffects,
+    place: (&str, &str),
+    parameter: &str,
+) -> f64 {
+    let effects = BenchEffects {
+        undeclared,
         ..BenchEffects::default()
     };
-    let d = diagnosed("tracking-sensor-lag", &spec, &lag);
+    let d = diagnosed(label, spec, &effects);
     let found = d
         .discovered
         .first()
-        .unwrap_or_else(|| panic!("nothing discovered: {}", d.summary()[0]));
-    assert_eq!(
-        (found.location, found.family),
-        ("force_sensor", "dynamics"),
-        "{}",
-        found.reading
-    );
-    let fitted = d.parameters.get(value_reference("force_sensor_lag")).unwrap();
-    assert!((fitted - 0.01).abs() < 0.001, "lag {fitted} s");
-    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+        .unwrap_or_else(|| panic!("{label}: nothing discovered: {}", d.summary()[0]));
+    assert_eq!((found.location, found.family), place, "{label}: {}", found.reading);
+    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
+    d.parameters.get(value_reference(parameter)).unwrap()
 }
 
 /// An extra 15 ms lag after the jet pipe's static curve, in series with its 1.03 ms corner
@@ -320,29 +334,20 @@ fn a_fifteen_millisecond_jet_pipe_lag_under_a_staircase_is_found_as_the_jet_pipe
         seed: 5,
         ..ProtocolSpec::default()
     };
-    let lag = BenchEffects {
-        undeclared: UndeclaredEffects {
-            jet_pipe_lag: 15e-3,
-            ..UndeclaredEffects::default()
-        },
-        ..BenchEffects::default()
+    let lag = UndeclaredEffects {
+        jet_pipe_lag: 15e-3,
+        ..UndeclaredEffects::default()
     };
-    let d = diagnosed("staircase-jet-pipe-lag", &spec, &lag);
-    let found = d
-        .discovered
-        .first()
-        .unwrap_or_else(|| panic!("nothing discovered: {}", d.summary()[0]));
-    assert_eq!(
-        (found.location, found.family),
+    let corner = discovered_and_explained(
+        "staircase-jet-pipe-lag",
+        &spec,
+        lag,
         ("jet_pipe", "dynamics"),
-        "{}",
-        found.reading
+        "omega_1",
     );
-    let corner = d.parameters.get(value_reference("omega_1")).unwrap();
     let summed = 1.0 / (15e-3 + 1.0 / 973.9);
     assert!(
         (corner / summed - 1.0).abs() < 0.1,
         "omega_1 {corner} rad/s against {summed}"
     );
-    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
 }
