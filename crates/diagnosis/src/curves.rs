@@ -610,17 +610,14 @@ pub fn corners_across_unvisited(
         if !changed {
             continue;
         }
-        set.retain(|(name, _)| {
-            !name.starts_with(&format!("{prefix}_x_")) && !name.starts_with(&format!("{prefix}_y_"))
-        });
         for (name, value) in set.iter_mut() {
-            if *name == format!("{prefix}_knots") {
-                *value = x.len() as f64;
+            for (k, (&xk, &yk)) in x.iter().zip(&y).enumerate() {
+                if *name == format!("{prefix}_x_{}", k + 1) {
+                    *value = xk;
+                } else if *name == format!("{prefix}_y_{}", k + 1) {
+                    *value = yk;
+                }
             }
-        }
-        for (k, (&xk, &yk)) in x.iter().zip(&y).enumerate() {
-            set.push((variable_name(&format!("{prefix}_x_{}", k + 1)), xk));
-            set.push((variable_name(&format!("{prefix}_y_{}", k + 1)), yk));
         }
     }
 }
