@@ -49,9 +49,7 @@ fn main() {
     config.export.item_types = vec![cbindgen::ItemType::Functions];
     config.parse.parse_deps = false;
     let header = out_dir.join("jetpipe_fmi2.h");
-    // From the exports' source file itself, not through `cargo metadata`: that nested cargo,
-    // run inside a build script, probed rustc with an input it did not control and cached the
-    // failed probe in the shared target directory, where the later `cargo doc` read it back.
+    // From the exports' source file itself: no nested `cargo metadata` inside the build.
     match cbindgen::Builder::new()
         .with_src(crate_dir.join("src/fmu_exports.rs"))
         .with_config(config)
