@@ -3,10 +3,6 @@
 # in fmu_tests/ against dist/JetPipeActuator.fmu. Exits non-zero on the first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# Cargo keeps rustc's answers to its target probe in target/.rustc_info.json. On fresh clones
-# here a probe run during the tests failed on input it was never given, the failure was kept,
-# and `cargo doc` then failed on it; with the cache off every cargo asks rustc afresh.
-export CARGO_CACHE_RUSTC_INFO=0
 
 run() {
     echo
