@@ -16,6 +16,7 @@ use jetpipe_diagnosis::recording::Recording;
 use jetpipe_model::physics::parameters::Parameters;
 
 use crate::html_report::{self, SummaryRow};
+use crate::output::write_atomically;
 use crate::plots::{diagnosis_figures, FigureInputs};
 
 /// A recording of a batch and the name its files take.
@@ -93,15 +94,6 @@ pub fn collect_recordings(inputs: &[PathBuf]) -> Result<Vec<Item>, String> {
         }
     }
     Ok(items)
-}
-
-/// Write `text` to `path` through a file beside it, so no half-written file is left.
-pub fn write_atomically(path: &Path, text: &str) -> Result<(), String> {
-    let mut partial = path.as_os_str().to_owned();
-    partial.push(".partial");
-    let partial = PathBuf::from(partial);
-    std::fs::write(&partial, text).map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
-    std::fs::rename(&partial, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// Diagnose one recording and write its report and page; its summary row.

@@ -392,7 +392,7 @@ fn diagnose(
     }
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
     // An existing report is never left half-written.
-    jetpipe_cli::batch::write_atomically(report, &text)?;
+    jetpipe_cli::output::write_atomically(report, &text)?;
     println!(
         "{name}: {} samples, noise floor {:.4} N",
         diagnosis.samples, diagnosis.noise_floor
