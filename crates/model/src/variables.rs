@@ -152,6 +152,12 @@ pub mod vr {
     pub const P2_SENSOR_CURVE_X_LAST: u32 = P2_SENSOR_CURVE_X + 7;
     pub const P2_SENSOR_CURVE_Y: u32 = 671;
     pub const P2_SENSOR_CURVE_Y_LAST: u32 = P2_SENSOR_CURVE_Y + 7;
+    pub const DISCHARGE_CURVE_KNOTS: u32 = 680;
+    /// Abscissa of knot k (k = 1..8) at this plus k − 1; the value at DISCHARGE_CURVE_Y plus k − 1.
+    pub const DISCHARGE_CURVE_X: u32 = 681;
+    pub const DISCHARGE_CURVE_X_LAST: u32 = DISCHARGE_CURVE_X + 7;
+    pub const DISCHARGE_CURVE_Y: u32 = 691;
+    pub const DISCHARGE_CURVE_Y_LAST: u32 = DISCHARGE_CURVE_Y + 7;
 }
 
 /// The D/A converter's range: a command outside it is refused.
@@ -344,6 +350,8 @@ const DEAD_VOLUME: &str = "1e-3 m3 (a litre): seventy times the two chambers' 1.
 const CURVE_COMMAND: &str = "the D/A spans 10 V either way; ten times that is no command";
 const CURVE_FORCE: &str = "1000 N: nine times the largest force the actuator gives (109 N)";
 const CURVE_PRESSURE: &str = PRESSURE;
+const CURVE_RATIO: &str = "a pressure ratio P_down/P_up lies between 0 and 1";
+const CURVE_DISCHARGE: &str = "a discharge coefficient lies between 0 (closed) and 1 (no contraction, no loss)";
 
 /// Every variable of the FMU, one row each: name, value reference, unit, start, limits,
 /// description and thesis reference. Defaults: Table 3.1 of the thesis and docs/model.md.
@@ -934,6 +942,23 @@ pub const TABLE: &[Row] = &[
     parameter("p2_sensor_curve_y_6", vr::P2_SENSOR_CURVE_Y + 5, "Pa", 0.0, "pressure transducer 2 static curve: knot 6, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_y_7", vr::P2_SENSOR_CURVE_Y + 6, "Pa", 0.0, "pressure transducer 2 static curve: knot 7, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
     parameter("p2_sensor_curve_y_8", vr::P2_SENSOR_CURVE_Y + 7, "Pa", 0.0, "pressure transducer 2 static curve: knot 8, its reading there").at_least(-1e7).at_most(1e7).because(CURVE_PRESSURE),
+    parameter("discharge_curve_knots", vr::DISCHARGE_CURVE_KNOTS, "1", 0.0, "discharge curve: the valve orifices' C_d as a function of the pressure ratio P_down/P_up across each, in place of C_d (area factors still apply): the number of knots in use, piecewise linear between them and along the end segments beyond, not below 0 (0 = off, C_d constant; else 2 to 8, abscissae increasing)").at_least(0.0).at_most(8.0).because("at most 8 knots"),
+    parameter("discharge_curve_x_1", vr::DISCHARGE_CURVE_X, "1", 0.0, "discharge curve: knot 1, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_x_2", vr::DISCHARGE_CURVE_X + 1, "1", 0.0, "discharge curve: knot 2, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_x_3", vr::DISCHARGE_CURVE_X + 2, "1", 0.0, "discharge curve: knot 3, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_x_4", vr::DISCHARGE_CURVE_X + 3, "1", 0.0, "discharge curve: knot 4, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_x_5", vr::DISCHARGE_CURVE_X + 4, "1", 0.0, "discharge curve: knot 5, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_x_6", vr::DISCHARGE_CURVE_X + 5, "1", 0.0, "discharge curve: knot 6, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_x_7", vr::DISCHARGE_CURVE_X + 6, "1", 0.0, "discharge curve: knot 7, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_x_8", vr::DISCHARGE_CURVE_X + 7, "1", 0.0, "discharge curve: knot 8, the pressure ratio P_down/P_up").at_least(0.0).at_most(1.0).because(CURVE_RATIO),
+    parameter("discharge_curve_y_1", vr::DISCHARGE_CURVE_Y, "1", 0.0, "discharge curve: knot 1, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
+    parameter("discharge_curve_y_2", vr::DISCHARGE_CURVE_Y + 1, "1", 0.0, "discharge curve: knot 2, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
+    parameter("discharge_curve_y_3", vr::DISCHARGE_CURVE_Y + 2, "1", 0.0, "discharge curve: knot 3, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
+    parameter("discharge_curve_y_4", vr::DISCHARGE_CURVE_Y + 3, "1", 0.0, "discharge curve: knot 4, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
+    parameter("discharge_curve_y_5", vr::DISCHARGE_CURVE_Y + 4, "1", 0.0, "discharge curve: knot 5, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
+    parameter("discharge_curve_y_6", vr::DISCHARGE_CURVE_Y + 5, "1", 0.0, "discharge curve: knot 6, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
+    parameter("discharge_curve_y_7", vr::DISCHARGE_CURVE_Y + 6, "1", 0.0, "discharge curve: knot 7, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
+    parameter("discharge_curve_y_8", vr::DISCHARGE_CURVE_Y + 7, "1", 0.0, "discharge curve: knot 8, C_d at that ratio").at_least(0.0).at_most(1.0).because(CURVE_DISCHARGE),
 ];
 
 const N_VARIABLES: usize = TABLE.len();

@@ -107,6 +107,12 @@ impl Outputs {
     }
 }
 
+/// The valve's orifices, as [`Actuator::discharge`] orders them.
+const SUPPLY_1: usize = 0;
+const RETURN_1: usize = 1;
+const SUPPLY_2: usize = 2;
+const RETURN_2: usize = 3;
+
 /// The thesis model with fixed parameters; derived constants computed once.
 #[derive(Clone, Debug)]
 pub struct Actuator {
@@ -120,6 +126,12 @@ pub struct Actuator {
     /// C_d times the area factor of each orifice, [supply 1, return 1, supply 2, return 2]:
     /// C_d for all four in the thesis model, other factors under the valve asymmetry terms.
     pub discharge: [f64; 4],
+    /// The area factor of each orifice, in the order of [`Self::discharge`]: with the
+    /// discharge curve on, C_d(r) takes the place of C_d.
+    area_scales: [f64; 4],
+    /// C_d as a function of the pressure ratio across each valve orifice
+    /// (`discharge_curve_*`), when on.
+    discharge_curve: Option<super::static_curve::StaticCurve>,
     /// Restrictions between the valve and the air, and the volumes behind them.
     pub restrictions: Restrictions,
     /// Which terms of the pressure rates are live, decided here once for all evaluations.
@@ -165,7 +177,8 @@ pub enum RateTerms {
     /// keep it.
     Thesis,
     /// The thesis's terms and any of: restrictions between the valve and the air, chamber
-    /// vents, a compliant stopper.
+    /// vents, a compliant stopper, a discharge coefficient that varies with the pressure
+    /// ratio.
     Extended,
 }
 
@@ -177,14 +190,17 @@ impl Actuator {
         let piston_area = cylinder.piston_area();
         let hysteresis = params.hysteresis();
         let polytropic_exponent = effects::polytropic_exponent(params.gamma, params.heat_transfer_fraction);
-        let discharge = [
-            params.c_d * params.supply_area_scale_1,
-            params.c_d * params.return_area_scale_1,
-            params.c_d * params.supply_area_scale_2,
-            params.c_d * params.return_area_scale_2,
+        let area_scales = [
+            params.supply_area_scale_1,
+            params.return_area_scale_1,
+            params.supply_area_scale_2,
+            params.return_area_scale_2,
         ];
+        let discharge = area_scales.map(|scale| params.c_d * scale);
+        let discharge_curve = params.discharge_curve.is_on().then_some(params.discharge_curve);
         let restrictions = Restrictions::from_parameters(&params);
         let rate_terms = if restrictions.any()
+            || discharge_curve.is_some()
             || params.chamber_vent_1 != 0.0
             || params.chamber_vent_2 != 0.0
             || params.stopper_compliance != 0.0
@@ -219,7 +235,26 @@ impl Actuator {
             hysteresis,
             polytropic_exponent,
             discharge,
+            area_scales,
+            discharge_curve,
         })
+    }
+
+    /// The mass flow through valve orifice `orifice` (an index of [`Self::discharge`]) of
+    /// geometric area `area` from `p_from` to `p_to`, (2.18), with the thesis's constant C_d
+    /// or, with the discharge curve on, C_d at the orifice's pressure ratio
+    /// P_down/P_up.
+    #[inline]
+    fn valve_flow(&self, orifice: usize, area: f64, p_from: f64, p_to: f64) -> f64 {
+        let cd_area = match &self.discharge_curve {
+            None => self.discharge[orifice] * area,
+            Some(curve) => {
+                let (up, down) = if p_from >= p_to { (p_from, p_to) } else { (p_to, p_from) };
+                let ratio = if up > 0.0 { (down / up).clamp(0.0, 1.0) } else { 1.0 };
+                self.area_scales[orifice] * curve.at(ratio).max(0.0) * area
+            }
+        };
+        mass_flow(&self.flow, cd_area, p_from, p_to)
     }
 
     /// The four orifice areas at a jet pipe position, from the tabulated geometry (within
@@ -259,13 +294,12 @@ impl Actuator {
         }
         let p = &self.params;
         let k = &self.flow;
-        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
         let (vent_1, vent_2) = self.chamber_vents(p1, p2);
         MassFlows {
-            supply_1: mass_flow(k, cd_s1 * a.supply_1, p.p_s, p1),
-            return_1: mass_flow(k, cd_r1 * a.return_1, p1, p.p_r),
-            supply_2: mass_flow(k, cd_s2 * a.supply_2, p.p_s, p2),
-            return_2: mass_flow(k, cd_r2 * a.return_2, p2, p.p_r),
+            supply_1: self.valve_flow(SUPPLY_1, a.supply_1, p.p_s, p1),
+            return_1: self.valve_flow(RETURN_1, a.return_1, p1, p.p_r),
+            supply_2: self.valve_flow(SUPPLY_2, a.supply_2, p.p_s, p2),
+            return_2: self.valve_flow(RETURN_2, a.return_2, p2, p.p_r),
             leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
             vent_1,
             vent_2,
@@ -302,18 +336,17 @@ impl Actuator {
         let k = &self.flow;
         let places = &self.restrictions.places;
         let stated = |i: usize| nodes.filter(|_| places[i].has_volume()).map(|n| n[i]);
-        let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
         let supply_known = stated(node::SUPPLY).unwrap_or(p.p_s);
         let return_known = stated(node::RETURN).unwrap_or(p.p_r);
-        let port = |i: usize, chamber: f64, supply_area: f64, return_area: f64| {
+        let port = |i: usize, chamber: f64, (supply_orifice, supply_area): (usize, f64), (return_orifice, return_area): (usize, f64)| {
             if let Some(q) = stated(i) {
                 return q;
             }
             let restriction = &places[i];
             let net_inflow = |q: f64| {
                 (
-                    mass_flow(k, supply_area, supply_known, q),
-                    mass_flow(k, return_area, q, return_known),
+                    self.valve_flow(supply_orifice, supply_area, supply_known, q),
+                    self.valve_flow(return_orifice, return_area, q, return_known),
                 )
             };
             if restriction.cd_area > 0.0 {
@@ -334,12 +367,12 @@ impl Actuator {
                 })
             }
         };
-        let q1 = port(node::LINE_1, p1, cd_s1 * a.supply_1, cd_r1 * a.return_1);
-        let q2 = port(node::LINE_2, p2, cd_s2 * a.supply_2, cd_r2 * a.return_2);
+        let q1 = port(node::LINE_1, p1, (SUPPLY_1, a.supply_1), (RETURN_1, a.return_1));
+        let q2 = port(node::LINE_2, p2, (SUPPLY_2, a.supply_2), (RETURN_2, a.return_2));
         let supply = |p_supply: f64| {
             (
-                mass_flow(k, cd_s1 * a.supply_1, p_supply, q1),
-                mass_flow(k, cd_s2 * a.supply_2, p_supply, q2),
+                self.valve_flow(SUPPLY_1, a.supply_1, p_supply, q1),
+                self.valve_flow(SUPPLY_2, a.supply_2, p_supply, q2),
             )
         };
         let supply_place = &places[node::SUPPLY];
@@ -357,8 +390,8 @@ impl Actuator {
         let (supply_1, supply_2) = supply(p_supply);
         let returns = |p_return: f64| {
             (
-                mass_flow(k, cd_r1 * a.return_1, q1, p_return),
-                mass_flow(k, cd_r2 * a.return_2, q2, p_return),
+                self.valve_flow(RETURN_1, a.return_1, q1, p_return),
+                self.valve_flow(RETURN_2, a.return_2, q2, p_return),
             )
         };
         let return_place = &places[node::RETURN];
@@ -847,8 +880,11 @@ mod tests {
     #[test]
     fn a_vent_a_restriction_or_a_compliant_stopper_takes_the_general_rates() {
         type Setter = fn(&mut Parameters);
-        let terms: [(&str, Setter); 4] = [
+        let terms: [(&str, Setter); 5] = [
             ("chamber_vent_2", |p| p.chamber_vent_2 = 2e-9),
+            ("discharge_curve", |p| {
+                p.discharge_curve = super::super::static_curve::StaticCurve::through(&[0.2, 1.0], &[0.8, 0.6])
+            }),
             ("supply_resistance", |p| p.supply_resistance = 3e8),
             ("port_restriction_area_1", |p| p.port_restriction_area_1 = 0.2e-6),
             ("stopper_compliance", |p| p.stopper_compliance = 1e-5),
@@ -865,6 +901,57 @@ mod tests {
             });
             assert!(differs, "{name} changes no rate");
         }
+    }
+
+    #[test]
+    fn with_the_discharge_curve_each_valve_orifice_flows_with_c_d_at_its_own_pressure_ratio() {
+        use super::super::static_curve::StaticCurve;
+        // C_d rising from 0.6 at equal pressures to 0.8 at a ratio of 0.2 and below.
+        let mut params = Parameters {
+            supply_area_scale_2: 1.1,
+            ..Parameters::default()
+        };
+        params.discharge_curve = StaticCurve::through(&[0.2, 1.0], &[0.8, 0.6]);
+        let model = Actuator::new(params.clone()).unwrap();
+        let cd = |ratio: f64| if ratio <= 0.2 { 0.8 } else { 0.8 - 0.25 * (ratio - 0.2) };
+        let k = params.flow_constants();
+        let (x_jp, p1, p2) = (0.03e-3, 420e3, 250e3);
+        let a = model.areas(x_jp);
+        let flows = model.mass_flows(x_jp, p1, p2);
+        let expected = [
+            (flows.supply_1, mass_flow(&k, cd(p1 / params.p_s) * a.supply_1, params.p_s, p1)),
+            (flows.return_1, mass_flow(&k, cd(params.p_r / p1) * a.return_1, p1, params.p_r)),
+            (
+                flows.supply_2,
+                mass_flow(&k, 1.1 * cd(p2 / params.p_s) * a.supply_2, params.p_s, p2),
+            ),
+            (flows.return_2, mass_flow(&k, cd(params.p_r / p2) * a.return_2, p2, params.p_r)),
+        ];
+        for (i, (got, want)) in expected.into_iter().enumerate() {
+            assert!(want != 0.0 || got == 0.0);
+            assert!((got - want).abs() <= 1e-12 * want.abs(), "orifice {i}: {got} against {want}");
+        }
+        // A flat curve at the thesis's C_d is the thesis model, to rounding.
+        let mut flat = Parameters::default();
+        flat.discharge_curve = StaticCurve::through(&[0.0, 1.0], &[flat.c_d, flat.c_d]);
+        let (flat, thesis) = (Actuator::new(flat).unwrap(), Actuator::new(Parameters::default()).unwrap());
+        for (x_jp, p1, p2, x_s, x_s_rate) in rate_samples() {
+            let (a, b) = flat.pressure_rates(x_jp, p1, p2, x_s, x_s_rate);
+            let (c, d) = thesis.pressure_rates(x_jp, p1, p2, x_s, x_s_rate);
+            assert!((a - c).abs() <= 1e-9 * c.abs().max(1.0) && (b - d).abs() <= 1e-9 * d.abs().max(1.0));
+        }
+    }
+
+    #[test]
+    fn a_discharge_curve_outside_its_range_is_refused_naming_the_knot() {
+        use crate::variables::vr;
+        let mut params = Parameters::default();
+        params.set(vr::DISCHARGE_CURVE_KNOTS, 2.0).unwrap();
+        params.set(vr::DISCHARGE_CURVE_X + 1, 1.0).unwrap();
+        let e = params.set(vr::DISCHARGE_CURVE_Y, 1.3).unwrap_err();
+        assert!(e.contains("discharge_curve_y_1") && e.contains("1.3"), "{e}");
+        let e = params.set(vr::DISCHARGE_CURVE_X, -0.1).unwrap_err();
+        assert!(e.contains("discharge_curve_x_1") && e.contains("-0.1"), "{e}");
     }
 
     #[test]

@@ -118,6 +118,9 @@ pub struct Parameters {
     pub force_sensor_curve: StaticCurve,
     pub p1_sensor_curve: StaticCurve,
     pub p2_sensor_curve: StaticCurve,
+    /// The valve orifices' discharge coefficient as a function of the pressure ratio
+    /// P_down/P_up across each (in place of `c_d`; off with no knots).
+    pub discharge_curve: StaticCurve,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -237,6 +240,7 @@ impl Default for Parameters {
             force_sensor_curve: StaticCurve::default(),
             p1_sensor_curve: StaticCurve::default(),
             p2_sensor_curve: StaticCurve::default(),
+            discharge_curve: StaticCurve::default(),
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -416,6 +420,23 @@ impl Parameters {
         vr::P2_SENSOR_CURVE_Y + 5,
         vr::P2_SENSOR_CURVE_Y + 6,
         vr::P2_SENSOR_CURVE_Y + 7,
+        vr::DISCHARGE_CURVE_KNOTS,
+        vr::DISCHARGE_CURVE_X,
+        vr::DISCHARGE_CURVE_X + 1,
+        vr::DISCHARGE_CURVE_X + 2,
+        vr::DISCHARGE_CURVE_X + 3,
+        vr::DISCHARGE_CURVE_X + 4,
+        vr::DISCHARGE_CURVE_X + 5,
+        vr::DISCHARGE_CURVE_X + 6,
+        vr::DISCHARGE_CURVE_X + 7,
+        vr::DISCHARGE_CURVE_Y,
+        vr::DISCHARGE_CURVE_Y + 1,
+        vr::DISCHARGE_CURVE_Y + 2,
+        vr::DISCHARGE_CURVE_Y + 3,
+        vr::DISCHARGE_CURVE_Y + 4,
+        vr::DISCHARGE_CURVE_Y + 5,
+        vr::DISCHARGE_CURVE_Y + 6,
+        vr::DISCHARGE_CURVE_Y + 7,
     ];
 
     fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
@@ -548,6 +569,13 @@ impl Parameters {
             r @ vr::P2_SENSOR_CURVE_Y..=vr::P2_SENSOR_CURVE_Y_LAST => {
                 &mut self.p2_sensor_curve.y[(r - vr::P2_SENSOR_CURVE_Y) as usize]
             }
+            vr::DISCHARGE_CURVE_KNOTS => &mut self.discharge_curve.knots,
+            r @ vr::DISCHARGE_CURVE_X..=vr::DISCHARGE_CURVE_X_LAST => {
+                &mut self.discharge_curve.x[(r - vr::DISCHARGE_CURVE_X) as usize]
+            }
+            r @ vr::DISCHARGE_CURVE_Y..=vr::DISCHARGE_CURVE_Y_LAST => {
+                &mut self.discharge_curve.y[(r - vr::DISCHARGE_CURVE_Y) as usize]
+            }
             _ => return None,
         })
     }
@@ -621,6 +649,7 @@ impl Parameters {
         self.force_sensor_curve.check("force_sensor_curve", "N")?;
         self.p1_sensor_curve.check("p1_sensor_curve", "Pa")?;
         self.p2_sensor_curve.check("p2_sensor_curve", "Pa")?;
+        self.discharge_curve.check("discharge_curve", "1")?;
         if self.l_cyl <= self.l_p {
             return Err(format!(
                 "L_cyl = {} m is invalid: must exceed L_p = {} m",
