@@ -283,6 +283,9 @@ pub fn unit_of(name: &str) -> &'static str {
 
 /// One sentence on what was added: each parameter against its value in the model before.
 pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, f64)], before: &Parameters) -> String {
+    if let Some(discharge) = crate::discharge::reading(set, before) {
+        return discharge;
+    }
     if let Some(curve) = crate::curves::reading(set) {
         return format!(
             "At the {location} ({}): {curve}",

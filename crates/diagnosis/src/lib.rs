@@ -24,6 +24,7 @@ pub mod calibrate;
 pub mod checks;
 pub mod corrections;
 pub mod curves;
+pub mod discharge;
 mod discover;
 mod eliminate;
 pub mod lines;
@@ -63,6 +64,9 @@ pub const EXPLAINED_WITHIN_NOISE: f64 = 1.5;
 pub const MIN_RELATIVE_GAIN: f64 = 0.1;
 /// …and by at least this many noise floors.
 pub const MIN_GAIN_IN_NOISE: f64 = 1.0;
+/// A place is an alternative to the located one when the held-out misfit it leaves is at
+/// most this many times the located one's ([`Localization::alternatives`]).
+pub const ALTERNATIVE_REMAINDER: f64 = 1.25;
 /// A place in the chain is named when its best candidate explains at least this share of
 /// the held-out misfit (sum over channels, each in its own noise floors).
 pub const LOCATED_SHARE: f64 = 0.3;
@@ -233,7 +237,10 @@ impl Localization {
         ))
     }
 
-    /// Places that explain nearly as much as the best (within 10 % of its share).
+    /// Places that explain nearly as much as the best: they leave at most a quarter more
+    /// of the held-out misfit than it does. Measured on what is left, not on the share
+    /// explained: where the model is far off, 99 % explained can leave seven noise floors
+    /// beside one.
     pub fn alternatives(&self) -> Vec<&'static str> {
         let Some(&(_, top, _)) = self.by_location.first() else {
             return vec![];
@@ -241,7 +248,7 @@ impl Localization {
         self.by_location
             .iter()
             .skip(1)
-            .filter(|(_, e, _)| *e >= 0.9 * top && *e >= LOCATED_SHARE)
+            .filter(|(_, e, _)| 1.0 - *e <= ALTERNATIVE_REMAINDER * (1.0 - top) && *e >= LOCATED_SHARE)
             .map(|(l, _, _)| *l)
             .collect()
     }

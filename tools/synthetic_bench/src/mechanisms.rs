@@ -114,6 +114,12 @@
 //!   supply's, the inflows' and (with heat exchange) the walls', is T + ΔT t / t_end, rising
 //!   linearly over the recording; the chambers start at T.
 //!
+//! * `discharge_ratio_rise` (`valve`/`nonlinearity`, s): each of the four valve orifices
+//!   flows with C_d (1 + s (1 − r)²) in place of C_d, r = P_down/P_up across it (a sharp-edged
+//!   orifice's jet contracts less as it chokes; s = 0.3 takes C_d from 0.696 at equal
+//!   pressures to 0.90 at r = 0). The leakage past the piston and the undeclared restrictions
+//!   keep their laws.
+//!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 
 /// Effects beyond the thesis model. `Default` switches every effect off.
@@ -228,6 +234,9 @@ pub struct UndeclaredEffects {
     /// `chambers`/`drift`: the gas temperature rises linearly by this (K) from the start to the
     /// end of the recording (supply air warming up); the chamber walls follow it.
     pub gas_temperature_drift: f64,
+    /// `valve`/`nonlinearity`: the valve orifices' discharge coefficient rises as the flow
+    /// chokes, C_d (1 + s (1 − r)²) with r = P_down/P_up across each; s this; 0 = none.
+    pub discharge_ratio_rise: f64,
 }
 
 impl Default for BenchEffects {

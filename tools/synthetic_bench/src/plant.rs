@@ -292,6 +292,18 @@ impl Model {
         }
     }
 
+    /// [`Self::orifice`] for a valve orifice of C_d·A = `cda` at the thesis's C_d: with
+    /// `discharge_ratio_rise` s, C_d grows by the factor 1 + s (1 − r)², r = P_down/P_up.
+    #[inline]
+    pub(crate) fn valve_orifice(&self, cda: f64, pa: f64, ta: f64, pb: f64, tb: f64) -> f64 {
+        let s = self.e.undeclared.discharge_ratio_rise;
+        if s == 0.0 {
+            return self.orifice(cda, pa, ta, pb, tb);
+        }
+        let r = if pa.max(pb) > 0.0 { pa.min(pb) / pa.max(pb) } else { 1.0 };
+        self.orifice(cda * (1.0 + s * (1.0 - r) * (1.0 - r)), pa, ta, pb, tb)
+    }
+
     /// Signed mass flow from side a to side b through C_d·A = `cda`, regularised near Δp = 0.
     #[inline]
     pub(crate) fn orifice(&self, cda: f64, pa: f64, ta: f64, pb: f64, tb: f64) -> f64 {
@@ -441,8 +453,8 @@ impl Model {
         };
         // with the undeclared port 1 restriction, port 1 feeds a line at temperature T
         let (p1v, t1v) = if self.line1 { (y[S_PL1], t0) } else { (p1, t1) };
-        let m_s1 = self.orifice(p.c_d * a_s1, ps, t0, p1v, t1v);
-        let m_r1 = self.orifice(p.c_d * a_r1, p1v, t1v, pr, t0);
+        let m_s1 = self.valve_orifice(p.c_d * a_s1, ps, t0, p1v, t1v);
+        let m_r1 = self.valve_orifice(p.c_d * a_r1, p1v, t1v, pr, t0);
         // line → chamber 1 through the restriction
         let m_ln = if self.line1 {
             let m = self.orifice(self.e.undeclared.port_1_restriction, p1v, t0, p1, t1);
@@ -452,8 +464,8 @@ impl Model {
             dy[S_PL1] = 0.0;
             0.0
         };
-        let m_s2 = self.orifice(p.c_d * a_s2, ps, t0, p2, t2);
-        let m_r2 = self.orifice(p.c_d * a_r2, p2, t2, pr, t0);
+        let m_s2 = self.valve_orifice(p.c_d * a_s2, ps, t0, p2, t2);
+        let m_r2 = self.valve_orifice(p.c_d * a_r2, p2, t2, pr, t0);
         // leakage past the piston (2.23), positive 1 → 2
         let (pu, pd) = if p1 >= p2 { (p1, p2) } else { (p2, p1) };
         let cda_l = (p.c_dm_a_lpp * (pd / pu) + p.c_db_a_lpp).max(0.0);

@@ -776,5 +776,6 @@ pub fn catalogue(
         ));
     }
     list.extend(crate::curves::candidates(base, knots, has_pressures));
+    list.extend(crate::discharge::candidate(base));
     list
 }

@@ -338,7 +338,10 @@ impl Actuator {
         let stated = |i: usize| nodes.filter(|_| places[i].has_volume()).map(|n| n[i]);
         let supply_known = stated(node::SUPPLY).unwrap_or(p.p_s);
         let return_known = stated(node::RETURN).unwrap_or(p.p_r);
-        let port = |i: usize, chamber: f64, (supply_orifice, supply_area): (usize, f64), (return_orifice, return_area): (usize, f64)| {
+        let port = |i: usize,
+                    chamber: f64,
+                    (supply_orifice, supply_area): (usize, f64),
+                    (return_orifice, return_area): (usize, f64)| {
             if let Some(q) = stated(i) {
                 return q;
             }
@@ -919,22 +922,37 @@ mod tests {
         let a = model.areas(x_jp);
         let flows = model.mass_flows(x_jp, p1, p2);
         let expected = [
-            (flows.supply_1, mass_flow(&k, cd(p1 / params.p_s) * a.supply_1, params.p_s, p1)),
-            (flows.return_1, mass_flow(&k, cd(params.p_r / p1) * a.return_1, p1, params.p_r)),
+            (
+                flows.supply_1,
+                mass_flow(&k, cd(p1 / params.p_s) * a.supply_1, params.p_s, p1),
+            ),
+            (
+                flows.return_1,
+                mass_flow(&k, cd(params.p_r / p1) * a.return_1, p1, params.p_r),
+            ),
             (
                 flows.supply_2,
                 mass_flow(&k, 1.1 * cd(p2 / params.p_s) * a.supply_2, params.p_s, p2),
             ),
-            (flows.return_2, mass_flow(&k, cd(params.p_r / p2) * a.return_2, p2, params.p_r)),
+            (
+                flows.return_2,
+                mass_flow(&k, cd(params.p_r / p2) * a.return_2, p2, params.p_r),
+            ),
         ];
         for (i, (got, want)) in expected.into_iter().enumerate() {
             assert!(want != 0.0 || got == 0.0);
-            assert!((got - want).abs() <= 1e-12 * want.abs(), "orifice {i}: {got} against {want}");
+            assert!(
+                (got - want).abs() <= 1e-12 * want.abs(),
+                "orifice {i}: {got} against {want}"
+            );
         }
         // A flat curve at the thesis's C_d is the thesis model, to rounding.
         let mut flat = Parameters::default();
         flat.discharge_curve = StaticCurve::through(&[0.0, 1.0], &[flat.c_d, flat.c_d]);
-        let (flat, thesis) = (Actuator::new(flat).unwrap(), Actuator::new(Parameters::default()).unwrap());
+        let (flat, thesis) = (
+            Actuator::new(flat).unwrap(),
+            Actuator::new(Parameters::default()).unwrap(),
+        );
         for (x_jp, p1, p2, x_s, x_s_rate) in rate_samples() {
             let (a, b) = flat.pressure_rates(x_jp, p1, p2, x_s, x_s_rate);
             let (c, d) = thesis.pressure_rates(x_jp, p1, p2, x_s, x_s_rate);

@@ -175,6 +175,9 @@ struct Cli {
     /// The gas temperature rises linearly by this over the recording, K (e.g. 20).
     #[arg(long, allow_hyphen_values = true)]
     gas_temperature_drift: Option<f64>,
+    /// The valve orifices' C_d grows to C_d (1 + s (1 − r)²) at pressure ratio r: s (e.g. 0.3).
+    #[arg(long)]
+    discharge_ratio_rise: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -240,6 +243,7 @@ fn main() -> ExitCode {
     set(&mut und.stopper_position_offset, cli.stopper_position_offset);
     set(&mut und.contact_lag, cli.contact_lag);
     set(&mut und.gas_temperature_drift, cli.gas_temperature_drift);
+    set(&mut und.discharge_ratio_rise, cli.discharge_ratio_rise);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -262,6 +266,7 @@ fn main() -> ExitCode {
         und.quadratic_damping,
         und.pressure_sensor_saturation_1,
         und.contact_lag,
+        und.discharge_ratio_rise,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -278,14 +283,17 @@ fn main() -> ExitCode {
         ]
         .iter()
         .all(|x| x.is_finite());
-    let und_bad = und_bad || und.stopper_position_offset.abs() > 5e-3 || und.gas_temperature_drift.abs() > 100.0;
+    let und_bad = und_bad
+        || und.stopper_position_offset.abs() > 5e-3
+        || und.gas_temperature_drift.abs() > 100.0
+        || und.discharge_ratio_rise > 1.0;
     let und_bad = und_bad || und.jet_pipe_curve_blend > 1.0 || und.return_area_reduction > 1.0;
     if und_bad {
         eprintln!(
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
              friction, moving mass, seal friction, damping, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
-             blend and return area reduction in 0..1; stopper position offset within ±5 mm, gas \
-             temperature drift within ±100 K"
+             blend, return area reduction and discharge ratio rise in 0..1; stopper position \
+             offset within ±5 mm, gas temperature drift within ±100 K"
         );
         return ExitCode::from(2);
     }
