@@ -285,3 +285,42 @@ fn saturations_whose_corner_only_the_held_out_blocks_cross_under_force_tracking_
     }
     pressures_explained(label, &d, term);
 }
+
+/// The valve orifices' C_d rising as the flow chokes, C_d (1 + 0.3 (1 − r)²) at the pressure
+/// ratio r (0.696 at equal pressures, 0.90 at r = 0): discovered at the valve as the
+/// discharge coefficient's curve of the ratio, the force explained, and the curve within
+/// 2 % of the truth over the ratios the orifices work at.
+fn discharge_curve_found(label: &str, spec: &ProtocolSpec) {
+    let d = diagnosed(
+        label,
+        spec,
+        &undeclared(UndeclaredEffects {
+            discharge_ratio_rise: 0.3,
+            ..UndeclaredEffects::default()
+        }),
+    );
+    let term = only_term(label, &d, "valve", "nonlinearity");
+    assert!(term.reading.contains("as the flow chokes"), "{label}: {}", term.reading);
+    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
+    let c_d = Parameters::default().c_d;
+    for r in [0.25, 0.5, 0.75] {
+        let truth = c_d * (1.0 + 0.3 * (1.0 - r) * (1.0 - r));
+        let fitted = d.parameters.discharge_curve.at(r);
+        assert!(
+            (fitted / truth - 1.0).abs() < 0.02,
+            "{label}: C_d {fitted} at r = {r} against {truth}"
+        );
+    }
+}
+
+#[test]
+fn a_discharge_coefficient_rising_as_the_flow_chokes_under_a_staircase_at_1_kilohertz_is_a_curve_of_the_pressure_ratio_at_the_valve(
+) {
+    discharge_curve_found("discharge-staircase", &spec(CommandProtocol::Staircase, 1000.0, true));
+}
+
+#[test]
+fn a_discharge_coefficient_rising_as_the_flow_chokes_under_a_multisine_at_500_hertz_without_pressures_is_a_curve_of_the_pressure_ratio_at_the_valve(
+) {
+    discharge_curve_found("discharge-multisine", &spec(CommandProtocol::Multisine, 500.0, false));
+}
