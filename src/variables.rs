@@ -138,6 +138,15 @@ pub const UNITS: &[UnitDefinition] = &[
         k: 0,
     },
     UnitDefinition {
+        // kg/(s·Pa) = m·s: a laminar conductance.
+        name: "kg/(s.Pa)",
+        kg: 0,
+        m: 1,
+        s: 1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
         name: "m/N",
         kg: -1,
         m: 0,

@@ -76,6 +76,10 @@ pub mod vr {
     pub const RETURN_RESISTANCE: u32 = 410;
     pub const CHAMBER_VENT_1: u32 = 420;
     pub const CHAMBER_VENT_2: u32 = 421;
+    pub const CHAMBER_SUPPLY_LEAK_1: u32 = 422;
+    pub const CHAMBER_SUPPLY_LEAK_2: u32 = 423;
+    pub const CHAMBER_LAMINAR_VENT_1: u32 = 424;
+    pub const CHAMBER_LAMINAR_VENT_2: u32 = 425;
     pub const PORT_RESISTANCE_1: u32 = 430;
     pub const PORT_RESISTANCE_2: u32 = 431;
     pub const STOPPER_COMPLIANCE: u32 = 440;
@@ -343,6 +347,8 @@ const RATE: &str =
 const TRAVEL: &str = "10 mm: the receiver's areas stop changing 3 D_jp (3 mm) from its centre (2.8)-(2.17)";
 const LEAK_AREA: &str =
     "1e-4 m2: half the bore's cross-section (2e-4 m2 with the thesis's D_cyl); a larger opening is no leak";
+const LAMINAR_CONDUCTANCE: &str =
+    "1e-6 kg/(s.Pa): 0.1 kg/s at a bar, about a hundred times what the valve's open port passes from the supply";
 const RESISTANCE: &str =
     "at the jet pipe's flow of about 1e-3 kg/s, 1e12 Pa.s/kg would drop 1e9 Pa, a thousand times the supply pressure";
 const AREA_SCALE: &str = "ten times the drawn area of (2.8)-(2.17); the diagnosis fits at most 3";
@@ -674,6 +680,22 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1e-4)
         .cite("(2.25)")
         .because(LEAK_AREA),
+    parameter("chamber_supply_leak_1", vr::CHAMBER_SUPPLY_LEAK_1, "m2", 0.0, "chamber leak: discharge coefficient times area of a leak from the supply pressure into chamber 1, by the orifice law (0 = off)")
+        .at_least(0.0).at_most(1e-4)
+        .cite("(2.18)")
+        .because(LEAK_AREA),
+    parameter("chamber_supply_leak_2", vr::CHAMBER_SUPPLY_LEAK_2, "m2", 0.0, "chamber leak: discharge coefficient times area of a leak from the supply pressure into chamber 2, by the orifice law (0 = off)")
+        .at_least(0.0).at_most(1e-4)
+        .cite("(2.18)")
+        .because(LEAK_AREA),
+    parameter("chamber_laminar_vent_1", vr::CHAMBER_LAMINAR_VENT_1, "kg/(s.Pa)", 0.0, "chamber leak: chamber 1 loses this times (P1 - P_r) to the return pressure through a long, narrow path (laminar: the flow in proportion to the pressure difference; 0 = off)")
+        .at_least(0.0).at_most(1e-6)
+        .cite("(2.24)")
+        .because(LAMINAR_CONDUCTANCE),
+    parameter("chamber_laminar_vent_2", vr::CHAMBER_LAMINAR_VENT_2, "kg/(s.Pa)", 0.0, "chamber leak: chamber 2 loses this times (P2 - P_r) to the return pressure through a long, narrow path (laminar: the flow in proportion to the pressure difference; 0 = off)")
+        .at_least(0.0).at_most(1e-6)
+        .cite("(2.24)")
+        .because(LAMINAR_CONDUCTANCE),
     parameter("port_resistance_1", vr::PORT_RESISTANCE_1, "Pa.s/kg", 0.0, "port restriction: the orifices of port 1 see a pressure that differs from chamber 1's by this times the net flow through the port (0 = off)")
         .at_least(0.0).at_most(1e12)
         .cite("(2.24)")

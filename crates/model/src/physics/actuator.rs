@@ -49,8 +49,9 @@ pub struct MassFlows {
     pub return_2: f64,
     /// From chamber 1 to chamber 2.
     pub leakage: f64,
-    /// From each chamber to the return pressure through a leak (the `chamber_vent_*` terms;
-    /// zero in the thesis model).
+    /// What each chamber loses through leaks of its own: to the return pressure (the
+    /// `chamber_vent_*` orifices, the `chamber_laminar_vent_*` paths) less what it gains
+    /// from the supply (the `chamber_supply_leak_*` orifices); zero in the thesis model.
     pub vent_1: f64,
     pub vent_2: f64,
 }
@@ -132,6 +133,9 @@ pub struct Actuator {
     /// C_d as a function of the pressure ratio across each valve orifice
     /// (`discharge_curve_*`), when on.
     discharge_curve: Option<super::static_curve::StaticCurve>,
+    /// Whether a chamber has a leak of its own (`chamber_vent_*`, `chamber_supply_leak_*`,
+    /// `chamber_laminar_vent_*`).
+    chamber_leaks: bool,
     /// Restrictions between the valve and the air, and the volumes behind them.
     pub restrictions: Restrictions,
     /// Which terms of the pressure rates are live, decided here once for all evaluations.
@@ -199,16 +203,22 @@ impl Actuator {
         let discharge = area_scales.map(|scale| params.c_d * scale);
         let discharge_curve = params.discharge_curve.is_on().then_some(params.discharge_curve);
         let restrictions = Restrictions::from_parameters(&params);
-        let rate_terms = if restrictions.any()
-            || discharge_curve.is_some()
-            || params.chamber_vent_1 != 0.0
-            || params.chamber_vent_2 != 0.0
-            || params.stopper_compliance != 0.0
-        {
-            RateTerms::Extended
-        } else {
-            RateTerms::Thesis
-        };
+        let chamber_leaks = [
+            params.chamber_vent_1,
+            params.chamber_vent_2,
+            params.chamber_supply_leak_1,
+            params.chamber_supply_leak_2,
+            params.chamber_laminar_vent_1,
+            params.chamber_laminar_vent_2,
+        ]
+        .iter()
+        .any(|&leak| leak != 0.0);
+        let rate_terms =
+            if restrictions.any() || discharge_curve.is_some() || chamber_leaks || params.stopper_compliance != 0.0 {
+                RateTerms::Extended
+            } else {
+                RateTerms::Thesis
+            };
         let extra_library = params.extra_force_acceleration != 0.0
             || params.extra_force_velocity_squared != 0.0
             || params.extra_force_sign_pressure != 0.0
@@ -237,6 +247,7 @@ impl Actuator {
             discharge,
             area_scales,
             discharge_curve,
+            chamber_leaks,
         })
     }
 
@@ -306,17 +317,22 @@ impl Actuator {
         }
     }
 
-    /// The `chamber_vent_*` leaks of each chamber to the return pressure.
+    /// The flows each chamber loses through leaks other than the valve's and the piston's:
+    /// the `chamber_vent_*` orifices to the return pressure, the `chamber_laminar_vent_*`
+    /// paths to it, less what the `chamber_supply_leak_*` orifices bring in from the supply.
     fn chamber_vents(&self, p1: f64, p2: f64) -> (f64, f64) {
-        let p = &self.params;
-        if p.chamber_vent_1 == 0.0 && p.chamber_vent_2 == 0.0 {
-            (0.0, 0.0)
-        } else {
-            (
-                mass_flow(&self.flow, p.chamber_vent_1, p1, p.p_r),
-                mass_flow(&self.flow, p.chamber_vent_2, p2, p.p_r),
-            )
+        if !self.chamber_leaks {
+            return (0.0, 0.0);
         }
+        let p = &self.params;
+        let k = &self.flow;
+        let lost = |vent: f64, laminar: f64, supplied: f64, chamber: f64| {
+            mass_flow(k, vent, chamber, p.p_r) + laminar * (chamber - p.p_r) - mass_flow(k, supplied, p.p_s, chamber)
+        };
+        (
+            lost(p.chamber_vent_1, p.chamber_laminar_vent_1, p.chamber_supply_leak_1, p1),
+            lost(p.chamber_vent_2, p.chamber_laminar_vent_2, p.chamber_supply_leak_2, p2),
+        )
     }
 
     /// The flows with restrictions between the valve and the air ([`super::restrictions`]).
@@ -883,8 +899,10 @@ mod tests {
     #[test]
     fn a_vent_a_restriction_or_a_compliant_stopper_takes_the_general_rates() {
         type Setter = fn(&mut Parameters);
-        let terms: [(&str, Setter); 5] = [
+        let terms: [(&str, Setter); 7] = [
             ("chamber_vent_2", |p| p.chamber_vent_2 = 2e-9),
+            ("chamber_supply_leak_1", |p| p.chamber_supply_leak_1 = 2e-9),
+            ("chamber_laminar_vent_2", |p| p.chamber_laminar_vent_2 = 1e-11),
             ("discharge_curve", |p| {
                 p.discharge_curve = super::super::static_curve::StaticCurve::through(&[0.2, 1.0], &[0.8, 0.6])
             }),
@@ -958,6 +976,40 @@ mod tests {
             let (c, d) = thesis.pressure_rates(x_jp, p1, p2, x_s, x_s_rate);
             assert!((a - c).abs() <= 1e-9 * c.abs().max(1.0) && (b - d).abs() <= 1e-9 * d.abs().max(1.0));
         }
+    }
+
+    #[test]
+    fn a_chambers_own_leaks_are_an_orifice_to_the_return_a_laminar_path_to_it_and_an_orifice_from_the_supply() {
+        let params = Parameters {
+            chamber_vent_1: 3e-9,
+            chamber_laminar_vent_1: 2e-11,
+            chamber_supply_leak_1: 1e-9,
+            chamber_supply_leak_2: 4e-9,
+            ..Parameters::default()
+        };
+        let k = params.flow_constants();
+        let model = Actuator::new(params.clone()).unwrap();
+        let (p1, p2) = (380e3, 210e3);
+        let flows = model.mass_flows(0.02e-3, p1, p2);
+        let lost_1 =
+            mass_flow(&k, 3e-9, p1, params.p_r) + 2e-11 * (p1 - params.p_r) - mass_flow(&k, 1e-9, params.p_s, p1);
+        let lost_2 = -mass_flow(&k, 4e-9, params.p_s, p2);
+        assert!(
+            (flows.vent_1 - lost_1).abs() <= 1e-15 * lost_1.abs(),
+            "{} against {lost_1}",
+            flows.vent_1
+        );
+        assert!(
+            (flows.vent_2 - lost_2).abs() <= 1e-15 * lost_2.abs(),
+            "{} against {lost_2}",
+            flows.vent_2
+        );
+        // The supply leak brings air in, the laminar path takes it out in proportion.
+        assert!(lost_2 < 0.0 && 2e-11 * (p1 - params.p_r) > 0.0);
+        let thesis = Actuator::new(Parameters::default())
+            .unwrap()
+            .mass_flows(0.02e-3, p1, p2);
+        assert_eq!((thesis.vent_1, thesis.vent_2), (0.0, 0.0));
     }
 
     #[test]
