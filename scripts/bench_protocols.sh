@@ -45,6 +45,8 @@ mechanisms=(
     "mount_lag_1ms|mechanics|compliance|--contact-stiffness 2e4 --contact-lag 1e-3"
     "gas_drift_20k|chambers|drift|--gas-temperature-drift 20"
     "discharge_ratio_rise|valve|nonlinearity|--discharge-ratio-rise 0.3"
+    "supply_leak_2|chambers|extra_flow|--supply-leak-2 1e-8"
+    "laminar_leak_1|chambers|extra_flow|--laminar-leak-1 3e-11"
     "receiver_and_supply|jet_pipe+supply|parameter_offset|--undeclared receiver_offset --supply-pressure 622925"
     "receiver_and_pickup|jet_pipe+force_sensor|parameter_offset+periodic|--undeclared receiver_offset --force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
 )

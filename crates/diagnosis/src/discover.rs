@@ -351,6 +351,21 @@ fn physical_reading(name: &str, added: f64) -> Option<String> {
             -added,
             added * 0.1
         ),
+        "chamber_vent_1" | "chamber_vent_2" if added > 0.0 => format!(
+            "Chamber {} leaks to the return pressure through an orifice of C_d·A {:.4} mm².",
+            &name[name.len() - 1..],
+            added * 1e6
+        ),
+        "chamber_supply_leak_1" | "chamber_supply_leak_2" if added > 0.0 => format!(
+            "Chamber {} gains air from the supply through a leak of C_d·A {:.4} mm² (the orifice law).",
+            &name[name.len() - 1..],
+            added * 1e6
+        ),
+        "chamber_laminar_vent_1" | "chamber_laminar_vent_2" if added > 0.0 => format!(
+            "Chamber {} loses {added:.3e} kg/(s·Pa) × its pressure above the return's through a laminar path: {:.2} g/s at 3 bar.",
+            &name[name.len() - 1..],
+            added * 3e5 * 1e3
+        ),
         _ => return None,
     })
 }

@@ -120,6 +120,11 @@
 //!   pressures to 0.90 at r = 0). The leakage past the piston and the undeclared restrictions
 //!   keep their laws.
 //!
+//! * `supply_leak_2` (`chambers`/`extra_flow`, C_d·A): an orifice from the supply (after
+//!   any supply restriction) into chamber 2, the same compressible law, inflow at T.
+//! * `laminar_leak_1` (`chambers`/`extra_flow`, g): chamber 1 loses g (P1 − 101 325 Pa) to
+//!   atmosphere (a long, narrow path, laminar).
+//!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 
 /// Effects beyond the thesis model. `Default` switches every effect off.
@@ -237,6 +242,12 @@ pub struct UndeclaredEffects {
     /// `valve`/`nonlinearity`: the valve orifices' discharge coefficient rises as the flow
     /// chokes, C_d (1 + s (1 − r)²) with r = P_down/P_up across each; s this; 0 = none.
     pub discharge_ratio_rise: f64,
+    /// `chambers`/`extra_flow`: C_d·A (m²) of a leak from the supply into chamber 2 (a worn
+    /// seat); 0 = none.
+    pub supply_leak_2: f64,
+    /// `chambers`/`extra_flow`: laminar conductance (kg/(s·Pa)) from chamber 1 to atmosphere,
+    /// the flow (P1 − 101 325 Pa) times this (a porous seal); 0 = none.
+    pub laminar_leak_1: f64,
 }
 
 impl Default for BenchEffects {

@@ -537,7 +537,17 @@ impl Model {
         if self.leak1 {
             m1 -= m_a1;
         }
-        let m2 = m_s2 - m_r2 + m_l - m_d2;
+        let u = &self.e.undeclared;
+        // undeclared chamber leaks beyond the orifice to atmosphere: an orifice from the
+        // supply into chamber 2, a laminar path from chamber 1 to atmosphere
+        let m_sl2 = if u.supply_leak_2 > 0.0 {
+            self.orifice(u.supply_leak_2, ps, t0, p2, t2)
+        } else {
+            0.0
+        };
+        let m_lam1 = u.laminar_leak_1 * (p1 - P_ATM);
+        m1 -= m_lam1;
+        let m2 = m_s2 - m_r2 + m_l - m_d2 + m_sl2;
         if !self.heat {
             dy[S_P1] = p.gamma / v1 * (rt * m1 - p1 * dv1);
             dy[S_P2] = p.gamma / v2 * (rt * m2 - p2 * dv2);
@@ -554,7 +564,8 @@ impl Model {
             if self.leak1 {
                 h1 += up(-m_a1, t0, t1);
             }
-            let h2 = up(m_s2, t0, t2) + up(-m_r2, t0, t2) + up(m_l, t1, t2) + up(-m_d2, t0, t2);
+            h1 += up(-m_lam1, t0, t1);
+            let h2 = up(m_s2, t0, t2) + up(-m_r2, t0, t2) + up(m_l, t1, t2) + up(-m_d2, t0, t2) + up(m_sl2, t0, t2);
             let chamber = |pc: f64, tc: f64, v: f64, dv: f64, m: f64, h: f64| {
                 let dp = p.gamma / v * (p.r_gas * h - pc * dv) + pc * (t0 - tc) / tc * self.inv_tau_th;
                 let dt = tc * (dp / pc + dv / v) - p.r_gas * tc * tc * m / (pc * v);

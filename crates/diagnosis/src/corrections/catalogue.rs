@@ -475,6 +475,28 @@ pub fn catalogue(
                 term_off("chamber_vent_2", "m2", 5e-9, 1e-6),
             ],
         ),
+        // The chambers' mass balances take a leak from the library of each source (the return,
+        // the supply) and law (an orifice, a laminar path); the pairs combine two of them.
+        c(
+            "laminar chamber leaks to the return",
+            "chambers",
+            "extra_flow",
+            None,
+            vec![
+                term_off("chamber_laminar_vent_1", "kg/(s.Pa)", 1e-11, 1e-6),
+                term_off("chamber_laminar_vent_2", "kg/(s.Pa)", 1e-11, 1e-6),
+            ],
+        ),
+        c(
+            "chamber leaks from the supply",
+            "chambers",
+            "extra_flow",
+            None,
+            vec![
+                term_off("chamber_supply_leak_1", "m2", 5e-9, 1e-6),
+                term_off("chamber_supply_leak_2", "m2", 5e-9, 1e-6),
+            ],
+        ),
         c(
             "Coulomb friction",
             "mechanics",

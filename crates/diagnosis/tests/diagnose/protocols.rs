@@ -351,3 +351,55 @@ fn a_fifteen_millisecond_jet_pipe_lag_under_a_staircase_is_found_as_the_jet_pipe
         "omega_1 {corner} rad/s against {summed}"
     );
 }
+
+/// A leak from the supply into chamber 2 (an orifice of C_d·A 0.01 mm², a worn seat) under a
+/// staircase at 1 kHz with pressures: one of the chambers' leak library, found with its area.
+#[test]
+fn a_leak_from_the_supply_into_chamber_2_under_a_staircase_is_an_extra_flow_of_the_chambers_with_its_area() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Staircase,
+        sample_rate: 1000.0,
+        duration: 20.0,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let leak = UndeclaredEffects {
+        supply_leak_2: 1e-8,
+        ..UndeclaredEffects::default()
+    };
+    let area = discovered_and_explained(
+        "staircase-supply-leak",
+        &spec,
+        leak,
+        ("chambers", "extra_flow"),
+        "chamber_supply_leak_2",
+    );
+    assert!((area / 1e-8 - 1.0).abs() < 0.05, "C_d·A {area} m²");
+}
+
+/// A laminar leak from chamber 1 to atmosphere (3e-11 kg/(s·Pa), about 9 mg/s at 3 bar) under
+/// a multisine at 500 Hz without pressures: the orifice law to the return left 1.51 noise
+/// floors; the laminar member of the library explains it.
+#[test]
+fn a_laminar_leak_from_chamber_1_under_a_multisine_without_pressures_is_a_laminar_extra_flow_of_the_chambers() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Multisine,
+        sample_rate: 500.0,
+        duration: 20.0,
+        pressures: false,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let leak = UndeclaredEffects {
+        laminar_leak_1: 3e-11,
+        ..UndeclaredEffects::default()
+    };
+    let conductance = discovered_and_explained(
+        "multisine-laminar-leak",
+        &spec,
+        leak,
+        ("chambers", "extra_flow"),
+        "chamber_laminar_vent_1",
+    );
+    assert!((conductance / 3e-11 - 1.0).abs() < 0.05, "{conductance} kg/(s·Pa)");
+}

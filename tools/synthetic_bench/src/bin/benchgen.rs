@@ -178,6 +178,12 @@ struct Cli {
     /// The valve orifices' C_d grows to C_d (1 + s (1 − r)²) at pressure ratio r: s (e.g. 0.3).
     #[arg(long)]
     discharge_ratio_rise: Option<f64>,
+    /// A leak from the supply into chamber 2: its C_d·A, m² (e.g. 5e-9).
+    #[arg(long)]
+    supply_leak_2: Option<f64>,
+    /// A laminar leak from chamber 1 to atmosphere: its conductance, kg/(s·Pa) (e.g. 2e-11).
+    #[arg(long)]
+    laminar_leak_1: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -244,6 +250,8 @@ fn main() -> ExitCode {
     set(&mut und.contact_lag, cli.contact_lag);
     set(&mut und.gas_temperature_drift, cli.gas_temperature_drift);
     set(&mut und.discharge_ratio_rise, cli.discharge_ratio_rise);
+    set(&mut und.supply_leak_2, cli.supply_leak_2);
+    set(&mut und.laminar_leak_1, cli.laminar_leak_1);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -267,6 +275,8 @@ fn main() -> ExitCode {
         und.pressure_sensor_saturation_1,
         und.contact_lag,
         und.discharge_ratio_rise,
+        und.supply_leak_2,
+        und.laminar_leak_1,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
