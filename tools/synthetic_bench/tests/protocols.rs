@@ -388,3 +388,74 @@ fn a_slower_stopper_mount_changes_the_logged_force_of_a_moving_stopper() {
         .collect();
     assert!(gap.iter().cloned().fold(0.0, f64::max) > 0.1, "the lag changes nothing");
 }
+
+/// Mean P1 and P2 (columns 4 and 5) over the recording's second half.
+fn late_mean_pressures(rec: &synthetic_bench::ProtocolRecording) -> (f64, f64) {
+    let late = &rec.rows[rec.rows.len() / 2..];
+    let n = late.len() as f64;
+    (
+        late.iter().map(|r| r[4]).sum::<f64>() / n,
+        late.iter().map(|r| r[5]).sum::<f64>() / n,
+    )
+}
+
+#[test]
+fn a_leak_from_the_supply_raises_chamber_2_and_a_laminar_leak_to_atmosphere_lowers_chamber_1() {
+    let spec = ProtocolSpec {
+        duration: 20.0,
+        sample_rate: 500.0,
+        ..ProtocolSpec::default()
+    };
+    let clean = late_mean_pressures(&generate_protocol(&spec, &BenchEffects::default()).unwrap());
+    let supplied = late_mean_pressures(
+        &generate_protocol(
+            &spec,
+            &with_undeclared(synthetic_bench::UndeclaredEffects {
+                supply_leak_2: 1e-8,
+                ..Default::default()
+            }),
+        )
+        .unwrap(),
+    );
+    let vented = late_mean_pressures(
+        &generate_protocol(
+            &spec,
+            &with_undeclared(synthetic_bench::UndeclaredEffects {
+                laminar_leak_1: 3e-11,
+                ..Default::default()
+            }),
+        )
+        .unwrap(),
+    );
+    assert!(supplied.1 > clean.1 + 1e3, "P2 {} against {}", supplied.1, clean.1);
+    assert!(vented.0 < clean.0 - 1e3, "P1 {} against {}", vented.0, clean.0);
+}
+
+#[test]
+fn a_discharge_coefficient_rising_as_the_flow_chokes_changes_the_pressures_and_zero_changes_nothing() {
+    let spec = ProtocolSpec {
+        duration: 20.0,
+        sample_rate: 500.0,
+        ..ProtocolSpec::default()
+    };
+    let rise = |s: f64| {
+        generate_protocol(
+            &spec,
+            &with_undeclared(synthetic_bench::UndeclaredEffects {
+                discharge_ratio_rise: s,
+                ..Default::default()
+            }),
+        )
+        .unwrap()
+    };
+    let clean = generate_protocol(&spec, &BenchEffects::default()).unwrap();
+    assert_eq!(rise(0.0).rows, clean.rows);
+    let risen = rise(0.3);
+    let gap = clean
+        .rows
+        .iter()
+        .zip(&risen.rows)
+        .map(|(a, b)| (a[4] - b[4]).abs().max((a[5] - b[5]).abs()))
+        .fold(0.0, f64::max);
+    assert!(gap > 5e3, "the pressures move by {gap} Pa at most");
+}
