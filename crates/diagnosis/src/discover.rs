@@ -316,27 +316,7 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
         sentence.push(' ');
         sentence.push_str(&p);
     }
-    if let Some(lags) = overdamped_reading(set, before) {
-        sentence.push(' ');
-        sentence.push_str(&lags);
-    }
     sentence
-}
-
-/// The jet pipe's second-order stage (2.6) with ζ₂ above 1 in `set`: two real poles, the
-/// slower a lag in series with the first-order stage's.
-fn overdamped_reading(set: &[(&'static str, f64)], before: &Parameters) -> Option<String> {
-    let get = |name: &str| set.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
-    let zeta = get("zeta_2").filter(|&z| z > 1.0)?;
-    let omega = get("omega_2").unwrap_or(before.omega_2);
-    let omega_1 = get("omega_1").unwrap_or(before.omega_1);
-    let root = (zeta * zeta - 1.0).sqrt();
-    let (slow, fast) = (omega * (zeta - root), omega * (zeta + root));
-    Some(format!(
-        "The jet pipe's second-order stage is overdamped (ζ₂ = {zeta:.2}): its poles are real, at {slow:.1} and {fast:.0} rad/s, so the tip follows the force through a lag of {:.2} ms in series with the first-order stage's {:.2} ms ({omega_1:.0} rad/s); the resonance at {omega:.0} rad/s is gone.",
-        1e3 / slow,
-        1e3 / omega_1
-    ))
 }
 
 /// What an extra force on the piston of `added` times its signal is, in physical words.

@@ -276,24 +276,6 @@ pub fn catalogue(
             vec![corner(base, "omega_1", 10.0, 1e4)],
         ),
         c(
-            "jet pipe lags in series",
-            "jet_pipe",
-            "dynamics",
-            None,
-            vec![
-                Term {
-                    name: "zeta_2",
-                    unit: "1",
-                    mechanism: Mechanism::Searched("zeta_2"),
-                    neutral: base.zeta_2,
-                    step: 0.0,
-                    lower: base.zeta_2.max(1e-3),
-                    upper: 100.0,
-                },
-                p("omega_1", "rad/s", 0.02, 10.0, 1e4),
-            ],
-        ),
-        c(
             "jet pipe hysteresis",
             "jet_pipe",
             "hysteresis",
