@@ -195,3 +195,26 @@ def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
         print(f"{name}: pressure errors after reported {reported}, FMU replay {through_fmu}")
         for c in range(2):
             assert abs(through_fmu[c] - reported[c]) <= 0.1 * reported[c]
+
+
+# The general classes added at the valve and in the chambers' balances: the discharge
+# coefficient as a curve of the pressure ratio, a leak from the supply into a chamber.
+@needs_binaries
+@pytest.mark.parametrize("name, options, parameter", [
+    ("discharge_rise", ("--protocol", "multisine", "--sample-rate", "500", "--no-pressures",
+                        "--discharge-ratio-rise", "0.3"), "discharge_curve_y_2"),
+    ("supply_leak", ("--protocol", "staircase", "--sample-rate", "500", "--supply-leak-2", "1e-8"),
+     "chamber_supply_leak_2"),
+])
+def test_fmu_start_values_of_a_valve_curve_or_a_chamber_leak_reproduce_the_after_error(
+        unzipdir, model_description, vrs, tmp_path, name, options, parameter):
+    recording, report = generated_and_diagnosed(tmp_path, name, "--seed", "5", "--duration", "20", *options)
+    assert report["effects"] == [], report["effects"]
+    assert parameter in report["fmu_start_values"], report["fmu_start_values"]
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
+    rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
+    reported = report["after"]["force_rms_N"]
+    print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; "
+          f"before {report['before']['force_rms_N']:.4f} N")
+    assert rms < 0.1 * report["before"]["force_rms_N"]
+    assert abs(rms - reported) <= 0.1 * reported
