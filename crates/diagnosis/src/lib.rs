@@ -10,7 +10,8 @@
 //!    channels and score it on the held-out blocks; the place in the chain whose best
 //!    candidate explains most of the held-out misfit is where the model departs.
 //! 5. A named effect is added only when it is a candidate at that place, explains most of
-//!    what that place can explain, lowers the force error by more than the noise, makes no
+//!    what that place can explain, lowers the force error's mean square by more than the
+//!    noise's ([`worth_adding`]), makes no
 //!    channel worse, and the residual carries its own signature (`named.rs`). Repeat.
 //! 6. Verdict: explained when the held-out force error after is within 1.5 noise floors;
 //!    otherwise the remainder, where it sits in the chain and its signature.
@@ -62,8 +63,18 @@ pub const BLOCK_SECONDS: f64 = 2.0;
 pub const EXPLAINED_WITHIN_NOISE: f64 = 1.5;
 /// A named effect must lower the held-out force error by this fraction…
 pub const MIN_RELATIVE_GAIN: f64 = 0.1;
-/// …and by at least this many noise floors.
+/// …and by at least this many noise floors (the pressures' judgement, in their RMS).
 pub const MIN_GAIN_IN_NOISE: f64 = 1.0;
+
+/// Whether lowering the held-out force RMS error from `before` to `after` earns an
+/// addition: by [`MIN_RELATIVE_GAIN`] of it, and by at least one noise floor squared of its
+/// mean square. The mean square, not the RMS: a remainder of two noise floors can lose at
+/// most 1.7 of its mean square's four to a perfect term but only one floor of its RMS, and a
+/// term that takes it to 1.4 (explained) gained 0.6 floor of RMS and 2.0 of mean square.
+pub fn worth_adding(before: f64, after: f64, noise: f64) -> bool {
+    let gain = before - after;
+    gain >= MIN_RELATIVE_GAIN * before && before * before - after * after >= MIN_GAIN_IN_NOISE * noise * noise
+}
 /// A place is an alternative to the located one when the held-out misfit it leaves is at
 /// most this many times the located one's ([`Localization::alternatives`]).
 pub const ALTERNATIVE_REMAINDER: f64 = 1.25;

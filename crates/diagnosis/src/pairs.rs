@@ -288,7 +288,6 @@ pub(crate) fn best_pair(
         &cx.blocks,
         Block::HeldOut,
     );
-    let gain = force_before - after;
     let worse_pressures =
         (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && heldout[c] > 1.05 * heldout_before[c] + count * 0.01);
     let before_total: f64 = heldout_before.iter().sum();
@@ -298,8 +297,7 @@ pub(crate) fn best_pair(
     ));
     let better = misfit + used * penalty < single_score
         && before_total - misfit > used * penalty
-        && gain >= MIN_RELATIVE_GAIN * force_before
-        && gain >= MIN_GAIN_IN_NOISE * cx.noise
+        && worth_adding(force_before, after, cx.noise)
         && !worse_pressures;
     if !better {
         return Ok(None);
