@@ -297,7 +297,7 @@ pub(crate) fn best_pair(
     ));
     let better = misfit + used * penalty < single_score
         && before_total - misfit > used * penalty
-        && worth_adding(force_before, after, cx.noise)
+        && worth_adding(force_before, after, cx.noise, false)
         && !worse_pressures;
     if !better {
         return Ok(None);

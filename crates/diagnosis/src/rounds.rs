@@ -357,7 +357,9 @@ fn find_addition(
         return Ok(Some(Addition::Pair(terms, Box::new(trial))));
     }
     if place != "unknown" {
-        if let Some((term, trial, s)) = discover_term(cx, r, problem, found, &f.params, replays, progress)? {
+        if let Some((term, trial, s)) =
+            discover_term(cx, r, problem, found, &f.params, &f.discovered, replays, progress)?
+        {
             return Ok(Some(Addition::Discovered(term, Box::new(trial), Some(Box::new(s)))));
         }
     }
@@ -389,7 +391,7 @@ fn named_at_place(
         let worse_pressures =
             (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
         let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share && s.explained >= NAMED_MIN_SHARE;
-        let gain_ok = worth_adding(force_before, force_before - gain, noise);
+        let gain_ok = worth_adding(force_before, force_before - gain, noise, false);
         let test = named_signature(
             name,
             cx.recording,
@@ -465,7 +467,7 @@ fn named_downstream(
         let after = rms_where(&difference(&recording.force, &with.force), &cx.blocks, Block::HeldOut);
         let gain = force_before - after;
         let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * side_share && s.explained >= NAMED_MIN_SHARE;
-        let gain_ok = worth_adding(force_before, force_before - gain, noise);
+        let gain_ok = worth_adding(force_before, force_before - gain, noise, false);
         let test = named_signature(
             name,
             recording,
@@ -500,6 +502,7 @@ fn discover_term(
     problem: &Problem,
     found: &Localization,
     params: &Parameters,
+    earlier: &[DiscoveredTerm],
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Option<(DiscoveredTerm, Parameters, Scored)>, String> {
@@ -563,7 +566,12 @@ fn discover_term(
         progress(&format!(
             "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
         ));
-        let force_ok = worth_adding(force_before, after, noise);
+        let refines = earlier.iter().any(|d| {
+            d.candidate == label
+                && d.parameters.len() == set.len()
+                && d.parameters.iter().zip(&set).all(|(a, b)| a.0 == b.0)
+        });
+        let force_ok = worth_adding(force_before, after, noise, refines);
         // A term on the pressure transducers is judged on the pressures; so is one upstream
         // of the piston whose departure shows in the pressures more than in the force (a
         // stopper position 1 mm off leaves 2 noise floors in the force, 9 in the pressures).
@@ -754,14 +762,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_term_that_takes_two_noise_floors_to_one_and_a_half_is_worth_adding_and_one_within_the_noise_is_not() {
+    fn a_refit_that_takes_two_noise_floors_to_one_and_a_half_is_worth_adding_and_a_new_term_must_take_a_whole_floor() {
         // In noise floors: 2.0 → 1.4 removes 2.0 of the mean square's 4.0.
-        assert!(worth_adding(2.0, 1.4, 1.0));
+        // A refit of a term already added: 2.0 → 1.4 removes 2.0 of the mean square's 4.0.
+        assert!(worth_adding(2.0, 1.4, 1.0, true));
+        // A new term must take a whole noise floor of the RMS.
+        assert!(!worth_adding(2.0, 1.4, 1.0, false));
+        assert!(worth_adding(2.0, 0.9, 1.0, false));
         // 1.2 → 1.0: a fifth of the RMS but under half a noise floor squared.
-        assert!(!worth_adding(1.2, 1.0, 1.0));
+        assert!(!worth_adding(1.2, 1.0, 1.0, true));
         // 10 → 9.5: 19 noise floors squared of mean square, but 5 % of the error.
-        assert!(!worth_adding(10.0, 9.5, 1.0));
-        assert!(!worth_adding(2.0, 2.1, 1.0));
+        assert!(!worth_adding(10.0, 9.5, 1.0, true));
+        assert!(!worth_adding(2.0, 2.1, 1.0, true));
     }
 
     fn term(candidate: &'static str, parameters: Vec<(&'static str, f64)>) -> DiscoveredTerm {
