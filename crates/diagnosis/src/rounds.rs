@@ -205,9 +205,14 @@ pub(crate) fn run_rounds(
 
 /// Whether two discovered terms are the same candidate carried by the same parameters.
 fn same_term(a: &DiscoveredTerm, b: &DiscoveredTerm) -> bool {
-    a.candidate == b.candidate
-        && a.parameters.len() == b.parameters.len()
-        && a.parameters.iter().zip(&b.parameters).all(|(x, y)| x.0 == y.0)
+    carried_alike(a, b.candidate, &b.parameters)
+}
+
+/// Whether `term` is `candidate` carried by the parameters named in `parameters`.
+fn carried_alike(term: &DiscoveredTerm, candidate: &str, parameters: &[(&'static str, f64)]) -> bool {
+    term.candidate == candidate
+        && term.parameters.len() == parameters.len()
+        && term.parameters.iter().zip(parameters).all(|(x, y)| x.0 == y.0)
 }
 
 /// Replay the current model; `None` when every channel is within its noise held out.
@@ -566,11 +571,7 @@ fn discover_term(
         progress(&format!(
             "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
         ));
-        let refines = earlier.iter().any(|d| {
-            d.candidate == label
-                && d.parameters.len() == set.len()
-                && d.parameters.iter().zip(&set).all(|(a, b)| a.0 == b.0)
-        });
+        let refines = earlier.iter().any(|d| carried_alike(d, label, &set));
         let force_ok = worth_adding(force_before, after, noise, refines);
         // A term on the pressure transducers is judged on the pressures; so is one upstream
         // of the piston whose departure shows in the pressures more than in the force (a
@@ -763,8 +764,7 @@ mod tests {
 
     #[test]
     fn a_refit_that_takes_two_noise_floors_to_one_and_a_half_is_worth_adding_and_a_new_term_must_take_a_whole_floor() {
-        // In noise floors: 2.0 → 1.4 removes 2.0 of the mean square's 4.0.
-        // A refit of a term already added: 2.0 → 1.4 removes 2.0 of the mean square's 4.0.
+        // In noise floors. A refit of a term already added: 2.0 → 1.4 removes 2.0 of the mean square's 4.0.
         assert!(worth_adding(2.0, 1.4, 1.0, true));
         // A new term must take a whole noise floor of the RMS.
         assert!(!worth_adding(2.0, 1.4, 1.0, false));
