@@ -362,9 +362,9 @@ fn physical_reading(name: &str, added: f64) -> Option<String> {
             added * 1e6
         ),
         "chamber_laminar_vent_1" | "chamber_laminar_vent_2" if added > 0.0 => format!(
-            "Chamber {} loses {added:.3e} kg/(s·Pa) × its pressure above the return's through a laminar path: {:.2} g/s at 3 bar.",
+            "Chamber {} loses {added:.3e} kg/(s·Pa) × its pressure above the return's through a laminar path: {:.2} mg/s at 3 bar.",
             &name[name.len() - 1..],
-            added * 3e5 * 1e3
+            added * 3e5 * 1e6
         ),
         _ => return None,
     })
