@@ -47,6 +47,8 @@ mechanisms=(
     "discharge_ratio_rise|valve|nonlinearity|--discharge-ratio-rise 0.3"
     "supply_leak_2|chambers|extra_flow|--supply-leak-2 1e-8"
     "laminar_leak_1|chambers|extra_flow|--laminar-leak-1 3e-11"
+    "force_filter_40hz|force_sensor|dynamics|--force-sensor-filter 40 --force-sensor-filter-damping 0.5"
+    "p1_filter_30hz|pressure_sensors|dynamics|--pressure-sensor-filter-1 30 --pressure-sensor-filter-damping-1 1"
     "receiver_and_supply|jet_pipe+supply|parameter_offset|--undeclared receiver_offset --supply-pressure 622925"
     "receiver_and_pickup|jet_pipe+force_sensor|parameter_offset+periodic|--undeclared receiver_offset --force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
 )

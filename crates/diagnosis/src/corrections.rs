@@ -83,6 +83,9 @@ pub enum Regressor {
 pub enum Filter {
     Delay,
     Lag,
+    /// A second-order low-pass filter of this damping ratio; the coefficient is its natural
+    /// frequency (Hz).
+    SecondOrder(f64),
     Play,
 }
 
@@ -94,6 +97,10 @@ impl Filter {
         match self {
             Filter::Delay => law.delay = value,
             Filter::Lag => law.lag = value,
+            Filter::SecondOrder(damping) => {
+                law.filter_frequency = value;
+                law.filter_damping = damping;
+            }
             Filter::Play => law.play = value,
         }
         sensors::filtered(&law, time, x.to_vec())
@@ -105,11 +112,14 @@ impl Filter {
         Some(match (channel, self) {
             (FORCE, Filter::Delay) => "force_sensor_delay",
             (FORCE, Filter::Lag) => "force_sensor_lag",
+            (FORCE, Filter::SecondOrder(_)) => "force_sensor_filter_frequency",
             (FORCE, Filter::Play) => "force_sensor_play",
             (P1, Filter::Delay) => "p1_sensor_delay",
             (P1, Filter::Lag) => "p1_sensor_lag",
+            (P1, Filter::SecondOrder(_)) => "p1_sensor_filter_frequency",
             (P2, Filter::Delay) => "p2_sensor_delay",
             (P2, Filter::Lag) => "p2_sensor_lag",
+            (P2, Filter::SecondOrder(_)) => "p2_sensor_filter_frequency",
             _ => return None,
         })
     }
@@ -149,9 +159,9 @@ pub enum Mechanism {
     OutputFilter { channel: usize, filter: Filter },
     /// A term on a measured channel: coefficient × regressor.
     Output { channel: usize, regressor: Regressor },
-    /// The shape parameter of the candidate's regressors (a friction's speed scale), found
-    /// by a search over its range on a logarithmic scale with the amplitudes solved at each
-    /// value.
+    /// The shape parameter of the candidate's regressors (a friction's speed scale) or of its
+    /// filter (a second-order filter's damping ratio), found by a search over its range on a
+    /// logarithmic scale with the amplitudes (or the filter's frequency) found at each value.
     Shape,
     /// A parameter varying in time: coefficient × its sensitivity × the modulation (first order).
     Modulated {

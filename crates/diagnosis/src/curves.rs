@@ -509,6 +509,7 @@ pub fn channel_model_terms(
                     && p.force_sensor_ripple_cosine == 0.0
                     && p.force_sensor_delay == 0.0
                     && p.force_sensor_lag == 0.0
+                    && p.force_sensor_filter_frequency == 0.0
                     && p.force_sensor_play == 0.0
                     && !p.force_sensor_curve.is_on();
                 if !plain {
@@ -521,6 +522,7 @@ pub fn channel_model_terms(
                 if p.p1_sensor_drift != 0.0
                     || p.p1_sensor_delay != 0.0
                     || p.p1_sensor_lag != 0.0
+                    || p.p1_sensor_filter_frequency != 0.0
                     || p.p1_sensor_curve.is_on()
                 {
                     return None;
@@ -532,6 +534,7 @@ pub fn channel_model_terms(
                 if p.p2_sensor_drift != 0.0
                     || p.p2_sensor_delay != 0.0
                     || p.p2_sensor_lag != 0.0
+                    || p.p2_sensor_filter_frequency != 0.0
                     || p.p2_sensor_curve.is_on()
                 {
                     return None;

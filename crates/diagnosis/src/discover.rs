@@ -73,6 +73,8 @@ pub fn model_terms(
                 }
                 set.push((term.name, value));
             }
+            // A second-order filter's damping ratio, with its frequency.
+            Mechanism::Shape if term.name.ends_with("_sensor_filter_damping") => set.push((term.name, value)),
             Mechanism::OutputFilter { channel, filter } => {
                 let name = filter.sensor_parameter(channel)?;
                 if parameter_value(base, name) != 0.0 && value != 0.0 {
@@ -286,6 +288,9 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
     if let Some(discharge) = crate::discharge::reading(set, before) {
         return discharge;
     }
+    if let Some(filter) = second_order_reading(location, family, set) {
+        return filter;
+    }
     if let Some(curve) = crate::curves::reading(set) {
         return format!(
             "At the {location} ({}): {curve}",
@@ -317,6 +322,38 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
         sentence.push_str(&p);
     }
     sentence
+}
+
+/// A transducer's second-order filter in physical words: its natural frequency, damping and
+/// −3 dB corner, f_n √(1 − 2ζ² + √((1 − 2ζ²)² + 1)).
+fn second_order_reading(location: &str, family: &str, set: &[(&'static str, f64)]) -> Option<String> {
+    let &(name, f_n) = set
+        .iter()
+        .find(|(n, v)| n.ends_with("_sensor_filter_frequency") && *v > 0.0)?;
+    let prefix = &name[..name.len() - "_filter_frequency".len()];
+    let zeta = set
+        .iter()
+        .find(|(n, _)| n.strip_prefix(prefix) == Some("_filter_damping"))
+        .map_or(std::f64::consts::FRAC_1_SQRT_2, |(_, v)| *v);
+    let a = 1.0 - 2.0 * zeta * zeta;
+    let corner = f_n * (a + (a * a + 1.0).sqrt()).sqrt();
+    let reader = match prefix {
+        "force_sensor" => "The force sensor",
+        "p1_sensor" => "The chamber 1 pressure transducer",
+        _ => "The chamber 2 pressure transducer",
+    };
+    let kind = if zeta < 0.6 {
+        "underdamped: it rings on a step"
+    } else if zeta <= 0.8 {
+        "near Butterworth's 0.707"
+    } else if zeta <= 1.05 {
+        "near critical: two equal lags"
+    } else {
+        "overdamped: two unequal lags"
+    };
+    Some(format!(
+        "At the {location} ({family}): {reader} reads through a second-order low-pass filter of natural frequency {f_n:.1} Hz and damping ratio {zeta:.2} ({kind}), its −3 dB corner at {corner:.1} Hz: {name} = {f_n:.4e} Hz, {prefix}_filter_damping = {zeta:.4}."
+    ))
 }
 
 /// What an extra force on the piston of `added` times its signal is, in physical words.

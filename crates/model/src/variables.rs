@@ -98,6 +98,8 @@ pub mod vr {
     pub const FORCE_SENSOR_RIPPLE_SINE: u32 = 466;
     pub const FORCE_SENSOR_RIPPLE_FREQUENCY: u32 = 467;
     pub const FORCE_SENSOR_RIPPLE_COSINE: u32 = 468;
+    pub const FORCE_SENSOR_FILTER_FREQUENCY: u32 = 469;
+    pub const FORCE_SENSOR_FILTER_DAMPING: u32 = 479;
     pub const VISCOUS_FRICTION: u32 = 470;
     pub const POSITION_FORCE_RATE: u32 = 471;
     pub const POSITION_FORCE_REFERENCE: u32 = 472;
@@ -118,11 +120,15 @@ pub mod vr {
     pub const P1_SENSOR_DRIFT: u32 = 502;
     pub const P1_SENSOR_LAG: u32 = 503;
     pub const P1_SENSOR_DELAY: u32 = 504;
+    pub const P1_SENSOR_FILTER_FREQUENCY: u32 = 505;
+    pub const P1_SENSOR_FILTER_DAMPING: u32 = 506;
     pub const P2_SENSOR_OFFSET: u32 = 510;
     pub const P2_SENSOR_GAIN: u32 = 511;
     pub const P2_SENSOR_DRIFT: u32 = 512;
     pub const P2_SENSOR_LAG: u32 = 513;
     pub const P2_SENSOR_DELAY: u32 = 514;
+    pub const P2_SENSOR_FILTER_FREQUENCY: u32 = 515;
+    pub const P2_SENSOR_FILTER_DAMPING: u32 = 516;
     pub const SUPPLY_RESTRICTION_AREA: u32 = 520;
     pub const SUPPLY_PLENUM_VOLUME: u32 = 521;
     pub const RETURN_PLENUM_VOLUME: u32 = 522;
@@ -357,6 +363,10 @@ const CURVE_COMMAND: &str = "the D/A spans 10 V either way; ten times that is no
 const CURVE_FORCE: &str = "1000 N: nine times the largest force the actuator gives (109 N)";
 const CURVE_PRESSURE: &str = PRESSURE;
 const CURVE_RATIO: &str = "a pressure ratio P_down/P_up lies between 0 and 1";
+const FILTER_FREQUENCY: &str =
+    "100 kHz: a hundred times the bench's sampling rate; a filter that fast reads no dynamics";
+const FILTER_DAMPING: &str =
+    "a damping ratio above 0 keeps the filter stable; at 10 it is already two lags a hundred times apart";
 const CURVE_DISCHARGE: &str = "a discharge coefficient lies between 0 (closed) and 1 (no contraction, no loss)";
 
 /// Every variable of the FMU, one row each: name, value reference, unit, start, limits,
@@ -374,9 +384,9 @@ pub const TABLE: &[Row] = &[
     output("P1", vr::P1, "Pa", "absolute pressure of chamber 1 (charging side)").cite("(2.26)-(2.29)"),
     output("P2", vr::P2, "Pa", "absolute pressure of chamber 2 (venting side)").cite("(2.26)-(2.29)"),
     output("i", vr::I, "A", "coil current").cite("(2.1)-(2.3)"),
-    output("F_meas", vr::F_MEAS, "N", "force as the force sensor reads it: F_act unless the force_sensor_* parameters give it an offset, gain, curve, drift, pick-up, delay, lag or play"),
-    output("P1_meas", vr::P1_MEAS, "Pa", "chamber 1 pressure as its transducer reads it: P1 unless the p1_sensor_* parameters give it an offset, gain, drift, delay or lag"),
-    output("P2_meas", vr::P2_MEAS, "Pa", "chamber 2 pressure as its transducer reads it: P2 unless the p2_sensor_* parameters give it an offset, gain, drift, delay or lag"),
+    output("F_meas", vr::F_MEAS, "N", "force as the force sensor reads it: F_act unless the force_sensor_* parameters give it an offset, gain, curve, drift, pick-up, delay, lag, second-order filter or play"),
+    output("P1_meas", vr::P1_MEAS, "Pa", "chamber 1 pressure as its transducer reads it: P1 unless the p1_sensor_* parameters give it an offset, gain, curve, drift, delay, lag or second-order filter"),
+    output("P2_meas", vr::P2_MEAS, "Pa", "chamber 2 pressure as its transducer reads it: P2 unless the p2_sensor_* parameters give it an offset, gain, curve, drift, delay, lag or second-order filter"),
     output(
         "x_jp",
         vr::X_JP,
@@ -768,6 +778,14 @@ pub const TABLE: &[Row] = &[
         .at_least(-1000.0).at_most(1000.0)
         .cite("")
         .because("1000 N: nine times the largest force"),
+    parameter("force_sensor_filter_frequency", vr::FORCE_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "force sensor dynamics: F_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between communication points (0 = off)")
+        .at_least(0.0).at_most(1e5)
+        .cite("")
+        .because(FILTER_FREQUENCY),
+    parameter("force_sensor_filter_damping", vr::FORCE_SENSOR_FILTER_DAMPING, "1", std::f64::consts::FRAC_1_SQRT_2, "force sensor dynamics: the damping ratio of its second-order filter (1/sqrt(2): Butterworth; 1: two equal lags)")
+        .above(0.0).at_most(10.0)
+        .cite("")
+        .because(FILTER_DAMPING),
     parameter("viscous_friction", vr::VISCOUS_FRICTION, "N.s/m", 0.0, "viscous friction: a force of this times the stopper velocity opposes the motion where the pressures set the force (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("(2.33)-(2.35)")
@@ -848,6 +866,14 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: as the command delay"),
+    parameter("p1_sensor_filter_frequency", vr::P1_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 1: P1_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between communication points (0 = off)")
+        .at_least(0.0).at_most(1e5)
+        .cite("")
+        .because(FILTER_FREQUENCY),
+    parameter("p1_sensor_filter_damping", vr::P1_SENSOR_FILTER_DAMPING, "1", std::f64::consts::FRAC_1_SQRT_2, "pressure transducer 1: the damping ratio of its second-order filter (1/sqrt(2): Butterworth; 1: two equal lags)")
+        .above(0.0).at_most(10.0)
+        .cite("")
+        .because(FILTER_DAMPING),
     parameter("p2_sensor_offset", vr::P2_SENSOR_OFFSET, "Pa", 0.0, "pressure transducer 2: offset of P2_meas (0 = off)")
         .at_least(-1e6).at_most(1e6)
         .cite("")
@@ -868,6 +894,14 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: as the command delay"),
+    parameter("p2_sensor_filter_frequency", vr::P2_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 2: P2_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between communication points (0 = off)")
+        .at_least(0.0).at_most(1e5)
+        .cite("")
+        .because(FILTER_FREQUENCY),
+    parameter("p2_sensor_filter_damping", vr::P2_SENSOR_FILTER_DAMPING, "1", std::f64::consts::FRAC_1_SQRT_2, "pressure transducer 2: the damping ratio of its second-order filter (1/sqrt(2): Butterworth; 1: two equal lags)")
+        .above(0.0).at_most(10.0)
+        .cite("")
+        .because(FILTER_DAMPING),
     parameter("supply_restriction_area", vr::SUPPLY_RESTRICTION_AREA, "m2", 0.0, "supply restriction: the jet pipe draws its supply through an orifice of this discharge coefficient times area, (2.18), instead of from P_s directly (0 = off; not with supply_resistance)")
         .at_least(0.0).at_most(1e-4)
         .cite("(2.18), §2.6")

@@ -227,6 +227,10 @@ pub fn run(
         y[S_DEL] = m.force(&y, stop_at(0.0), 0.0) / und.contact_stiffness;
     }
     y[S_FF] = m.force(&y, stop_at(0.0), 0.0);
+    y[S_FF2] = y[S_FF];
+    y[S_FF2_RATE] = 0.0;
+    y[S_PF1] = y[S_P1];
+    y[S_PF1_RATE] = 0.0;
 
     let pre_steps = (opts.pre_time / H).round() as i64;
     let mut step: i64 = -pre_steps;
@@ -280,7 +284,9 @@ pub fn run(
     for k in 0..n_samples {
         let t = k as f64 * sample;
         let (xs, xd) = stopper(t);
-        let mut f_true = if m.f_lag {
+        let mut f_true = if und.force_sensor_filter_frequency > 0.0 {
+            y[S_FF2]
+        } else if m.f_lag {
             y[S_FF]
         } else if und.moving_mass != 0.0 {
             let delta = 1e-6;
@@ -302,6 +308,9 @@ pub fn run(
             f += und.force_sensor_pickup_amplitude * (2.0 * PI * und.force_sensor_pickup_frequency * t + 1.0).sin();
         }
         let (mut p1, mut p2) = (y[S_P1], y[S_P2]);
+        if und.pressure_sensor_filter_1 > 0.0 {
+            p1 = y[S_PF1];
+        }
         if und.pressure_sensor_offset_1 != 0.0 {
             p1 += und.pressure_sensor_offset_1;
         }

@@ -124,6 +124,12 @@
 //!   any supply restriction) into chamber 2, the same compressible law, inflow at T.
 //! * `laminar_leak_1` (`chambers`/`extra_flow`, g): chamber 1 loses g (P1 − 101 325 Pa) to
 //!   atmosphere (a long, narrow path, laminar).
+//! * `force_sensor_filter_frequency` (`force_sensor`/`dynamics`, f_n, with
+//!   `force_sensor_filter_damping` ζ): the force reading passes, after any lag, through
+//!   y'' + 2ζω y' + ω² y = ω² u, ω = 2π f_n (an amplifier's anti-aliasing filter; ζ = 1/√2
+//!   when 0). `pressure_sensor_filter_1` (`pressure_sensors`/`dynamics`, with
+//!   `pressure_sensor_filter_damping_1`): the same on the chamber 1 transducer. Both are
+//!   integrated with the plant.
 //!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 
@@ -248,6 +254,16 @@ pub struct UndeclaredEffects {
     /// `chambers`/`extra_flow`: laminar conductance (kg/(s·Pa)) from chamber 1 to atmosphere,
     /// the flow (P1 − 101 325 Pa) times this (a porous seal); 0 = none.
     pub laminar_leak_1: f64,
+    /// `force_sensor`/`dynamics`: natural frequency (Hz) of a second-order low-pass filter
+    /// (the bridge amplifier's anti-aliasing filter) after any force sensor lag; 0 = none.
+    pub force_sensor_filter_frequency: f64,
+    /// Its damping ratio (0: 1/√2, Butterworth).
+    pub force_sensor_filter_damping: f64,
+    /// `pressure_sensors`/`dynamics`: natural frequency (Hz) of a second-order low-pass
+    /// filter on the chamber 1 pressure transducer; 0 = none.
+    pub pressure_sensor_filter_1: f64,
+    /// Its damping ratio (0: 1/√2).
+    pub pressure_sensor_filter_damping_1: f64,
 }
 
 impl Default for BenchEffects {

@@ -116,7 +116,7 @@ pub(crate) fn port_areas(x: f64, d_jp: f64) -> (f64, f64, f64, f64) {
 // Model
 // ---------------------------------------------------------------------------------------------
 
-pub(crate) const NS: usize = 16;
+pub(crate) const NS: usize = 20;
 pub(crate) type State = [f64; NS];
 pub(crate) const S_I: usize = 0; // coil current
 pub(crate) const S_X1: usize = 1; // output of the first-order jet pipe lag
@@ -134,6 +134,10 @@ pub(crate) const S_XL: usize = 12; // output of the extra jet pipe lag (undeclar
 pub(crate) const S_FF: usize = 13; // force sensor lag output (undeclared)
 pub(crate) const S_DEL: usize = 14; // piston-stopper contact deflection (undeclared)
 pub(crate) const S_PL1: usize = 15; // port 1 line pressure upstream of the restriction (undeclared)
+pub(crate) const S_FF2: usize = 16; // force sensor second-order filter output (undeclared)
+pub(crate) const S_FF2_RATE: usize = 17; // and its rate
+pub(crate) const S_PF1: usize = 18; // pressure transducer 1 second-order filter output (undeclared)
+pub(crate) const S_PF1_RATE: usize = 19; // and its rate
 
 /// Integration step (s): 50 steps per 1 ms command/log period.
 pub(crate) const H: f64 = 20e-6;
@@ -526,6 +530,38 @@ impl Model {
         } else {
             0.0
         };
+        // undeclared second-order filters of the force sensor (after its lag) and of
+        // pressure transducer 1
+        let u = &self.e.undeclared;
+        if u.force_sensor_filter_frequency > 0.0 {
+            let input = if self.f_lag { y[S_FF] } else { self.force(y, xs, xs_dot) };
+            let (rate, acceleration) = second_order(
+                u.force_sensor_filter_frequency,
+                u.force_sensor_filter_damping,
+                input,
+                y[S_FF2],
+                y[S_FF2_RATE],
+            );
+            dy[S_FF2] = rate;
+            dy[S_FF2_RATE] = acceleration;
+        } else {
+            dy[S_FF2] = 0.0;
+            dy[S_FF2_RATE] = 0.0;
+        }
+        if u.pressure_sensor_filter_1 > 0.0 {
+            let (rate, acceleration) = second_order(
+                u.pressure_sensor_filter_1,
+                u.pressure_sensor_filter_damping_1,
+                y[S_P1],
+                y[S_PF1],
+                y[S_PF1_RATE],
+            );
+            dy[S_PF1] = rate;
+            dy[S_PF1_RATE] = acceleration;
+        } else {
+            dy[S_PF1] = 0.0;
+            dy[S_PF1_RATE] = 0.0;
+        }
         // chambers
         let (v1, v2) = self.volumes(x_pist);
         let (dv1, dv2) = (self.a_p * x_pist_dot, -self.a_p * x_pist_dot);
@@ -584,3 +620,15 @@ impl Model {
 // ---------------------------------------------------------------------------------------------
 // Protocol (bench/README.md)
 // ---------------------------------------------------------------------------------------------
+
+/// y'' = ω² (u − y) − 2ζω y' of a unit-gain second-order low-pass filter of natural
+/// frequency f (Hz) and damping ζ (1/√2 when 0): (y', y'').
+pub(crate) fn second_order(frequency: f64, damping: f64, input: f64, y: f64, rate: f64) -> (f64, f64) {
+    let omega = 2.0 * std::f64::consts::PI * frequency;
+    let zeta = if damping > 0.0 {
+        damping
+    } else {
+        std::f64::consts::FRAC_1_SQRT_2
+    };
+    (rate, omega * omega * (input - y) - 2.0 * zeta * omega * rate)
+}

@@ -114,6 +114,30 @@ fn filter(name: &'static str, unit: &'static str, channel: usize, filter: Filter
     }
 }
 
+/// A second-order low-pass filter on a measured channel: its natural frequency searched on
+/// a logarithmic scale for each damping ratio tried (the damping a shape, 0.2–5).
+fn second_order(frequency: &'static str, damping: &'static str, channel: usize) -> Vec<Term> {
+    vec![
+        filter(
+            frequency,
+            "Hz",
+            channel,
+            Filter::SecondOrder(std::f64::consts::FRAC_1_SQRT_2),
+            1.0,
+            2000.0,
+        ),
+        Term {
+            name: damping,
+            unit: "1",
+            mechanism: Mechanism::Shape,
+            neutral: std::f64::consts::FRAC_1_SQRT_2,
+            step: 0.0,
+            lower: 0.2,
+            upper: 5.0,
+        },
+    ]
+}
+
 fn modulated(
     name: &'static str,
     unit: &'static str,
@@ -670,6 +694,13 @@ pub fn catalogue(
             vec![filter("force_sensor_lag", "s", FORCE, Filter::Lag, 1e-4, 0.2)],
         ),
         c(
+            "force sensor second-order filter",
+            "force_sensor",
+            "dynamics",
+            None,
+            second_order("force_sensor_filter_frequency", "force_sensor_filter_damping", FORCE),
+        ),
+        c(
             "force sensor delay",
             "force_sensor",
             "delay",
@@ -765,9 +796,19 @@ pub fn catalogue(
                 output("p2_sensor_gain_error", "1", P2, Regressor::Own, 1e-3),
             ],
         ));
-        for (channel, lag, delay) in [
-            (P1, "p1_sensor_lag", "p1_sensor_delay"),
-            (P2, "p2_sensor_lag", "p2_sensor_delay"),
+        for (channel, lag, delay, [frequency, damping]) in [
+            (
+                P1,
+                "p1_sensor_lag",
+                "p1_sensor_delay",
+                ["p1_sensor_filter_frequency", "p1_sensor_filter_damping"],
+            ),
+            (
+                P2,
+                "p2_sensor_lag",
+                "p2_sensor_delay",
+                ["p2_sensor_filter_frequency", "p2_sensor_filter_damping"],
+            ),
         ] {
             list.push(c(
                 "pressure sensor lag",
@@ -775,6 +816,13 @@ pub fn catalogue(
                 "dynamics",
                 None,
                 vec![filter(lag, "s", channel, Filter::Lag, 1e-4, 0.2)],
+            ));
+            list.push(c(
+                "pressure sensor second-order filter",
+                "pressure_sensors",
+                "dynamics",
+                None,
+                second_order(frequency, damping, channel),
             ));
             list.push(c(
                 "pressure sensor delay",

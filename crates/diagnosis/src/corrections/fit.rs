@@ -373,6 +373,13 @@ impl Problem<'_> {
         damped: bool,
     ) -> Result<Fit, String> {
         let terms = &candidate.terms;
+        if let Some(Mechanism::OutputFilter {
+            channel,
+            filter: Filter::SecondOrder(_),
+        }) = terms.first().map(|t| t.mechanism)
+        {
+            return self.fit_second_order(candidate, channel, iterations, base_replay);
+        }
         if terms.iter().any(|t| t.mechanism == Mechanism::Shape) {
             return self.fit_shape(candidate, base_replay);
         }
@@ -658,6 +665,56 @@ impl Problem<'_> {
             candidate: candidate.clone(),
             values,
             ..fit
+        })
+    }
+
+    /// A second-order filter on a measured channel (its natural frequency, then its damping
+    /// ratio as a shape): it acts on the channel exactly, so it is applied to the base
+    /// prediction, with no replay. Golden-section search of the damping's logarithm, and for
+    /// each damping of the frequency's; the filter stays off unless it lowers the misfit.
+    fn fit_second_order(
+        &self,
+        candidate: &Candidate,
+        channel: usize,
+        iterations: usize,
+        base_replay: &Replay,
+    ) -> Result<Fit, String> {
+        let [frequency, damping] = match candidate.terms.as_slice() {
+            [f, d] if d.mechanism == Mechanism::Shape => [f, d],
+            _ => return Err("a second-order filter is its frequency and its damping".to_string()),
+        };
+        let (steps, grid) = if iterations <= 1 {
+            (COARSE_GOLDEN_STEPS, COARSE_GRID)
+        } else {
+            (GOLDEN_STEPS, FINE_GRID)
+        };
+        let base = Prediction::of_replay(base_replay);
+        let filtered = |f: f64, z: f64| {
+            let mut y = base.clone();
+            y[channel] = Filter::SecondOrder(z).apply(&self.recording.time, &base[channel], f);
+            y
+        };
+        let cost = |y: &[Vec<f64>; CHANNELS]| self.errors(y).0.iter().sum::<f64>();
+        let on_scale = |t: &Term, u: f64| t.lower * (t.upper / t.lower).powf(u);
+        let best_frequency =
+            |z: f64| golden_from_several(grid, steps, &mut |u| cost(&filtered(on_scale(frequency, u), z)));
+        let (u_damping, _) = golden_from_several(grid, steps, &mut |u| best_frequency(on_scale(damping, u)).1);
+        let z = on_scale(damping, u_damping);
+        let f = on_scale(frequency, best_frequency(z).0);
+        let on = filtered(f, z);
+        let (values, prediction) = if cost(&on) < cost(&base) {
+            (vec![f, z], on)
+        } else {
+            (vec![frequency.neutral, damping.neutral], base)
+        };
+        let (train, heldout) = self.errors(&prediction);
+        Ok(Fit {
+            candidate: candidate.clone(),
+            values,
+            prediction,
+            train,
+            heldout,
+            replays: 0,
         })
     }
 

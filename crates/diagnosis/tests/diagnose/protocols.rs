@@ -307,6 +307,13 @@ fn discovered_and_explained(
     place: (&str, &str),
     parameter: &str,
 ) -> f64 {
+    explained_at(label, spec, undeclared, place)
+        .get(value_reference(parameter))
+        .unwrap()
+}
+
+/// [`discovered_and_explained`]'s diagnosis: the model it ends with.
+fn explained_at(label: &str, spec: &ProtocolSpec, undeclared: UndeclaredEffects, place: (&str, &str)) -> Parameters {
     let effects = BenchEffects {
         undeclared,
         ..BenchEffects::default()
@@ -318,7 +325,7 @@ fn discovered_and_explained(
         .unwrap_or_else(|| panic!("{label}: nothing discovered: {}", d.summary()[0]));
     assert_eq!((found.location, found.family), place, "{label}: {}", found.reading);
     assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
-    d.parameters.get(value_reference(parameter)).unwrap()
+    d.parameters
 }
 
 /// An extra 15 ms lag after the jet pipe's static curve, in series with its 1.03 ms corner
@@ -402,4 +409,86 @@ fn a_laminar_leak_from_chamber_1_under_a_multisine_without_pressures_is_a_lamina
         "chamber_laminar_vent_1",
     );
     assert!((conductance / 3e-11 - 1.0).abs() < 0.05, "{conductance} kg/(s·Pa)");
+}
+
+/// A second-order low-pass filter on a reading (an amplifier's anti-aliasing filter) of
+/// `frequency` Hz and damping `damping`, integrated by the bench with its plant: found at
+/// `place` as a second-order filter, the force explained, the frequency within 5 % and the
+/// damping within 10 %.
+fn second_order_filter_found(
+    label: &str,
+    spec: &ProtocolSpec,
+    undeclared: UndeclaredEffects,
+    place: (&str, &str),
+    prefix: &str,
+    (frequency, damping): (f64, f64),
+) {
+    let model = explained_at(label, spec, undeclared, place);
+    let at = |name: String| model.get(value_reference(&name)).unwrap();
+    let (fitted, d) = (
+        at(format!("{prefix}_filter_frequency")),
+        at(format!("{prefix}_filter_damping")),
+    );
+    assert!(
+        (fitted / frequency - 1.0).abs() < 0.05,
+        "{label}: {fitted} Hz against {frequency}"
+    );
+    assert!(
+        (d / damping - 1.0).abs() < 0.1,
+        "{label}: damping {d} against {damping}"
+    );
+}
+
+/// A 40 Hz filter of damping 0.5 on the force sensor under a multisine at 1 kHz without
+/// pressures (19 noise floors before): not a lag, a second-order filter.
+#[test]
+fn a_ringing_second_order_filter_on_the_force_sensor_under_a_multisine_is_found_with_its_frequency_and_damping() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Multisine,
+        sample_rate: 1000.0,
+        duration: 20.0,
+        pressures: false,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let filter = UndeclaredEffects {
+        force_sensor_filter_frequency: 40.0,
+        force_sensor_filter_damping: 0.5,
+        ..UndeclaredEffects::default()
+    };
+    second_order_filter_found(
+        "multisine-force-filter",
+        &spec,
+        filter,
+        ("force_sensor", "dynamics"),
+        "force_sensor",
+        (40.0, 0.5),
+    );
+}
+
+/// A critically damped 30 Hz filter on the chamber 1 transducer under a staircase at 250 Hz
+/// with pressures: found at the pressure sensors.
+#[test]
+fn a_critically_damped_filter_on_a_pressure_transducer_under_a_staircase_at_250_hertz_is_found_at_the_pressure_sensors()
+{
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Staircase,
+        sample_rate: 250.0,
+        duration: 20.0,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let filter = UndeclaredEffects {
+        pressure_sensor_filter_1: 30.0,
+        pressure_sensor_filter_damping_1: 1.0,
+        ..UndeclaredEffects::default()
+    };
+    second_order_filter_found(
+        "staircase-pressure-filter",
+        &spec,
+        filter,
+        ("pressure_sensors", "dynamics"),
+        "p1_sensor",
+        (30.0, 1.0),
+    );
 }

@@ -184,6 +184,20 @@ struct Cli {
     /// A laminar leak from chamber 1 to atmosphere: its conductance, kg/(s·Pa) (e.g. 2e-11).
     #[arg(long)]
     laminar_leak_1: Option<f64>,
+    /// The force reading passes through a second-order low-pass filter of this natural
+    /// frequency, Hz (e.g. 40).
+    #[arg(long)]
+    force_sensor_filter: Option<f64>,
+    /// With --force-sensor-filter: its damping ratio (1/√2 unless given).
+    #[arg(long)]
+    force_sensor_filter_damping: Option<f64>,
+    /// The chamber 1 pressure reading passes through a second-order low-pass filter of this
+    /// natural frequency, Hz (e.g. 40).
+    #[arg(long)]
+    pressure_sensor_filter_1: Option<f64>,
+    /// With --pressure-sensor-filter-1: its damping ratio (1/√2 unless given).
+    #[arg(long)]
+    pressure_sensor_filter_damping_1: Option<f64>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -252,6 +266,13 @@ fn main() -> ExitCode {
     set(&mut und.discharge_ratio_rise, cli.discharge_ratio_rise);
     set(&mut und.supply_leak_2, cli.supply_leak_2);
     set(&mut und.laminar_leak_1, cli.laminar_leak_1);
+    set(&mut und.force_sensor_filter_frequency, cli.force_sensor_filter);
+    set(&mut und.force_sensor_filter_damping, cli.force_sensor_filter_damping);
+    set(&mut und.pressure_sensor_filter_1, cli.pressure_sensor_filter_1);
+    set(
+        &mut und.pressure_sensor_filter_damping_1,
+        cli.pressure_sensor_filter_damping_1,
+    );
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -277,6 +298,10 @@ fn main() -> ExitCode {
         und.discharge_ratio_rise,
         und.supply_leak_2,
         und.laminar_leak_1,
+        und.force_sensor_filter_frequency,
+        und.force_sensor_filter_damping,
+        und.pressure_sensor_filter_1,
+        und.pressure_sensor_filter_damping_1,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
@@ -301,7 +326,7 @@ fn main() -> ExitCode {
     if und_bad {
         eprintln!(
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
-             friction, moving mass, seal friction, damping, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
+             friction, moving mass, seal friction, damping, filter frequencies and dampings, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
              blend, return area reduction and discharge ratio rise in 0..1; stopper position \
              offset within ±5 mm, gas temperature drift within ±100 K"
         );
