@@ -203,19 +203,22 @@ def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
             assert abs(through_fmu[c] - reported[c]) <= 0.1 * reported[c]
 
 
-# The general classes added at the valve, in the chambers' balances and at the force sensor:
-# the discharge coefficient as a curve of the pressure ratio, a leak from the supply into a
-# chamber, a second-order filter on the reading (the FMU filters at its communication points).
+# The general classes added at the valve, in the chambers' balances, at the force sensor and
+# at the stopper's mount: the discharge coefficient as a curve of the pressure ratio, a leak
+# from the supply into a chamber, a second-order filter on the reading (the FMU filters at its
+# communication points), a compliant mount that lags (its state in the FMU's).
 @needs_binaries
 @pytest.mark.parametrize("name, options, parameter", [
     ("force_filter", ("--protocol", "sine", "--sample-rate", "250", "--force-sensor-filter", "25"),
      "force_sensor_filter_frequency"),
+    ("mount_lag", ("--protocol", "staircase", "--sample-rate", "500", "--contact-stiffness", "2e4",
+                   "--contact-lag", "1e-3"), "stopper_mount_lag"),
     ("discharge_rise", ("--protocol", "multisine", "--sample-rate", "500", "--no-pressures",
                         "--discharge-ratio-rise", "0.3"), "discharge_curve_y_2"),
     ("supply_leak", ("--protocol", "staircase", "--sample-rate", "500", "--supply-leak-2", "1e-8"),
      "chamber_supply_leak_2"),
 ])
-def test_fmu_start_values_of_a_valve_curve_a_chamber_leak_or_a_sensor_filter_reproduce_the_after_error(
+def test_fmu_start_values_of_a_general_class_at_the_valve_chambers_sensor_or_mount_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path, name, options, parameter):
     recording, report = generated_and_diagnosed(tmp_path, name, "--seed", "5", "--duration", "20", *options)
     assert report["effects"] == [], report["effects"]

@@ -388,6 +388,14 @@ fn physical_reading(name: &str, added: f64) -> Option<String> {
             -added,
             added * 0.1
         ),
+        "stopper_compliance" if added > 0.0 => format!(
+            "The piston sits beyond the stopper by the force it carries over a stiffness of {:.3e} N/m: a compliant mount.",
+            1.0 / added
+        ),
+        "stopper_mount_lag" if added > 0.0 => format!(
+            "The mount follows the force through a lag of {:.2} ms (its own mass and damping).",
+            added * 1e3
+        ),
         "chamber_vent_1" | "chamber_vent_2" if added > 0.0 => format!(
             "Chamber {} leaks to the return pressure through an orifice of C_d·A {:.4} mm².",
             &name[name.len() - 1..],

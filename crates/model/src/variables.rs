@@ -83,6 +83,7 @@ pub mod vr {
     pub const PORT_RESISTANCE_1: u32 = 430;
     pub const PORT_RESISTANCE_2: u32 = 431;
     pub const STOPPER_COMPLIANCE: u32 = 440;
+    pub const STOPPER_MOUNT_LAG: u32 = 441;
     pub const COMMAND_LAG: u32 = 450;
     pub const COMMAND_LIMIT: u32 = 451;
     pub const CURRENT_LIMIT: u32 = 452;
@@ -714,10 +715,14 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1e12)
         .cite("(2.25)")
         .because(RESISTANCE),
-    parameter("stopper_compliance", vr::STOPPER_COMPLIANCE, "m/N", 0.0, "compliance between stopper and piston: the piston sits this times A_p (P1 - P2) beyond the stopper, which moves the chamber volumes (0 = rigid)")
+    parameter("stopper_compliance", vr::STOPPER_COMPLIANCE, "m/N", 0.0, "compliance between stopper and piston: the piston sits this times the actuator force (A_p (P1 - P2), floored by the spring force) beyond the stopper, which moves the chamber volumes (0 = rigid)")
         .at_least(0.0).at_most(1e-3)
         .cite("(2.32)")
         .because("at the piston's largest force, 109 N, 1e-3 m/N would put it 0.11 m beyond the stopper, more than the 78 mm cylinder"),
+    parameter("stopper_mount_lag", vr::STOPPER_MOUNT_LAG, "s", 0.0, "compliant stopper mount: the piston's offset beyond the stopper follows stopper_compliance times the actuator force through a first-order lag of this time constant, the mount's own mass and damping, instead of at once (0 = at once; needs stopper_compliance)")
+        .at_least(0.0).at_most(0.1)
+        .cite("(2.32)")
+        .because("0.1 s: a mount that slow is no stiffness any more but a second actuator"),
     parameter("command_lag", vr::COMMAND_LAG, "s", 0.0, "command dynamics: the current driver sees v_DA through a first-order lag of this time constant, updated at each communication point with the command held over the step (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("(2.1)")

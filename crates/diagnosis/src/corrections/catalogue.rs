@@ -603,6 +603,18 @@ pub fn catalogue(
             vec![term_off("stopper_compliance", "m/N", 1e-6, 1e-3)],
         ),
         c(
+            "stopper mount with a lag",
+            "mechanics",
+            "compliance",
+            None,
+            // The lag acts only with a compliance: started at 0.5 ms, it moves from the
+            // second Gauss–Newton step on, once the compliance has.
+            vec![
+                term_off("stopper_compliance", "m/N", 1e-6, 1e-3),
+                started("stopper_mount_lag", "s", 5e-4, 1e-4, 0.0, 0.1),
+            ],
+        ),
+        c(
             "force on the stopper position",
             "mechanics",
             "extra_force",

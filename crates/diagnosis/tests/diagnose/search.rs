@@ -155,9 +155,9 @@ fn a_stopper_position_logged_one_millimetre_off_is_placed_at_the_chambers_under_
 }
 
 /// A compliant stopper mount (2e4 N/m) with a 1 ms lag: at the mechanics as a compliance,
-/// the compliance within 30 % of 1/k, most of the force error gone. The model has no lag of
-/// the mount, so what the lag leaves may stay.
-fn compliant_mount_found(label: &str, spec: &ProtocolSpec) {
+/// the compliance within 5 % of 1/k, the force explained; where the protocol shows the lag
+/// (`lag_shows`), the mount's lag within 25 % of 1 ms.
+fn compliant_mount_found(label: &str, spec: &ProtocolSpec, lag_shows: bool) {
     let d = diagnosed(
         label,
         spec,
@@ -180,20 +180,18 @@ fn compliant_mount_found(label: &str, spec: &ProtocolSpec) {
     );
     let compliance = get(&d, "stopper_compliance");
     assert!(
-        (compliance - 5e-5).abs() < 0.3 * 5e-5,
+        (compliance - 5e-5).abs() < 0.05 * 5e-5,
         "{label}: compliance {compliance}"
     );
-    assert!(
-        d.after.heldout_rms < 0.25 * d.before.heldout_rms,
-        "{label}: {} -> {}",
-        d.before.heldout_rms,
-        d.after.heldout_rms
-    );
+    if lag_shows {
+        let lag = get(&d, "stopper_mount_lag");
+        assert!((lag - 1e-3).abs() < 0.25e-3, "{label}: lag {lag} s");
+    }
+    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
 }
 
 #[test]
-#[ignore = "the slowest of the mount's cases (74 s wall under load); scripts/bench_protocols.sh runs the mount under every protocol"]
-fn a_compliant_stopper_mount_with_a_one_millisecond_lag_is_placed_at_the_mechanics_under_a_shaken_stopper_at_500_hz() {
+fn a_compliant_stopper_mount_with_a_one_millisecond_lag_is_explained_with_its_lag_under_a_shaken_stopper_at_500_hz() {
     compliant_mount_found(
         "mount-shaken",
         &spec(
@@ -206,13 +204,19 @@ fn a_compliant_stopper_mount_with_a_one_millisecond_lag_is_placed_at_the_mechani
             500.0,
             true,
         ),
+        true,
     );
 }
 
 #[test]
-fn a_compliant_stopper_mount_with_a_one_millisecond_lag_is_placed_at_the_mechanics_under_ramps_at_250_hz_without_pressures(
-) {
-    compliant_mount_found("mount-ramps", &spec(CommandProtocol::Ramps, moves(), 250.0, false));
+fn a_compliant_stopper_mount_with_a_one_millisecond_lag_is_explained_under_ramps_at_250_hz_without_pressures() {
+    // Slow ramps sampled at 250 Hz hardly show a 1 ms lag: the plain compliance explains the
+    // force (1.0 noise floor), and the simpler term wins.
+    compliant_mount_found(
+        "mount-ramps",
+        &spec(CommandProtocol::Ramps, moves(), 250.0, false),
+        false,
+    );
 }
 
 /// The gas temperature rising 20 K over the recording (1 K/s over 20 s): at the chambers as

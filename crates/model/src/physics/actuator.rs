@@ -138,6 +138,9 @@ pub struct Actuator {
     chamber_leaks: bool,
     /// Restrictions between the valve and the air, and the volumes behind them.
     pub restrictions: Restrictions,
+    /// The compliant stopper mount's lag (s), when it has one and a compliance: its state is
+    /// then integrated with the volumes' ([`node::MOUNT`]).
+    mount_lag: Option<f64>,
     /// Which terms of the pressure rates are live, decided here once for all evaluations.
     rate_terms: RateTerms,
     /// Whether the outputs are the thesis's alone: no friction or extra piston force, every
@@ -232,12 +235,15 @@ impl Actuator {
             && Channel::ALL
                 .iter()
                 .all(|&channel| SensorLaw::of(&params, channel).is_identity());
+        let mount_lag =
+            (params.stopper_mount_lag > 0.0 && params.stopper_compliance != 0.0).then_some(params.stopper_mount_lag);
         Ok(Self {
             thesis_outputs,
             extra_library,
             acceleration_term,
             rate_terms,
             restrictions,
+            mount_lag,
             params,
             flow,
             cylinder,
@@ -461,9 +467,22 @@ impl Actuator {
         }
     }
 
-    /// The rates of P1, P2 and the gas volumes' pressures ([`super::restrictions::node`]) for
-    /// the pressures `p` in that order: (2.29) for the chambers, and for each volume the same
-    /// law at a fixed volume. A place without a volume has the rate 0.
+    /// Whether states beyond P1 and P2 are integrated: a gas volume behind a restriction, or
+    /// a stopper mount that lags.
+    pub fn has_volume_states(&self) -> bool {
+        self.restrictions.has_volumes() || self.mount_lag.is_some()
+    }
+
+    /// Whether the stopper mount lags ([`node::MOUNT`] is a state).
+    pub fn mount_lags(&self) -> bool {
+        self.mount_lag.is_some()
+    }
+
+    /// The rates of P1, P2, the gas volumes' pressures ([`super::restrictions::node`]) and the
+    /// mount's state for the states `p` in that order: (2.29) for the chambers, for each volume
+    /// the same law at a fixed volume, and for the mount q̇ = (F/A_p − q)/τ, F the actuator
+    /// force ([`Self::mount_load`]). A place
+    /// without a volume, and the mount without a lag, have the rate 0.
     pub fn pressure_rates_with_volumes(
         &self,
         areas: &OrificeAreas,
@@ -476,8 +495,23 @@ impl Actuator {
         let f = &network.flows;
         let net_1 = network.into_chambers[0] - f.leakage - f.vent_1;
         let net_2 = network.into_chambers[1] + f.leakage - f.vent_2;
-        let (dp1, dp2) = self.chamber_rates(net_1, net_2, p[0], p[1], x_s, x_s_rate);
-        let mut rates = [dp1, dp2, 0.0, 0.0, 0.0, 0.0];
+        let mount = 2 + node::MOUNT;
+        let (dp1, dp2, dq) = match self.mount_lag {
+            Some(lag) => {
+                let dq = (self.mount_load(p[0], p[1], x_s) - p[mount]) / lag;
+                let (dp1, dp2) =
+                    self.pressure_rates_on_a_lagging_mount(net_1, net_2, p[0], p[1], p[mount], dq, x_s, x_s_rate);
+                (dp1, dp2, dq)
+            }
+            None => {
+                let (dp1, dp2) = self.chamber_rates(net_1, net_2, p[0], p[1], x_s, x_s_rate);
+                (dp1, dp2, 0.0)
+            }
+        };
+        let mut rates = [0.0; PRESSURES_WITH_VOLUMES];
+        rates[0] = dp1;
+        rates[1] = dp2;
+        rates[mount] = dq;
         let rt = self.params.r_gas * self.params.temperature;
         for (i, place) in self.restrictions.places.iter().enumerate() {
             if place.has_volume() {
@@ -485,6 +519,33 @@ impl Actuator {
             }
         }
         rates
+    }
+
+    /// (2.29) when the piston sits c A_p q beyond the stopper (`stopper_compliance` c) and q
+    /// moves at the rate `q_rate`: the volumes at x_s + c A_p q, their rates with
+    /// ẋ_s + c A_p q̇. For a lagging mount q is its state; without a lag, on the spring's
+    /// floor, q is the floor ([`Self::pressure_rates_on_a_compliant_stopper`]).
+    #[allow(clippy::too_many_arguments)]
+    fn pressure_rates_on_a_lagging_mount(
+        &self,
+        net_1: f64,
+        net_2: f64,
+        p1: f64,
+        p2: f64,
+        q: f64,
+        q_rate: f64,
+        x_s: f64,
+        x_s_rate: f64,
+    ) -> (f64, f64) {
+        let p = &self.params;
+        let n = self.polytropic_exponent;
+        let stretch = p.stopper_compliance * self.piston_area;
+        let (v1, v2) = self.cylinder.volumes(x_s + stretch * q);
+        let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate + stretch * q_rate);
+        (
+            pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1),
+            pressure_rate(n, p.r_gas, p.temperature, v2, dv2, net_2, p2),
+        )
     }
 
     /// dP1/dt and dP2/dt, (2.29).
@@ -596,10 +657,12 @@ impl Actuator {
         )
     }
 
-    /// (2.29) when the piston sits c A_p (P1 − P2) beyond the stopper (`stopper_compliance`
-    /// c): the volumes move with the pressures, and so the rates appear on both sides,
-    /// Ṗ1 = a1 − b1 (ẋ_s + c A_p D), Ṗ2 = a2 + b2 (ẋ_s + c A_p D) with D = Ṗ1 − Ṗ2,
-    /// b_i = n P_i A_p / V_i; solved for D in closed form.
+    /// (2.29) when the piston sits c F beyond the stopper (`stopper_compliance` c), F the
+    /// force the mount carries: the actuator force of (2.36), A_p (P1 − P2) floored by the
+    /// spring force. Above the floor the volumes move with the pressures, and so the rates
+    /// appear on both sides, Ṗ1 = a1 − b1 (ẋ_s + c A_p D), Ṗ2 = a2 + b2 (ẋ_s + c A_p D) with
+    /// D = Ṗ1 − Ṗ2, b_i = n P_i A_p / V_i, solved for D in closed form; on the floor the
+    /// spring alone loads the mount, and the piston moves with the stopper and the spring.
     fn pressure_rates_on_a_compliant_stopper(
         &self,
         net_1: f64,
@@ -612,6 +675,11 @@ impl Actuator {
         let p = &self.params;
         let n = self.polytropic_exponent;
         let stretch = p.stopper_compliance * self.piston_area;
+        let floor = self.mount_floor(x_s);
+        if p1 - p2 < floor {
+            let floor_rate = -p.k_spring * x_s_rate / self.piston_area;
+            return self.pressure_rates_on_a_lagging_mount(net_1, net_2, p1, p2, floor, floor_rate, x_s, x_s_rate);
+        }
         let (v1, v2) = self.cylinder.volumes(x_s + stretch * (p1 - p2));
         let (dv1, dv2) = self.cylinder.volume_rates(x_s_rate);
         let d1 = pressure_rate(n, p.r_gas, p.temperature, v1, dv1, net_1, p1);
@@ -619,6 +687,18 @@ impl Actuator {
         let (b1, b2) = (n * p1 * self.piston_area / v1, n * p2 * self.piston_area / v2);
         let difference = (d1 - d2) / (1.0 + (b1 + b2) * stretch);
         (d1 - b1 * stretch * difference, d2 + b2 * stretch * difference)
+    }
+
+    /// The spring force of (2.37) over A_p: the pressure difference below which the spring,
+    /// not the pressures, loads the stopper mount.
+    fn mount_floor(&self, x_s: f64) -> f64 {
+        self.spring_force(x_s) / self.piston_area
+    }
+
+    /// The pressure difference the stopper mount carries: the actuator force (2.36) over A_p,
+    /// the state a lagging mount follows ([`node::MOUNT`]).
+    pub fn mount_load(&self, p1: f64, p2: f64, x_s: f64) -> f64 {
+        (p1 - p2).max(self.mount_floor(x_s))
     }
 
     /// Static jet pipe position x̄ for a current, (2.4)–(2.5).

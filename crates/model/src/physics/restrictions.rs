@@ -49,17 +49,26 @@ impl Restriction {
 }
 
 /// Positions of the gas volumes' pressures after P1 and P2 in the extended pressure vector
-/// the integrators carry when any volume is on.
+/// the integrators carry when any volume is on, and after them the lagging stopper mount's
+/// state.
 pub mod node {
     pub const SUPPLY: usize = 0;
     pub const RETURN: usize = 1;
     pub const LINE_1: usize = 2;
     pub const LINE_2: usize = 3;
+    /// The places that can hold a restriction.
     pub const COUNT: usize = 4;
+    /// The pressure difference P1 − P2 as the lagging stopper mount has followed it
+    /// (`stopper_mount_lag`): the piston sits `stopper_compliance` A_p times it beyond the
+    /// stopper. In Pa, so that the integrators' tolerances, set for pressures, fit it.
+    pub const MOUNT: usize = 4;
+    /// The states after P1 and P2.
+    pub const STATES: usize = 5;
 }
 
-/// The pressures the integrators carry with the volumes: P1, P2 and the four nodes.
-pub const PRESSURES_WITH_VOLUMES: usize = 2 + node::COUNT;
+/// The states the integrators carry with the volumes: P1, P2, the four nodes' pressures and
+/// the mount's.
+pub const PRESSURES_WITH_VOLUMES: usize = 2 + node::STATES;
 
 /// The restrictions of the four places, in the order of [`node`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

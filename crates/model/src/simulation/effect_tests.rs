@@ -179,7 +179,7 @@ fn with_volumes_the_equilibrium_balances_every_flow_and_stays_put() {
         let mut pressures = [0.0; PRESSURES_WITH_VOLUMES];
         pressures[0] = sim.state[index::P1];
         pressures[1] = sim.state[index::P2];
-        pressures[2..].copy_from_slice(&sim.node_pressures());
+        pressures[2..2 + node::COUNT].copy_from_slice(&sim.node_pressures());
         let rates =
             model.pressure_rates_with_volumes(&model.areas(sim.state[index::JET_POSITION]), &pressures, 0.06, 0.0);
         // A pascal per second at most: far below a millisecond's change of 1 Pa.
@@ -437,4 +437,83 @@ fn a_step_that_would_take_the_drifting_gas_temperature_below_zero_kelvin_is_refu
         }
         other => panic!("a gas temperature of -1.85 K was not refused: {other:?}"),
     }
+}
+
+/// Commands stepped every 20 ms with the stopper shaken, the force at each millisecond.
+fn forces_under_steps_and_a_shaken_stopper(model: &Actuator) -> Vec<f64> {
+    let w = 2.0 * std::f64::consts::PI * 2.5;
+    let mut sim = Simulation::at_equilibrium(model.clone(), 2.0, 0.054, 0.0, 1e-8).unwrap();
+    let mut forces = vec![];
+    for k in 0..300 {
+        let t = k as f64 * 1e-3;
+        if k % 20 == 0 {
+            sim.set_command(if (k / 20) % 2 == 0 { 5.0 } else { -1.0 }).unwrap();
+        }
+        sim.set_stopper_rate(0.01 * w * (w * t).cos()).unwrap();
+        sim.step(1e-3).unwrap();
+        forces.push(sim.outputs().f_act);
+    }
+    forces
+}
+
+#[test]
+fn a_stopper_mount_with_a_vanishing_lag_is_the_quasi_static_compliance() {
+    let rigid = forces_under_steps_and_a_shaken_stopper(&thesis_model());
+    let compliant = forces_under_steps_and_a_shaken_stopper(&with(|p| p.stopper_compliance = 5e-5));
+    let lagging = forces_under_steps_and_a_shaken_stopper(&with(|p| {
+        p.stopper_compliance = 5e-5;
+        p.stopper_mount_lag = 1e-6;
+    }));
+    let slow = forces_under_steps_and_a_shaken_stopper(&with(|p| {
+        p.stopper_compliance = 5e-5;
+        p.stopper_mount_lag = 3e-3;
+    }));
+    let effect = worst_difference(&compliant, &rigid);
+    assert!(effect > 1.0, "the compliance moves the force by {effect} N only");
+    // A microsecond's lag against the pressures' milliseconds: the quasi-static law (its own
+    // closed form) to a thousandth of the compliance's effect.
+    let near = worst_difference(&lagging, &compliant);
+    assert!(near < 1e-3 * effect, "{near} N against the compliance's {effect} N");
+    let lagged = worst_difference(&slow, &compliant);
+    assert!(lagged > 0.05 * effect, "a 3 ms lag moves the force by {lagged} N only");
+}
+
+#[test]
+fn a_lagging_mounts_state_follows_the_pressure_difference_through_its_lag_and_rests_on_it() {
+    let tau = 2e-3;
+    let model = with(|p| {
+        p.stopper_compliance = 5e-5;
+        p.stopper_mount_lag = tau;
+    });
+    let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-9).unwrap();
+    let difference = |sim: &Simulation| model.mount_load(sim.state[index::P1], sim.state[index::P2], 0.054);
+    let rested = sim.stopper_mount_state().unwrap();
+    assert!(
+        (rested - difference(&sim)).abs() < 1e-6 * difference(&sim).abs(),
+        "{rested}"
+    );
+    sim.step(0.2).unwrap();
+    assert!((sim.stopper_mount_state().unwrap() - rested).abs() < 1.0);
+    // After a command step, q̇ = (F/A_p − q)/τ integrated exactly for F/A_p linear between
+    // samples every 10 µs: an oracle apart from the integrator's.
+    sim.set_command(4.0).unwrap();
+    let h = 1e-5;
+    let mut q = sim.stopper_mount_state().unwrap();
+    let mut before = difference(&sim);
+    let decay = (-h / tau).exp();
+    let mut worst: f64 = 0.0;
+    for _ in 0..2000 {
+        sim.step(h).unwrap();
+        let now = difference(&sim);
+        q = decay * q + (1.0 - decay) * before + (1.0 - tau * (1.0 - decay) / h) * (now - before);
+        before = now;
+        worst = worst.max((sim.stopper_mount_state().unwrap() - q).abs());
+    }
+    let swing = (difference(&sim) - rested).abs();
+    assert!(swing > 1e4, "the step moves ΔP by {swing} Pa only");
+    assert!(worst < 1e-4 * swing, "{worst} Pa off, against a swing of {swing} Pa");
+    assert!(Simulation::at_equilibrium(thesis_model(), 1.0, 0.054, 0.0, 1e-6)
+        .unwrap()
+        .stopper_mount_state()
+        .is_none());
 }

@@ -129,7 +129,7 @@ pub fn balance_with_volumes(
     state: &State,
     x_s: f64,
     time: f64,
-) -> Result<(State, [f64; node::COUNT]), String> {
+) -> Result<(State, [f64; node::STATES]), String> {
     let held;
     let model = if time_varying::varies(&model.params) {
         let mut at = model.clone();
@@ -143,13 +143,19 @@ pub fn balance_with_volumes(
     let quasi_static = model
         .network_flows(&areas, state[index::P1], state[index::P2], None)
         .node_pressures;
+    let mount = 2 + node::MOUNT;
     let active: Vec<usize> = (0..PRESSURES_WITH_VOLUMES)
-        .filter(|&i| i < 2 || model.restrictions.places[i - 2].has_volume())
+        .filter(|&i| {
+            i < 2 || (i == mount && model.mount_lags()) || (i < mount && model.restrictions.places[i - 2].has_volume())
+        })
         .collect();
     let mut all = [0.0; PRESSURES_WITH_VOLUMES];
     all[0] = state[index::P1];
     all[1] = state[index::P2];
-    all[2..].copy_from_slice(&quasi_static);
+    all[2..mount].copy_from_slice(&quasi_static);
+    if model.mount_lags() {
+        all[mount] = model.mount_load(state[index::P1], state[index::P2], x_s);
+    }
     let residual = |all: &[f64; PRESSURES_WITH_VOLUMES]| {
         let rates = model.pressure_rates_with_volumes(&areas, all, x_s, 0.0);
         DVector::from_iterator(active.len(), active.iter().map(|&i| rates[i]))
@@ -209,7 +215,7 @@ pub fn balance_with_volumes(
     let mut balanced = *state;
     balanced[index::P1] = all[0];
     balanced[index::P2] = all[1];
-    let mut nodes = [0.0; node::COUNT];
+    let mut nodes = [0.0; node::STATES];
     nodes.copy_from_slice(&all[2..]);
     Ok((balanced, nodes))
 }

@@ -121,7 +121,7 @@ impl FixedStep {
             time_varying::set_model_at(&mut self.simulation.model, nominal, 0.5 * (t0 + time))
                 .map_err(StepFailure::InvalidRequest)?;
         }
-        let result = if self.simulation.model.restrictions.has_volumes() {
+        let result = if self.simulation.model.has_volume_states() {
             advance(&mut self.simulation, &mut self.with_volumes, step, rate)
         } else {
             advance(&mut self.simulation, &mut self.chambers, step, rate)
@@ -166,7 +166,7 @@ fn advance<const N: usize>(
     ros2: &mut Ros2<N>,
     step: f64,
     rate: f64,
-) -> Result<(State, [f64; node::COUNT], Statistics), StepFailure>
+) -> Result<(State, [f64; node::STATES], Statistics), StepFailure>
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>>,
 {
@@ -329,7 +329,7 @@ mod tests {
         // ROS2's error just after the 3 V command steps: 0.05 N for the thesis model, 0.002 N
         // with the lag smoothing the steps; a term the two paths took apart (the delay line,
         // the varying supply, the sensor's lag) would show above the latter's bound.
-        // The volumes behind restrictions take the six-pressure path of both steppers.
+        // The volumes behind restrictions take the seven-state path of both steppers.
         let with_volumes = Actuator::new(Parameters {
             command_lag: 0.01,
             supply_restriction_area: 0.25e-6,
@@ -339,7 +339,20 @@ mod tests {
             ..Parameters::default()
         })
         .unwrap();
-        for (model, bound) in [(thesis_model(), 0.1), (delayed, 0.01), (with_volumes, 0.01)] {
+        // A lagging stopper mount's state is the seventh (with the stopper moving).
+        let lagging_mount = Actuator::new(Parameters {
+            command_lag: 0.01,
+            stopper_compliance: 5e-5,
+            stopper_mount_lag: 1e-3,
+            ..Parameters::default()
+        })
+        .unwrap();
+        for (model, bound) in [
+            (thesis_model(), 0.1),
+            (delayed, 0.01),
+            (with_volumes, 0.01),
+            (lagging_mount, 0.01),
+        ] {
             let (fixed, accurate) = (forces(&model, true), forces(&model, false));
             let worst = fixed
                 .iter()

@@ -134,8 +134,9 @@ pub struct Simulation {
     transducers: [Option<SensorMemory>; 3],
     propagator: Option<ElectromechanicalPropagator>,
     /// The pressures of the gas volumes behind restrictions, in the order of
-    /// [`crate::physics::restrictions::node`] (followed only for the places with a volume).
-    nodes: [f64; node::COUNT],
+    /// [`crate::physics::restrictions::node`] (followed only for the places with a volume),
+    /// then the lagging stopper mount's state (followed only when it lags).
+    nodes: [f64; node::STATES],
     /// The chambers' pressure rates at the end of the last split step, with what they are a
     /// function of: when the next step starts from the same jet pipe position, pressures and
     /// stopper motion, they are its rates at the start and are not evaluated again.
@@ -204,7 +205,7 @@ impl Simulation {
         check_finite("v_DA", v_da, "V")?;
         model.params.check_stopper(x_s)?;
         let state = equilibrium_at(&model, v_da, x_s, time)?;
-        if !model.restrictions.has_volumes() {
+        if !model.has_volume_states() {
             return Ok(Self::from_state(model, state, v_da, x_s, time, relative_tolerance));
         }
         let (state, nodes) = balance_with_volumes(&model, &state, x_s, time)?;
@@ -231,18 +232,21 @@ impl Simulation {
         // through the stage, as every later entry of the line is.
         let seen_before = command_stage.current(&model.params);
         let plan = StepPlan::of(&model, &transducers);
-        let nodes = if model.restrictions.any() {
-            model
+        let mut nodes = [0.0; node::STATES];
+        if model.restrictions.any() {
+            let places = model
                 .network_flows(
                     &model.areas(state[index::JET_POSITION]),
                     state[index::P1],
                     state[index::P2],
                     None,
                 )
-                .node_pressures
-        } else {
-            [0.0; node::COUNT]
-        };
+                .node_pressures;
+            nodes[..node::COUNT].copy_from_slice(&places);
+        }
+        if model.mount_lags() {
+            nodes[node::MOUNT] = model.mount_load(state[index::P1], state[index::P2], x_s);
+        }
         Self {
             nodes,
             model,
@@ -304,9 +308,22 @@ impl Simulation {
                 &self.model.areas(x_jp),
                 self.state[index::P1],
                 self.state[index::P2],
-                Some(&self.nodes),
+                Some(&self.restriction_nodes()),
             )
             .node_pressures
+    }
+
+    /// The pressure difference the lagging stopper mount has followed, Pa
+    /// ([`node::MOUNT`]), when it lags.
+    pub fn stopper_mount_state(&self) -> Option<f64> {
+        self.model.mount_lags().then(|| self.nodes[node::MOUNT])
+    }
+
+    /// The first [`node::COUNT`] of the nodes: the places' pressures.
+    fn restriction_nodes(&self) -> [f64; node::COUNT] {
+        let mut places = [0.0; node::COUNT];
+        places.copy_from_slice(&self.nodes[..node::COUNT]);
+        places
     }
 
     /// The command v_DA, V: as set, or where its ramp ended (the driver may see another

@@ -27,7 +27,7 @@ use crate::physics::sensors::SensorMemory;
 pub struct SimulationSnapshot {
     time: f64,
     state: [f64; N_STATES],
-    nodes: [f64; node::COUNT],
+    nodes: [f64; node::STATES],
     v_da: f64,
     x_s: f64,
     v_da_rate: f64,
@@ -56,7 +56,7 @@ pub const SNAPSHOT_LAYOUT: f64 = 5.0;
 
 /// Numbers before the two counted lists: the layout, 21 scalars, the state, the volumes'
 /// pressures, the plays, the command stage (3) and the six work counters as two halves each.
-const FIXED_VALUES: usize = 1 + 21 + N_STATES + node::COUNT + PLAY_OPERATORS + 3 + 2 * STATISTICS;
+const FIXED_VALUES: usize = 1 + 21 + N_STATES + node::STATES + PLAY_OPERATORS + 3 + 2 * STATISTICS;
 const STATISTICS: usize = 6;
 
 impl Simulation {
@@ -227,8 +227,8 @@ impl SimulationSnapshot {
             scalars.try_into().expect("21 values");
         let mut state = [0.0; N_STATES];
         state.copy_from_slice(next(N_STATES));
-        let mut nodes = [0.0; node::COUNT];
-        nodes.copy_from_slice(next(node::COUNT));
+        let mut nodes = [0.0; node::STATES];
+        nodes.copy_from_slice(next(node::STATES));
         let mut plays = [0.0; PLAY_OPERATORS];
         plays.copy_from_slice(next(PLAY_OPERATORS));
         let stage: [f64; 3] = next(3).try_into().expect("3 values");
@@ -401,7 +401,7 @@ fn whole_number(value: f64, max: usize, what: &str) -> Result<usize, String> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::thesis_model;
+    use super::super::tests::{thesis_model, with};
     use super::*;
     use crate::physics::actuator::Outputs;
     use crate::physics::parameters::Parameters;
@@ -465,7 +465,11 @@ mod tests {
 
     #[test]
     fn a_snapshot_taken_mid_run_continues_bit_identically_in_a_new_simulation() {
-        for model in [with_memory(), with_staged_memory(), thesis_model()] {
+        let lagging_mount = with(|p| {
+            p.stopper_compliance = 5e-5;
+            p.stopper_mount_lag = 1e-3;
+        });
+        for model in [with_memory(), with_staged_memory(), thesis_model(), lagging_mount] {
             let mut original = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-6).unwrap();
             for k in 0..50 {
                 drive(&mut original, k);

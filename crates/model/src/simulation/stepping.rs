@@ -170,7 +170,7 @@ impl Simulation {
     fn advance(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<(), StepFailure> {
         let outcome = match (self.method, &self.propagator) {
             (Method::Split, Some(_)) => self.split_step(duration, v, v_rate),
-            _ if self.model.restrictions.has_volumes() => {
+            _ if self.model.has_volume_states() => {
                 return Err(StepFailure::InvalidRequest(volumes_need_the_split_method(&self.model)))
             }
             _ => self.monolithic_step(duration, v, v_rate),
@@ -181,7 +181,7 @@ impl Simulation {
     /// The split method's step: the jet pipe's exact trajectory drives the chambers, whose
     /// two pressures alone are integrated.
     fn split_step(&mut self, duration: f64, v: f64, v_rate: f64) -> Result<State, IntegrationFailure<N_STATES>> {
-        if self.model.restrictions.has_volumes() {
+        if self.model.has_volume_states() {
             return self.split_step_over::<PRESSURES_WITH_VOLUMES, VolumesLaw>(duration, v, v_rate);
         }
         match self.model.rate_terms() {
@@ -469,18 +469,18 @@ where
 }
 
 /// Keep the volumes' pressures of an integrated pressure vector (entries 2.. of N = 6).
-pub(super) fn keep_nodes<const N: usize>(nodes: &mut [f64; node::COUNT], p: &SVector<f64, N>) {
+pub(super) fn keep_nodes<const N: usize>(nodes: &mut [f64; node::STATES], p: &SVector<f64, N>) {
     for i in 2..N {
         nodes[i - 2] = p[i];
     }
 }
 
-/// Why a model with gas volumes cannot take a monolithic step.
+/// Why a model with gas volumes or a lagging stopper mount cannot take a monolithic step.
 pub(super) fn volumes_need_the_split_method(model: &Actuator) -> String {
     let p = &model.params;
     format!(
-        "the gas volumes behind restrictions (supply_plenum_volume = {} m3, return_plenum_volume = {} m3, port_line_volume_1 = {} m3, port_line_volume_2 = {} m3) are integrated by the split method only, which needs a jet pipe with two distinct eigenvalues (zeta_2 = {} must be < 1)",
-        p.supply_plenum_volume, p.return_plenum_volume, p.port_line_volume_1, p.port_line_volume_2, p.zeta_2
+        "the gas volumes behind restrictions (supply_plenum_volume = {} m3, return_plenum_volume = {} m3, port_line_volume_1 = {} m3, port_line_volume_2 = {} m3) and the stopper mount's lag (stopper_mount_lag = {} s) are integrated by the split method only, which needs a jet pipe with two distinct eigenvalues (zeta_2 = {} must be < 1)",
+        p.supply_plenum_volume, p.return_plenum_volume, p.port_line_volume_1, p.port_line_volume_2, p.stopper_mount_lag, p.zeta_2
     )
 }
 
