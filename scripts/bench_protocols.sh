@@ -49,6 +49,13 @@ mechanisms=(
     "laminar_leak_1|chambers|extra_flow|--laminar-leak-1 3e-11"
     "force_filter_40hz|force_sensor|dynamics|--force-sensor-filter 40 --force-sensor-filter-damping 0.5"
     "p1_filter_30hz|pressure_sensors|dynamics|--pressure-sensor-filter-1 30 --pressure-sensor-filter-damping-1 1"
+    "spring_rate_150|mechanics|parameter_offset|--plant k_spring=150"
+    "spring_length_85mm|mechanics|parameter_offset|--plant l_spring0=0.085"
+    "slow_current_driver|current_driver|dynamics|--plant omega_cd=1500"
+    "jet_diameter|valve|parameter_offset|--plant d_jp=1.0e-3"
+    "jet_resonance|jet_pipe|dynamics|--plant omega_2=1300 --plant zeta_2=0.1"
+    "piston_bore|mechanics|parameter_offset|--plant d_cyl=0.0163"
+    "gas_gamma_1_3|chambers|parameter_offset|--plant gamma=1.3"
     "receiver_and_supply|jet_pipe+supply|parameter_offset|--undeclared receiver_offset --supply-pressure 622925"
     "receiver_and_pickup|jet_pipe+force_sensor|parameter_offset+periodic|--undeclared receiver_offset --force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
 )

@@ -143,6 +143,11 @@ pub enum Mechanism {
     Searched(&'static str),
     /// A first-order lag (time constant, s) on the command the current driver sees.
     CommandLag,
+    /// A corner frequency of the model (rad/s) fitted as its time constant 1/ω (s): where the
+    /// corner lies above the signals the outputs move nearly linearly with the time constant
+    /// (a lag that short is nearly a delay of its length), not with the frequency, so that a
+    /// Gauss–Newton step from the thesis's corner reaches a slower one.
+    TimeConstantOf(&'static str),
     /// The command the current driver sees saturates at ± this (V).
     CommandLimit,
     /// A cubic term on the static curve's input: the tip force k_m i, and so (the current
@@ -186,13 +191,21 @@ impl Mechanism {
     /// The model parameter that carries this term in the replay, if one does.
     pub fn model_parameter(&self) -> Option<&'static str> {
         match *self {
-            Mechanism::Parameter(name) | Mechanism::Searched(name) => Some(name),
+            Mechanism::Parameter(name) | Mechanism::Searched(name) | Mechanism::TimeConstantOf(name) => Some(name),
             Mechanism::CommandLag => Some("command_lag"),
             Mechanism::CommandLimit => Some("command_limit"),
             Mechanism::CurrentLimit => Some("current_limit"),
             Mechanism::CurrentSlewLimit => Some("current_slew_limit"),
             Mechanism::InputCubic => Some("f3_input_cubic"),
             _ => None,
+        }
+    }
+
+    /// The model parameter's value for the term's value `value` (a time constant's corner).
+    pub fn model_value(&self, value: f64) -> f64 {
+        match self {
+            Mechanism::TimeConstantOf(_) => 1.0 / value,
+            _ => value,
         }
     }
 
@@ -254,4 +267,54 @@ pub fn declared_bounds(name: &str) -> (f64, f64) {
 /// Set an FMU parameter, with the model's own checks.
 pub fn set_parameter(p: &mut Parameters, name: &str, value: f64) -> Result<(), String> {
     p.set(value_reference(name), value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_corner_fitted_as_its_time_constant_puts_its_frequency_into_the_model() {
+        let term = Mechanism::TimeConstantOf("omega_cd");
+        assert_eq!(term.model_parameter(), Some("omega_cd"));
+        assert_eq!(term.model_value(2e-3), 500.0);
+        assert_eq!(Mechanism::Parameter("k_cd").model_value(0.05), 0.05);
+        // The current driver's corner in the catalogue starts at the model's own.
+        let base = Parameters::default();
+        let knots = crate::curves::CurveKnots {
+            command: vec![],
+            channels: [vec![], vec![], vec![]],
+        };
+        let corner = catalogue(&base, true, None, &knots)
+            .into_iter()
+            .find(|c| c.label == "current driver corner")
+            .unwrap();
+        let start = &corner.terms[0];
+        assert_eq!(start.mechanism.model_value(start.neutral), base.omega_cd);
+    }
+
+    #[test]
+    fn every_catalogue_parameter_is_a_parameter_of_the_model_within_its_declared_limits() {
+        let base = Parameters::default();
+        let knots = crate::curves::CurveKnots {
+            command: vec![],
+            channels: [vec![], vec![], vec![]],
+        };
+        for candidate in catalogue(&base, true, Some(50.0), &knots) {
+            for term in &candidate.terms {
+                let Some(name) = term.mechanism.model_parameter() else {
+                    continue;
+                };
+                let (lower, upper) = declared_bounds(name);
+                let start = term.mechanism.model_value(term.neutral);
+                if term.neutral.is_finite() {
+                    assert!(
+                        (lower..=upper).contains(&start),
+                        "{}: {name} starts at {start}, outside [{lower}, {upper}]",
+                        candidate.label
+                    );
+                }
+            }
+        }
+    }
 }

@@ -65,7 +65,7 @@ pub fn model_terms(
                     }
                 }
             }
-            m if m.model_parameter().is_some() => set.push((m.model_parameter()?, value)),
+            m if m.model_parameter().is_some() => set.push((m.model_parameter()?, m.model_value(value))),
             // The seal's speed scale, a shape the FMU carries; one seal term at a time.
             Mechanism::Shape if term.name == "extra_force_sign_velocity" => {
                 if base.extra_force_sign_pressure != 0.0 {
@@ -387,6 +387,10 @@ fn physical_reading(name: &str, added: f64) -> Option<String> {
             "A force of {:.4e} N·s/m × the stopper's velocity acts on the piston: viscous friction, {:.3} N at 0.1 m/s.",
             -added,
             added * 0.1
+        ),
+        "k_spring" | "L_spring0" => format!(
+            "The return spring holds the piston against the stopper with {} force than the model's while the pressures push less than it (2.37); a change of its rate and one of its free length give the same floor wherever the stopper stays put.",
+            if added > 0.0 { "more" } else { "less" }
         ),
         "stopper_compliance" if added > 0.0 => format!(
             "The piston sits beyond the stopper by the force it carries over a stiffness of {:.3e} N/m: a compliant mount.",

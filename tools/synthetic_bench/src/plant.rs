@@ -67,6 +67,42 @@ impl Default for BenchParams {
     }
 }
 
+impl BenchParams {
+    /// The constants by name (the fields' names), for a plant whose thesis constants depart
+    /// from the defaults.
+    pub fn field_mut(&mut self, name: &str) -> Option<&mut f64> {
+        Some(match name {
+            "p_supply" => &mut self.p_supply,
+            "p_return" => &mut self.p_return,
+            "temperature" => &mut self.temperature,
+            "gamma" => &mut self.gamma,
+            "r_gas" => &mut self.r_gas,
+            "k_cd" => &mut self.k_cd,
+            "i_offset" => &mut self.i_offset,
+            "omega_cd" => &mut self.omega_cd,
+            "k_m" => &mut self.k_m,
+            "omega_1" => &mut self.omega_1,
+            "omega_2" => &mut self.omega_2,
+            "zeta_2" => &mut self.zeta_2,
+            "x_jp_sat" => &mut self.x_jp_sat,
+            "f_jp_sat" => &mut self.f_jp_sat,
+            "x_jp_offset" => &mut self.x_jp_offset,
+            "d_jp" => &mut self.d_jp,
+            "c_d" => &mut self.c_d,
+            "c_dm_a_lpp" => &mut self.c_dm_a_lpp,
+            "c_db_a_lpp" => &mut self.c_db_a_lpp,
+            "l_cyl" => &mut self.l_cyl,
+            "l_p" => &mut self.l_p,
+            "l_s" => &mut self.l_s,
+            "l_sup" => &mut self.l_sup,
+            "l_spring0" => &mut self.l_spring0,
+            "d_cyl" => &mut self.d_cyl,
+            "k_spring" => &mut self.k_spring,
+            _ => return None,
+        })
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Geometry: circle overlaps (own closed forms, checked against grid integration in the tests)
 // ---------------------------------------------------------------------------------------------
@@ -631,4 +667,51 @@ pub(crate) fn second_order(frequency: f64, damping: f64, input: f64, y: f64, rat
         std::f64::consts::FRAC_1_SQRT_2
     };
     (rate, omega * omega * (input - y) - 2.0 * zeta * omega * rate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BenchParams;
+
+    #[test]
+    fn every_constant_is_found_by_its_own_name_and_no_other() {
+        let names = [
+            "p_supply",
+            "p_return",
+            "temperature",
+            "gamma",
+            "r_gas",
+            "k_cd",
+            "i_offset",
+            "omega_cd",
+            "k_m",
+            "omega_1",
+            "omega_2",
+            "zeta_2",
+            "x_jp_sat",
+            "f_jp_sat",
+            "x_jp_offset",
+            "d_jp",
+            "c_d",
+            "c_dm_a_lpp",
+            "c_db_a_lpp",
+            "l_cyl",
+            "l_p",
+            "l_s",
+            "l_sup",
+            "l_spring0",
+            "d_cyl",
+            "k_spring",
+        ];
+        let mut changed = vec![];
+        for name in names {
+            let mut p = BenchParams::default();
+            *p.field_mut(name).unwrap() = -12345.0;
+            assert_ne!(p, BenchParams::default(), "{name}");
+            assert!(!changed.contains(&p), "{name} sets another's field");
+            changed.push(p);
+        }
+        assert!(BenchParams::default().field_mut("k_spring ").is_none());
+        assert!(BenchParams::default().field_mut("spring").is_none());
+    }
 }

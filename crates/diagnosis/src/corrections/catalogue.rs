@@ -231,6 +231,21 @@ pub fn catalogue(
             ],
         ),
         c(
+            "current driver corner",
+            "current_driver",
+            "dynamics",
+            None,
+            vec![Term {
+                name: "current_driver_time_constant",
+                unit: "s",
+                mechanism: Mechanism::TimeConstantOf("omega_cd"),
+                neutral: 1.0 / parameter_value(base, "omega_cd"),
+                step: 2e-5,
+                lower: 1e-5,
+                upper: 0.01,
+            }],
+        ),
+        c(
             "current limit",
             "current_driver",
             "limit",
@@ -293,11 +308,31 @@ pub fn catalogue(
             vec![term_off("f3_algebraic_share", "1", 0.05, 1.0)],
         ),
         c(
+            "jet and receiver diameter",
+            "valve",
+            "parameter_offset",
+            None,
+            // D_jp sets the receiver's geometry, (2.8)–(2.17): the areas' shape along the jet's
+            // travel, not only their size.
+            vec![p("D_jp", "m", 0.01, 1e-4, 5e-3)],
+        ),
+        c(
             "jet pipe lag",
             "jet_pipe",
             "dynamics",
             None,
             vec![corner(base, "omega_1", 10.0, 1e4)],
+        ),
+        c(
+            "jet pipe resonance",
+            "jet_pipe",
+            "dynamics",
+            None,
+            // ω2 and ζ2 of (2.6): the modal form the model steps with needs ζ2 below 1.
+            vec![
+                p("omega_2", "rad/s", 0.01, 100.0, 1e5),
+                offset("zeta_2", "1", 0.01, 0.001, 0.95),
+            ],
         ),
         c(
             "jet pipe hysteresis",
@@ -477,6 +512,15 @@ pub fn catalogue(
                 base.l_sup + 5e-3,
             )],
         ),
+        // The gas's isentropic exponent: in the orifices' law (2.19)–(2.22) and the chambers'
+        // (2.29) together (heat exchange changes the chambers' exponent alone).
+        c(
+            "gas isentropic exponent",
+            "chambers",
+            "parameter_offset",
+            None,
+            vec![p("gamma", "1", 0.005, 1.0 + 1e-6, 5.0 / 3.0)],
+        ),
         // The gas temperature of (2.6), a constant of the model, drifting over the recording
         // (the supply air warming up): the FMU carries the ramp as T_drift.
         c(
@@ -594,6 +638,32 @@ pub fn catalogue(
             "extra_force",
             None,
             vec![output("viscous_friction", "N.s/m", FORCE, Regressor::Viscous, 1.0)],
+        ),
+        // The return spring's rate and its free length, (2.37): the floor the force sits on
+        // while the pressures push less than the spring. Where the stopper stays put only the
+        // floor's force shows, and either gives it; where it moves, the held-out blocks choose.
+        c(
+            "piston bore",
+            "mechanics",
+            "parameter_offset",
+            None,
+            // D_cyl sets the piston's area, (2.30)–(2.34): the force per pressure difference and
+            // the chambers' volumes together.
+            vec![p("D_cyl", "m", 0.002, 1e-3, 0.1)],
+        ),
+        c(
+            "return spring rate",
+            "mechanics",
+            "parameter_offset",
+            None,
+            vec![p("k_spring", "N/m", 0.01, 0.0, 1e5)],
+        ),
+        c(
+            "return spring free length",
+            "mechanics",
+            "parameter_offset",
+            None,
+            vec![offset("L_spring0", "m", 1e-4, 0.0, 1.0)],
         ),
         c(
             "stopper compliance",

@@ -144,7 +144,7 @@ impl<'a> Problem<'a> {
         }
         for (term, &value) in candidate.terms.iter().zip(values) {
             if let Some(name) = term.mechanism.model_parameter() {
-                set_parameter(&mut p, name, value)?;
+                set_parameter(&mut p, name, term.mechanism.model_value(value))?;
             }
         }
         replay_fast(&Actuator::new(p)?, self.recording, self.recording.len())
@@ -427,7 +427,10 @@ impl Problem<'_> {
                     known[*j].is_none()
                         && matches!(
                             term.mechanism,
-                            Mechanism::Parameter(_) | Mechanism::CommandLag | Mechanism::InputCubic
+                            Mechanism::Parameter(_)
+                                | Mechanism::TimeConstantOf(_)
+                                | Mechanism::CommandLag
+                                | Mechanism::InputCubic
                         )
                 })
                 .map(|(j, term)| {
@@ -733,10 +736,11 @@ impl Problem<'_> {
     ) -> Result<Fit, String> {
         let (first, rest) = candidate.terms.split_first().ok_or("a candidate without terms")?;
         let mut settings = candidate.settings.clone();
-        settings.extend(
-            rest.iter()
-                .filter_map(|t| t.mechanism.model_parameter().map(|name| (name, t.neutral))),
-        );
+        settings.extend(rest.iter().filter_map(|t| {
+            t.mechanism
+                .model_parameter()
+                .map(|name| (name, t.mechanism.model_value(t.neutral)))
+        }));
         let searched = Candidate {
             terms: vec![first.clone()],
             settings,
@@ -755,7 +759,8 @@ impl Problem<'_> {
             let mut values = neutral;
             for (value, term) in values.iter_mut().zip(&candidate.terms).skip(1) {
                 if let Some(name) = term.mechanism.model_parameter() {
-                    *value = parameter_value(self.base, name);
+                    // (a time constant is its own inverse's inverse)
+                    *value = term.mechanism.model_value(parameter_value(self.base, name));
                 }
             }
             return Ok(Fit {

@@ -198,6 +198,11 @@ struct Cli {
     /// With --pressure-sensor-filter-1: its damping ratio (1/√2 unless given).
     #[arg(long)]
     pressure_sensor_filter_damping_1: Option<f64>,
+    /// With --protocol: a thesis constant of the plant other than its default, NAME=VALUE in SI
+    /// units, NAME a field of the bench's constants (k_spring, l_spring0, omega_cd, d_jp, ...);
+    /// repeatable.
+    #[arg(long, value_name = "NAME=VALUE")]
+    plant: Vec<String>,
     /// With --protocol: the supply pressure, Pa (the thesis's 652 925 Pa by default).
     #[arg(long)]
     supply_pressure: Option<f64>,
@@ -383,6 +388,22 @@ fn main() -> ExitCode {
                 return ExitCode::from(2);
             }
             params.p_supply = p;
+        }
+        for setting in &cli.plant {
+            let parsed = setting
+                .split_once('=')
+                .and_then(|(name, value)| Some((name, value.trim().parse::<f64>().ok()?)));
+            let Some((name, value)) = parsed.filter(|(_, v)| v.is_finite()) else {
+                eprintln!("benchgen: --plant {setting:?} is not NAME=VALUE with a finite number");
+                return ExitCode::from(2);
+            };
+            match params.field_mut(name.trim()) {
+                Some(field) => *field = value,
+                None => {
+                    eprintln!("benchgen: --plant {name:?} is not a constant of the bench");
+                    return ExitCode::from(2);
+                }
+            }
         }
         let recording = match generate_protocol_with(&params, &spec, &effects) {
             Ok(r) => r,
