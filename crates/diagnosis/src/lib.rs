@@ -234,13 +234,13 @@ impl Localization {
     }
 
     /// A clause naming the places that explain nearly as much as the located one
-    /// ([`Localization::alternatives`]), with their shares, for a term added at the located
-    /// place; `None` when there are none. What the recording cannot tell apart is said
-    /// beside what was added.
-    pub fn undecided_beside(&self, has_pressures: bool) -> Option<String> {
-        let others: Vec<String> = self
-            .alternatives()
-            .into_iter()
+    /// ([`Localization::alternatives`]), with their shares, for a term added at `added` (the
+    /// located place or one of those); `None` when there are none. What the recording cannot
+    /// tell apart is said beside what was added.
+    pub fn undecided_beside(&self, added: &str, has_pressures: bool) -> Option<String> {
+        let others: Vec<String> = std::iter::once(self.location)
+            .chain(self.alternatives())
+            .filter(|l| *l != added)
             .filter_map(|l| self.by_location.iter().find(|(at, _, _)| *at == l))
             .map(|(l, e, _)| format!("the {l} ({:.1} %)", 100.0 * e))
             .collect();

@@ -254,11 +254,20 @@ mod tests {
             ("supply", 0.9977, "supply pressure"),
             ("mechanics", 0.5, "viscous friction"),
         ]);
-        let clause = l.undecided_beside(false).expect("the supply explains as much");
+        let clause = l
+            .undecided_beside(l.location, false)
+            .expect("the supply explains as much");
         assert!(clause.contains("the supply (99.8 %)"), "{clause}");
         assert!(!clause.contains("mechanics"), "{clause}");
         assert!(clause.contains("pressure channels"), "{clause}");
-        assert!(!l.undecided_beside(true).unwrap().contains("pressure channels"));
+        assert!(!l
+            .undecided_beside(l.location, true)
+            .unwrap()
+            .contains("pressure channels"));
+        // A term added at the tied place names the located one beside it, not itself.
+        let beside_supply = l.undecided_beside("supply", true).unwrap();
+        assert!(beside_supply.contains("the force_sensor (99.8 %)"), "{beside_supply}");
+        assert!(!beside_supply.contains("the supply"), "{beside_supply}");
     }
 
     #[test]
@@ -267,7 +276,7 @@ mod tests {
             ("force_sensor", 0.998, "force sensor lag"),
             ("jet_pipe", 0.8, "jet pipe lag"),
         ]);
-        assert_eq!(l.undecided_beside(true), None);
+        assert_eq!(l.undecided_beside(l.location, true), None);
     }
 
     #[test]
@@ -277,7 +286,7 @@ mod tests {
             ("valve", 0.9998, "discharge coefficient against the pressure ratio"),
             ("command", 0.991, "command static curve"),
         ]);
-        assert_eq!(l.undecided_beside(false), None);
+        assert_eq!(l.undecided_beside(l.location, false), None);
         assert!(l.alternatives().is_empty());
     }
 }

@@ -512,15 +512,28 @@ fn discover_term(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Option<(DiscoveredTerm, Parameters, Scored)>, String> {
     let (recording, count, force_before, noise) = (cx.recording, r.count, r.force_before, cx.noise);
-    let mut at_place: Vec<&Scored> = found
-        .candidates
-        .iter()
-        .filter(|s| s.fit.candidate.location == found.location && s.fit.candidate.named.is_none())
-        .filter(|s| s.explained >= LOCATED_SHARE)
-        .collect();
-    at_place.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
+    // The located place's candidates first, then those of the places that explain nearly as
+    // much: where the recording cannot tell places apart (a short lag anywhere before the jet
+    // pipe reads as a delay under a slow sine) and the located place has no term to keep, the
+    // best of the others is tried. Up to DISCOVERY_TRIALS of each.
+    let tied = found.alternatives();
+    let unnamed_at = |place: &str| -> Vec<&Scored> {
+        let mut at: Vec<&Scored> = found
+            .candidates
+            .iter()
+            .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
+            .filter(|s| s.explained >= LOCATED_SHARE)
+            .collect();
+        at.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
+        at.truncate(DISCOVERY_TRIALS);
+        at
+    };
+    let mut others: Vec<&Scored> = tied.iter().flat_map(|place| unnamed_at(place)).collect();
+    others.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
+    others.truncate(DISCOVERY_TRIALS);
+    let at_place: Vec<&Scored> = unnamed_at(found.location).into_iter().chain(others).collect();
     let before_total: f64 = r.heldout.iter().sum();
-    for s in at_place.into_iter().take(DISCOVERY_TRIALS) {
+    for s in at_place {
         let label = s.fit.candidate.label;
         let penalty = used_terms(s) * discovery_penalty_per_term(count);
         let worse_pressures =
@@ -591,7 +604,7 @@ fn discover_term(
                 candidate: candidate.label,
                 reading: with_undecided(
                     discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
-                    found.undecided_beside(cx.pressure_noise.is_some()),
+                    found.undecided_beside(candidate.location, cx.pressure_noise.is_some()),
                 ),
                 parameters: set,
                 heldout_before: force_before,
@@ -739,7 +752,7 @@ fn add_effect(
         s.force_heldout_rms,
         100.0 * share
     );
-    let evidence = match found.undecided_beside(cx.pressure_noise.is_some()) {
+    let evidence = match found.undecided_beside(found.location, cx.pressure_noise.is_some()) {
         Some(clause) if !downstream => format!("{evidence} Beside it, {clause}."),
         _ => evidence,
     };
