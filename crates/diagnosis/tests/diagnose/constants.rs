@@ -4,52 +4,17 @@
 //! that had no candidate before (the return spring, the current driver's corner, the jet's
 //! diameter, the jet pipe's resonance, the piston bore, the gas's isentropic exponent).
 
-use jetpipe_diagnosis::recording::Recording;
-use jetpipe_diagnosis::{diagnose, Diagnosis};
-use jetpipe_model::physics::parameters::Parameters;
-use synthetic_bench::{
-    generate_protocol_with, BenchEffects, BenchParams, CommandProtocol, ProtocolSpec, StopperMotion,
-};
+use jetpipe_diagnosis::Diagnosis;
+use synthetic_bench::{BenchParams, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects};
 
-use super::value_reference;
-
-fn spec(command: CommandProtocol, stopper: StopperMotion, sample_rate: f64, pressures: bool) -> ProtocolSpec {
-    ProtocolSpec {
-        command,
-        stopper,
-        sample_rate,
-        duration: 20.0,
-        pressures,
-        seed: 5,
-        ..ProtocolSpec::default()
-    }
-}
-
-fn fixed() -> StopperMotion {
-    StopperMotion::Fixed { position: 0.054 }
-}
+use super::search::{diagnosed_with, fixed, get, spec};
 
 /// Diagnose the plant with `set` applied to its constants under `spec`: the first term at
-/// `place` (location, family), explained, nothing named; the model it ends with.
+/// `place` (location, family), explained, nothing named.
 fn re_identified(label: &str, spec: &ProtocolSpec, set: impl Fn(&mut BenchParams), place: (&str, &str)) -> Diagnosis {
     let mut plant = BenchParams::default();
     set(&mut plant);
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-{label}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    generate_protocol_with(&plant, spec, &BenchEffects::default())
-        .unwrap()
-        .write_csv(&path)
-        .unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
-    println!(
-        "{label} ({}): {}; {}",
-        spec.label(),
-        d.verdict(),
-        d.summary().join(" | ")
-    );
+    let d = diagnosed_with(label, &plant, spec, UndeclaredEffects::default());
     assert!(
         d.effects.is_empty(),
         "{label}: named {:?}",
@@ -62,10 +27,6 @@ fn re_identified(label: &str, spec: &ProtocolSpec, set: impl Fn(&mut BenchParams
     assert_eq!((first.location, first.family), place, "{label}: {}", first.reading);
     assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
     d
-}
-
-fn get(d: &Diagnosis, name: &str) -> f64 {
-    d.parameters.get(value_reference(name)).unwrap()
 }
 
 /// A return spring of 150 N/m instead of 88.14 under a staircase at 1 kHz with the stopper

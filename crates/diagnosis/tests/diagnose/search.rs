@@ -17,7 +17,12 @@ fn diagnosed(label: &str, spec: &ProtocolSpec, undeclared: UndeclaredEffects) ->
     diagnosed_with(label, &BenchParams::default(), spec, undeclared)
 }
 
-fn diagnosed_with(label: &str, plant: &BenchParams, spec: &ProtocolSpec, undeclared: UndeclaredEffects) -> Diagnosis {
+pub(super) fn diagnosed_with(
+    label: &str,
+    plant: &BenchParams,
+    spec: &ProtocolSpec,
+    undeclared: UndeclaredEffects,
+) -> Diagnosis {
     let effects = BenchEffects {
         undeclared,
         ..BenchEffects::default()
@@ -43,7 +48,12 @@ fn diagnosed_with(label: &str, plant: &BenchParams, spec: &ProtocolSpec, undecla
     d
 }
 
-fn spec(command: CommandProtocol, stopper: StopperMotion, sample_rate: f64, pressures: bool) -> ProtocolSpec {
+pub(super) fn spec(
+    command: CommandProtocol,
+    stopper: StopperMotion,
+    sample_rate: f64,
+    pressures: bool,
+) -> ProtocolSpec {
     ProtocolSpec {
         command,
         stopper,
@@ -59,11 +69,11 @@ fn moves() -> StopperMotion {
     StopperMotion::Moves { speed: 0.02 }
 }
 
-fn fixed() -> StopperMotion {
+pub(super) fn fixed() -> StopperMotion {
     StopperMotion::Fixed { position: 0.054 }
 }
 
-fn get(d: &Diagnosis, name: &str) -> f64 {
+pub(super) fn get(d: &Diagnosis, name: &str) -> f64 {
     d.parameters.get(value_reference(name)).unwrap()
 }
 
