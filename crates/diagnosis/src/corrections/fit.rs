@@ -759,7 +759,7 @@ impl Problem<'_> {
             let mut values = neutral;
             for (value, term) in values.iter_mut().zip(&candidate.terms).skip(1) {
                 if let Some(name) = term.mechanism.model_parameter() {
-                    // (a time constant is its own inverse's inverse)
+                    // (in the term's own unit: a corner's time constant)
                     *value = term.mechanism.model_value(parameter_value(self.base, name));
                 }
             }
