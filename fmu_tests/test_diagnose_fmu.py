@@ -4,7 +4,7 @@ A recording with a named effect, or with an undeclared one that the diagnosis di
 comes from the independent generator (benchgen); `jetpipe diagnose` adds the effect or the
 term and reports `fmu_start_values`. Setting those on the packaged FMU and replaying the
 recording through FMPy (command held between samples, the stopper moving linearly via
-fmi2SetRealInputDerivatives between the averaged positions the report's `stopper_positions`
+fmi2SetRealInputDerivatives between the smoothed positions the report's `stopper_positions`
 names) must give the reported `after` error within 5 %.
 """
 
@@ -22,9 +22,14 @@ BIN = ROOT / "target" / "release"
 
 
 def stopper_positions(x):
-    """The report's `stopper_positions`: x_s averaged over samples k-3..k+3 (fewer at the ends)."""
-    n = len(x)
-    return np.array([x[k] + np.mean(x[max(k - 3, 0):min(k + 4, n)] - x[k]) for k in range(n)])
+    """The report's `stopper_positions`: x_s smoothed over samples k-3..k+3 with the weights
+    (-2, 3, 6, 7, 6, 3, -2)/21, the recorded positions at the first and last three samples."""
+    x = np.asarray(x, dtype=float)
+    weights = np.array([-2.0, 3.0, 6.0, 7.0, 6.0, 3.0, -2.0]) / 21.0
+    out = x.copy()
+    for k in range(3, len(x) - 3):
+        out[k] = x[k] + np.sum(weights * (x[k - 3:k + 4] - x[k]))
+    return out
 
 
 def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, outputs=("F_meas",)):

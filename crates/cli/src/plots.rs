@@ -300,7 +300,7 @@ pub struct FigureInputs<'a> {
 pub fn diagnosis_figures(inputs: &FigureInputs) -> Result<Vec<Figure>, String> {
     let recording = inputs.recording;
     let diagnosis = inputs.diagnosis;
-    // The diagnosis drives the model with the averaged stopper positions; so do the figures.
+    // The diagnosis drives the model with the smoothed stopper positions; so do the figures.
     let driven = recording.with_stopper_smoothed();
     let before_model = Actuator::new(inputs.base.clone())?;
     let after_model = Actuator::new(diagnosis.parameters.clone())?;

@@ -1,6 +1,6 @@
 //! The FMU with a diagnosis report's `fmu_start_values` is the model whose error the report
 //! gives: the recording replayed through the exported `fmi2*` functions (the command held
-//! over each sample interval, the stopper moving linearly between the averaged positions the
+//! over each sample interval, the stopper moving linearly between the smoothed positions the
 //! report's `stopper_positions` names) reproduces the reported force error after.
 
 // The FMU's test helpers (a logging callback and instances through the exported symbols).
@@ -19,13 +19,17 @@ use synthetic_bench::{
     generate_protocol_with, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
 };
 
-/// The report's `stopper_positions`: x_s averaged over samples k-3..k+3 (fewer at the ends).
+/// The report's `stopper_positions`: x_s smoothed over samples k-3..k+3 with the weights
+/// (-2, 3, 6, 7, 6, 3, -2)/21, the recorded positions at the first and last three samples.
 fn stopper_positions(x: &[f64]) -> Vec<f64> {
     let n = x.len();
+    let weights = [-2.0, 3.0, 6.0, 7.0, 6.0, 3.0, -2.0];
     (0..n)
         .map(|k| {
-            let window = &x[k.saturating_sub(3)..(k + 4).min(n)];
-            x[k] + window.iter().map(|v| v - x[k]).sum::<f64>() / window.len() as f64
+            if k < 3 || k + 3 >= n {
+                return x[k];
+            }
+            x[k] + (0..7).map(|j| weights[j] / 21.0 * (x[k + j - 3] - x[k])).sum::<f64>()
         })
         .collect()
 }

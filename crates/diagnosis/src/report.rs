@@ -173,7 +173,7 @@ impl Diagnosis {
             })).collect::<Vec<_>>(),
             "residual_tests": self.residual_tests,
             "fmu_start_values": start_values,
-            "stopper_positions": "the model was driven with x_s_m averaged over samples k-3..k+3 (fewer at the ends), as the FMU must be to reproduce these errors",
+            "stopper_positions": "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21 (the recorded positions at the first and last three samples), as the FMU must be to reproduce these errors",
             "joint_refit": self.joint_refit.map(|(a, b)| json!({"heldout_before_rms_N": a, "heldout_after_rms_N": b})),
             "replays": self.replays,
         });
