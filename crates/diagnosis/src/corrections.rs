@@ -26,7 +26,7 @@ use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::sensors::{self, Channel, SensorLaw};
 use jetpipe_model::variables::VARIABLES;
 
-use super::signals::{difference, stopper_velocity, CHANNELS, FORCE, P1, P2};
+use super::signals::{difference, stopper_acceleration, stopper_velocity, CHANNELS, FORCE, P1, P2};
 
 mod catalogue;
 mod fit;

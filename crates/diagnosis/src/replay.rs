@@ -290,7 +290,7 @@ mod tests {
         let full = replay(&model, &recording, 1e-6, recording.len()).unwrap();
         let thin = replay(&model, &thinned, 1e-6, thinned.len()).unwrap();
         assert_eq!(thin.force, full.at_rows(&rows).force);
-        // The stopper's velocity is the full-rate slope at each row.
+        // The stopper's velocity is the full-rate one at each row.
         let velocity = crate::signals::stopper_velocity(&recording);
         let at_rows: Vec<f64> = rows.iter().map(|&k| velocity[k]).collect();
         assert_eq!(crate::signals::stopper_velocity(&thinned), at_rows);

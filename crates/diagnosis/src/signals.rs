@@ -5,6 +5,7 @@ use crate::blocks::Block;
 use crate::recording::Recording;
 use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::extra_force;
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 
 /// Channels compared with the model: the force always, the two chamber pressures when the
@@ -15,22 +16,29 @@ pub const P2: usize = 2;
 pub const CHANNELS: usize = 3;
 pub const CHANNEL_NAMES: [&str; CHANNELS] = ["force", "p1", "p2"];
 
-/// Stopper velocity as the replays see it at sample k: the slope of the interval that
-/// ends there (zero at the first sample). For a recording thinned for the fits, the
-/// interval of the full-rate recording that ends at the row.
+/// Stopper velocity as the replays' forces read it at sample k: the slope of the interval
+/// that ends there carried to the sample with the acceleration the model forms
+/// (`jetpipe_model::physics::extra_force::stopper_velocities`; zero at the first sample).
+/// For a recording thinned for the fits, the full-rate recording's at the row.
 pub fn stopper_velocity(recording: &Recording) -> Vec<f64> {
-    let slope = |time: &[f64], x: &[f64], k: usize| {
-        if k == 0 {
-            0.0
-        } else {
-            (x[k] - x[k - 1]) / (time[k] - time[k - 1])
-        }
-    };
+    at_rows(recording, extra_force::stopper_velocities)
+}
+
+/// The stopper acceleration as the model forms it at each sample
+/// (`jetpipe_model::physics::extra_force::stopper_accelerations`), of the full-rate
+/// recording at the rows of a thinned one.
+pub fn stopper_acceleration(recording: &Recording) -> Vec<f64> {
+    at_rows(recording, extra_force::stopper_accelerations)
+}
+
+/// `motion` of the recording's stopper positions at its rows.
+fn at_rows(recording: &Recording, motion: fn(&[f64], &[f64]) -> Vec<f64>) -> Vec<f64> {
     match &recording.full_rate {
-        Some(full) => full.rows.iter().map(|&k| slope(&full.time, &full.x_s, k)).collect(),
-        None => (0..recording.len())
-            .map(|k| slope(&recording.time, &recording.x_s, k))
-            .collect(),
+        Some(full) => {
+            let all = motion(&full.time, &full.x_s);
+            full.rows.iter().map(|&k| all[k]).collect()
+        }
+        None => motion(&recording.time, &recording.x_s),
     }
 }
 

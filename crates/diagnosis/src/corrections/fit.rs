@@ -122,7 +122,7 @@ impl<'a> Problem<'a> {
             weights,
             measured,
             velocity: stopper_velocity(recording),
-            acceleration: jetpipe_model::physics::extra_force::stopper_accelerations(&recording.time, &recording.x_s),
+            acceleration: stopper_acceleration(recording),
             mean_position: recording.x_s.iter().sum::<f64>() / n as f64,
             t_mid: 0.5 * (t0 + t1),
             t_span: (t1 - t0).max(1e-9),

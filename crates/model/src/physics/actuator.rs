@@ -149,9 +149,11 @@ pub struct Actuator {
     /// Whether the extra force's library terms beyond viscous friction and the position
     /// force are on ([`super::extra_force`]).
     extra_library: bool,
-    /// Whether the extra force follows the stopper acceleration (`extra_force_acceleration`
-    /// ≠ 0): a simulation then forms it after each step.
-    pub acceleration_term: bool,
+    /// Whether a force on the piston follows the stopper's velocity or acceleration (friction,
+    /// viscous friction, the extra force's library terms but the pressure difference): a
+    /// simulation then forms the stopper's motion at each sample after each step
+    /// ([`super::extra_force::StopperMotion`]).
+    pub reads_stopper_motion: bool,
 }
 
 /// The factors of (2.29), dP/dt = (γ/V)(R T ṁ − P dV/dt), that do not change while the stopper
@@ -226,7 +228,14 @@ impl Actuator {
             || params.extra_force_velocity_squared != 0.0
             || params.extra_force_sign_pressure != 0.0
             || params.extra_force_pressure_difference != 0.0;
-        let acceleration_term = params.extra_force_acceleration != 0.0;
+        // The velocity the forces read is taken at the sample from the last two intervals'
+        // motions ([`super::extra_force`]), as the acceleration is.
+        let reads_stopper_motion = params.extra_force_acceleration != 0.0
+            || params.extra_force_velocity_squared != 0.0
+            || params.extra_force_sign_pressure != 0.0
+            || params.friction_coulomb != 0.0
+            || params.friction_stribeck != 0.0
+            || params.viscous_friction != 0.0;
         let thesis_outputs = params.friction_coulomb == 0.0
             && params.friction_stribeck == 0.0
             && params.viscous_friction == 0.0
@@ -240,7 +249,7 @@ impl Actuator {
         Ok(Self {
             thesis_outputs,
             extra_library,
-            acceleration_term,
+            reads_stopper_motion,
             rate_terms,
             restrictions,
             mount_lag,

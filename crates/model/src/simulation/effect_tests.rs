@@ -268,15 +268,16 @@ fn the_extra_force_adds_each_library_term_to_the_measured_force_as_the_diagnosis
     for rate in [1000.0, 250.0] {
         let (plain, time, x) = shaken(&thesis_model(), rate, (0.8 * rate) as usize);
         let (extra, _, _) = shaken(&on, rate, time.len());
-        // The column the diagnosis builds from the recorded positions alone.
+        // The columns the diagnosis builds from the recorded positions alone.
         let acceleration = extra_force::stopper_accelerations(&time, &x);
+        let velocity = extra_force::stopper_velocities(&time, &x);
         let p_r = on.params.p_r;
         let mut largest = 0.0f64;
         for k in 1..time.len() {
             let (a, b) = (&plain[k], &extra[k]);
             // The extra force changes no pressure: it acts on the piston held by the stopper.
             assert_eq!((a.p1, a.p2), (b.p1, b.p2));
-            let v = (x[k] - x[k - 1]) / (time[k] - time[k - 1]);
+            let v = velocity[k];
             let expected = c_a * acceleration[k]
                 + c_q * v * v.abs()
                 + c_s * (v / 1e-3).tanh() * (a.p1 + a.p2 - 2.0 * p_r)

@@ -150,9 +150,13 @@ impl FixedStep {
                 sim.stopper_acceleration = sim.stopper_motion.advance((x_s - x_start) / length, length);
             }
         }
-        let mut y = sim
-            .model
-            .outputs_in_motion(&sim.state, x_s, rate, sim.stopper_acceleration, time);
+        let mut y = sim.model.outputs_in_motion(
+            &sim.state,
+            x_s,
+            sim.stopper_velocity_at_sample(),
+            sim.stopper_acceleration,
+            time,
+        );
         sim.record_transducers(&mut y);
         self.outputs = y;
         Ok(())

@@ -38,7 +38,7 @@ use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
-use crate::physics::extra_force::StopperMotion;
+use crate::physics::extra_force::{self, StopperMotion};
 use crate::physics::restrictions::node;
 use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
 use crate::physics::time_varying;
@@ -119,12 +119,13 @@ pub struct Simulation {
     plays: [f64; PLAY_OPERATORS],
     /// Commands of the recent past, for the transport_delay effect.
     command_history: Vec<CommandChange>,
-    /// Mean stopper velocity over the last step (for piston friction).
+    /// Mean stopper velocity over the last step.
     stopper_velocity: f64,
     x_s_at_last_step: f64,
-    /// The stopper's motion over the last step, from which the extra force's stopper
-    /// acceleration is formed ([`crate::physics::extra_force`]; followed only when that term
-    /// is on), and the acceleration at the end of the last step (0 when off).
+    /// The stopper's motion over the last step, from which the acceleration and the velocity
+    /// at the sample that the forces on the piston read are formed
+    /// ([`crate::physics::extra_force`]; followed only when such a force is on), and the
+    /// acceleration at the end of the last step (0 when off).
     stopper_motion: StopperMotion,
     stopper_acceleration: f64,
     /// The command stage's memory (see [`crate::physics::command_stage`]).
@@ -163,7 +164,8 @@ struct StepPlan {
     filtering_transducers: bool,
     /// The hysteresis operator has a memory to follow.
     hysteresis: bool,
-    /// The extra force follows the stopper acceleration, formed from the steps' motions.
+    /// A force follows the stopper's velocity or acceleration at the sample, formed from the
+    /// steps' motions.
     stopper_acceleration: bool,
     /// Something is recorded after each step: a transducer's memory or the stopper's motion.
     after_step: bool,
@@ -177,8 +179,8 @@ impl StepPlan {
             command_path: command_stage::is_active(p) || p.command_delay != 0.0,
             filtering_transducers: transducers.iter().any(Option::is_some),
             hysteresis: model.hysteresis.is_active(),
-            stopper_acceleration: model.acceleration_term,
-            after_step: transducers.iter().any(Option::is_some) || model.acceleration_term,
+            stopper_acceleration: model.reads_stopper_motion,
+            after_step: transducers.iter().any(Option::is_some) || model.reads_stopper_motion,
         }
     }
 }
@@ -368,11 +370,25 @@ impl Simulation {
         self.x_s = x_s;
     }
 
+    /// The stopper velocity the forces read at the last sample: at the sample, from the
+    /// last two steps' motions, where a force reads it ([`extra_force::velocity_at_sample`]).
+    pub(super) fn stopper_velocity_at_sample(&self) -> f64 {
+        if self.plan.stopper_acceleration {
+            extra_force::velocity_at_sample(
+                self.stopper_velocity,
+                self.stopper_motion.interval,
+                self.stopper_acceleration,
+            )
+        } else {
+            self.stopper_velocity
+        }
+    }
+
     pub fn outputs(&self) -> Outputs {
         let mut y = self.model.outputs_in_motion(
             &self.state,
             self.x_s,
-            self.stopper_velocity,
+            self.stopper_velocity_at_sample(),
             self.stopper_acceleration,
             self.time,
         );

@@ -138,7 +138,7 @@ impl Simulation {
             let mut y = self.model.outputs_in_motion(
                 &self.state,
                 self.x_s,
-                self.stopper_velocity,
+                self.stopper_velocity_at_sample(),
                 self.stopper_acceleration,
                 self.time,
             );
