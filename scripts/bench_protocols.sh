@@ -56,6 +56,7 @@ mechanisms=(
     "jet_resonance|jet_pipe|dynamics|--plant omega_2=1300 --plant zeta_2=0.1"
     "piston_bore|mechanics|parameter_offset|--plant d_cyl=0.0163"
     "gas_gamma_1_3|chambers|parameter_offset|--plant gamma=1.3"
+    "command_filter_30hz|command|dynamics|--command-filter 30 --command-filter-damping 0.6"
     "receiver_and_supply|jet_pipe+supply|parameter_offset|--undeclared receiver_offset --supply-pressure 622925"
     "receiver_and_pickup|jet_pipe+force_sensor|parameter_offset+periodic|--undeclared receiver_offset --force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
 )

@@ -3,7 +3,10 @@
 //! tried again in the replayed model, and the simplest that is adequate on the held-out
 //! blocks (its parameters' penalty counted) takes its place. A supply pressure set 30 kPa
 //! low is explained by the line resistance of the named `supply_pressure_drop` to within 10
-//! noise floors, and by a plain `P_s` to the noise.
+//! noise floors, and by a plain `P_s` to the noise. A named effect also competes with the
+//! general terms at its place that have more parameters: one whose penalised misfit is
+//! lower by a further penalty replaces it (a second-order filter at the command, which the
+//! named `transport_delay` followed to within 4.4 noise floors).
 
 use super::*;
 
@@ -50,8 +53,9 @@ pub(crate) struct Added<'a> {
     pub scored: &'a Scored,
     /// The model with it.
     pub with: &'a Parameters,
-    /// A named effect (its alternatives may have as many parameters as it) or a discovered
-    /// term (one with as many must do strictly better).
+    /// A named effect (its alternatives may have as many parameters as it, or more when they
+    /// do better by a penalty) or a discovered term (one with as many must do strictly
+    /// better).
     pub named: bool,
 }
 
@@ -59,10 +63,12 @@ pub(crate) struct Added<'a> {
 /// held-out misfit plus its parameters' penalty no larger than the addition's, and a
 /// held-out force error no larger (within a twentieth of the noise floor when it has fewer
 /// parameters): that term, as discovered, with the parameters that carry it. The candidates
-/// with no more parameters than the addition are tried, best first by their penalised
-/// held-out misfit, at most [`DISCOVERY_TRIALS`]; among those adequate, the fewest
-/// parameters win, then the smaller penalised misfit.
-pub(crate) fn simpler_at_place(
+/// with no more parameters than the addition are tried (after a named effect, those with
+/// more too, which must leave a penalised misfit lower by a further penalty and a smaller
+/// force error), best first by their penalised held-out misfit, at most
+/// [`DISCOVERY_TRIALS`]; among those adequate, the fewest parameters win, then the smaller
+/// penalised misfit.
+pub(crate) fn alternative_at_place(
     check: &Check,
     found: &Localization,
     params: &Parameters,
@@ -80,7 +86,8 @@ pub(crate) fn simpler_at_place(
         .iter()
         .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
         .filter(|s| s.fit.candidate.label != scored.fit.candidate.label)
-        .filter(|s| s.explained >= LOCATED_SHARE && used_terms(s) <= added_terms && used_terms(s) > 0.0)
+        .filter(|s| s.explained >= LOCATED_SHARE && used_terms(s) > 0.0)
+        .filter(|s| used_terms(s) <= added_terms || added.named)
         .collect();
     if alternatives.is_empty() {
         return Ok(None);
@@ -108,9 +115,10 @@ pub(crate) fn simpler_at_place(
             "  instead of {name}: {} leaves {misfit:.0} held out against its {added_misfit:.0} (noise floors squared), force {force:.4} against {added_force:.4} N",
             candidate.label
         ));
-        let simpler = terms < added_terms;
-        let ok = if simpler {
+        let ok = if terms < added_terms {
             score <= added_score && force <= added_force + 0.05 * noise
+        } else if terms > added_terms {
+            score < added_score - penalty && force < added_force
         } else {
             // a discovered term must be beaten by its penalty, a named effect by any margin
             let margin = if added.named { 0.0 } else { penalty };

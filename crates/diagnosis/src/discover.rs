@@ -324,12 +324,10 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
     sentence
 }
 
-/// A transducer's second-order filter in physical words: its natural frequency, damping and
-/// −3 dB corner, f_n √(1 − 2ζ² + √((1 − 2ζ²)² + 1)).
+/// A transducer's or the command's second-order filter in physical words: its natural
+/// frequency, damping and −3 dB corner, f_n √(1 − 2ζ² + √((1 − 2ζ²)² + 1)).
 fn second_order_reading(location: &str, family: &str, set: &[(&'static str, f64)]) -> Option<String> {
-    let &(name, f_n) = set
-        .iter()
-        .find(|(n, v)| n.ends_with("_sensor_filter_frequency") && *v > 0.0)?;
+    let &(name, f_n) = set.iter().find(|(n, v)| n.ends_with("_filter_frequency") && *v > 0.0)?;
     let prefix = &name[..name.len() - "_filter_frequency".len()];
     let zeta = set
         .iter()
@@ -338,9 +336,10 @@ fn second_order_reading(location: &str, family: &str, set: &[(&'static str, f64)
     let a = 1.0 - 2.0 * zeta * zeta;
     let corner = f_n * (a + (a * a + 1.0).sqrt()).sqrt();
     let reader = match prefix {
-        "force_sensor" => "The force sensor",
-        "p1_sensor" => "The chamber 1 pressure transducer",
-        _ => "The chamber 2 pressure transducer",
+        "force_sensor" => "The force sensor reads",
+        "p1_sensor" => "The chamber 1 pressure transducer reads",
+        "command" => "The current driver sees the command",
+        _ => "The chamber 2 pressure transducer reads",
     };
     let kind = if zeta < 0.6 {
         "underdamped: it rings on a step"
@@ -352,7 +351,7 @@ fn second_order_reading(location: &str, family: &str, set: &[(&'static str, f64)
         "overdamped: two unequal lags"
     };
     Some(format!(
-        "At the {location} ({family}): {reader} reads through a second-order low-pass filter of natural frequency {f_n:.1} Hz and damping ratio {zeta:.2} ({kind}), its −3 dB corner at {corner:.1} Hz: {name} = {f_n:.4e} Hz, {prefix}_filter_damping = {zeta:.4}."
+        "At the {location} ({family}): {reader} through a second-order low-pass filter of natural frequency {f_n:.1} Hz and damping ratio {zeta:.2} ({kind}), its −3 dB corner at {corner:.1} Hz: {name} = {f_n:.4e} Hz, {prefix}_filter_damping = {zeta:.4}."
     ))
 }
 

@@ -95,7 +95,8 @@ pub(crate) fn run_rounds(
         };
         // What was added is a hypothesis, not a lock: a simpler term at its place that does
         // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
-        // not a line resistance).
+        // not a line resistance), and so does a richer one that does better than a named
+        // effect by its penalty.
         let check = alternatives::Check {
             cx,
             problem: &problem,
@@ -111,7 +112,7 @@ pub(crate) fn run_rounds(
                         with: &with,
                         named: true,
                     };
-                    alternatives::simpler_at_place(&check, &found, &f.params, &a, replays, progress)?
+                    alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)?
                 } else {
                     None
                 };
@@ -126,7 +127,7 @@ pub(crate) fn run_rounds(
                     with: &trial,
                     named: false,
                 };
-                match alternatives::simpler_at_place(&check, &found, &f.params, &a, replays, progress)? {
+                match alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)? {
                     Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
                     None => Some(Addition::Discovered(term, trial, Some(s))),
                 }

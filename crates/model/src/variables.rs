@@ -90,6 +90,8 @@ pub mod vr {
     pub const CURRENT_SLEW_LIMIT: u32 = 453;
     pub const F3_INPUT_CUBIC: u32 = 454;
     pub const F3_ALGEBRAIC_SHARE: u32 = 455;
+    pub const COMMAND_FILTER_FREQUENCY: u32 = 456;
+    pub const COMMAND_FILTER_DAMPING: u32 = 457;
     pub const FORCE_SENSOR_QUADRATIC: u32 = 460;
     pub const FORCE_SENSOR_CUBIC: u32 = 461;
     pub const FORCE_SENSOR_DRIFT: u32 = 462;
@@ -727,6 +729,14 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("(2.1)")
         .because("1 s: a lag that long is no D/A stage any more"),
+    parameter("command_filter_frequency", vr::COMMAND_FILTER_FREQUENCY, "Hz", 0.0, "command dynamics: the current driver sees v_DA, after the lag, through a second-order low-pass filter of this natural frequency, exact for its input held over each communication step, its output moving linearly over the step (0 = off)")
+        .at_least(0.0).at_most(1e5)
+        .cite("(2.1)")
+        .because(FILTER_FREQUENCY),
+    parameter("command_filter_damping", vr::COMMAND_FILTER_DAMPING, "1", std::f64::consts::FRAC_1_SQRT_2, "command dynamics: the damping ratio of its second-order filter (1/sqrt(2): Butterworth; 1: two equal lags)")
+        .above(0.0).at_most(10.0)
+        .cite("(2.1)")
+        .because(FILTER_DAMPING),
     parameter("command_limit", vr::COMMAND_LIMIT, "V", 0.0, "command limit: the command the current driver sees saturates at plus or minus this (0 = off)")
         .at_least(0.0).at_most(100.0)
         .cite("(2.3)")

@@ -231,6 +231,8 @@ pub fn run(
     y[S_FF2_RATE] = 0.0;
     y[S_PF1] = y[S_P1];
     y[S_PF1_RATE] = 0.0;
+    y[S_CF] = m.driver_input(cmds[0]);
+    y[S_CF_RATE] = 0.0;
 
     let pre_steps = (opts.pre_time / H).round() as i64;
     let mut step: i64 = -pre_steps;

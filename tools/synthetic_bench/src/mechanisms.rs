@@ -128,8 +128,10 @@
 //!   `force_sensor_filter_damping` ζ): the force reading passes, after any lag, through
 //!   y'' + 2ζω y' + ω² y = ω² u, ω = 2π f_n (an amplifier's anti-aliasing filter; ζ = 1/√2
 //!   when 0). `pressure_sensor_filter_1` (`pressure_sensors`/`dynamics`, with
-//!   `pressure_sensor_filter_damping_1`): the same on the chamber 1 transducer. Both are
-//!   integrated with the plant.
+//!   `pressure_sensor_filter_damping_1`): the same on the chamber 1 transducer.
+//!   `command_filter_frequency` (`command`/`dynamics`, with `command_filter_damping`): the
+//!   same between the D/A and the current driver, after the driver's static input curve
+//!   (a reconstruction filter on the held command). All three are integrated with the plant.
 //!
 //! Near equal pressures the orifice law is replaced below Δp = 20 Pa by the secant line through
 
@@ -264,6 +266,11 @@ pub struct UndeclaredEffects {
     pub pressure_sensor_filter_1: f64,
     /// Its damping ratio (0: 1/√2).
     pub pressure_sensor_filter_damping_1: f64,
+    /// `command`/`dynamics`: natural frequency (Hz) of a second-order low-pass filter between
+    /// the D/A and the current driver (a reconstruction filter); 0 = none.
+    pub command_filter_frequency: f64,
+    /// Its damping ratio (0: 1/√2).
+    pub command_filter_damping: f64,
 }
 
 impl Default for BenchEffects {

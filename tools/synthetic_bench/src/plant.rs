@@ -152,7 +152,7 @@ pub(crate) fn port_areas(x: f64, d_jp: f64) -> (f64, f64, f64, f64) {
 // Model
 // ---------------------------------------------------------------------------------------------
 
-pub(crate) const NS: usize = 20;
+pub(crate) const NS: usize = 22;
 pub(crate) type State = [f64; NS];
 pub(crate) const S_I: usize = 0; // coil current
 pub(crate) const S_X1: usize = 1; // output of the first-order jet pipe lag
@@ -174,6 +174,8 @@ pub(crate) const S_FF2: usize = 16; // force sensor second-order filter output (
 pub(crate) const S_FF2_RATE: usize = 17; // and its rate
 pub(crate) const S_PF1: usize = 18; // pressure transducer 1 second-order filter output (undeclared)
 pub(crate) const S_PF1_RATE: usize = 19; // and its rate
+pub(crate) const S_CF: usize = 20; // command second-order filter output (undeclared)
+pub(crate) const S_CF_RATE: usize = 21; // and its rate
 
 /// Integration step (s): 50 steps per 1 ms command/log period.
 pub(crate) const H: f64 = 20e-6;
@@ -431,7 +433,23 @@ impl Model {
         let rt = p.r_gas * t0;
         // current driver (2.1)–(2.3)
         let i = y[S_I];
-        let v_cmd = self.driver_input(v_cmd);
+        let mut v_cmd = self.driver_input(v_cmd);
+        let command_filter = self.e.undeclared.command_filter_frequency;
+        if command_filter > 0.0 {
+            let (rate, acceleration) = second_order(
+                command_filter,
+                self.e.undeclared.command_filter_damping,
+                v_cmd,
+                y[S_CF],
+                y[S_CF_RATE],
+            );
+            dy[S_CF] = rate;
+            dy[S_CF_RATE] = acceleration;
+            v_cmd = y[S_CF];
+        } else {
+            dy[S_CF] = 0.0;
+            dy[S_CF_RATE] = 0.0;
+        }
         let mut di = p.omega_cd * (p.k_cd * v_cmd + p.i_offset - i);
         if self.slew {
             let s = self.e.undeclared.current_slew_limit;

@@ -214,6 +214,33 @@ pub fn catalogue(
             }],
         ),
         c(
+            "command second-order filter",
+            "command",
+            "dynamics",
+            None,
+            // The natural frequency searched on a logarithmic scale (a corner far above the
+            // signals barely moves the outputs), then refined with the damping.
+            vec![
+                Term {
+                    name: "command_filter_frequency",
+                    unit: "Hz",
+                    mechanism: Mechanism::Searched("command_filter_frequency"),
+                    neutral: 0.0,
+                    step: 0.0,
+                    lower: 1.0,
+                    upper: 1000.0,
+                },
+                started(
+                    "command_filter_damping",
+                    "1",
+                    std::f64::consts::FRAC_1_SQRT_2,
+                    0.05,
+                    0.2,
+                    5.0,
+                ),
+            ],
+        ),
+        c(
             "command limit",
             "command",
             "limit",

@@ -492,3 +492,31 @@ fn a_critically_damped_filter_on_a_pressure_transducer_under_a_staircase_at_250_
         (30.0, 1.0),
     );
 }
+
+/// A 30 Hz filter of damping 0.6 between the D/A and the current driver (a reconstruction
+/// filter) under a multisine at 1 kHz without pressures: found at the command as a
+/// second-order filter, not as a lag or a delay.
+#[test]
+fn a_second_order_filter_on_the_command_under_a_multisine_is_found_at_the_command_with_its_frequency_and_damping() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Multisine,
+        sample_rate: 1000.0,
+        duration: 20.0,
+        pressures: false,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let filter = UndeclaredEffects {
+        command_filter_frequency: 30.0,
+        command_filter_damping: 0.6,
+        ..UndeclaredEffects::default()
+    };
+    second_order_filter_found(
+        "multisine-command-filter",
+        &spec,
+        filter,
+        ("command", "dynamics"),
+        "command",
+        (30.0, 0.6),
+    );
+}

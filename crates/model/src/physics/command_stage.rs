@@ -9,13 +9,17 @@
 //! | `current_limit` (A) | clipped where k_cd v + i_offset reaches ± the limit, (2.1) |
 //! | `current_slew_limit` (A/s) | between communication points the held command moves by at most the limit / k_cd per second |
 //! | `command_lag` (s) | a first-order lag, exact for the command held between communication points |
+//! | `command_filter_frequency` (Hz), `command_filter_damping` | a second-order low-pass filter after the lag, exact for its input held between communication points |
 //!
-//! The slew limit and the lag act on the command as it is held between communication
+//! The slew limit, the lag and the filter act on the command as it is held between communication
 //! points (a sampled D/A stage): the FMU stepped at a recording's sample times and the
-//! replay of that recording see the same command.
+//! replay of that recording see the same command. The lag's output is held over a step; the
+//! filter's moves linearly from its value at the step's start to its value at the step's end
+//! ([`CommandStage::rate_over`]).
 
 use super::current_driver;
 use super::parameters::Parameters;
+use super::sensors::second_order_step;
 
 /// Whether any term of the command stage is on.
 pub fn is_active(p: &Parameters) -> bool {
@@ -25,6 +29,7 @@ pub fn is_active(p: &Parameters) -> bool {
         || p.current_limit > 0.0
         || p.current_slew_limit > 0.0
         || p.command_lag > 0.0
+        || p.command_filter_frequency > 0.0
 }
 
 /// The static part of the stage: the static curve, the cubic, then the command and current
@@ -47,6 +52,9 @@ pub fn static_map(p: &Parameters, v_da: f64) -> f64 {
     v
 }
 
+/// How many numbers [`CommandStage::to_values`] gives.
+pub const VALUES: usize = 5;
+
 /// The stage's memory between communication points.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CommandStage {
@@ -56,6 +64,9 @@ pub struct CommandStage {
     held: f64,
     /// The lag's output at that time.
     lagged: f64,
+    /// The second-order filter's output and its rate (V/s) at that time.
+    filtered: f64,
+    filtered_rate: f64,
 }
 
 impl CommandStage {
@@ -66,6 +77,8 @@ impl CommandStage {
             time,
             held: v,
             lagged: v,
+            filtered: v,
+            filtered_rate: 0.0,
         }
     }
 
@@ -74,6 +87,19 @@ impl CommandStage {
     pub fn next(&mut self, p: &Parameters, time: f64, v_da: f64) -> f64 {
         let dt = (time - self.time).max(0.0);
         let v = static_map(p, v_da);
+        if p.command_filter_frequency > 0.0 {
+            // The filter's input over the last interval: the lag's output or the held command
+            // as they stood at its start.
+            let input = self.unfiltered(p);
+            (self.filtered, self.filtered_rate) = second_order_step(
+                p.command_filter_frequency,
+                p.command_filter_damping,
+                dt,
+                (self.filtered, self.filtered_rate),
+                input,
+                input,
+            );
+        }
         if p.command_lag > 0.0 {
             // The lag integrated over the last interval, with its input held there.
             self.lagged += (1.0 - (-dt / p.command_lag).exp()) * (self.held - self.lagged);
@@ -90,6 +116,36 @@ impl CommandStage {
 
     /// The command the current driver has seen since the last communication point.
     pub fn current(&self, p: &Parameters) -> f64 {
+        if p.command_filter_frequency > 0.0 {
+            self.filtered
+        } else {
+            self.unfiltered(p)
+        }
+    }
+
+    /// The rate (V/s) at which the command the driver sees moves over the next `step` seconds:
+    /// with the second-order filter on, from its output now to its output at the step's end,
+    /// its input held (the filter's exact response at both ends, linear between, rather than
+    /// held, which would lag it by half a step); 0 otherwise, the command held.
+    pub fn rate_over(&self, p: &Parameters, step: f64) -> f64 {
+        if p.command_filter_frequency > 0.0 && step > 0.0 {
+            let input = self.unfiltered(p);
+            let (end, _) = second_order_step(
+                p.command_filter_frequency,
+                p.command_filter_damping,
+                step,
+                (self.filtered, self.filtered_rate),
+                input,
+                input,
+            );
+            (end - self.filtered) / step
+        } else {
+            0.0
+        }
+    }
+
+    /// The command before the second-order filter.
+    fn unfiltered(&self, p: &Parameters) -> f64 {
         if p.command_lag > 0.0 {
             self.lagged
         } else {
@@ -97,16 +153,18 @@ impl CommandStage {
         }
     }
 
-    /// The stage as numbers (for FMU states): time, held, lagged.
-    pub fn to_values(&self) -> [f64; 3] {
-        [self.time, self.held, self.lagged]
+    /// The stage as numbers (for FMU states): time, held, lagged, filtered and its rate.
+    pub fn to_values(&self) -> [f64; VALUES] {
+        [self.time, self.held, self.lagged, self.filtered, self.filtered_rate]
     }
 
-    pub fn from_values(values: [f64; 3]) -> Self {
+    pub fn from_values(values: [f64; VALUES]) -> Self {
         Self {
             time: values[0],
             held: values[1],
             lagged: values[2],
+            filtered: values[3],
+            filtered_rate: values[4],
         }
     }
 }
@@ -145,6 +203,71 @@ mod tests {
         // The step is applied at t = 1 ms; 10 ms later the lag has 1 − e⁻¹ of it.
         assert!((seen[11] - (1.0 - (-1.0f64).exp())).abs() < 1e-12, "{}", seen[11]);
         assert_eq!(seen[1], 0.0, "a lag does not pass a step at once");
+    }
+
+    #[test]
+    fn a_filtered_step_follows_the_second_order_step_response_at_every_sample() {
+        // The filter's input held between samples is the step itself, so the samples lie on
+        // the continuous response 1 − e^{−ζωt} (cos ω_d t + ζ/√(1−ζ²) sin ω_d t).
+        for (frequency, damping) in [(40.0, 0.3), (40.0, std::f64::consts::FRAC_1_SQRT_2), (15.0, 0.95)] {
+            let p = Parameters {
+                command_filter_frequency: frequency,
+                command_filter_damping: damping,
+                ..Parameters::default()
+            };
+            let t: Vec<f64> = (0..=60).map(|k| k as f64 * 1e-3).collect();
+            let mut v = vec![0.0; t.len()];
+            v[1..].iter_mut().for_each(|x| *x = 2.0);
+            let seen = seen_commands(&p, &t, &v);
+            let omega = 2.0 * std::f64::consts::PI * frequency;
+            let omega_d = omega * (1.0 - damping * damping).sqrt();
+            for k in 1..t.len() {
+                let s = t[k] - 1e-3;
+                let response = 1.0
+                    - (-damping * omega * s).exp()
+                        * ((omega_d * s).cos() + damping / (1.0 - damping * damping).sqrt() * (omega_d * s).sin());
+                assert!(
+                    (seen[k] - 2.0 * response).abs() < 1e-12,
+                    "{frequency} Hz, ζ {damping}, sample {k}: {} against {}",
+                    seen[k],
+                    2.0 * response
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_filter_after_a_lag_takes_the_lags_output_held_over_each_step() {
+        let p = Parameters {
+            command_lag: 0.005,
+            command_filter_frequency: 50.0,
+            command_filter_damping: 1.0,
+            ..Parameters::default()
+        };
+        let lag_only = Parameters {
+            command_filter_frequency: 0.0,
+            ..p.clone()
+        };
+        let t: Vec<f64> = (0..=40).map(|k| k as f64 * 1e-3).collect();
+        let mut v = vec![0.0; t.len()];
+        v[1..].iter_mut().for_each(|x| *x = 1.0);
+        let lagged = seen_commands(&lag_only, &t, &v);
+        let both = seen_commands(&p, &t, &v);
+        // The filter alone, driven by the lag's samples.
+        let filter = Parameters {
+            command_lag: 0.0,
+            ..p.clone()
+        };
+        let refiltered = seen_commands(&filter, &t, &lagged);
+        for k in 0..t.len() {
+            assert!(
+                (both[k] - refiltered[k]).abs() < 1e-12,
+                "{k}: {} against {}",
+                both[k],
+                refiltered[k]
+            );
+        }
+        assert!(both[10] < lagged[10], "the filter slows the lagged step further");
     }
 
     #[test]

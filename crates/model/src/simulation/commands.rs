@@ -21,8 +21,9 @@ impl Simulation {
         if !self.plan.command_path {
             return smallvec::smallvec![(step, self.v_da, self.v_da_rate)];
         }
-        // The command stage holds what the driver sees over the step (a command ramp
-        // reaches it at the next communication point).
+        // The command stage holds what the driver sees over the step, or ramps it to the
+        // filter's output at the step's end (a command ramp reaches it at the next
+        // communication point).
         let applied = self.v_da;
         let staged = command_stage::is_active(&self.model.params);
         if staged {
@@ -33,7 +34,7 @@ impl Simulation {
         }
         let rate = self.v_da_rate;
         if staged {
-            self.v_da_rate = 0.0;
+            self.v_da_rate = self.command_stage.rate_over(&self.model.params, step);
         }
         let segments = self.command_segments(step);
         self.v_da = applied;

@@ -16,7 +16,7 @@
 use super::{ChamberMethod, CommandChange, Method, Simulation, StepPlan};
 use crate::integrator::{Sdirk4, Statistics};
 use crate::physics::actuator::{Actuator, State, N_STATES};
-use crate::physics::command_stage::CommandStage;
+use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::extra_force::StopperMotion;
 use crate::physics::restrictions::node;
@@ -52,11 +52,11 @@ pub struct SimulationSnapshot {
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-pub const SNAPSHOT_LAYOUT: f64 = 5.0;
+pub const SNAPSHOT_LAYOUT: f64 = 6.0;
 
 /// Numbers before the two counted lists: the layout, 21 scalars, the state, the volumes'
-/// pressures, the plays, the command stage (3) and the six work counters as two halves each.
-const FIXED_VALUES: usize = 1 + 21 + N_STATES + node::STATES + PLAY_OPERATORS + 3 + 2 * STATISTICS;
+/// pressures, the plays, the command stage ([`command_stage::VALUES`]) and the six work counters as two halves each.
+const FIXED_VALUES: usize = 1 + 21 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + 2 * STATISTICS;
 const STATISTICS: usize = 6;
 
 impl Simulation {
@@ -140,7 +140,7 @@ impl SimulationSnapshot {
     /// velocity over the step before the last and that step's length, and the stopper
     /// acceleration they gave; the state;
     /// the pressures of the gas volumes behind restrictions (supply, return, line 1, line 2); the
-    /// plays; the command stage (time, held, lagged); the work counters (steps, rejected,
+    /// plays; the command stage (time, held, lagged, filtered and its rate); the work counters (steps, rejected,
     /// right-hand sides, Jacobians, Newton failures, stiff hand-overs), each as its low then
     /// its high 32 bits, since an `f64` holds integers exactly only up to 2^53; then the
     /// number of past commands and their (time, v_DA, rate); then for each transducer (force,
@@ -231,7 +231,9 @@ impl SimulationSnapshot {
         nodes.copy_from_slice(next(node::STATES));
         let mut plays = [0.0; PLAY_OPERATORS];
         plays.copy_from_slice(next(PLAY_OPERATORS));
-        let stage: [f64; 3] = next(3).try_into().expect("3 values");
+        let stage: [f64; command_stage::VALUES] = next(command_stage::VALUES)
+            .try_into()
+            .expect("the command stage's values");
         let halves = next(2 * STATISTICS);
         let mut counts = [0u64; STATISTICS];
         for (k, count) in counts.iter_mut().enumerate() {
@@ -425,7 +427,7 @@ mod tests {
         })
     }
 
-    /// The rest of it: the command stage (a lag), the force and chamber 2 transducers' delays, a
+    /// The rest of it: the command stage (a lag and a second-order filter), the force and chamber 2 transducers' delays, a
     /// varying supply feeding a plenum, a port line's volume.
     fn with_staged_memory() -> Actuator {
         model(|p| {
@@ -434,6 +436,8 @@ mod tests {
             p.port_restriction_area_1 = 0.2e-6;
             p.port_line_volume_1 = 3e-6;
             p.command_lag = 0.002;
+            p.command_filter_frequency = 80.0;
+            p.command_filter_damping = 0.5;
             p.force_sensor_delay = 0.002;
             p.p2_sensor_delay = 0.003;
             p.supply_ripple_sine = 2e4;

@@ -198,6 +198,13 @@ struct Cli {
     /// With --pressure-sensor-filter-1: its damping ratio (1/√2 unless given).
     #[arg(long)]
     pressure_sensor_filter_damping_1: Option<f64>,
+    /// The held command passes through a second-order low-pass filter of this natural
+    /// frequency on its way to the current driver, Hz (e.g. 30).
+    #[arg(long)]
+    command_filter: Option<f64>,
+    /// With --command-filter: its damping ratio (1/√2 unless given).
+    #[arg(long)]
+    command_filter_damping: Option<f64>,
     /// With --protocol: a thesis constant of the plant other than its default, NAME=VALUE in SI
     /// units, NAME a field of the bench's constants (k_spring, l_spring0, omega_cd, d_jp, ...);
     /// repeatable.
@@ -278,6 +285,8 @@ fn main() -> ExitCode {
         &mut und.pressure_sensor_filter_damping_1,
         cli.pressure_sensor_filter_damping_1,
     );
+    set(&mut und.command_filter_frequency, cli.command_filter);
+    set(&mut und.command_filter_damping, cli.command_filter_damping);
     let und_bad = [
         und.supply_ripple_frequency,
         und.command_limit,
@@ -307,6 +316,8 @@ fn main() -> ExitCode {
         und.force_sensor_filter_damping,
         und.pressure_sensor_filter_1,
         und.pressure_sensor_filter_damping_1,
+        und.command_filter_frequency,
+        und.command_filter_damping,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
