@@ -44,7 +44,7 @@ enum Addition {
 }
 
 pub(crate) fn run_rounds(
-    cx: &Context,
+    cx: &mut Context,
     params: Parameters,
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
@@ -63,6 +63,10 @@ pub(crate) fn run_rounds(
     // upstream places' scores, as they were.
     let mut reusable: Option<Localization> = None;
     for round in 0..=MAX_EFFECTS {
+        if round > 0 {
+            cx.lower_noise_to_departure(&f.params, replays, progress)?;
+        }
+        let cx: &Context = cx;
         let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
         let Some(r) = replay_round(cx, &problem, &f, round, replays, progress)? else {
             progress("every channel is within its noise on the held-out blocks");
