@@ -84,8 +84,8 @@ impl Recording {
     /// [`STOPPER_SMOOTHING_WEIGHTS`] (a quadratic Savitzky–Golay filter); the recorded
     /// position itself at the first and last three samples.
     ///
-    /// The model moves the stopper linearly between samples and reads a velocity-dependent
-    /// force (friction) at a sample with the slope of the interval that ends there. Positions
+    /// The model moves the stopper linearly between samples and forms the velocity a
+    /// velocity-dependent force (friction) reads from the slopes of the intervals. Positions
     /// are rounded (1 µm on the bench), so on the recorded positions an interval's slope comes
     /// in steps of 1 mm/s and is zero wherever the position stays within a step, around every
     /// reversal, where the moving stopper's friction is near its stiction. The filter averages
@@ -94,7 +94,9 @@ impl Recording {
     /// rounding: a plain mean of the seven shrinks a sine by 2 (ω Δt)², which under a 2.5 Hz,
     /// 10 mm shake sampled at 250 Hz is 80 µm of stopper travel and 0.23 N of force, where
     /// the filter's departure is below a micrometre. The window is centred, so the positions
-    /// do not lead or lag; the slope stays the velocity half a sample early.
+    /// do not lead or lag; an interval's slope is the velocity half an interval before its
+    /// end, which the model carries to the sample with the acceleration
+    /// (`jetpipe_model::physics::extra_force::velocity_at_sample`).
     ///
     /// The diagnosis replays these positions, so the FMU reproduces its errors when it is
     /// driven with them (`fmu_tests/test_diagnose_fmu.py` does the same filtering).
