@@ -67,6 +67,39 @@ pub struct ElectromechanicalPropagator<C = F3> {
     pub(super) tanh_memo: jet_pipe::TanhMemo,
     /// 2π/ω_d (s), the ringing pair's period, asked for twice a step.
     pub(super) ringing_period: f64,
+    /// The quadrature's exponentials at a full panel's nodes (see [`full_panel_factors`]).
+    pub(super) panel_factors: PanelFactors,
+}
+
+/// For the quadrature's full panel (of length [`PANEL`](super::trajectory::PANEL)), at its
+/// Gauss nodes xⱼ: e^{λk h (1 − xⱼ)} and e^{−ω_cd h xⱼ}, h the half-length (the modes' growth
+/// from a node to the panel's end, and the current transient's decay from its centre to the
+/// node). Every full panel of every step shares them: they are taken once per parameter set.
+/// Also e^{λk PANEL}, which carries the integral across a full panel.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct PanelFactors {
+    pub(super) nodes: [([C64; 3], f64); 8],
+    pub(super) across: [C64; 3],
+}
+
+pub(super) fn full_panel_factors(lambda: &[C64; 3], omega_cd: f64) -> PanelFactors {
+    let panel = super::trajectory::PANEL;
+    let half = 0.5 * panel;
+    let mut nodes = [([C64::new(0.0, 0.0); 3], 0.0); 8];
+    for (factor, node) in nodes.iter_mut().zip(super::trajectory::GAUSS_NODES) {
+        for k in 0..3 {
+            factor.0[k] = (lambda[k] * (half * (1.0 - node))).exp();
+        }
+        factor.1 = (-omega_cd * half * node).exp();
+    }
+    PanelFactors {
+        nodes,
+        across: [
+            (lambda[0] * panel).exp(),
+            (lambda[1] * panel).exp(),
+            (lambda[2] * panel).exp(),
+        ],
+    }
 }
 
 /// [`ElectromechanicalPropagator::exponentials`] at the last s asked for, and whether with the
@@ -146,6 +179,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
         let modes = dynamics.modes()?;
         let (lambda, inverse, beta) = (modes.poles, modes.from_state, modes.residues);
         let driver = CurrentDriver::from_parameters(p);
+        let panel_factors = full_panel_factors(&lambda, driver.omega_cd);
         let mut series_weights = Vec::with_capacity(MAX_SERIES_TERMS);
         'terms: for n in 0..MAX_SERIES_TERMS {
             let n_omega = n as f64 * driver.omega_cd;
@@ -183,6 +217,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
             last_exponentials: ExponentialsMemo::default(),
             tanh_memo: jet_pipe::TanhMemo::default(),
             ringing_period: 2.0 * std::f64::consts::PI / lambda[1].im.abs(),
+            panel_factors,
         })
     }
 }

@@ -250,6 +250,15 @@ impl<C: StaticCurve> Trajectory<'_, C> {
         }
     }
 
+    /// [`Self::jet_input`] with the current transient's decay e^{−ω_cd s} given.
+    fn jet_input_with_decay(&self, s: f64, decay: f64) -> f64 {
+        if self.propagator.hysteresis.is_active() {
+            self.propagator.hysteresis.output(&self.plays_at(s))
+        } else {
+            self.propagator.static_position(self.drive.with_decay(s, decay))
+        }
+    }
+
     /// Kinks of the jet pipe input for a held command: the instants at which plays of the
     /// hysteresis operator start to move (the static position is monotone, so each is
     /// found by bisection), plus the current's turning point.
@@ -310,6 +319,24 @@ impl<C: StaticCurve> Trajectory<'_, C> {
         integral
     }
 
+    /// [`Self::panel`] over [a, a + PANEL], with the exponentials that every such panel
+    /// shares (the propagator's `panel_factors`) and one exponential of the current's decay.
+    fn full_panel(&self, a: f64) -> [C64; 3] {
+        let p = self.propagator;
+        let mut integral = [C64::new(0.0, 0.0); 3];
+        let half = 0.5 * PANEL;
+        let centre = a + half;
+        let decay_at_centre = (-p.driver.omega_cd * centre).exp();
+        for ((node, weight), (modes, decay)) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS).zip(&p.panel_factors.nodes) {
+            let sigma = centre + half * node;
+            let u = self.jet_input_with_decay(sigma, decay_at_centre * decay) * weight * half;
+            for k in 0..3 {
+                integral[k] += modes[k] * u;
+            }
+        }
+        integral
+    }
+
     /// ∫₀ˢ e^{λ(s−σ)} u(σ) dσ for each mode: composite Gauss–Legendre on panels of at most
     /// [`PANEL`] that end at every kink of u. The integrals at panel ends are kept, so a
     /// query costs one panel however far into the step it is.
@@ -333,7 +360,16 @@ impl<C: StaticCurve> Trajectory<'_, C> {
             if next > s {
                 break;
             }
-            let value = carry(&integral, end, next, self.panel(end, next));
+            let value = if next_kink.map_or(true, |k| k >= end + PANEL) {
+                let across = &self.propagator.panel_factors.across;
+                let mut value = self.full_panel(end);
+                for k in 0..3 {
+                    value[k] += across[k] * integral[k];
+                }
+                value
+            } else {
+                carry(&integral, end, next, self.panel(end, next))
+            };
             table.push((next, value));
         }
         let j = table.partition_point(|(end, _)| *end <= s).saturating_sub(1);
@@ -612,6 +648,40 @@ mod tests {
                 if hysteresis == 0.0 { 5 } else { 2 },
                 "hysteresis {hysteresis}"
             );
+        }
+    }
+
+    /// A full panel takes its exponentials from the propagator's shared factors and the
+    /// current's decay from the panel's centre: the general panel's integral within 1e-13 of
+    /// its size, for a ramp with a current transient (the command filter's steps), a held
+    /// jump, and with a play hysteresis.
+    #[test]
+    fn a_full_panel_from_the_shared_factors_is_the_general_panels_integral() {
+        for hysteresis in [0.0, 4e-5] {
+            let p = Parameters {
+                hysteresis_width: hysteresis,
+                ..Parameters::default()
+            };
+            let quadrature =
+                ElectromechanicalPropagator::with_curve(&p, WithoutSeries(F3::from_parameters(&p))).unwrap();
+            for (v, rate) in [(1.0, 400.0), (-3.0, -60.0), (3.1, 0.0)] {
+                let x0 = quadrature.static_position(swinging().current);
+                let mut plays = [x0 - 1e-3; PLAY_OPERATORS];
+                quadrature.hysteresis.advance(&mut plays, x0);
+                let trajectory = quadrature.trajectory(&swinging(), v, rate, &plays);
+                for a in [0.0, 3.0 * PANEL, 7.0 * PANEL] {
+                    let (shared, general) = (trajectory.full_panel(a), trajectory.panel(a, a + PANEL));
+                    for k in 0..3 {
+                        let size = general[k].norm().max(1e-30);
+                        assert!(
+                            (shared[k] - general[k]).norm() <= 1e-13 * size,
+                            "hysteresis {hysteresis} v {v} rate {rate} a {a} mode {k}: {} vs {}",
+                            shared[k],
+                            general[k]
+                        );
+                    }
+                }
+            }
         }
     }
 
