@@ -593,7 +593,7 @@ impl<'a> Context<'a> {
         drop(modelled);
         if n < full.len() {
             let message = format!(
-                "The fits use {n} of the {} samples: stretches of {} s spread over the whole recording. The noise floors and the errors reported are of every sample.",
+                "The fits use {n} of the {} samples: stretches of {} s spread over the whole recording. The errors reported are of every sample, and so are the noise floors but for one taken again on the stretches after an addition.",
                 full.len(),
                 recording::FIT_STRETCH_SECONDS
             );
@@ -659,17 +659,15 @@ impl<'a> Context<'a> {
     /// After an addition, each channel's floor taken again from its departure from the model
     /// with `params`, where that is lower: a departure the model before could not follow (a
     /// friction's sharp turns at the reversals) lifted the first estimate as a fast signal
-    /// lifts the recording's, and a floor too high reads an error left as noise. Only on a
-    /// recording fitted whole (the stretches of a thinned one have gaps).
+    /// lifts the recording's, and a floor too high reads an error left as noise. On a
+    /// recording thinned for the fits, from the departure on its stretches: the floor is a
+    /// median over windows of 64 samples, which the few windows across a gap do not move.
     fn lower_noise_to_departure(
         &mut self,
         params: &Parameters,
         replays: &mut usize,
         progress: &mut dyn FnMut(&str),
     ) -> Result<(), String> {
-        if self.recording.full_rate.is_some() {
-            return Ok(());
-        }
         let with = replay_fast(&Actuator::new(params.clone())?, self.recording, self.n)?;
         *replays += 1;
         let sample_rate = self.recording.sample_rate();

@@ -129,6 +129,19 @@ mod tests {
         assert!((sigma - 0.05).abs() < 0.05 * 0.03, "{sigma}");
     }
 
+    /// A recording thinned for the fits is its stretches joined end to end: the signal
+    /// jumps at every joint, which moves only the few windows across one.
+    #[test]
+    fn stretches_joined_with_jumps_keep_the_floor_of_their_noise() {
+        let mut x = bench_like(7, 0.05, 0.0);
+        for (k, v) in x.iter_mut().enumerate() {
+            // twenty joints, 4,000 samples apart, each with a jump of up to 30 N
+            *v += 30.0 * ((k / 4_000) as f64 * 1.7).sin();
+        }
+        let sigma = noise_floor(&x);
+        assert!((sigma - 0.05).abs() < 0.05 * 0.03, "{sigma}");
+    }
+
     #[test]
     fn quantisation_step_is_found_on_a_quantised_channel_only() {
         let lsb = 1000.0 / 65536.0;

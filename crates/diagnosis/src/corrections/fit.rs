@@ -10,6 +10,10 @@ use crate::blocks::Block;
 /// it). The leaders' refinement and a discovered term's trial search to the finer bracket.
 const GOLDEN_STEPS: usize = 16;
 const COARSE_GOLDEN_STEPS: usize = 10;
+/// The first pass's steps of the outer search of two nested ones (a friction's second speed
+/// scale, a second-order filter's damping): 0.618^7 = 3 % of the range, as each of its
+/// points costs a whole inner search.
+const FIRST_PASS_OUTER_STEPS: usize = 7;
 /// Points of the grid from which a golden-section search is started again when one of
 /// them does better than where the search over the whole range ended: the first pass's
 /// ranking and the shape searches, then the leaders' refinement.
@@ -381,7 +385,7 @@ impl Problem<'_> {
             return self.fit_second_order(candidate, channel, iterations, base_replay);
         }
         if terms.iter().any(|t| t.mechanism == Mechanism::Shape) {
-            return self.fit_shape(candidate, base_replay);
+            return self.fit_shape(candidate, base_replay, iterations <= 1);
         }
         if terms.iter().any(|t| t.mechanism.is_searched()) {
             if terms.len() > 1 {
@@ -617,8 +621,9 @@ impl Problem<'_> {
     /// on the coefficient, on a logarithmic scale where it spans decades.
     /// A candidate whose regressors share one or two shape parameters (a friction's speed
     /// scales): golden-section search of their logarithms (the second outside the first),
-    /// the linear amplitudes solved at each trial point.
-    fn fit_shape(&self, candidate: &Candidate, base_replay: &Replay) -> Result<Fit, String> {
+    /// the linear amplitudes solved at each trial point. The first pass, which only ranks
+    /// the candidates, searches to a coarser bracket.
+    fn fit_shape(&self, candidate: &Candidate, base_replay: &Replay, first_pass: bool) -> Result<Fit, String> {
         let shapes: Vec<usize> = (0..candidate.terms.len())
             .filter(|&k| candidate.terms[k].mechanism == Mechanism::Shape)
             .collect();
@@ -650,9 +655,14 @@ impl Problem<'_> {
         let golden = |iterations: usize, f: &dyn Fn(f64) -> f64| -> (f64, f64) {
             golden_from_several(COARSE_GRID, iterations, &mut |u| f(u))
         };
-        let inner = |vs: f64| golden(14, &|u| cost(&fit_at(value_of(0, u), vs)));
+        let (inner_steps, outer_steps) = if first_pass {
+            (COARSE_GOLDEN_STEPS, FIRST_PASS_OUTER_STEPS)
+        } else {
+            (14, 10)
+        };
+        let inner = |vs: f64| golden(inner_steps, &|u| cost(&fit_at(value_of(0, u), vs)));
         let (vc, vs) = if shapes.len() >= 2 {
-            let (u_s, _) = golden(10, &|u| inner(value_of(1, u)).1);
+            let (u_s, _) = golden(outer_steps, &|u| inner(value_of(1, u)).1);
             let vs = value_of(1, u_s);
             (value_of(0, inner(vs).0), vs)
         } else {
@@ -686,10 +696,10 @@ impl Problem<'_> {
             [f, d] if d.mechanism == Mechanism::Shape => [f, d],
             _ => return Err("a second-order filter is its frequency and its damping".to_string()),
         };
-        let (steps, grid) = if iterations <= 1 {
-            (COARSE_GOLDEN_STEPS, COARSE_GRID)
+        let (steps, outer_steps, grid) = if iterations <= 1 {
+            (COARSE_GOLDEN_STEPS, FIRST_PASS_OUTER_STEPS, COARSE_GRID)
         } else {
-            (GOLDEN_STEPS, FINE_GRID)
+            (GOLDEN_STEPS, GOLDEN_STEPS, FINE_GRID)
         };
         let base = Prediction::of_replay(base_replay);
         let filtered = |f: f64, z: f64| {
@@ -701,7 +711,7 @@ impl Problem<'_> {
         let on_scale = |t: &Term, u: f64| t.lower * (t.upper / t.lower).powf(u);
         let best_frequency =
             |z: f64| golden_from_several(grid, steps, &mut |u| cost(&filtered(on_scale(frequency, u), z)));
-        let (u_damping, _) = golden_from_several(grid, steps, &mut |u| best_frequency(on_scale(damping, u)).1);
+        let (u_damping, _) = golden_from_several(grid, outer_steps, &mut |u| best_frequency(on_scale(damping, u)).1);
         let z = on_scale(damping, u_damping);
         let f = on_scale(frequency, best_frequency(z).0);
         let on = filtered(f, z);

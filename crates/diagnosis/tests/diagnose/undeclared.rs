@@ -151,6 +151,7 @@ fn a_reshaped_jet_pipe_curve_is_found_at_the_jet_pipe_as_a_nonlinearity() {
 }
 
 #[test]
+#[ignore = "a broad case (about 60 s of wall time two at a time); scripts/bench_cases.sh runs every case"]
 fn a_shifted_jet_pipe_null_is_found_at_the_jet_pipe() {
     placed("receiver_offset", 309);
 }
@@ -173,6 +174,7 @@ fn a_back_pressure_on_the_exhaust_is_found_at_the_return() {
 }
 
 #[test]
+#[ignore = "a broad case (about 60 s of wall time two at a time); scripts/bench_cases.sh runs every case"]
 fn a_chamber_leaking_to_atmosphere_is_found_at_the_chambers_as_an_extra_flow() {
     placed("chamber_1_leak", 313);
 }
