@@ -20,6 +20,7 @@
 //! through the model (crate `jetpipe-model`).
 
 mod alternatives;
+mod beside;
 pub mod blocks;
 pub mod calibrate;
 pub mod checks;

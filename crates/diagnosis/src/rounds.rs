@@ -172,6 +172,8 @@ pub(crate) fn run_rounds(
                 f.discovered.extend(terms);
                 f.newest = Some((false, f.discovered.len() - 1));
                 f.params = *trial;
+                // A term added beside the earlier ones moved their constants.
+                sync_earlier(&mut f);
                 reusable = None;
             }
             Some(Addition::Named(s, sentence)) => {
@@ -206,6 +208,24 @@ pub(crate) fn run_rounds(
     }
     crate::eliminate::attribute_from_joint_fit(cx, &mut f, replays, progress)?;
     Ok(f)
+}
+
+/// Every addition's constants and reading as they now stand in the parameters.
+fn sync_earlier(f: &mut Findings) {
+    for (name, value) in f.effects.iter_mut().flat_map(|e| e.parameters.iter_mut()) {
+        *value = parameter_value(&f.params, name);
+    }
+    for d in f.discovered.iter_mut() {
+        let mut moved = false;
+        for (name, value) in d.parameters.iter_mut() {
+            let now = parameter_value(&f.params, name);
+            moved |= now != *value;
+            *value = now;
+        }
+        if moved {
+            d.reading = discover::reading(d.candidate, d.location, d.family, &d.parameters, &f.start);
+        }
+    }
 }
 
 /// Whether two discovered terms are the same candidate carried by the same parameters.
@@ -372,6 +392,19 @@ fn find_addition(
         {
             return Ok(Some(Addition::Discovered(term, Box::new(trial), Some(Box::new(s)))));
         }
+    }
+    if let Some((term, trial)) = crate::beside::best_beside_earlier(
+        cx,
+        problem,
+        found,
+        f,
+        &r.current,
+        &r.heldout,
+        r.force_before,
+        replays,
+        progress,
+    )? {
+        return Ok(Some(Addition::Pair(vec![term], Box::new(trial))));
     }
     Ok(None)
 }

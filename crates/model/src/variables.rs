@@ -729,7 +729,7 @@ pub const TABLE: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("(2.1)")
         .because("1 s: a lag that long is no D/A stage any more"),
-    parameter("command_filter_frequency", vr::COMMAND_FILTER_FREQUENCY, "Hz", 0.0, "command dynamics: the current driver sees v_DA, after the lag, through a second-order low-pass filter of this natural frequency, exact for its input held over each communication step, its output moving linearly over the step (0 = off)")
+    parameter("command_filter_frequency", vr::COMMAND_FILTER_FREQUENCY, "Hz", 0.0, "command dynamics: the current driver sees v_DA, after the lag, through a second-order low-pass filter of this natural frequency, exact for its input held over each communication step, its output moving linearly between its exact values at the step's end, or at up to 16 nodes a quarter of its period apart where it is that fast (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("(2.1)")
         .because(FILTER_FREQUENCY),

@@ -33,6 +33,12 @@ impl Simulation {
             self.v_da = seen;
         }
         let rate = self.v_da_rate;
+        if staged && self.model.params.command_delay == 0.0 {
+            if let Some(pieces) = self.command_stage.pieces_over(&self.model.params, step) {
+                self.v_da = applied;
+                return pieces;
+            }
+        }
         if staged {
             self.v_da_rate = self.command_stage.rate_over(&self.model.params, step);
         }
