@@ -333,6 +333,7 @@ fn explained_at(label: &str, spec: &ProtocolSpec, undeclared: UndeclaredEffects,
 /// is searched on a logarithmic scale; one Gauss–Newton step from 974 rad/s, where the
 /// force barely moves with it, left it behind a current slew limit (7.3 noise floors).
 #[test]
+#[ignore = "a broad case (about 16 s of wall time two at a time); scripts/bench_cases.sh runs every case"]
 fn a_fifteen_millisecond_jet_pipe_lag_under_a_staircase_is_found_as_the_jet_pipes_corner_at_the_summed_time_constant() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Staircase,
@@ -476,6 +477,7 @@ fn second_order_filter_found(
 /// A 40 Hz filter of damping 0.5 on the force sensor under a multisine at 1 kHz without
 /// pressures (19 noise floors before): not a lag, a second-order filter.
 #[test]
+#[ignore = "a broad case (about 26 s of wall time two at a time); scripts/bench_cases.sh runs every case"]
 fn a_ringing_second_order_filter_on_the_force_sensor_under_a_multisine_is_found_with_its_frequency_and_damping() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Multisine,

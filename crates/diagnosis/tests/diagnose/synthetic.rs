@@ -130,6 +130,7 @@ fn command_delay() {
 }
 
 #[test]
+#[ignore = "a broad case (about 15 s of wall time two at a time); scripts/bench_cases.sh runs every case"]
 fn piston_friction_with_a_stribeck_curve() {
     single(
         "friction",

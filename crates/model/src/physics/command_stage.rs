@@ -155,7 +155,7 @@ impl CommandStage {
     /// one ramp over the whole step does ([`Self::rate_over`]). A 460 Hz filter ramped over
     /// the 4 ms of a 250 Hz sample reached its input 2 ms late, where it takes 0.5 ms.
     pub fn pieces_over(&self, p: &Parameters, step: f64) -> Option<smallvec::SmallVec<[(f64, f64, f64); 2]>> {
-        if p.command_filter_frequency <= 0.0 || !(step > 0.0) {
+        if p.command_filter_frequency <= 0.0 || step.is_nan() || step <= 0.0 {
             return None;
         }
         let pieces = (4.0 * p.command_filter_frequency * step)
