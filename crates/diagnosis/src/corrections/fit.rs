@@ -830,6 +830,12 @@ impl Problem<'_> {
                 let largest = commands.map(|v| v.abs()).fold(0.0, f64::max);
                 (0.2 * largest, largest, false)
             }
+            // Above the recording's Nyquist frequency the command's filter reads as a delay of
+            // 2ζ/ω, which the delay candidate is; and there each step is cut into pieces
+            // (`CommandStage::pieces_over`), which makes its replays the slowest of the pass.
+            Mechanism::Searched("command_filter_frequency") => {
+                (term.lower, term.upper.min(0.5 * self.recording.sample_rate()), true)
+            }
             _ => (term.lower, term.upper, true),
         };
         let base = Prediction::of_replay(base_replay);
