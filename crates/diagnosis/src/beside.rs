@@ -186,31 +186,20 @@ pub(crate) fn best_beside_earlier(
     {
         return Ok(None);
     }
-    let with = replay_fast(&Actuator::new(trial.clone())?, cx.recording, cx.n)?;
-    *replays += 1;
-    let (_, heldout) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
-    let misfit: f64 = heldout.iter().sum();
     let used = set.len().min(candidate.terms.len()) as f64;
-    let after = rms_where(
-        &difference(&cx.recording.force, &with.force),
-        &cx.blocks,
-        Block::HeldOut,
-    );
-    let worse_pressures =
-        (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && heldout[c] > 1.05 * heldout_before[c] + count * 0.01);
-    let before_total: f64 = heldout_before.iter().sum();
+    let judged = crate::pairs::Replayed::judge(cx, problem, &trial, heldout_before, replays)?;
     progress(&format!(
-        "  the {} with the earlier constants refitted, in the model: force held-out {force_before:.4} -> {after:.4} N, misfit {misfit:.0} + penalty {:.0} against {before_total:.0} before and the best candidate's {single_score:.0}",
+        "  the {} with the earlier constants refitted, in the model: force held-out {force_before:.4} -> {:.4} N, misfit {:.0} + penalty {:.0} against {:.0} before and the best candidate's {single_score:.0}",
         candidate.label,
-        used * penalty
+        judged.after,
+        judged.misfit,
+        used * penalty,
+        heldout_before.iter().sum::<f64>()
     ));
-    let better = misfit + used * penalty < single_score
-        && before_total - misfit > used * penalty
-        && worth_adding(force_before, after, cx.noise, false)
-        && !worse_pressures;
-    if !better {
+    if !judged.earns(used * penalty, single_score, force_before, cx.noise) {
         return Ok(None);
     }
+    let after = judged.after;
     progress(&format!(
         "adding a {} at the {}, the earlier additions refitted beside it",
         candidate.label, candidate.location

@@ -34,6 +34,52 @@ fn pairable(c: &Candidate) -> bool {
         })
 }
 
+/// A trial model replayed and scored on the held-out blocks, as an addition of several terms
+/// is judged (a pair, or a term with the earlier ones refitted beside it).
+pub(crate) struct Replayed {
+    /// Held-out misfit, every channel in its noise floors squared.
+    pub misfit: f64,
+    /// Held-out force RMS error, N.
+    pub after: f64,
+    before_total: f64,
+    worse_pressures: bool,
+}
+
+impl Replayed {
+    pub(crate) fn judge(
+        cx: &Context,
+        problem: &Problem,
+        trial: &Parameters,
+        heldout_before: &[f64; CHANNELS],
+        replays: &mut usize,
+    ) -> Result<Self, String> {
+        let count = heldout_count(&cx.blocks) as f64;
+        let with = replay_fast(&Actuator::new(trial.clone())?, cx.recording, cx.n)?;
+        *replays += 1;
+        let (_, heldout) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
+        Ok(Self {
+            misfit: heldout.iter().sum(),
+            after: rms_where(
+                &difference(&cx.recording.force, &with.force),
+                &cx.blocks,
+                Block::HeldOut,
+            ),
+            before_total: heldout_before.iter().sum(),
+            worse_pressures: (1..CHANNELS)
+                .any(|c| problem.weights[c] > 0.0 && heldout[c] > 1.05 * heldout_before[c] + count * 0.01),
+        })
+    }
+
+    /// Whether the addition is kept: its penalised misfit below the best single candidate's,
+    /// its penalty earned, the force error down as [`worth_adding`] asks, no pressure worse.
+    pub(crate) fn earns(&self, penalty: f64, single_score: f64, force_before: f64, noise: f64) -> bool {
+        self.misfit + penalty < single_score
+            && self.before_total - self.misfit > penalty
+            && worth_adding(force_before, self.after, noise, false)
+            && !self.worse_pressures
+    }
+}
+
 fn joined(a: &Candidate, b: &Candidate) -> Candidate {
     Candidate {
         terms: a.terms.iter().chain(&b.terms).cloned().collect(),
@@ -278,30 +324,18 @@ pub(crate) fn best_pair(
     {
         return Ok(None);
     }
-    let with = replay_fast(&Actuator::new(trial.clone())?, cx.recording, cx.n)?;
-    *replays += 1;
-    let (_, heldout) = problem.errors(&[with.force.clone(), with.p1.clone(), with.p2.clone()]);
-    let misfit: f64 = heldout.iter().sum();
     let used = (set_a.len() + set_b.len()).min(a.terms.len() + b.terms.len()) as f64;
-    let after = rms_where(
-        &difference(&cx.recording.force, &with.force),
-        &cx.blocks,
-        Block::HeldOut,
-    );
-    let worse_pressures =
-        (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && heldout[c] > 1.05 * heldout_before[c] + count * 0.01);
-    let before_total: f64 = heldout_before.iter().sum();
+    let judged = Replayed::judge(cx, problem, &trial, heldout_before, replays)?;
     progress(&format!(
-        "  the pair in the model: force held-out {force_before:.4} -> {after:.4} N, misfit {misfit:.0} + penalty {:.0} against {single_score:.0}",
+        "  the pair in the model: force held-out {force_before:.4} -> {:.4} N, misfit {:.0} + penalty {:.0} against {single_score:.0}",
+        judged.after,
+        judged.misfit,
         used * penalty
     ));
-    let better = misfit + used * penalty < single_score
-        && before_total - misfit > used * penalty
-        && worth_adding(force_before, after, cx.noise, false)
-        && !worse_pressures;
-    if !better {
+    if !judged.earns(used * penalty, single_score, force_before, cx.noise) {
         return Ok(None);
     }
+    let (misfit, after) = (judged.misfit, judged.after);
     // Each member must earn its own penalty: the other alone (as fitted alone, replayed)
     // leaves more than the pair by more than this member's parameters' penalty. Otherwise
     // one term with a passenger would be added where the single term does.
