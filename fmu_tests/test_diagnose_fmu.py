@@ -98,7 +98,7 @@ def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description,
 @needs_binaries
 @pytest.mark.parametrize("mechanism,parameter,duration", [pytest.param("current_slew_limit", "current_slew_limit", 80,
                                                                        marks=pytest.mark.broad),
-                                                          ("force_sensor_lag", "force_sensor_lag", 80),
+                                                          ("force_sensor_lag", "force_sensor_lag", 20),
                                                           ("port_1_restriction", "port_line_volume_1", 40)])
 def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path, mechanism, parameter, duration):

@@ -14,20 +14,37 @@ run() {
 
 # Debian's Chromium, in which a test renders the diagnosis's HTML pages.
 run bash scripts/install_chromium.sh
+mkdir -p target
+# The Python environment (pip's downloads and unpacking, little CPU) is made beside the
+# release build and the Rust tests; package.sh and pytest need it.
+venv_log=target/venv.log
+echo
+echo "==> bash scripts/venv.sh (beside cargo test; output in $venv_log)"
+venv_started=$SECONDS
+bash scripts/venv.sh >"$venv_log" 2>&1 </dev/null &
+venv_pid=$!
+background=("$venv_pid")
+trap 'kill "${background[@]}" 2>/dev/null || true' EXIT
 run cargo test --release
+if ! wait "$venv_pid"; then
+    cat "$venv_log" >&2
+    echo "test.sh: scripts/venv.sh failed" >&2
+    exit 1
+fi
+cat "$venv_log"
+echo "<== $(( SECONDS - venv_started )) s: bash scripts/venv.sh"
 # Lints: clippy with warnings as errors, on every crate and target (the component is
 # installed when the toolchain lacks it).
 cargo clippy --version >/dev/null 2>&1 || run rustup component add clippy
 # The Windows DLL is built by Debian's rustc one crate at a time, on one core: beside the
 # lints and the docs, which leave the other core idle much of the time.
-mkdir -p target
 win64_log=target/build_win64.log
 echo
 echo "==> bash scripts/build_win64.sh (beside clippy and the docs; output in $win64_log)"
 win64_started=$SECONDS
 bash scripts/build_win64.sh >"$win64_log" 2>&1 &
 win64_pid=$!
-trap 'kill "$win64_pid" 2>/dev/null || true' EXIT
+background+=("$win64_pid")
 run cargo clippy --workspace --all-targets --release -- -D warnings
 RUSTDOCFLAGS="-D warnings" run cargo doc --no-deps --workspace --release
 if ! wait "$win64_pid"; then
@@ -54,7 +71,8 @@ fi
 run cargo test --release -p fmu_common -p tendon -p finger_joint -p joint_controller
 run cargo test --release -p antagonistic
 run cargo run --release -p antagonistic -- package
-run bash scripts/venv.sh
-run .venv/bin/python -m pytest fmu_tests -q
+# pytest-xdist: the suite on every core (its diagnoses and simulations are independent; each
+# worker extracts the FMU into its own temporary folder).
+run .venv/bin/python -m pytest fmu_tests -q -n auto --dist worksteal
 echo
 echo "==> all tests passed in $SECONDS s"
