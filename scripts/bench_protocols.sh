@@ -57,6 +57,13 @@ mechanisms=(
     "piston_bore|mechanics|parameter_offset|--plant d_cyl=0.0163"
     "gas_gamma_1_3|chambers|parameter_offset|--plant gamma=1.3"
     "command_filter_30hz|command|dynamics|--command-filter 30 --command-filter-damping 0.6"
+    "torque_motor_gain|jet_pipe|parameter_offset|--plant k_m=1.75"
+    "discharge_coefficient|valve|parameter_offset|--plant c_d=0.64"
+    "gas_temperature_313k|chambers|parameter_offset|--plant temperature=313.15"
+    "cylinder_length_84mm|chambers|parameter_offset|--plant l_cyl=0.084"
+    "current_offset|current_driver|parameter_offset|--plant i_offset=5e-3"
+    "jet_pipe_saturation|jet_pipe|parameter_offset|--plant x_jp_sat=0.35e-3"
+    "jet_pipe_corner_500|jet_pipe|dynamics|--plant omega_1=500"
     "receiver_and_supply|jet_pipe+supply|parameter_offset|--undeclared receiver_offset --supply-pressure 622925"
     "receiver_and_pickup|jet_pipe+force_sensor|parameter_offset+periodic|--undeclared receiver_offset --force-sensor-pickup-amplitude 0.2 --force-sensor-pickup-frequency 50"
 )

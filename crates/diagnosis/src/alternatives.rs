@@ -152,3 +152,137 @@ pub(crate) fn alternative_at_place(
         (term, trial)
     }))
 }
+
+/// An addition with at least this many parameters (a static curve through its knots) can
+/// stand in for a simpler term at another place of the chain: those are re-tried after it.
+const FLEXIBLE_TERMS: f64 = 4.0;
+/// The simpler terms re-tried at other places have at most this many parameters.
+const SIMPLE_TERMS: f64 = 2.0;
+/// Their linearisations: a jet pipe's travel 30 % short comes to within the noise in three.
+const ELSEWHERE_ITERATIONS: usize = 4;
+/// How many of them: the best of each place, best first by their penalised held-out misfit.
+const ELSEWHERE_TRIALS: usize = 8;
+
+/// After a flexible addition (a static curve), the simplest term at another place of the
+/// chain that, refitted to convergence and replayed, does as well on the held-out blocks:
+/// that term, as discovered, with the parameters that carry it. A curve at the command
+/// reshapes everything downstream of it, so one Gauss–Newton step from its identity already
+/// takes it to a jet pipe whose travel is 30 % short, where the travel's own constant, a step
+/// from its neutral value, is still half way; refitted, the constant explains as much with
+/// two parameters against the curve's eight. Candidates with at most [`SIMPLE_TERMS`]
+/// parameters that explained at least [`LOCATED_SHARE`] in the first pass, the best of each
+/// place and none searched, are refitted from their neutral values with
+/// [`ELSEWHERE_ITERATIONS`] linearisations,
+/// best first, at most [`ELSEWHERE_TRIALS`]; one is adequate when its misfit plus its parameters' penalty is no
+/// larger than the curve's and its held-out force error no larger by a twentieth of the noise
+/// floor.
+pub(crate) fn simpler_elsewhere(
+    check: &Check,
+    found: &Localization,
+    params: &Parameters,
+    added: &Added,
+    current: &Replay,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<(DiscoveredTerm, Parameters)>, String> {
+    let scored = added.scored;
+    let added_terms = used_terms(scored);
+    if added.named || added_terms < FLEXIBLE_TERMS {
+        return Ok(None);
+    }
+    let place = scored.fit.candidate.location;
+    let count = check.count;
+    let penalty = discovery_penalty_per_term(count);
+    let mut others: Vec<&Scored> = found
+        .candidates
+        .iter()
+        .filter(|s| s.fit.candidate.location != place && s.fit.candidate.named.is_none())
+        .filter(|s| s.fit.candidate.settings.is_empty())
+        // A searched term (a limit, a filter, a friction's shape) was searched in the first
+        // pass too: it is not behind for having been linearised once.
+        .filter(|s| s.fit.candidate.terms.iter().all(|t| !t.mechanism.is_searched()))
+        .filter(|s| s.explained >= LOCATED_SHARE && s.fit.candidate.terms.len() as f64 <= SIMPLE_TERMS)
+        .collect();
+    if others.is_empty() {
+        return Ok(None);
+    }
+    others.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
+    // One step from neutral ranks the constants by how far a linearisation reaches, not by
+    // where the departure is (a large one lets any gain along the chain take most of it):
+    // the best of each place is refitted, not the best few of one place.
+    let mut places: Vec<&'static str> = vec![];
+    others.retain(|s| {
+        let new_place = !places.contains(&s.fit.candidate.location);
+        if new_place {
+            places.push(s.fit.candidate.location);
+        }
+        new_place
+    });
+    others.truncate(ELSEWHERE_TRIALS);
+    let name = scored.fit.candidate.label;
+    progress(&format!(
+        "the {name} has {added_terms} parameters: {} simpler terms at other places refitted",
+        others.len()
+    ));
+    let (added_misfit, added_force) = check.judge(added.with, replays)?;
+    let added_score = added_misfit + added_terms * penalty;
+    let refits: Vec<Option<Fit>> = crate::localize::parallel_map(&others, check.cx.options.jobs, |s| {
+        check
+            .problem
+            .fit(&s.fit.candidate, ELSEWHERE_ITERATIONS, current, &|_| None)
+            .ok()
+            .map(Fit::without_prediction)
+    });
+    let noise = check.cx.noise;
+    // (terms, score, term, parameters) of each adequate term.
+    let mut adequate: Vec<(f64, f64, DiscoveredTerm, Parameters)> = vec![];
+    for fit in refits.into_iter().flatten() {
+        *replays += fit.replays;
+        let candidate = &fit.candidate;
+        let Some(set) = discover::model_terms(candidate, &fit.values, params, check.problem) else {
+            continue;
+        };
+        let mut trial = params.clone();
+        if set.iter().any(|(n, v)| set_parameter(&mut trial, n, *v).is_err()) || trial.validate().is_err() {
+            continue;
+        }
+        let (misfit, force) = check.judge(&trial, replays)?;
+        let terms = fit
+            .values
+            .iter()
+            .zip(&candidate.terms)
+            .filter(|(v, t)| **v != t.neutral)
+            .count() as f64;
+        let score = misfit + terms * penalty;
+        progress(&format!(
+            "  instead of the {name}: the {} at the {} leaves {misfit:.0} held out against its {added_misfit:.0} (noise floors squared), force {force:.4} against {added_force:.4} N",
+            candidate.label, candidate.location
+        ));
+        if terms == 0.0 || score > added_score || force > added_force + 0.05 * noise {
+            continue;
+        }
+        let before = check.force_before;
+        let term = DiscoveredTerm {
+            location: candidate.location,
+            family: crate::curves::family(candidate.family, &set),
+            candidate: candidate.label,
+            reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+            parameters: set,
+            heldout_before: before,
+            heldout_after: force,
+            share: 1.0 - (force / before).powi(2),
+            pressures_heldout: None,
+        };
+        adequate.push((terms, score, term, trial));
+    }
+    let best = adequate
+        .into_iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    Ok(best.map(|(_, _, term, trial)| {
+        progress(&format!(
+            "adding a {} at the {} instead of the {name}",
+            term.candidate, term.location
+        ));
+        (term, trial)
+    }))
+}

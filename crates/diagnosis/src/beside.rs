@@ -10,7 +10,8 @@
 //! that fit left them.
 
 use super::*;
-use crate::localize::{discovery_penalised, discovery_penalty_per_term, heldout_count};
+use crate::localize::{discovery_penalised, discovery_penalty_per_term, heldout_count, WantedSensitivities};
+use crate::pairs::joined;
 use crate::rounds::Findings;
 
 /// Candidates of the round fitted beside the earlier additions.
@@ -110,35 +111,18 @@ pub(crate) fn best_beside_earlier(
         earlier.len()
     ));
     let earlier_terms = joint_candidate(params, &earlier);
-    let mut wanted: Vec<(&'static str, f64)> = earlier_terms.terms.iter().map(|t| (t.name, t.step)).collect();
+    let mut wanted = WantedSensitivities::default();
+    wanted.add_constants_of(&earlier_terms.terms);
     for s in &ranked {
-        for t in &s.fit.candidate.terms {
-            if let Mechanism::Parameter(name) = t.mechanism {
-                if !wanted.iter().any(|(n, _)| *n == name) {
-                    wanted.push((name, t.step));
-                }
-            }
-        }
+        wanted.add_constants_of(&s.fit.candidate.terms);
     }
     let jobs = cx.options.jobs;
-    let sensitivities: Vec<Option<Sensitivity>> =
-        parallel_map(&wanted, jobs, |(name, step)| problem.sensitivity(name, *step, current));
     *replays += wanted.len();
-    let shared = |name: &'static str| -> Option<Sensitivity> {
-        wanted
-            .iter()
-            .position(|(n, _)| *n == name)
-            .and_then(|k| sensitivities[k].clone())
-    };
-    let joined = |c: &Candidate| Candidate {
-        terms: c.terms.iter().chain(&earlier_terms.terms).cloned().collect(),
-        named: None,
-        settings: vec![],
-        ..c.clone()
-    };
+    let sensitivities = wanted.taken(problem, current, jobs, "beside", &None);
+    let shared = |name: &'static str| sensitivities.get(name);
     let fits: Vec<Option<Fit>> = parallel_map(&ranked, jobs, |s| {
         problem
-            .fit(&joined(&s.fit.candidate), ITERATIONS, current, &shared)
+            .fit(&joined(&s.fit.candidate, &earlier_terms), ITERATIONS, current, &shared)
             .ok()
             .map(Fit::without_prediction)
     });

@@ -176,7 +176,7 @@ pub enum Mechanism {
 }
 
 impl Mechanism {
-    fn is_searched(&self) -> bool {
+    pub(crate) fn is_searched(&self) -> bool {
         matches!(
             self,
             Mechanism::CurrentLimit

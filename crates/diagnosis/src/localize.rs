@@ -71,6 +71,62 @@ pub(crate) fn parallel_map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl F
     out.into_iter().map(|(_, r)| r).collect()
 }
 
+/// The model constants whose sensitivities several fits share at one point, each once, with
+/// its difference step: every fit's first linearisation reads them instead of replaying.
+#[derive(Default)]
+pub(crate) struct WantedSensitivities(Vec<(&'static str, f64)>);
+
+impl WantedSensitivities {
+    pub(crate) fn add(&mut self, name: &'static str, step: f64) {
+        if !self.0.iter().any(|(n, _)| *n == name) {
+            self.0.push((name, step));
+        }
+    }
+
+    /// The constants that `terms` vary (not their curves, filters or modulations).
+    pub(crate) fn add_constants_of(&mut self, terms: &[Term]) {
+        for t in terms {
+            if let Mechanism::Parameter(name) = t.mechanism {
+                self.add(name, t.step);
+            }
+        }
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Each sensitivity replayed at `at`, over `jobs` threads (shown as `phase` on `bars`).
+    pub(crate) fn taken(
+        self,
+        problem: &Problem,
+        at: &Replay,
+        jobs: usize,
+        phase: &str,
+        bars: &Option<std::sync::Arc<dyn ProgressBars>>,
+    ) -> SharedSensitivities {
+        let taken = parallel_map_shown(phase, bars, &self.0, jobs, |(name, step)| {
+            problem.sensitivity(name, *step, at)
+        });
+        SharedSensitivities { wanted: self.0, taken }
+    }
+}
+
+/// Sensitivities taken once at a point ([`WantedSensitivities::taken`]), read by name.
+pub(crate) struct SharedSensitivities {
+    wanted: Vec<(&'static str, f64)>,
+    taken: Vec<Option<Sensitivity>>,
+}
+
+impl SharedSensitivities {
+    pub(crate) fn get(&self, name: &'static str) -> Option<Sensitivity> {
+        self.wanted
+            .iter()
+            .position(|(n, _)| *n == name)
+            .and_then(|k| self.taken[k].clone())
+    }
+}
+
 pub(crate) fn heldout_count(blocks: &[Block]) -> usize {
     count(blocks, Block::HeldOut).max(1)
 }
@@ -93,7 +149,7 @@ pub(crate) fn localize(
     let (_, heldout_before) = problem.errors(&base_prediction);
     let before_total: f64 = heldout_before.iter().sum::<f64>().max(1e-300);
     // Sensitivities at the base point, shared by every candidate's first step.
-    let mut wanted: Vec<(&'static str, f64)> = vec![];
+    let mut wanted = WantedSensitivities::default();
     for c in candidates.iter().filter(|c| c.settings.is_empty()) {
         for t in &c.terms {
             let name = match t.mechanism {
@@ -106,9 +162,7 @@ pub(crate) fn localize(
                 _ => None,
             };
             if let Some((name, step)) = name {
-                if !wanted.iter().any(|(n, _)| *n == name) {
-                    wanted.push((name, step));
-                }
+                wanted.add(name, step);
             }
         }
     }
@@ -117,17 +171,9 @@ pub(crate) fn localize(
         wanted.len(),
         jobs
     ));
-    let sensitivities: Vec<Option<Sensitivity>> =
-        parallel_map_shown("sensitivities", bars, &wanted, jobs, |(name, step)| {
-            problem.sensitivity(name, *step, base_replay)
-        });
     let mut replays = wanted.len();
-    let shared = |name: &'static str| -> Option<Sensitivity> {
-        wanted
-            .iter()
-            .position(|(n, _)| *n == name)
-            .and_then(|k| sensitivities[k].clone())
-    };
+    let sensitivities = wanted.taken(problem, base_replay, jobs, "sensitivities", bars);
+    let shared = |name: &'static str| sensitivities.get(name);
     let score = |mut fit: Fit| -> Scored {
         let explained = 1.0 - fit.heldout_total() / before_total;
         let residual = difference(&problem.recording.force, &fit.prediction[FORCE]);

@@ -9,6 +9,7 @@
 //! terms.
 
 use super::*;
+use crate::localize::WantedSensitivities;
 
 /// Places whose best candidate enters the pairs.
 const PAIRED_PLACES: usize = 6;
@@ -80,7 +81,8 @@ impl Replayed {
     }
 }
 
-fn joined(a: &Candidate, b: &Candidate) -> Candidate {
+/// One candidate with the terms of `a`, then those of `b`.
+pub(crate) fn joined(a: &Candidate, b: &Candidate) -> Candidate {
     Candidate {
         terms: a.terms.iter().chain(&b.terms).cloned().collect(),
         named: None,
@@ -154,23 +156,14 @@ pub(crate) fn best_pair(
         }
     }
     // Sensitivities at the current point of every constant the members vary.
-    let mut wanted: Vec<(&'static str, f64)> = vec![];
+    let mut wanted = WantedSensitivities::default();
     for m in &members {
-        for t in &m.fit.candidate.terms {
-            if let Mechanism::Parameter(name) = t.mechanism {
-                if !wanted.iter().any(|(n, _)| *n == name) {
-                    wanted.push((name, t.step));
-                }
-            }
-        }
+        wanted.add_constants_of(&m.fit.candidate.terms);
     }
     for m in &members {
         for t in &m.fit.candidate.terms {
             if let Mechanism::Modulated { parameter, .. } = t.mechanism {
-                if !wanted.iter().any(|(n, _)| *n == parameter) {
-                    let step = (1e-3 * parameter_value(params, parameter).abs()).max(1e-12);
-                    wanted.push((parameter, step));
-                }
+                wanted.add(parameter, (1e-3 * parameter_value(params, parameter).abs()).max(1e-12));
             }
         }
     }
@@ -180,15 +173,9 @@ pub(crate) fn best_pair(
         members.len()
     ));
     let jobs = cx.options.jobs;
-    let sensitivities: Vec<Option<Sensitivity>> =
-        parallel_map(&wanted, jobs, |(name, step)| problem.sensitivity(name, *step, current));
     *replays += wanted.len();
-    let shared = |name: &'static str| -> Option<Sensitivity> {
-        wanted
-            .iter()
-            .position(|(n, _)| *n == name)
-            .and_then(|k| sensitivities[k].clone())
-    };
+    let sensitivities = wanted.taken(problem, current, jobs, "pairs", &None);
+    let shared = |name: &'static str| sensitivities.get(name);
     // Every pair from the shared sensitivities, the leading pairs again with fresh ones.
     let first: Vec<Option<Fit>> = parallel_map(&pairs, jobs, |&(i, j)| {
         let pair = joined(&members[i].fit.candidate, &members[j].fit.candidate);

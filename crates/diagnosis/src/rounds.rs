@@ -133,7 +133,12 @@ pub(crate) fn run_rounds(
                 };
                 match alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)? {
                     Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
-                    None => Some(Addition::Discovered(term, trial, Some(s))),
+                    None => match alternatives::simpler_elsewhere(
+                        &check, &found, &f.params, &a, &r.current, replays, progress,
+                    )? {
+                        Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
+                        None => Some(Addition::Discovered(term, trial, Some(s))),
+                    },
                 }
             }
             other => other,

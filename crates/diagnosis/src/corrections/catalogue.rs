@@ -548,8 +548,16 @@ pub fn catalogue(
             None,
             vec![p("gamma", "1", 0.005, 1.0 + 1e-6, 5.0 / 3.0)],
         ),
-        // The gas temperature of (2.6), a constant of the model, drifting over the recording
-        // (the supply air warming up): the FMU carries the ramp as T_drift.
+        // The gas temperature of (2.6), a constant of the model (the orifices' mass flows and
+        // the chambers' pressure rates), and the same drifting over the recording (the supply
+        // air warming up): the FMU carries the ramp as T_drift.
+        c(
+            "gas temperature",
+            "chambers",
+            "parameter_offset",
+            None,
+            vec![p("T", "K", 0.005, 200.0, 400.0)],
+        ),
         c(
             "gas temperature drift",
             "chambers",
