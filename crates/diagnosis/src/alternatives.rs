@@ -26,6 +26,50 @@ impl Check<'_> {
     pub(crate) fn judge(&self, params: &Parameters, replays: &mut usize) -> Result<(f64, f64), String> {
         judge(self.cx, self.problem, params, replays)
     }
+
+    /// A fitted candidate's `values` set in the model `params` and replayed: the parameters
+    /// that carry it, the model with it, its held-out misfit and its held-out force error.
+    /// `None` when the values cannot be set or the model is not valid with them.
+    #[allow(clippy::type_complexity)]
+    fn replayed(
+        &self,
+        candidate: &Candidate,
+        values: &[f64],
+        params: &Parameters,
+        replays: &mut usize,
+    ) -> Result<Option<(Vec<(&'static str, f64)>, Parameters, f64, f64)>, String> {
+        let Some(set) = discover::model_terms(candidate, values, params, self.problem) else {
+            return Ok(None);
+        };
+        let mut trial = params.clone();
+        if set.iter().any(|(n, v)| set_parameter(&mut trial, n, *v).is_err()) || trial.validate().is_err() {
+            return Ok(None);
+        }
+        let (misfit, force) = self.judge(&trial, replays)?;
+        Ok(Some((set, trial, misfit, force)))
+    }
+
+    /// The candidate, carried by `set`, as a discovered term that leaves `force` held out.
+    fn discovered(
+        &self,
+        candidate: &Candidate,
+        set: Vec<(&'static str, f64)>,
+        params: &Parameters,
+        force: f64,
+    ) -> DiscoveredTerm {
+        let before = self.force_before;
+        DiscoveredTerm {
+            location: candidate.location,
+            family: crate::curves::family(candidate.family, &set),
+            candidate: candidate.label,
+            reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+            parameters: set,
+            heldout_before: before,
+            heldout_after: force,
+            share: 1.0 - (force / before).powi(2),
+            pressures_heldout: None,
+        }
+    }
 }
 
 /// The model with `params` replayed: its held-out misfit (all channels, in noise floors
@@ -101,14 +145,9 @@ pub(crate) fn alternative_at_place(
     let mut adequate: Vec<(f64, f64, DiscoveredTerm, Parameters)> = vec![];
     for s in alternatives.into_iter().take(DISCOVERY_TRIALS) {
         let candidate = &s.fit.candidate;
-        let Some(set) = discover::model_terms(candidate, &s.fit.values, params, check.problem) else {
+        let Some((set, trial, misfit, force)) = check.replayed(candidate, &s.fit.values, params, replays)? else {
             continue;
         };
-        let mut trial = params.clone();
-        if set.iter().any(|(n, v)| set_parameter(&mut trial, n, *v).is_err()) || trial.validate().is_err() {
-            continue;
-        }
-        let (misfit, force) = check.judge(&trial, replays)?;
         let terms = used_terms(s);
         let score = misfit + terms * penalty;
         progress(&format!(
@@ -127,19 +166,7 @@ pub(crate) fn alternative_at_place(
         if !ok {
             continue;
         }
-        let before = check.force_before;
-        let term = DiscoveredTerm {
-            location: place,
-            family: crate::curves::family(candidate.family, &set),
-            candidate: candidate.label,
-            reading: discover::reading(candidate.label, place, candidate.family, &set, params),
-            parameters: set,
-            heldout_before: before,
-            heldout_after: force,
-            share: 1.0 - (force / before).powi(2),
-            pressures_heldout: None,
-        };
-        adequate.push((terms, score, term, trial));
+        adequate.push((terms, score, check.discovered(candidate, set, params, force), trial));
     }
     let best = adequate
         .into_iter()
@@ -164,18 +191,17 @@ const ELSEWHERE_ITERATIONS: usize = 4;
 const ELSEWHERE_TRIALS: usize = 8;
 
 /// After a flexible addition (a static curve), the simplest term at another place of the
-/// chain that, refitted to convergence and replayed, does as well on the held-out blocks:
-/// that term, as discovered, with the parameters that carry it. A curve at the command
-/// reshapes everything downstream of it, so one Gauss–Newton step from its identity already
-/// takes it to a jet pipe whose travel is 30 % short, where the travel's own constant, a step
-/// from its neutral value, is still half way; refitted, the constant explains as much with
-/// two parameters against the curve's eight. Candidates with at most [`SIMPLE_TERMS`]
-/// parameters that explained at least [`LOCATED_SHARE`] in the first pass, the best of each
-/// place and none searched, are refitted from their neutral values with
-/// [`ELSEWHERE_ITERATIONS`] linearisations,
-/// best first, at most [`ELSEWHERE_TRIALS`]; one is adequate when its misfit plus its parameters' penalty is no
-/// larger than the curve's and its held-out force error no larger by a twentieth of the noise
-/// floor.
+/// chain that, refitted and replayed, does as well on the held-out blocks: that term, as
+/// discovered, with the parameters that carry it. A curve at the command reshapes everything
+/// downstream of it, so one Gauss–Newton step from its identity already takes it to a jet
+/// pipe whose travel is 30 % short, where the travel's own constant, a step from its neutral
+/// value, is still part of the way; refitted, the constant explains as much with two
+/// parameters against the curve's eight. Candidates with at most [`SIMPLE_TERMS`] parameters
+/// that explained at least [`LOCATED_SHARE`] in the first pass, the best of each place and
+/// none searched, are refitted from their neutral values with [`ELSEWHERE_ITERATIONS`]
+/// linearisations, best first, at most [`ELSEWHERE_TRIALS`]; one is adequate when its misfit
+/// plus its parameters' penalty is no larger than the curve's and its held-out force error no
+/// larger by a twentieth of the noise floor.
 pub(crate) fn simpler_elsewhere(
     check: &Check,
     found: &Localization,
@@ -239,20 +265,10 @@ pub(crate) fn simpler_elsewhere(
     for fit in refits.into_iter().flatten() {
         *replays += fit.replays;
         let candidate = &fit.candidate;
-        let Some(set) = discover::model_terms(candidate, &fit.values, params, check.problem) else {
+        let Some((set, trial, misfit, force)) = check.replayed(candidate, &fit.values, params, replays)? else {
             continue;
         };
-        let mut trial = params.clone();
-        if set.iter().any(|(n, v)| set_parameter(&mut trial, n, *v).is_err()) || trial.validate().is_err() {
-            continue;
-        }
-        let (misfit, force) = check.judge(&trial, replays)?;
-        let terms = fit
-            .values
-            .iter()
-            .zip(&candidate.terms)
-            .filter(|(v, t)| **v != t.neutral)
-            .count() as f64;
+        let terms = crate::localize::terms_used(&fit);
         let score = misfit + terms * penalty;
         progress(&format!(
             "  instead of the {name}: the {} at the {} leaves {misfit:.0} held out against its {added_misfit:.0} (noise floors squared), force {force:.4} against {added_force:.4} N",
@@ -261,19 +277,7 @@ pub(crate) fn simpler_elsewhere(
         if terms == 0.0 || score > added_score || force > added_force + 0.05 * noise {
             continue;
         }
-        let before = check.force_before;
-        let term = DiscoveredTerm {
-            location: candidate.location,
-            family: crate::curves::family(candidate.family, &set),
-            candidate: candidate.label,
-            reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
-            parameters: set,
-            heldout_before: before,
-            heldout_after: force,
-            share: 1.0 - (force / before).powi(2),
-            pressures_heldout: None,
-        };
-        adequate.push((terms, score, term, trial));
+        adequate.push((terms, score, check.discovered(candidate, set, params, force), trial));
     }
     let best = adequate
         .into_iter()

@@ -5,10 +5,14 @@ use super::*;
 
 /// How many of a fitted candidate's terms are away from their neutral values.
 pub(crate) fn used_terms(s: &Scored) -> f64 {
-    s.fit
-        .values
+    terms_used(&s.fit)
+}
+
+/// [`used_terms`] of a fit not yet scored.
+pub(crate) fn terms_used(fit: &Fit) -> f64 {
+    fit.values
         .iter()
-        .zip(&s.fit.candidate.terms)
+        .zip(&fit.candidate.terms)
         .filter(|(v, t)| **v != t.neutral)
         .count() as f64
 }
