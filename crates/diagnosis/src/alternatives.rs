@@ -168,16 +168,7 @@ pub(crate) fn alternative_at_place(
         }
         adequate.push((terms, score, check.discovered(candidate, set, params, force), trial));
     }
-    let best = adequate
-        .into_iter()
-        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    Ok(best.map(|(_, _, term, trial)| {
-        progress(&format!(
-            "adding a {} at the {} instead of {name}",
-            term.candidate, place
-        ));
-        (term, trial)
-    }))
+    Ok(simplest(adequate, name, progress))
 }
 
 /// An addition with at least this many parameters (a static curve through its knots) can
@@ -279,14 +270,24 @@ pub(crate) fn simpler_elsewhere(
         }
         adequate.push((terms, score, check.discovered(candidate, set, params, force), trial));
     }
+    Ok(simplest(adequate, &format!("the {name}"), progress))
+}
+
+/// Of the adequate terms (their parameters, penalised misfit, term and model), the one with
+/// the fewest parameters, then the smallest penalised misfit.
+fn simplest(
+    adequate: Vec<(f64, f64, DiscoveredTerm, Parameters)>,
+    instead_of: &str,
+    progress: &mut dyn FnMut(&str),
+) -> Option<(DiscoveredTerm, Parameters)> {
     let best = adequate
         .into_iter()
         .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    Ok(best.map(|(_, _, term, trial)| {
+    best.map(|(_, _, term, trial)| {
         progress(&format!(
-            "adding a {} at the {} instead of the {name}",
+            "adding a {} at the {} instead of {instead_of}",
             term.candidate, term.location
         ));
         (term, trial)
-    }))
+    })
 }
