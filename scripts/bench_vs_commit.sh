@@ -3,7 +3,7 @@
 # plain C importer through the exported fmi2* functions (a benchmark, not a test: it fails only
 # when a build or a run fails).
 #
-#   bash scripts/bench_vs_commit.sh [--pairs N] [--repeat R] [--callgrind] [COMMIT]
+#   bash scripts/bench_vs_commit.sh [--pairs N] [--rounds R] [--callgrind] [COMMIT]
 #
 # COMMIT (default 545a082) is checked out into a temporary git worktree and built there with
 # `cargo build --release --lib` (its build is kept under target/bench_vs_commit/ for the next
@@ -12,11 +12,13 @@
 # 1 ms), the standard scenario's inputs (held for 10 ms), default parameters, the outputs read
 # after every step. The script
 #   1. checks that the two builds' outputs agree (bit for bit, or by how much they differ);
-#   2. runs N pairs (default 9), the two builds one after the other, the order alternating
-#      from pair to pair; each run is one process that warms the library with one untimed run
-#      and reports the CPU time of the fastest of R timed runs (default 3);
-#   3. prints each pair, the median CPU time of each build and the median of the pairs'
-#      ratios (current / COMMIT), with the load average before and after;
+#   2. loads both libraries into one process and runs N pairs of runs (default 200), one of
+#      each build, the order alternating from pair to pair, after one untimed run of each:
+#      the two runs of a pair are some 20 ms apart, so a change in the machine's speed
+#      (another tenant, the clock) falls on both; R such processes (default 5);
+#   3. prints, per process, each build's median and fastest CPU time and the median of the
+#      pairs' ratios (current / COMMIT), then the median of those ratios, with the load
+#      average before and after;
 #   4. with --callgrind, counts the instructions executed inside fmi2DoStep, fmi2GetReal and
 #      fmi2SetReal (the calls of each step) for one cold run of each build (valgrind
 #      --tool=callgrind): figures that do not drift with the machine.
@@ -24,18 +26,18 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$(pwd)"
 
-pairs=9
-repeat=3
+pairs=200
+rounds=5
 callgrind=0
 commit=545a082
 usage() {
-    echo "usage: bash scripts/bench_vs_commit.sh [--pairs N] [--repeat R] [--callgrind] [COMMIT]" >&2
+    echo "usage: bash scripts/bench_vs_commit.sh [--pairs N] [--rounds R] [--callgrind] [COMMIT]" >&2
     exit 2
 }
 while [ $# -gt 0 ]; do
     case "$1" in
         --pairs) [ $# -ge 2 ] || usage; pairs="$2"; shift 2 ;;
-        --repeat) [ $# -ge 2 ] || usage; repeat="$2"; shift 2 ;;
+        --rounds) [ $# -ge 2 ] || usage; rounds="$2"; shift 2 ;;
         --callgrind) callgrind=1; shift ;;
         -h | --help) usage ;;
         -*) echo "unknown option $1" >&2; usage ;;
@@ -44,8 +46,8 @@ while [ $# -gt 0 ]; do
 done
 case "$pairs" in '' | *[!0-9]*) echo "--pairs $pairs: expected a positive integer" >&2; exit 2 ;; esac
 [ "$pairs" -ge 1 ] || { echo "--pairs $pairs: expected a positive integer" >&2; exit 2; }
-case "$repeat" in '' | *[!0-9]*) echo "--repeat $repeat: expected a positive integer" >&2; exit 2 ;; esac
-[ "$repeat" -ge 1 ] || { echo "--repeat $repeat: expected a positive integer" >&2; exit 2; }
+case "$rounds" in '' | *[!0-9]*) echo "--rounds $rounds: expected a positive integer" >&2; exit 2 ;; esac
+[ "$rounds" -ge 1 ] || { echo "--rounds $rounds: expected a positive integer" >&2; exit 2; }
 full="$(git rev-parse --verify --quiet "$commit^{commit}")" || {
     echo "COMMIT $commit: not a commit of this repository" >&2
     exit 2
@@ -106,27 +108,19 @@ else
               for (c = 2; c <= 6; c++) printf "  max |d %s| = %.3g at t = %s s\n", name[c - 1], m[c], at[c] }'
 fi
 
-cpu_of() { "$driver" --repeat "$repeat" "$1" "$2" | sed -n 's/^cpu_ms=//p'; }
-echo "==> $pairs interleaved pairs (CPU ms of a 10 s run, best of $repeat per process)"
+echo "==> $rounds times $pairs interleaved pairs in one process (CPU ms of a 10 s run)"
 load_before="$(load)"
-: >"$work/pairs"
-for ((k = 1; k <= pairs; k++)); do
-    if ((k % 2)); then
-        old_ms="$(cpu_of "$old_lib" "$old_guid")"
-        current_ms="$(cpu_of "$current_lib" "$current_guid")"
-    else
-        current_ms="$(cpu_of "$current_lib" "$current_guid")"
-        old_ms="$(cpu_of "$old_lib" "$old_guid")"
-    fi
-    ratio="$(awk -v a="$current_ms" -v b="$old_ms" 'BEGIN { printf "%.3f", a / b }')"
-    printf 'pair %2d: %s %8.3f ms, current %8.3f ms, ratio %s\n' "$k" "$short" "$old_ms" "$current_ms" "$ratio"
-    echo "$old_ms $current_ms $ratio" >>"$work/pairs"
+: >"$work/rounds"
+for ((k = 1; k <= rounds; k++)); do
+    "$driver" --pairs "$pairs" "$old_lib" "$old_guid" "$current_lib" "$current_guid" >"$work/round"
+    value() { sed -n "s/^$1=//p" "$work/round"; }
+    printf 'round %2d: median %s %8.3f ms, current %8.3f ms; fastest %8.3f and %8.3f ms; median ratio %s\n' \
+        "$k" "$short" "$(value median_a_ms)" "$(value median_b_ms)" "$(value min_a_ms)" "$(value min_b_ms)" \
+        "$(value median_ratio)"
+    value median_ratio >>"$work/rounds"
 done
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
-old_median="$(cut -d' ' -f1 "$work/pairs" | median)"
-current_median="$(cut -d' ' -f2 "$work/pairs" | median)"
-ratio_median="$(cut -d' ' -f3 "$work/pairs" | median)"
-echo "median: $short $old_median ms, current $current_median ms; median ratio (current / $short) $ratio_median"
+echo "median of the rounds' median ratios (current / $short): $(median <"$work/rounds")"
 echo "load average before $load_before, after $(load)"
 
 if ((callgrind)); then

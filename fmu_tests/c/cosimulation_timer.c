@@ -3,6 +3,7 @@
  * scripts/bench_vs_commit.sh, which runs two builds through it side by side.
  *
  * usage: cosimulation_timer [--repeat N] [--cold] [--csv FILE] LIBRARY GUID
+ *        cosimulation_timer --pairs N LIBRARY_A GUID_A LIBRARY_B GUID_B
  *
  * It loads LIBRARY (a libjetpipe.so) and runs a 10 s co-simulation at 1 kHz: fmi2DoStep of
  * 1 ms, the inputs v_DA and x_s of the standard scenario (src/scenario.rs: sampled every
@@ -18,6 +19,13 @@
  * collision, their digests are equal). --csv FILE also writes t and the five outputs after
  * every step of the last run with 17 significant digits, for a comparison that says by how
  * much two builds differ.
+ *
+ * --pairs N loads two builds into the one process (each with RTLD_LOCAL, so each keeps its
+ * own symbols and state), warms both, then times N pairs of runs, one of each build, the
+ * order alternating from pair to pair: the two runs of a pair are some 20 ms apart, so a
+ * change in the machine's speed (another tenant, the clock) falls on both. Prints
+ * median_ratio (the median over the pairs of B's CPU time over A's), median_a_ms,
+ * median_b_ms, min_a_ms, min_b_ms, and digest_a, digest_b.
  * Exit status 0 on success, 1 on any failure, 2 on bad usage.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -61,15 +69,19 @@ static void logger(fmi2ComponentEnvironment env, fmi2String instanceName, fmi2St
     fprintf(stderr, "\n");
 }
 
-static fmi2InstantiateTYPE *p_Instantiate;
-static fmi2FreeInstanceTYPE *p_FreeInstance;
-static fmi2SetupExperimentTYPE *p_SetupExperiment;
-static fmi2EnterInitializationModeTYPE *p_EnterInitializationMode;
-static fmi2ExitInitializationModeTYPE *p_ExitInitializationMode;
-static fmi2TerminateTYPE *p_Terminate;
-static fmi2SetRealTYPE *p_SetReal;
-static fmi2GetRealTYPE *p_GetReal;
-static fmi2DoStepTYPE *p_DoStep;
+/* One loaded build: its exported functions and its GUID. */
+typedef struct {
+    const char *library, *guid;
+    fmi2InstantiateTYPE *Instantiate;
+    fmi2FreeInstanceTYPE *FreeInstance;
+    fmi2SetupExperimentTYPE *SetupExperiment;
+    fmi2EnterInitializationModeTYPE *EnterInitializationMode;
+    fmi2ExitInitializationModeTYPE *ExitInitializationMode;
+    fmi2TerminateTYPE *Terminate;
+    fmi2SetRealTYPE *SetReal;
+    fmi2GetRealTYPE *GetReal;
+    fmi2DoStepTYPE *DoStep;
+} Build;
 static fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
 
 #define CHECK(call)                                                            \
@@ -98,53 +110,127 @@ static uint64_t fnv1a(uint64_t hash, double value) {
 }
 
 /* One run of the scenario; the digest of its outputs, and each step's outputs to `csv` if set. */
-static uint64_t run(const char *guid, FILE *csv) {
-    fmi2Component c = p_Instantiate("timer", fmi2CoSimulation, guid, "", &callbacks, fmi2False, fmi2False);
+static uint64_t run(const Build *b, FILE *csv) {
+    fmi2Component c = b->Instantiate("timer", fmi2CoSimulation, b->guid, "", &callbacks, fmi2False, fmi2False);
     fmi2Real u[2], y[5];
     uint64_t digest = 0xcbf29ce484222325ull;
     if (!c) {
-        fprintf(stderr, "fmi2Instantiate returned NULL (is %s the library's GUID?)\n", guid);
+        fprintf(stderr, "fmi2Instantiate returned NULL (is %s the GUID of %s?)\n", b->guid, b->library);
         exit(1);
     }
     inputs(0, u);
-    CHECK(p_SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0));
-    CHECK(p_EnterInitializationMode(c));
-    CHECK(p_SetReal(c, INPUTS, 2, u));
-    CHECK(p_ExitInitializationMode(c));
+    CHECK(b->SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0));
+    CHECK(b->EnterInitializationMode(c));
+    CHECK(b->SetReal(c, INPUTS, 2, u));
+    CHECK(b->ExitInitializationMode(c));
     for (int k = 0; k < SAMPLES; k++) {
         inputs(k, u);
-        CHECK(p_SetReal(c, INPUTS, 2, u));
+        CHECK(b->SetReal(c, INPUTS, 2, u));
         for (int j = 0; j < STEPS_PER_SAMPLE; j++) {
             int n = k * STEPS_PER_SAMPLE + j;
-            CHECK(p_DoStep(c, n * STEP, STEP, fmi2True));
-            CHECK(p_GetReal(c, OUTPUTS, 5, y));
+            CHECK(b->DoStep(c, n * STEP, STEP, fmi2True));
+            CHECK(b->GetReal(c, OUTPUTS, 5, y));
             for (int m = 0; m < 5; m++) digest = fnv1a(digest, y[m]);
             if (csv)
                 fprintf(csv, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", (n + 1) * STEP, y[0], y[1], y[2],
                         y[3], y[4]);
         }
     }
-    CHECK(p_Terminate(c));
-    p_FreeInstance(c);
+    CHECK(b->Terminate(c));
+    b->FreeInstance(c);
     return digest;
 }
 
-#define RESOLVE(var, name)                                                     \
+#define RESOLVE(name)                                                          \
     do {                                                                       \
-        var = (name##TYPE *)dlsym(lib, #name);                                 \
-        if (!var) {                                                            \
-            fprintf(stderr, "%s: cannot resolve %s\n", library, #name);        \
+        b->name = (fmi2##name##TYPE *)dlsym(lib, "fmi2" #name);                \
+        if (!b->name) {                                                        \
+            fprintf(stderr, "%s: cannot resolve fmi2%s\n", library, #name);     \
             return 1;                                                          \
         }                                                                      \
     } while (0)
 
+/* Loads `library` into `b`; 0 on success. */
+static int load(Build *b, const char *library, const char *guid) {
+    void *lib = dlopen(library, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        fprintf(stderr, "cannot load %s: %s\n", library, dlerror());
+        return 1;
+    }
+    b->library = library;
+    b->guid = guid;
+    RESOLVE(Instantiate);
+    RESOLVE(FreeInstance);
+    RESOLVE(SetupExperiment);
+    RESOLVE(EnterInitializationMode);
+    RESOLVE(ExitInitializationMode);
+    RESOLVE(Terminate);
+    RESOLVE(SetReal);
+    RESOLVE(GetReal);
+    RESOLVE(DoStep);
+    return 0;
+}
+
+/* The CPU seconds of one run of `b`, its digest in *digest. */
+static double timed_run(const Build *b, uint64_t *digest) {
+    double cpu0 = seconds(CLOCK_PROCESS_CPUTIME_ID);
+    *digest = run(b, NULL);
+    return seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
+}
+
+static int compare_doubles(const void *x, const void *y) {
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+static double median(double *v, int n) {
+    qsort(v, (size_t)n, sizeof *v, compare_doubles);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* --pairs: the two builds interleaved in one process (see the header). */
+static int pairs_mode(int pairs, Build *a, Build *b) {
+    double *ta = malloc(sizeof(double) * (size_t)pairs), *tb = malloc(sizeof(double) * (size_t)pairs);
+    double *ratio = malloc(sizeof(double) * (size_t)pairs);
+    uint64_t digest_a, digest_b, first_a = run(a, NULL), first_b = run(b, NULL);
+    double min_a = INFINITY, min_b = INFINITY;
+    if (!ta || !tb || !ratio) {
+        fprintf(stderr, "out of memory\n");
+        return 1;
+    }
+    for (int k = 0; k < pairs; k++) {
+        if (k % 2 == 0) {
+            ta[k] = timed_run(a, &digest_a);
+            tb[k] = timed_run(b, &digest_b);
+        } else {
+            tb[k] = timed_run(b, &digest_b);
+            ta[k] = timed_run(a, &digest_a);
+        }
+        if (digest_a != first_a || digest_b != first_b) {
+            fprintf(stderr, "two runs of the same build differ\n");
+            return 1;
+        }
+        ratio[k] = tb[k] / ta[k];
+        if (ta[k] < min_a) min_a = ta[k];
+        if (tb[k] < min_b) min_b = tb[k];
+    }
+    printf("median_ratio=%.4f\nmedian_a_ms=%.4f\nmedian_b_ms=%.4f\nmin_a_ms=%.4f\nmin_b_ms=%.4f\n",
+           median(ratio, pairs), 1e3 * median(ta, pairs), 1e3 * median(tb, pairs), 1e3 * min_a, 1e3 * min_b);
+    printf("digest_a=%016llx\ndigest_b=%016llx\n", (unsigned long long)first_a, (unsigned long long)first_b);
+    free(ta);
+    free(tb);
+    free(ratio);
+    return 0;
+}
+
 static int usage(const char *program) {
     fprintf(stderr, "usage: %s [--repeat N] [--cold] [--csv FILE] LIBRARY GUID\n", program);
+    fprintf(stderr, "       %s --pairs N LIBRARY_A GUID_A LIBRARY_B GUID_B\n", program);
     return 2;
 }
 
 int main(int argc, char **argv) {
-    int repeat = 1, cold = 0, arg = 1;
+    int repeat = 1, cold = 0, arg = 1, pairs = 0;
     const char *csv_path = NULL;
     while (arg < argc && strncmp(argv[arg], "--", 2) == 0) {
         if (strcmp(argv[arg], "--cold") == 0) {
@@ -159,6 +245,15 @@ int main(int argc, char **argv) {
             }
             repeat = (int)n;
             arg += 2;
+        } else if (strcmp(argv[arg], "--pairs") == 0 && arg + 1 < argc) {
+            char *end;
+            long n = strtol(argv[arg + 1], &end, 10);
+            if (*end != '\0' || n < 1 || n > 100000) {
+                fprintf(stderr, "--pairs %s: expected an integer from 1 to 100000\n", argv[arg + 1]);
+                return 2;
+            }
+            pairs = (int)n;
+            arg += 2;
         } else if (strcmp(argv[arg], "--csv") == 0 && arg + 1 < argc) {
             csv_path = argv[arg + 1];
             arg += 2;
@@ -166,22 +261,15 @@ int main(int argc, char **argv) {
             return usage(argv[0]);
         }
     }
-    if (argc - arg != 2) return usage(argv[0]);
-    const char *library = argv[arg], *guid = argv[arg + 1];
-    void *lib = dlopen(library, RTLD_NOW | RTLD_LOCAL);
-    if (!lib) {
-        fprintf(stderr, "cannot load %s: %s\n", library, dlerror());
-        return 1;
+    if (pairs) {
+        static Build a, b;
+        if (argc - arg != 4 || cold || csv_path) return usage(argv[0]);
+        if (load(&a, argv[arg], argv[arg + 1]) || load(&b, argv[arg + 2], argv[arg + 3])) return 1;
+        return pairs_mode(pairs, &a, &b);
     }
-    RESOLVE(p_Instantiate, fmi2Instantiate);
-    RESOLVE(p_FreeInstance, fmi2FreeInstance);
-    RESOLVE(p_SetupExperiment, fmi2SetupExperiment);
-    RESOLVE(p_EnterInitializationMode, fmi2EnterInitializationMode);
-    RESOLVE(p_ExitInitializationMode, fmi2ExitInitializationMode);
-    RESOLVE(p_Terminate, fmi2Terminate);
-    RESOLVE(p_SetReal, fmi2SetReal);
-    RESOLVE(p_GetReal, fmi2GetReal);
-    RESOLVE(p_DoStep, fmi2DoStep);
+    if (argc - arg != 2) return usage(argv[0]);
+    static Build build;
+    if (load(&build, argv[arg], argv[arg + 1])) return 1;
 
     FILE *csv = NULL;
     if (csv_path) {
@@ -192,11 +280,11 @@ int main(int argc, char **argv) {
         }
         fprintf(csv, "t,F_act,P1,P2,i,x_jp\n");
     }
-    uint64_t first = cold ? 0 : run(guid, NULL), digest = 0;
+    uint64_t first = cold ? 0 : run(&build, NULL), digest = 0;
     double best_cpu = INFINITY, best_wall = INFINITY;
     for (int r = 0; r < repeat; r++) {
         double cpu0 = seconds(CLOCK_PROCESS_CPUTIME_ID), wall0 = seconds(CLOCK_MONOTONIC);
-        digest = run(guid, r == repeat - 1 ? csv : NULL);
+        digest = run(&build, r == repeat - 1 ? csv : NULL);
         double cpu = seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0, wall = seconds(CLOCK_MONOTONIC) - wall0;
         if (cpu < best_cpu) {
             best_cpu = cpu;
