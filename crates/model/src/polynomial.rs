@@ -53,6 +53,13 @@ impl<const PIECES: usize> Piecewise<PIECES> {
         })
     }
 
+    /// start, end, pieces per unit length and the pieces: what [`Self::value`] works from,
+    /// for evaluations that take several points at once.
+    #[inline(always)]
+    pub(crate) fn parts(&self) -> (f64, f64, f64, &[Piece; PIECES]) {
+        (self.start, self.end, self.pieces_per_unit, &self.coefficients)
+    }
+
     /// The value at `x`, or `None` outside [start, end] (and for NaN).
     #[inline]
     pub fn value(&self, x: f64) -> Option<f64> {

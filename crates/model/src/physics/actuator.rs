@@ -627,11 +627,26 @@ impl Actuator {
         let p = &self.params;
         let k = &self.flow;
         let [cd_s1, cd_r1, cd_s2, cd_r2] = self.discharge;
-        let supply_1 = orifice_flow::mass_flow_inline(k, cd_s1 * a.supply_1, p.p_s, p1);
-        let return_1 = orifice_flow::mass_flow_inline(k, cd_r1 * a.return_1, p1, p.p_r);
-        let supply_2 = orifice_flow::mass_flow_inline(k, cd_s2 * a.supply_2, p.p_s, p2);
-        let return_2 = orifice_flow::mass_flow_inline(k, cd_r2 * a.return_2, p2, p.p_r);
-        let leakage = orifice_flow::leakage_flow_inline(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2);
+        let (s1, r1, s2, r2) = (
+            cd_s1 * a.supply_1,
+            cd_r1 * a.return_1,
+            cd_s2 * a.supply_2,
+            cd_r2 * a.return_2,
+        );
+        // The open supply and the leakage, unchoked over most of the stroke, in one packed
+        // evaluation (`orifice_flow::mass_flow_and_leakage`); the returns vent to the
+        // atmosphere, choked, and a closed orifice costs a comparison.
+        let (supply_1, supply_2, leakage) = if s2 == 0.0 {
+            let [supply_1, leakage] =
+                orifice_flow::mass_flow_and_leakage(k, s1, p.p_s, p1, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2);
+            (supply_1, 0.0, leakage)
+        } else {
+            let [supply_2, leakage] =
+                orifice_flow::mass_flow_and_leakage(k, s2, p.p_s, p2, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2);
+            (orifice_flow::mass_flow_inline(k, s1, p.p_s, p1), supply_2, leakage)
+        };
+        let return_1 = orifice_flow::mass_flow_inline(k, r1, p1, p.p_r);
+        let return_2 = orifice_flow::mass_flow_inline(k, r2, p2, p.p_r);
         // (2.24), (2.25)
         let net_1 = supply_1 - return_1 - leakage;
         let net_2 = supply_2 - return_2 + leakage;

@@ -2,6 +2,9 @@
 
 use crate::polynomial::{Piecewise, DEGREE};
 
+mod pair;
+pub use pair::mass_flow_and_leakage;
+
 /// Width of the band of pressure ratios next to 1 in which the √(1 − r) law of (2.22) is
 /// replaced by a C¹ cubic through zero. The exact law has an infinite slope at equal
 /// pressures, which no implicit integrator can use; inside the band the pressure
@@ -153,6 +156,11 @@ impl UnchokedFactor {
             accurate: worst_ratio.powi(DEGREE as i32 + 1) < 1e-16,
             pieces,
         }
+    }
+
+    /// The pieces, when they are accurate (see the type's text).
+    pub(crate) fn table(&self) -> Option<&Piecewise<UNCHOKED_PIECES>> {
+        self.accurate.then_some(&self.pieces)
     }
 
     /// g(r), or `None` outside [r_c, 1], for NaN, and when the table is not accurate.
