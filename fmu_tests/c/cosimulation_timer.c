@@ -229,6 +229,18 @@ static int usage(const char *program) {
     return 2;
 }
 
+/* The count after `option` in 1..=max into *count; 0 on success, else a message and 2. */
+static int parse_count(const char *option, const char *text, long max, int *count) {
+    char *end;
+    long n = strtol(text, &end, 10);
+    if (*end != '\0' || n < 1 || n > max) {
+        fprintf(stderr, "%s %s: expected an integer from 1 to %ld\n", option, text, max);
+        return 2;
+    }
+    *count = (int)n;
+    return 0;
+}
+
 int main(int argc, char **argv) {
     int repeat = 1, cold = 0, arg = 1, pairs = 0;
     const char *csv_path = NULL;
@@ -237,22 +249,10 @@ int main(int argc, char **argv) {
             cold = 1;
             arg += 1;
         } else if (strcmp(argv[arg], "--repeat") == 0 && arg + 1 < argc) {
-            char *end;
-            long n = strtol(argv[arg + 1], &end, 10);
-            if (*end != '\0' || n < 1 || n > 1000) {
-                fprintf(stderr, "--repeat %s: expected an integer from 1 to 1000\n", argv[arg + 1]);
-                return 2;
-            }
-            repeat = (int)n;
+            if (parse_count("--repeat", argv[arg + 1], 1000, &repeat)) return 2;
             arg += 2;
         } else if (strcmp(argv[arg], "--pairs") == 0 && arg + 1 < argc) {
-            char *end;
-            long n = strtol(argv[arg + 1], &end, 10);
-            if (*end != '\0' || n < 1 || n > 100000) {
-                fprintf(stderr, "--pairs %s: expected an integer from 1 to 100000\n", argv[arg + 1]);
-                return 2;
-            }
-            pairs = (int)n;
+            if (parse_count("--pairs", argv[arg + 1], 100000, &pairs)) return 2;
             arg += 2;
         } else if (strcmp(argv[arg], "--csv") == 0 && arg + 1 < argc) {
             csv_path = argv[arg + 1];
