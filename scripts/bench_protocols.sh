@@ -23,6 +23,8 @@ protocols=(
     "ramps_500_moves_nop|--protocol ramps --sample-rate 500 --stopper moves:0.02 --no-pressures"
     "tracking_500_p|--protocol force_tracking --sample-rate 500 --force-noise 0.08"
     "sine_250_p|--protocol sine --sample-rate 250"
+    "sine_2k_moves_noisy_nop|--protocol sine --sample-rate 2000 --stopper moves:0.01 --no-pressures --force-noise 0.15"
+    "staircase_250_shake_p|--protocol staircase --sample-rate 250 --stopper sine:0.05:0.006:0.7 --pressure-noise 600"
 )
 # name|truth location|truth family|benchgen effect options
 # A compound's truth lists its places (and families) joined by "+": it is at the right place
