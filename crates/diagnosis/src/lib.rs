@@ -411,7 +411,14 @@ fn pressure_split(
     let ratio = mechanical / mechanical_noise.max(1e-12);
     let pressures_off = pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE);
     let force_off = ratio > EXPLAINED_WITHIN_NOISE;
+    // Where both agree within their noise but the force departs from the model, the pressures
+    // are too noisy to place the departure: one of them would move by half the force's
+    // departure over A_p, which is within their noise.
+    let force_from_model = rms(&difference(&recording.force, &replay.force)) / noise.max(1e-12);
     let reading = match (force_off, pressures_off) {
+        (false, false) if force_from_model > EXPLAINED_WITHIN_NOISE => {
+            "the force departs from the model, by less than the pressures' noise can place on either side of the piston"
+        }
         (false, false) => "force, pressures and model agree",
         (false, true) => {
             "the force agrees with the pressures but the pressures depart from the model's: the departure lies upstream of the piston (command to chambers)"

@@ -246,6 +246,10 @@ fn carried_alike(term: &DiscoveredTerm, candidate: &str, parameters: &[(&'static
 }
 
 /// Replay the current model; `None` when every channel is within its noise held out.
+/// A departure of this many noise floors of a channel lifts the channel's held-out misfit,
+/// noise and departure together, to [`EXPLAINED_WITHIN_NOISE`]: √(1 + 1.118²) = 1.5.
+const PRESSURES_SHOW_FROM: f64 = 1.118;
+
 fn replay_round(
     cx: &Context,
     problem: &Problem,
@@ -281,9 +285,18 @@ fn replay_round(
             lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n]).map(|l| l.hz)
         });
     // Pressures within their noise: nothing upstream of the piston departs by more
-    // than they can show, and only the mechanics and the force sensor are fitted.
+    // than they can show, and only the mechanics and the force sensor are fitted. They can
+    // show it only where it is large enough: a departure upstream moves the force by
+    // A_p (Δp1 − Δp2), so one pressure departs by at least half the force's departure
+    // over A_p, and that must lift its channel above the limit. Noisy pressures (600 Pa
+    // against a force departure of 0.1 N, 250 Pa in each) tell nothing, and every place
+    // stays in the search.
+    let force_departure = ((heldout[FORCE] / count) - 1.0).max(0.0).sqrt() * cx.channel_noise[FORCE];
+    let pressure_shown = force_departure / (2.0 * model.piston_area);
+    let pressures_could_show = pressure_shown >= PRESSURES_SHOW_FROM * cx.channel_noise[1].max(cx.channel_noise[2]);
     let pressures_agree = problem.weights[1] > 0.0
         && problem.weights[2] > 0.0
+        && pressures_could_show
         && (1..CHANNELS).all(|c| (heldout[c] / count).sqrt() <= EXPLAINED_WITHIN_NOISE);
     let knots = curve_knots(cx, problem, &current);
     let candidates: Vec<Candidate> = catalogue(&f.params, cx.pressure_noise.is_some(), periodic, &knots)
