@@ -288,9 +288,9 @@ fn replay_round(
     // than they can show, and only the mechanics and the force sensor are fitted. They can
     // show it only where it is large enough: a departure upstream moves the force by
     // A_p (Δp1 − Δp2), so one pressure departs by at least half the force's departure
-    // over A_p, and that must lift its channel above the limit. Noisy pressures (600 Pa
-    // against a force departure of 0.1 N, 250 Pa in each) tell nothing, and every place
-    // stays in the search.
+    // over A_p, and that must lift its channel above the limit. Noisy pressures (600 Pa of
+    // noise against a force departure of 0.1 N, at least 250 Pa in one pressure) tell
+    // nothing, and every place stays in the search.
     let force_departure = ((heldout[FORCE] / count) - 1.0).max(0.0).sqrt() * cx.channel_noise[FORCE];
     let pressure_shown = force_departure / (2.0 * model.piston_area);
     let pressures_could_show = pressure_shown >= PRESSURES_SHOW_FROM * cx.channel_noise[1].max(cx.channel_noise[2]);
