@@ -245,11 +245,11 @@ fn carried_alike(term: &DiscoveredTerm, candidate: &str, parameters: &[(&'static
         && term.parameters.iter().zip(parameters).all(|(x, y)| x.0 == y.0)
 }
 
-/// Replay the current model; `None` when every channel is within its noise held out.
 /// A departure of this many noise floors of a channel lifts the channel's held-out misfit,
 /// noise and departure together, to [`EXPLAINED_WITHIN_NOISE`]: √(1 + 1.118²) = 1.5.
 const PRESSURES_SHOW_FROM: f64 = 1.118;
 
+/// Replay the current model; `None` when every channel is within its noise held out.
 fn replay_round(
     cx: &Context,
     problem: &Problem,
