@@ -251,4 +251,118 @@ fn one_recording_with_report_and_out_together_is_refused_by_name() {
         .output()
         .unwrap();
     assert!(String::from_utf8_lossy(&two.stderr).contains("--report takes one recording, got 2"));
+    let without_out = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .args(["diagnose", "a.csv", "b.csv"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&without_out.stderr).contains("2 recordings without --out"));
+}
+
+/// The shipped example recording the demo diagnoses first (examples/recordings/README.md).
+fn example_recording(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/recordings")
+        .join(name)
+}
+
+#[test]
+fn one_recording_without_a_report_path_gets_its_report_and_its_page_in_the_current_directory() {
+    let root = std::env::temp_dir().join(format!("jetpipe-one-page-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let recording = example_recording("hysteresis.csv");
+    let run = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .current_dir(&root)
+        .args(["diagnose", recording.to_str().unwrap(), "--jobs", "2"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        stdout.contains("report: hysteresis.json") && stdout.contains("page: hysteresis.html"),
+        "{stdout}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join("hysteresis.json")).unwrap()).unwrap();
+    // What examples/recordings/README.md says the demo finds in this recording.
+    assert_eq!(report["verdict"], "explained", "{}", report["summary"]);
+    assert_eq!(
+        report["effects"][0]["name"], "jet_pipe_hysteresis",
+        "{}",
+        report["summary"]
+    );
+
+    let page = root.join("hysteresis.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains("href=\"hysteresis.json\""),
+        "the page does not link its report"
+    );
+    assert!(
+        !html.contains("index.html"),
+        "a page of one recording links an index that does not exist"
+    );
+    let dom = render(&page, &root.join("chromium-profile"), "--dump-dom");
+    assert!(
+        dom.contains("explained</span>"),
+        "the rendered page does not show its verdict"
+    );
+    assert!(
+        dom.contains("jet_pipe_hysteresis"),
+        "the rendered page does not name the effect added"
+    );
+    for figure in [
+        "figure-force_over_time",
+        "figure-force_against_command",
+        "figure-pressures_over_time",
+    ] {
+        assert!(dom.contains(figure), "no {figure}");
+    }
+    let screenshot = root.join("hysteresis.png");
+    render(
+        &page,
+        &root.join("chromium-profile"),
+        &format!("--screenshot={}", screenshot.display()),
+    );
+    let blue = pixels_near(&screenshot, [31, 119, 180]);
+    assert!(
+        blue > 5000,
+        "the model with the hysteresis is not painted: {blue} blue pixels"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_report_named_html_is_refused_before_any_work_since_its_page_would_overwrite_it() {
+    let output = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .args(["diagnose", example_recording("hysteresis.csv").to_str().unwrap()])
+        .args(["--report", "r.html"])
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--report r.html") && stderr.contains("--no-html"),
+        "{stderr}"
+    );
+    assert!(!Path::new("r.html").exists());
+}
+
+#[test]
+fn no_html_writes_the_report_alone() {
+    let root = std::env::temp_dir().join(format!("jetpipe-no-html-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    // A clean recording: the thesis model explains it at once.
+    write_recording(&root, "clean.csv", &BenchEffects::default(), 3);
+    let report = root.join("clean-report.json");
+    let run = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .args(["diagnose", root.join("clean.csv").to_str().unwrap(), "--no-html"])
+        .args(["--report", report.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(report.is_file());
+    assert!(!root.join("clean-report.html").exists(), "--no-html wrote a page");
+    let _ = std::fs::remove_dir_all(&root);
 }

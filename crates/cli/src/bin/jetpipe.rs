@@ -55,18 +55,22 @@ enum Command {
     },
     /// Compare bench recordings with the model, find the effects they lack, report before/after.
     ///
-    /// One recording: `diagnose REC.csv --report r.json`. Many: `diagnose A.csv B.csv DIR --out OUT`
+    /// One recording: `diagnose REC.csv` writes REC.json and its page REC.html in the current
+    /// directory (`--report r.json` writes r.json and r.html). Many: `diagnose A.csv B.csv DIR --out OUT`
     /// writes OUT/NAME.json and OUT/NAME.html per recording, OUT/summary.csv and OUT/index.html.
-    #[command(group = clap::ArgGroup::new("destination").required(true).args(["report", "out"]))]
     Diagnose {
         /// The recordings (CSV: time_s, v_da_V, x_s_m, force_N[, p1_Pa, p2_Pa]); with --out, also
         /// directories, which stand for the .csv files in them and their subdirectories.
         #[arg(required = true, num_args = 1..)]
         recordings: Vec<PathBuf>,
         /// Where to write the JSON report of the one recording (written only if the diagnosis
-        /// succeeds).
+        /// succeeds); its page goes beside it with the extension .html. Default: the
+        /// recording's name with .json, in the current directory.
         #[arg(long, conflicts_with = "out")]
         report: Option<PathBuf>,
+        /// Write no HTML page beside the one recording's report.
+        #[arg(long = "no-html", conflicts_with = "out")]
+        no_html: bool,
         /// Directory for each recording's JSON report and HTML page, summary.csv and index.html.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -234,15 +238,22 @@ fn run(cli: Cli) -> Result<(), String> {
             params,
             calibrate,
             plots,
+            no_html,
             jobs,
-        } => match (out, report) {
-            (Some(out), _) => diagnose_batch(recordings, out, params.as_deref(), calibrate, jobs),
-            (None, Some(report)) => {
+        } => match out {
+            Some(out) => diagnose_batch(recordings, out, params.as_deref(), calibrate, jobs),
+            None => {
                 let [recording] = recordings.as_slice() else {
-                    return Err(format!(
-                        "--report takes one recording, got {}: give several with --out DIR",
-                        recordings.len()
-                    ));
+                    return Err(match report {
+                        Some(_) => format!(
+                            "--report takes one recording, got {}: give several with --out DIR",
+                            recordings.len()
+                        ),
+                        None => format!(
+                            "{} recordings without --out: give one recording, or several with --out DIR",
+                            recordings.len()
+                        ),
+                    });
                 };
                 if recording.is_dir() {
                     return Err(format!(
@@ -250,9 +261,18 @@ fn run(cli: Cli) -> Result<(), String> {
                         recording.display()
                     ));
                 }
-                diagnose(recording, &report, params.as_deref(), calibrate, plots.as_deref(), jobs)
+                let report = match report {
+                    Some(report) => report,
+                    None => default_report_path(recording)?,
+                };
+                let page = if no_html { None } else { Some(page_path(&report)?) };
+                let destination = Destination {
+                    report: &report,
+                    page: page.as_deref(),
+                    plots: plots.as_deref(),
+                };
+                diagnose(recording, &destination, params.as_deref(), calibrate, jobs)
             }
-            (None, None) => Err("give --report FILE (one recording) or --out DIR".to_string()),
         },
     }
 }
@@ -308,16 +328,23 @@ fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String>
     Ok(p)
 }
 
-/// Progress bars on the diagnosis's long phases, on stderr when it is a terminal (indicatif
-/// draws nothing otherwise, and the progress lines go out as they are).
+/// Progress of the diagnosis's long phases on stderr: on a terminal a bar with the time left
+/// (indicatif); in a log, where the bar is hidden, a plain line when a phase starts and when it
+/// ends, with its duration.
 #[derive(Default)]
 struct TerminalBars {
-    bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
+    bar: std::sync::Mutex<Option<(indicatif::ProgressBar, String, Instant)>>,
 }
 
 impl TerminalBars {
     fn println(&self, line: &str) {
-        match self.bar.lock().ok().as_deref().and_then(|b| b.clone()) {
+        match self
+            .bar
+            .lock()
+            .ok()
+            .as_deref()
+            .and_then(|b| b.as_ref().map(|(bar, ..)| bar.clone()))
+        {
             Some(bar) if !bar.is_hidden() => bar.suspend(|| eprintln!("{line}")),
             _ => eprintln!("{line}"),
         }
@@ -327,38 +354,77 @@ impl TerminalBars {
 impl jetpipe_diagnosis::ProgressBars for TerminalBars {
     fn start(&self, phase: &str, total: usize) {
         let bar = indicatif::ProgressBar::new(total as u64);
-        if let Ok(style) = indicatif::ProgressStyle::with_template("{prefix:>13} [{bar:30}] {pos}/{len} {elapsed}") {
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{prefix:>13} [{bar:30}] {pos}/{len} {elapsed}, about {eta} left")
+        {
             bar.set_style(style.progress_chars("=> "));
         }
         bar.set_prefix(phase.to_string());
+        if bar.is_hidden() {
+            eprintln!("{phase}: {total} to do");
+        }
         if let Ok(mut slot) = self.bar.lock() {
-            *slot = Some(bar);
+            *slot = Some((bar, phase.to_string(), Instant::now()));
         }
     }
     fn advance(&self) {
         if let Ok(slot) = self.bar.lock() {
-            if let Some(bar) = slot.as_ref() {
+            if let Some((bar, ..)) = slot.as_ref() {
                 bar.inc(1);
             }
         }
     }
     fn finish(&self) {
         if let Ok(mut slot) = self.bar.lock() {
-            if let Some(bar) = slot.take() {
+            if let Some((bar, phase, started)) = slot.take() {
+                if bar.is_hidden() {
+                    eprintln!("{phase}: done in {:.1} s", started.elapsed().as_secs_f64());
+                }
                 bar.finish_and_clear();
             }
         }
     }
 }
 
+/// Where one recording's diagnosis goes: its JSON report, its HTML page (none with
+/// `--no-html`) and the directory of its SVG figures (`--plots`).
+struct Destination<'a> {
+    report: &'a std::path::Path,
+    page: Option<&'a std::path::Path>,
+    plots: Option<&'a std::path::Path>,
+}
+
+/// `NAME.json` in the current directory for the recording `.../NAME.csv`.
+fn default_report_path(recording: &std::path::Path) -> Result<PathBuf, String> {
+    let stem = recording.file_stem().filter(|s| !s.is_empty()).ok_or_else(|| {
+        format!(
+            "{}: cannot name a report after this path: give --report FILE",
+            recording.display()
+        )
+    })?;
+    Ok(PathBuf::from(stem).with_extension("json"))
+}
+
+/// The page beside the report: the report's path with the extension `.html`.
+fn page_path(report: &std::path::Path) -> Result<PathBuf, String> {
+    let page = report.with_extension("html");
+    if page == report {
+        return Err(format!(
+            "--report {}: the HTML page would overwrite the report; name the report .json (or give --no-html)",
+            report.display()
+        ));
+    }
+    Ok(page)
+}
+
 fn diagnose(
     recording_path: &std::path::Path,
-    report: &std::path::Path,
+    destination: &Destination,
     params: Option<&std::path::Path>,
     calibrate: bool,
-    plots: Option<&std::path::Path>,
     jobs: Option<usize>,
 ) -> Result<(), String> {
+    let report = destination.report;
     if jobs == Some(0) {
         return Err("--jobs 0 is invalid: must be at least 1".to_string());
     }
@@ -381,18 +447,36 @@ fn diagnose(
     let diagnosis = jetpipe_diagnosis::diagnose_with(&recording, &base, &options, &mut progress)?;
     let name = recording_path.display().to_string();
     let json = diagnosis.to_json(&name);
-    if let Some(dir) = plots {
-        let inputs = jetpipe_cli::plots::FigureInputs {
-            recording: &recording,
-            diagnosis: &diagnosis,
-            base: &base,
-        };
-        jetpipe_cli::plots::write_diagnosis_plots(dir, &inputs)?;
-        eprintln!("plots written to {}", dir.display());
-    }
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
-    // An existing report is never left half-written.
+    // An existing report is never left half-written; it is written before the figures, so
+    // that should they fail, the diagnosis is not lost with them.
     jetpipe_cli::output::write_atomically(report, &text)?;
+    let inputs = jetpipe_cli::plots::FigureInputs {
+        recording: &recording,
+        diagnosis: &diagnosis,
+        base: &base,
+    };
+    let figures_failed = |e: String| format!("{e} (the report {} was written)", report.display());
+    let figures = match destination.plots {
+        Some(dir) => {
+            let figures = jetpipe_cli::plots::write_diagnosis_plots(dir, &inputs).map_err(figures_failed)?;
+            eprintln!("plots written to {}", dir.display());
+            Some(figures)
+        }
+        None => None,
+    };
+    if let Some(page) = destination.page {
+        let figures = match figures {
+            Some(figures) => figures,
+            None => jetpipe_cli::plots::diagnosis_figures(&inputs).map_err(figures_failed)?,
+        };
+        // The page links the report by its file name: the two sit side by side.
+        let report_file = report
+            .file_name()
+            .map_or_else(|| report.display().to_string(), |f| f.to_string_lossy().into_owned());
+        let html = jetpipe_cli::html_report::page(&name, &json, &figures, &report_file, None);
+        jetpipe_cli::output::write_atomically(page, &html)?;
+    }
     println!(
         "{name}: {} samples, noise floor {:.4} N",
         diagnosis.samples, diagnosis.noise_floor
@@ -401,11 +485,11 @@ fn diagnose(
     for line in diagnosis.summary() {
         println!("  {line}");
     }
-    println!(
-        "  report: {} ({:.1} s)",
-        report.display(),
-        started.elapsed().as_secs_f64()
-    );
+    println!("  report: {}", report.display());
+    if let Some(page) = destination.page {
+        println!("  page: {}", page.display());
+    }
+    println!("  ({:.1} s)", started.elapsed().as_secs_f64());
     Ok(())
 }
 
