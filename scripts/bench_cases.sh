@@ -11,6 +11,8 @@
 # Exits non-zero when a case fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/results.sh
+record_results diagnosis_cases "The diagnosis's end-to-end test cases, one by one" "$@"
 only_broad=0
 [ "${1:-}" = "broad" ] && only_broad=1
 

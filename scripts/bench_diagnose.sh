@@ -6,6 +6,8 @@
 # the repository if they are there. JETPIPE_BENCH_UNDECLARED=0 leaves the undeclared set out.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/results.sh
+record_results diagnosis_recordings "Diagnosis of the synthetic bench's recordings, 80 s at 1 kHz" "$@"
 cargo build --release --bin jetpipe --bin benchgen
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT

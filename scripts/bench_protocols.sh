@@ -10,6 +10,8 @@
 # below) choose a subset.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/results.sh
+record_results diagnosis_protocols "Diagnosis of mechanisms under protocols" "$@"
 seconds="${1:-40}"
 cargo build --release --bin jetpipe --bin benchgen >/dev/null 2>&1
 work="$(mktemp -d)"

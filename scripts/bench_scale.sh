@@ -3,10 +3,12 @@
 # resident memory (/usr/bin/time -v) of one diagnosis of a synthetic 1 kHz recording with
 # pressure channels (a random staircase, the stopper fixed, an exhaust back pressure), at each
 # length of JETPIPE_SCALE_DURATIONS (s; default "80 600 3600") and with `--jobs 2`. Prints one
-# Markdown table row per length; the figures are in docs/diagnosis.md, "Speed".
+# Markdown table row per length, and writes them into docs/results/diagnosis_scale.md.
 # JETPIPE_SCALE_JETPIPE=PATH times another build of the CLI (e.g. an older commit's).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/results.sh
+record_results diagnosis_scale "Diagnosis time and memory against the recording's length" "$@"
 cargo build --release --bin jetpipe --bin benchgen
 jetpipe="${JETPIPE_SCALE_JETPIPE:-./target/release/jetpipe}"
 work="$(mktemp -d)"
