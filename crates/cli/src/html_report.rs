@@ -129,6 +129,17 @@ fn additions_section(report: &Value) -> String {
     if effects.is_empty() && discovered.is_empty() {
         html.push_str("<p>Nothing: no effect or term was added to the thesis model.</p>");
     }
+    if let Some(names) = report["withdrawn"]["names"].as_array() {
+        let names: Vec<String> = names.iter().filter_map(Value::as_str).map(escape).collect();
+        html.push_str(&format!(
+            "<p id=withdrawn>Withdrawn: {}. Replayed accurately, the model with them had a force error of {} held out and {}              over the whole recording, worse than the starting model's {} and {}; the model reported is the starting model.</p>",
+            names.join(" and "),
+            newtons(&report["withdrawn"]["heldout_with_rms_N"]),
+            newtons(&report["withdrawn"]["whole_with_rms_N"]),
+            newtons(&report["heldout"]["before_rms_N"]),
+            newtons(&report["before"]["force_rms_N"]),
+        ));
+    }
     for e in &effects {
         html.push_str(&format!(
             "<h3>Named effect <code>{}</code> at the {}</h3><p>{}</p>",

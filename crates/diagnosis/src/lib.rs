@@ -40,6 +40,7 @@ mod report;
 mod rounds;
 pub mod signals;
 pub mod signature;
+mod withdraw;
 
 use serde_json::{json, Value};
 
@@ -362,11 +363,27 @@ pub struct Diagnosis {
     pub before_force: Vec<f64>,
     pub after_force: Vec<f64>,
     pub replays: usize,
+    /// What the search added and the accurate replay then found worse than the model the
+    /// diagnosis started from: taken out again, so that the report never hands back a worse
+    /// model than it was given.
+    pub withdrawn: Option<Withdrawn>,
 }
 
+pub use withdraw::Withdrawn;
+
 impl Diagnosis {
-    pub fn explained(&self) -> bool {
+    /// Whether the force is within its noise on the held-out blocks.
+    pub fn force_explained(&self) -> bool {
         self.after.heldout_rms <= EXPLAINED_WITHIN_NOISE * self.noise_floor
+    }
+    /// Whether every measured channel is within its noise: the force on the held-out blocks,
+    /// and each pressure, when the recording has them, after the start.
+    pub fn explained(&self) -> bool {
+        self.force_explained()
+            && self
+                .pressure_split
+                .as_ref()
+                .map_or(true, |s| s.pressure_ratio.iter().all(|r| *r <= EXPLAINED_WITHIN_NOISE))
     }
     pub fn verdict(&self) -> &'static str {
         if self.explained() {
@@ -917,7 +934,26 @@ fn conclude(
         None => cx.blocks.clone(),
     };
     let blocks = &full_blocks;
-    let after_errors = errors(&after, full, blocks);
+    let before_errors = errors(&before, full, blocks);
+    let mut after_errors = errors(&after, full, blocks);
+    let mut found = found;
+    let (mut final_model, mut after, mut joint_refit) = (final_model, after, joint_refit);
+    let withdrawn = withdraw::withdraw_if_worse(&mut found, &before_model.params, &before_errors, &after_errors);
+    if let Some(w) = &withdrawn {
+        progress(&format!(
+            "the accurate replay finds the model with {} worse than the starting model (held-out {:.4} against {:.4} N, whole {:.4} against {:.4} N): they are withdrawn",
+            w.names.join(" and "),
+            w.heldout_with,
+            before_errors.heldout_rms,
+            w.whole_with,
+            before_errors.rms
+        ));
+        joint_refit = None;
+        final_model = Actuator::new(found.params.clone())?;
+        after = before.clone();
+        after_errors = before_errors;
+    }
+    let after = after;
     let split = cx
         .pressure_noise
         .and_then(|pn| pressure_split(&final_model, full, &after, noise, pn, blocks));
@@ -959,7 +995,7 @@ fn conclude(
         noise_floor: noise,
         pressure_noise: cx.pressure_noise,
         input_checks,
-        before: errors(&before, full, blocks),
+        before: before_errors,
         after: after_errors,
         settling: cx.settled_from - full.time[0],
         calibrated,
@@ -975,6 +1011,7 @@ fn conclude(
         before_force: before.force,
         after_force: after.force,
         replays,
+        withdrawn,
     })
 }
 
@@ -991,10 +1028,10 @@ fn what_stays_unexplained(
 ) -> Option<Unexplained> {
     let noise = cx.noise;
     let explained = after_errors.heldout_rms <= EXPLAINED_WITHIN_NOISE * noise;
-    // The force is the verdict's channel; pressures that depart while the force does not
-    // (a pressure transducer, say) still get their place and signature.
+    // Every measured channel counts: pressures that depart while the force does not (a
+    // pressure transducer, say) leave a remainder too, with its place and signature.
     let pressures_off = split.map_or(false, |s| s.pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE));
-    if explained && !(pressures_off && localization.is_some()) {
+    if explained && !pressures_off {
         return None;
     }
     let (location, family, alternatives) = match localization {

@@ -14,7 +14,7 @@ impl Diagnosis {
         let mut names: Vec<&str> = self.effects.iter().map(|e| e.name).collect();
         names.extend(self.discovered.iter().map(|d| d.candidate));
         lines.push(match (&self.unexplained, names.is_empty()) {
-            (Some(u), _) if self.explained() => format!("Explained in the force, not in the pressures: {}", u.sentence),
+            (Some(u), _) if self.force_explained() => format!("Not explained in every channel: {}", u.sentence),
             (None, true) => format!(
                 "Explained: the thesis model reproduces the force to within its noise (held-out error {:.4} N, {ratio:.1}× the noise floor {:.4} N); nothing was added.",
                 self.after.heldout_rms, self.noise_floor
@@ -46,6 +46,16 @@ impl Diagnosis {
         });
         if let Some(s) = &self.pressure_split {
             lines.push(s.sentence.clone());
+        }
+        if let Some(w) = &self.withdrawn {
+            lines.push(format!(
+                "Withdrawn: {} lowered the error of the replay the search fits with, but replayed accurately the model with them is worse than the starting model (held-out force error {:.4} N against {:.4} N, whole recording {:.4} N against {:.4} N); the model reported is the starting model.",
+                w.names.join(" and "),
+                w.heldout_with,
+                self.before.heldout_rms,
+                w.whole_with,
+                self.before.rms
+            ));
         }
         lines.extend(self.input_checks.iter().cloned());
         for c in &self.calibrated {
@@ -175,6 +185,11 @@ impl Diagnosis {
             "fmu_start_values": start_values,
             "stopper_positions": "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21 (the recorded positions at the first and last three samples), as the FMU must be to reproduce these errors",
             "joint_refit": self.joint_refit.map(|(a, b)| json!({"heldout_before_rms_N": a, "heldout_after_rms_N": b})),
+            "withdrawn": self.withdrawn.as_ref().map(|w| json!({
+                "names": w.names,
+                "heldout_with_rms_N": w.heldout_with,
+                "whole_with_rms_N": w.whole_with,
+            })),
             "replays": self.replays,
         });
         let object = report.as_object_mut().expect("a JSON object");
@@ -192,7 +207,7 @@ impl Diagnosis {
                     "alternatives": u.alternatives,
                     "signature": u.signature.to_json("N"),
                     "sentence": u.sentence,
-                    "channel": if self.explained() { "pressures" } else { "force" },
+                    "channel": if self.force_explained() { "pressures" } else { "force" },
                 }),
             );
         }

@@ -12,7 +12,7 @@
 //! The test command runs a representative subset: every module, each place of the chain
 //! and each function class at least once. The other cases are `#[ignore]`d with the reason
 //! "a broad case", and `scripts/bench_cases.sh` runs every case, each on its own, with its
-//! time (docs/diagnosis.md has the table).
+//! time (docs/results/diagnosis_cases.md has the table).
 //!
 //! Why one binary and not three: cargo runs test binaries one after another and each
 //! harness runs its tests two at a time, so a binary's last, long test left a core idle
