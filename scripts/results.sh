@@ -23,7 +23,11 @@ record_results() {
     local settings=""
     local variable
     for variable in $(compgen -e | grep -E '^(JETPIPE|BENCH)_' | grep -v '^JETPIPE_RECORDING_RESULTS$' | sort); do
-        settings+="$variable=${!variable} "
+        local value="${!variable}"
+        # A folder outside the project is named by its last component only.
+        case "$value" in /*|../*) value=".../$(basename "$value")" ;; esac
+        case "$value" in *" "*) value="\"$value\"" ;; esac
+        settings+="$variable=$value "
     done
     local started load_before
     started="$(date -u '+%Y-%m-%d %H:%M UTC')"

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Benchmark of `jetpipe diagnose` on recordings drawn by blindgen, an independent simulator of
+# the actuator with randomly drawn mechanisms, protocols, rates and noise, whose truth stays
+# sealed until its scorer reads the reports. Writes docs/results/blindgen.md: one row per draw
+# (rate, length, pressure channels, verdict, what was found, the held-out error after in noise
+# floors, wall time per sample), then the scorer's lines and totals (honest, located, explained;
+# by class, by rate and with or without pressures).
+#
+#   JETPIPE_BLINDGEN=DIR bash scripts/bench_blindgen.sh SEED COUNT
+#
+# DIR is blindgen's folder (blindgen.py). Use a seed never used before for every measurement:
+# a seed whose truth has been read is spent. The simulator runs in target/blindgen-venv (numpy
+# and numba from PyPI, made on first use).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source scripts/results.sh
+record_results blindgen "Diagnosis of recordings drawn by an independent simulator (blindgen)" "$@"
+if [ $# -ne 2 ] || [ -z "${JETPIPE_BLINDGEN:-}" ]; then
+    echo "usage: JETPIPE_BLINDGEN=DIR bash scripts/bench_blindgen.sh SEED COUNT" >&2
+    exit 2
+fi
+seed="$1"
+count="$2"
+blindgen="$(cd "$JETPIPE_BLINDGEN" && pwd)/blindgen.py"
+[ -f "$blindgen" ] || { echo "bench_blindgen.sh: no blindgen.py in $JETPIPE_BLINDGEN" >&2; exit 2; }
+venv=target/blindgen-venv
+if ! "$venv/bin/python" -c 'import numpy, numba' >/dev/null 2>&1; then
+    python3 -m venv "$venv" >&2
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check numpy numba >&2
+fi
+export NUMBA_CACHE_DIR="$PWD/target/blindgen-numba-cache"
+cargo build --release --bin jetpipe >&2
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+"$venv/bin/python" "$blindgen" draw --seed "$seed" --count "$count" --out "$work/draws" >&2
+mkdir -p "$work/reports"
+echo "| draw | rate (Hz) | length (s) | pressures | verdict | found (location, family) | held-out after / noise floor | wall (s) | wall per sample (ms) |"
+echo "|---|---|---|---|---|---|---|---|---|"
+for rec in "$work"/draws/*.csv; do
+    name="$(basename "$rec" .csv)"
+    start=$(date +%s%N)
+    ./target/release/jetpipe diagnose "$rec" --report "$work/reports/$name.json" --no-html --jobs 2 \
+        >"$work/$name.log" 2>&1 || true
+    end=$(date +%s%N)
+    python3 - "$rec" "$work/reports/$name.json" "$(( (end - start) / 1000000 ))" <<'PY'
+import csv, json, os, sys
+path, report_path, ms = sys.argv[1], sys.argv[2], int(sys.argv[3])
+with open(path) as f:
+    reader = csv.reader(f)
+    header = next(reader)
+    times = [float(row[0]) for row in reader]
+samples = len(times)
+rate = round((samples - 1) / (times[-1] - times[0])) if samples > 1 else 0
+pressures = "yes" if "p1_Pa" in header else "no"
+name = os.path.basename(path)[:-4]
+if not os.path.exists(report_path):
+    print(f"| {name} | {rate} | {times[-1]:.0f} | {pressures} | error | — | — | {ms / 1000:.1f} | {ms / samples:.2f} |")
+    sys.exit()
+d = json.load(open(report_path))
+places = [f'{t["location"]}, {t["family"]}' for t in d["discovered"]]
+places += [f'named: {e["name"]}' for e in d["effects"]]
+if "unexplained" in d:
+    places.append(f'remainder at {d["unexplained"]["location"]}')
+ratio = d["heldout"]["after_rms_N"] / d["noise_floor_N"]
+print(f'| {name} | {rate} | {times[-1]:.0f} | {pressures} | {d["verdict"]} | {"; ".join(places) or "nothing"} '
+      f'| {ratio:.2f} | {ms / 1000:.1f} | {ms / samples:.2f} |')
+PY
+done
+echo
+echo "The scorer's account (truth revealed only here):"
+echo
+echo '```'
+"$venv/bin/python" "$blindgen" score "$work/draws" --reports "$work/reports"
+echo '```'
