@@ -16,7 +16,8 @@ record_results() {
     mkdir -p docs/results
     local commit changes=""
     commit="$(git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)"
-    if ! git diff --quiet HEAD -- Cargo.toml Cargo.lock build.rs src crates tools fmus scripts 2>/dev/null; then
+    # What the diagnosis's figures depend on (the FMI layer and the FMUs do not change them).
+    if ! git diff --quiet HEAD -- Cargo.lock crates/model crates/diagnosis crates/cli tools scripts 2>/dev/null; then
         changes=" with uncommitted changes to the code"
     fi
     # The variables that choose what a benchmark runs, as they were given.
