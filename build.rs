@@ -26,6 +26,7 @@ const STANDARD_TYPES: &[&str] = &[
     "fmi2CallbackFreeMemory",
     "fmi2StepFinished",
     "fmi2CallbackFunctions",
+    "fmi2EventInfo",
 ];
 
 fn main() {

@@ -1,8 +1,13 @@
 //! The actuator behind the generic FMI layer: maps the variable table onto the physics
-//! and the simulation driver. No FFI types here.
+//! and the simulation driver. No FFI types here. Model Exchange: the private module
+//! `model_exchange`.
 
-use crate::variables::{vr, UNITS, VARIABLES};
-use fmi2::model::{CoSimModel, DependencyKind, Extent, GuidCache, ModelInfo, OutputDependencies, StepError};
+mod model_exchange;
+
+use crate::variables::{me_vr, vr, CONTINUOUS_STATES, UNITS, VARIABLES};
+use fmi2::model::{
+    CoSimModel, DependencyKind, Extent, GuidCache, ModelExchangeInfo, ModelInfo, OutputDependencies, StepError,
+};
 use fmi2::state_bytes::StateFormat;
 use jetpipe_model::physics::actuator::{index, Actuator};
 use jetpipe_model::physics::parameters::{variable_name, Parameters};
@@ -165,7 +170,15 @@ pub static MODEL_INFO: ModelInfo = ModelInfo {
     can_interpolate_inputs: true,
     extent,
     dependencies: DEPENDENCIES,
+    model_exchange: Some(&MODEL_EXCHANGE),
     guid_cache: GuidCache::new(),
+};
+
+/// Model Exchange: the six states of (4.1) and the event indicators of
+/// the private module `model_exchange`.
+pub static MODEL_EXCHANGE: ModelExchangeInfo = ModelExchangeInfo {
+    states: &CONTINUOUS_STATES,
+    event_indicators: model_exchange::EVENT_INDICATORS,
 };
 
 /// v_DA within the D/A range; the message names the variable, the value and the range.
@@ -196,6 +209,10 @@ pub struct ActuatorFmu {
     /// The last x_s set before initialisation ended that was inside the cylinder (the table's
     /// start at first): where the stopper starts if the last x_s set was not.
     x_s_valid: f64,
+    /// Made for Model Exchange ([`CoSimModel::use_model_exchange`]).
+    model_exchange: bool,
+    /// A Model Exchange instance after initialisation (then `simulation` stays `None`).
+    me: Option<model_exchange::MeState>,
 }
 
 fn start(value_reference: u32) -> f64 {
@@ -228,6 +245,27 @@ impl ActuatorFmu {
     #[cold]
     #[inline(never)]
     fn get_real_otherwise(&self, value_reference: u32) -> Result<f64, String> {
+        if let Some(x) = self.me_real(value_reference) {
+            return Ok(x);
+        }
+        if (me_vr::X_JP_VELOCITY..=me_vr::DER_P2).contains(&value_reference) {
+            let computed;
+            let simulation = match &self.simulation {
+                Some(s) => s,
+                None => {
+                    computed = self.initial_simulation()?;
+                    &computed
+                }
+            };
+            return model_exchange::state_variable(
+                simulation.model(),
+                simulation.state(),
+                simulation.v_da(),
+                simulation.x_s(),
+                value_reference,
+            )
+            .ok_or_else(|| format!("no Real variable with value reference {value_reference}"));
+        }
         match value_reference {
             vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, Simulation::v_da)),
             vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, Simulation::x_s)),
@@ -288,7 +326,13 @@ impl CoSimModel for ActuatorFmu {
             start_time: 0.0,
             simulation: None,
             x_s_valid: start(vr::X_S),
+            model_exchange: false,
+            me: None,
         }
+    }
+
+    fn use_model_exchange(&mut self) {
+        self.model_exchange = true;
     }
 
     /// The inputs and outputs of a simulation at once (an importer reads them every step);
@@ -334,6 +378,7 @@ impl CoSimModel for ActuatorFmu {
                 // Before initialisation ends, a master may start its connectors at 0 and
                 // propagate the other FMUs' outputs only afterwards: any finite value is taken,
                 // and checked when initialisation ends and at each step.
+                None if value.is_finite() && self.me.is_some() => self.move_stopper_model_exchange(value),
                 None if value.is_finite() => {
                     self.x_s = value;
                     if self.params.check_stopper(value).is_ok() {
@@ -352,7 +397,12 @@ impl CoSimModel for ActuatorFmu {
                 }
                 Ok(())
             }
-            _ => self.params.set(value_reference, value),
+            _ => {
+                if self.model_exchange {
+                    model_exchange::refused_setting(value_reference, value)?;
+                }
+                self.params.set(value_reference, value)
+            }
         }
     }
 
@@ -397,6 +447,9 @@ impl CoSimModel for ActuatorFmu {
     /// outputs only with the first step), the stopper starts at the last valid x_s set (or the
     /// start value), and the first step is refused unless a valid x_s has been set by then.
     fn exit_initialization(&mut self) -> Result<(), String> {
+        if self.model_exchange {
+            return self.exit_initialization_model_exchange();
+        }
         let simulation = match self.params.check_stopper(self.x_s) {
             Ok(()) => self.initial_simulation()?,
             Err(e) => {
@@ -459,7 +512,10 @@ impl CoSimModel for ActuatorFmu {
     }
 
     fn time(&self) -> f64 {
-        self.simulation.as_ref().map_or(self.start_time, Simulation::time)
+        match &self.simulation {
+            Some(simulation) => simulation.time(),
+            None => self.me_time().unwrap_or(self.start_time),
+        }
     }
 
     fn serialize(&self) -> Vec<u8> {
@@ -480,6 +536,7 @@ impl CoSimModel for ActuatorFmu {
             w.f64(v);
         }
         w.bool(self.start_at_equilibrium);
+        self.serialize_model_exchange(&mut w);
         match &self.simulation {
             None => w.bool(false),
             Some(s) => {
@@ -505,6 +562,7 @@ impl CoSimModel for ActuatorFmu {
         restored.tolerance = r.f64()?;
         restored.start_time = r.f64()?;
         restored.start_at_equilibrium = r.bool("startAtEquilibrium")?;
+        Self::deserialize_model_exchange(&mut r, &mut restored)?;
         if r.bool("initialised")? {
             let model = Actuator::new(restored.params.clone())?;
             let values = r.f64s_at_most(MAX_SIMULATION_VALUES, "simulation values")?;
@@ -521,9 +579,10 @@ impl CoSimModel for ActuatorFmu {
 /// then the parameters, the inputs and settings of the instance, and, once initialised, the
 /// simulation's snapshot as one counted array (`SimulationSnapshot::to_values`). Version 3:
 /// the snapshot replaced the simulation's fields written one by one; version 4: the
-/// restrictions' parameters and the pressures of the gas volumes behind them.
+/// restrictions' parameters and the pressures of the gas volumes behind them; version 5: the
+/// interface and the Model Exchange state.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 4, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 5, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped

@@ -1,14 +1,15 @@
-//! The exported FMI 2.0 Co-Simulation symbols. Each is a thin forwarder to the generic
-//! implementation in [`fmi2::api`], instantiated for [`crate::ExportedModel`].
+//! The exported FMI 2.0 symbols, Co-Simulation and Model Exchange. Each is a thin forwarder
+//! to the generic implementation in [`fmi2::api`] or [`fmi2::model_exchange`], instantiated
+//! for [`crate::ExportedModel`].
 //! Written out literally (no macros) so that cbindgen can read this file.
 #![allow(non_snake_case, clippy::missing_safety_doc)]
 
 use crate::ExportedModel;
-use fmi2::api;
 use fmi2::types::{
-    fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status,
-    fmi2StatusKind, fmi2String, fmi2Type, fmi2ValueReference,
+    fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2Component, fmi2EventInfo, fmi2FMUstate, fmi2Integer, fmi2Real,
+    fmi2Status, fmi2StatusKind, fmi2String, fmi2Type, fmi2ValueReference,
 };
+use fmi2::{api, model_exchange as me};
 use std::os::raw::c_char;
 
 // ---- Common functions ----------------------------------------------------------------
@@ -307,4 +308,74 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
     value: *mut fmi2String,
 ) -> fmi2Status {
     api::get_string_status::<ExportedModel>(c, s, value)
+}
+
+// ---- Model Exchange ----------------------------------------------------------------
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
+    me::enter_event_mode::<ExportedModel>(c)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2NewDiscreteStates(c: fmi2Component, fmi2eventInfo: *mut fmi2EventInfo) -> fmi2Status {
+    me::new_discrete_states::<ExportedModel>(c, fmi2eventInfo)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
+    me::enter_continuous_time_mode::<ExportedModel>(c)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
+    c: fmi2Component,
+    noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+    enterEventMode: *mut fmi2Boolean,
+    terminateSimulation: *mut fmi2Boolean,
+) -> fmi2Status {
+    me::completed_integrator_step::<ExportedModel>(
+        c,
+        noSetFMUStatePriorToCurrentPoint,
+        enterEventMode,
+        terminateSimulation,
+    )
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
+    me::set_time::<ExportedModel>(c, time)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetContinuousStates(c: fmi2Component, x: *const fmi2Real, nx: usize) -> fmi2Status {
+    me::set_continuous_states::<ExportedModel>(c, x, nx)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetDerivatives(c: fmi2Component, derivatives: *mut fmi2Real, nx: usize) -> fmi2Status {
+    me::get_derivatives::<ExportedModel>(c, derivatives, nx)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetEventIndicators(
+    c: fmi2Component,
+    eventIndicators: *mut fmi2Real,
+    ni: usize,
+) -> fmi2Status {
+    me::get_event_indicators::<ExportedModel>(c, eventIndicators, ni)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetContinuousStates(c: fmi2Component, x: *mut fmi2Real, nx: usize) -> fmi2Status {
+    me::get_continuous_states::<ExportedModel>(c, x, nx)
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
+    c: fmi2Component,
+    x_nominal: *mut fmi2Real,
+    nx: usize,
+) -> fmi2Status {
+    me::get_nominals_of_continuous_states::<ExportedModel>(c, x_nominal, nx)
 }

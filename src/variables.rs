@@ -242,6 +242,22 @@ pub const UNITS: &[UnitDefinition] = &[
         a: 0,
         k: 0,
     },
+    UnitDefinition {
+        name: "m/s2",
+        kg: 0,
+        m: 1,
+        s: -2,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "m/s3",
+        kg: 0,
+        m: 1,
+        s: -3,
+        a: 0,
+        k: 0,
+    },
 ];
 
 const fn causality(c: table::Causality) -> Causality {
@@ -287,13 +303,104 @@ const fn fmi_variable(row: &Row) -> Variable {
     }
 }
 
-const N_VARIABLES: usize = TABLE.len();
+/// Value references of the variables of Model Exchange beyond the table's: the jet pipe's
+/// velocity and acceleration (states that are not outputs) and the six derivatives.
+pub mod me_vr {
+    pub const X_JP_VELOCITY: u32 = 900;
+    pub const X_JP_ACCELERATION: u32 = 901;
+    pub const DER_I: u32 = 902;
+    pub const DER_X_JP: u32 = 903;
+    pub const DER_X_JP_VELOCITY: u32 = 904;
+    pub const DER_X_JP_ACCELERATION: u32 = 905;
+    pub const DER_P1: u32 = 906;
+    pub const DER_P2: u32 = 907;
+}
+
+/// A continuous local of Model Exchange.
+const fn local(name: &'static str, value_reference: u32, unit: &'static str, description: &'static str) -> Variable {
+    Variable {
+        name,
+        value_reference,
+        var_type: VarType::Real,
+        causality: Causality::Local,
+        variability: Variability::Continuous,
+        unit: Some(unit),
+        start: 0.0,
+        min: None,
+        max: None,
+        description,
+    }
+}
+
+/// The continuous states of Model Exchange and their derivatives, after the table's rows: the
+/// six states of (4.1), [i, x_jp, ẋ_jp, ẍ_jp, P1, P2] (i, x_jp, P1 and P2 are outputs).
+pub const MODEL_EXCHANGE_VARIABLES: [Variable; 8] = [
+    local(
+        "x_jp_velocity",
+        me_vr::X_JP_VELOCITY,
+        "m/s",
+        "jet-pipe tip velocity (a continuous state of Model Exchange)",
+    ),
+    local(
+        "x_jp_acceleration",
+        me_vr::X_JP_ACCELERATION,
+        "m/s2",
+        "jet-pipe tip acceleration (a continuous state of Model Exchange)",
+    ),
+    local("der(i)", me_vr::DER_I, "A/s", "rate of the coil current, (2.3)"),
+    local("der(x_jp)", me_vr::DER_X_JP, "m/s", "rate of the jet-pipe position"),
+    local(
+        "der(x_jp_velocity)",
+        me_vr::DER_X_JP_VELOCITY,
+        "m/s2",
+        "rate of the jet-pipe velocity",
+    ),
+    local(
+        "der(x_jp_acceleration)",
+        me_vr::DER_X_JP_ACCELERATION,
+        "m/s3",
+        "rate of the jet-pipe acceleration, (2.6)",
+    ),
+    local(
+        "der(P1)",
+        me_vr::DER_P1,
+        "Pa/s",
+        "rate of the chamber 1 pressure, (2.29)",
+    ),
+    local(
+        "der(P2)",
+        me_vr::DER_P2,
+        "Pa/s",
+        "rate of the chamber 2 pressure, (2.29)",
+    ),
+];
+
+/// The states' value references in the order of the state vector, with their derivatives'.
+pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 6] = [
+    state(vr::I, me_vr::DER_I),
+    state(vr::X_JP, me_vr::DER_X_JP),
+    state(me_vr::X_JP_VELOCITY, me_vr::DER_X_JP_VELOCITY),
+    state(me_vr::X_JP_ACCELERATION, me_vr::DER_X_JP_ACCELERATION),
+    state(vr::P1, me_vr::DER_P1),
+    state(vr::P2, me_vr::DER_P2),
+];
+
+const fn state(state: u32, derivative: u32) -> fmi2::model::ContinuousState {
+    fmi2::model::ContinuousState { state, derivative }
+}
+
+const N_TABLE: usize = TABLE.len();
+const N_VARIABLES: usize = N_TABLE + MODEL_EXCHANGE_VARIABLES.len();
 
 const fn variables_of(rows: &[Row]) -> [Variable; N_VARIABLES] {
     let mut out = [fmi_variable(&rows[0]); N_VARIABLES];
     let mut k = 1;
-    while k < N_VARIABLES {
+    while k < N_TABLE {
         out[k] = fmi_variable(&rows[k]);
+        k += 1;
+    }
+    while k < N_VARIABLES {
+        out[k] = MODEL_EXCHANGE_VARIABLES[k - N_TABLE];
         k += 1;
     }
     out
@@ -304,8 +411,8 @@ const fn variables_of(rows: &[Row]) -> [Variable; N_VARIABLES] {
 #[allow(clippy::large_const_arrays)]
 const VARIABLE_ARRAY: [Variable; N_VARIABLES] = variables_of(TABLE);
 
-/// The FMI variables of the table, in its order: what the model description, the getters and
-/// the setters of the FMI layer see.
+/// The FMI variables of the table, in its order, then those of Model Exchange: what the model
+/// description, the getters and the setters of the FMI layer see.
 pub const VARIABLES: &[Variable] = &VARIABLE_ARRAY;
 
 #[cfg(test)]
@@ -317,7 +424,11 @@ mod tests {
 
     #[test]
     fn the_fmi_variables_are_the_table_rows() {
-        assert_eq!(VARIABLES.len(), TABLE.len());
+        assert_eq!(VARIABLES.len(), TABLE.len() + MODEL_EXCHANGE_VARIABLES.len());
+        assert!(VARIABLES[TABLE.len()..]
+            .iter()
+            .zip(&MODEL_EXCHANGE_VARIABLES)
+            .all(|(a, b)| a.value_reference == b.value_reference && a.name == b.name));
         for (v, row) in VARIABLES.iter().zip(TABLE) {
             let r = &row.variable;
             assert_eq!(

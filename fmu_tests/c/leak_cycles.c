@@ -3,7 +3,10 @@
  * (issue 5): N cycles of instantiate / setup / initialise / step / FMU state get, serialize,
  * deserialize, set, free / terminate / reset / free, with error paths on the way (illegal
  * calls, rejected values, corrupted state bytes, NULL and freed handles, repeated
- * fmi2FreeInstance, failed fmi2Instantiate). Meant to run under Valgrind or LeakSanitizer.
+ * fmi2FreeInstance, failed fmi2Instantiate); and in each cycle a Model Exchange instance
+ * (issue 44): initialise, event and continuous-time modes, states, derivatives, event
+ * indicators, an FMU state, illegal calls, a refused effect. Meant to run under Valgrind or
+ * LeakSanitizer.
  *
  * usage: leak_cycles EXTRACTED_FMU_DIR GUID N_CYCLES [--leak-one]
  * --leak-one skips one fmi2FreeInstance on purpose: the negative control that shows the
@@ -96,6 +99,16 @@ int main(int argc, char **argv) {
     RESOLVE(fmi2DeSerializeFMUstate)
     RESOLVE(fmi2SetDebugLogging)
     RESOLVE(fmi2SetRealInputDerivatives)
+    RESOLVE(fmi2EnterEventMode)
+    RESOLVE(fmi2NewDiscreteStates)
+    RESOLVE(fmi2EnterContinuousTimeMode)
+    RESOLVE(fmi2CompletedIntegratorStep)
+    RESOLVE(fmi2SetTime)
+    RESOLVE(fmi2SetContinuousStates)
+    RESOLVE(fmi2GetContinuousStates)
+    RESOLVE(fmi2GetDerivatives)
+    RESOLVE(fmi2GetEventIndicators)
+    RESOLVE(fmi2GetNominalsOfContinuousStates)
 
     fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     const fmi2ValueReference vr_in[2] = {VR_V_DA, VR_X_S};
@@ -175,6 +188,54 @@ int main(int argc, char **argv) {
         }
         if (leak_one && k == 0) continue; /* the deliberate leak */
         fmi2FreeInstance(c);
+
+        /* Model Exchange: a few explicit Euler steps through the calls an integrator makes */
+        fmi2Component m = fmi2Instantiate("me", fmi2ModelExchange, guid, resources, &callbacks, fmi2False,
+                                          (k % 2) ? fmi2True : fmi2False);
+        if (!m) {
+            fprintf(stderr, "cycle %d: fmi2Instantiate(fmi2ModelExchange) returned NULL\n", k);
+            return 1;
+        }
+        {
+            fmi2Real x[6], dx[6], z[7], nominal[6];
+            fmi2EventInfo info;
+            fmi2Boolean enter = fmi2True, stop = fmi2True;
+            const fmi2ValueReference vr_delay[1] = {350u}; /* command_delay: refused in Model Exchange */
+            const fmi2Real delay[1] = {1e-3};
+            EXPECT(fmi2GetNominalsOfContinuousStates(m, nominal, 6), fmi2OK);
+            EXPECT(fmi2SetupExperiment(m, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
+            EXPECT(fmi2EnterInitializationMode(m), fmi2OK);
+            EXPECT(fmi2SetReal(m, vr_delay, 1, delay), fmi2Error);
+            EXPECT(fmi2SetReal(m, vr_in, 2, in), fmi2OK);
+            EXPECT(fmi2ExitInitializationMode(m), fmi2OK);
+            EXPECT(fmi2NewDiscreteStates(m, &info), fmi2OK);
+            EXPECT(fmi2DoStep(m, 0.0, 1e-3, fmi2True), fmi2Error); /* a Co-Simulation call */
+            EXPECT(fmi2EnterContinuousTimeMode(m), fmi2OK);
+            EXPECT(fmi2GetContinuousStates(m, x, 6), fmi2OK);
+            EXPECT(fmi2GetContinuousStates(m, x, 5), fmi2Error);
+            for (int j = 0; j < 5; j++) {
+                EXPECT(fmi2SetTime(m, j * 1e-6), fmi2OK);
+                EXPECT(fmi2SetContinuousStates(m, x, 6), fmi2OK);
+                EXPECT(fmi2GetDerivatives(m, dx, 6), fmi2OK);
+                EXPECT(fmi2GetEventIndicators(m, z, 7), fmi2OK);
+                EXPECT(fmi2CompletedIntegratorStep(m, fmi2True, &enter, &stop), fmi2OK);
+                for (int i = 0; i < 6; i++) x[i] += 1e-6 * dx[i];
+            }
+            EXPECT(fmi2EnterEventMode(m), fmi2OK);
+            EXPECT(fmi2SetReal(m, vr_in, 2, in), fmi2OK);
+            EXPECT(fmi2NewDiscreteStates(m, &info), fmi2OK);
+            fmi2FMUstate ms = NULL;
+            EXPECT(fmi2GetFMUstate(m, &ms), fmi2OK);
+            EXPECT(fmi2EnterContinuousTimeMode(m), fmi2OK);
+            EXPECT(fmi2SetFMUstate(m, ms), fmi2OK);
+            EXPECT(fmi2FreeFMUstate(m, &ms), fmi2OK);
+            if (k % 2) {
+                EXPECT(fmi2Terminate(m), fmi2OK);
+            } else {
+                EXPECT(fmi2Reset(m), fmi2OK);
+            }
+        }
+        fmi2FreeInstance(m);
         if (k % 10 == 0) {
             fmi2FreeInstance(c); /* repeated: must be harmless */
             EXPECT(fmi2Reset(c), fmi2Error);
@@ -182,7 +243,7 @@ int main(int argc, char **argv) {
             EXPECT(fmi2DoStep(NULL, 0.0, 1e-3, fmi2True), fmi2Error);
             /* failed instantiations */
             if (fmi2Instantiate("bad", fmi2CoSimulation, "{not-the-guid}", resources, &callbacks, fmi2False, fmi2False) ||
-                fmi2Instantiate("me", fmi2ModelExchange, guid, resources, &callbacks, fmi2False, fmi2False) ||
+                fmi2Instantiate("me", fmi2ModelExchange, "{not-the-guid}", resources, &callbacks, fmi2False, fmi2False) ||
                 fmi2Instantiate(NULL, fmi2CoSimulation, guid, resources, &callbacks, fmi2False, fmi2False) ||
                 fmi2Instantiate("nocb", fmi2CoSimulation, guid, resources, NULL, fmi2False, fmi2False)) {
                 fprintf(stderr, "cycle %d: a bad fmi2Instantiate returned an instance\n", k);

@@ -129,6 +129,23 @@ pub unsafe fn instantiate(sink: &Sink, name: &str) -> fmi2Component {
     c
 }
 
+/// A new Model Exchange instance logging into `sink` (which must outlive it).
+pub unsafe fn instantiate_model_exchange(sink: &Sink, name: &str) -> fmi2Component {
+    let cb = callbacks(sink);
+    let name = CString::new(name).unwrap();
+    let c = fmi2Instantiate(
+        name.as_ptr(),
+        fmi2ModelExchange,
+        guid().as_ptr(),
+        null(),
+        &cb,
+        fmi2False,
+        fmi2False,
+    );
+    assert!(!c.is_null(), "fmi2Instantiate(fmi2ModelExchange) returned NULL");
+    c
+}
+
 /// Setup, initialisation with the given inputs and Real parameters, exit.
 pub unsafe fn initialise(c: fmi2Component, tolerance: Option<f64>, params: &[(u32, f64)], v_da: f64, x_s: f64) {
     let (defined, tol) = tolerance.map_or((fmi2False, 0.0), |t| (fmi2True, t));

@@ -26,6 +26,7 @@
 mod argument_calls;
 #[path = "../common/mod.rs"]
 mod common;
+mod model_exchange;
 
 use std::collections::BTreeMap;
 use std::ffi::CString;
@@ -38,7 +39,7 @@ type Tally = BTreeMap<(&'static str, &'static str), [u32; 5]>;
 
 use common::*;
 use fmi2::fmu_state::crc32;
-use fmi2::state::{Function, State};
+use fmi2::state::{Function, Interface, State};
 use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::{vr, VARIABLES};
@@ -61,7 +62,7 @@ const REACHABLE: [State; 7] = [
     State::Error,
 ];
 
-const ALL_FUNCTIONS: [Function; 31] = [
+const ALL_FUNCTIONS: [Function; 41] = [
     Function::SetDebugLogging,
     Function::FreeInstance,
     Function::SetupExperiment,
@@ -93,6 +94,16 @@ const ALL_FUNCTIONS: [Function; 31] = [
     Function::GetIntegerStatus,
     Function::GetBooleanStatus,
     Function::GetStringStatus,
+    Function::EnterEventMode,
+    Function::NewDiscreteStates,
+    Function::EnterContinuousTimeMode,
+    Function::CompletedIntegratorStep,
+    Function::SetTime,
+    Function::SetContinuousStates,
+    Function::GetDerivatives,
+    Function::GetEventIndicators,
+    Function::GetContinuousStates,
+    Function::GetNominalsOfContinuousStates,
 ];
 
 /// Byte offset of the layer-state code in a serialized FMU state (see fmu_state.rs).
@@ -198,7 +209,7 @@ impl Fuzz {
         on_ok: Option<State>,
     ) {
         self.calls += 1;
-        let legal = f.allowed_in(self.mirror);
+        let legal = f.legal(self.mirror, Interface::CoSimulation);
         let msgs = self.sink.since(logged_from);
         self.trace
             .push(format!("[{}] {desc} -> {}", self.mirror.name(), status_name(status)));
@@ -804,6 +815,11 @@ impl Fuzz {
             | Function::GetIntegerStatus
             | Function::GetBooleanStatus
             | Function::GetStringStatus => self.op_status(f, valid),
+            // Model Exchange calls: illegal for a Co-Simulation instance in every state
+            _ => {
+                let (desc, s) = model_exchange::call(c, f, valid);
+                self.check(f, desc, s, Expect::Error, m, None);
+            }
         }
     }
 

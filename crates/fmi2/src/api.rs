@@ -22,13 +22,14 @@
 
 use std::any::Any;
 use std::ffi::{CStr, CString};
+use std::fmt::Write;
 use std::os::raw::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use super::fmu_state::Snapshot;
 use super::instance::*;
 use super::model::{Causality, CoSimModel, StepError, VarType, Variability, Variable};
-use super::state::{Function, State};
+use super::state::{Function, Interface, State};
 use super::types::*;
 
 fn panic_message(payload: &(dyn Any + Send)) -> String {
@@ -48,6 +49,21 @@ fn drop_payload(payload: Box<dyn Any + Send>) {
     }
 }
 
+/// The illegal-call message for `f` in state `s` of an instance of `interface`.
+pub fn illegal_call_message_for(f: Function, s: State, interface: Interface) -> String {
+    match f.interface() {
+        Some(wanted) if wanted != interface && f.allowed_in(s) => format!(
+            "{}: illegal call in state {} ({} is a {} function; this instance was instantiated for {})",
+            f.name(),
+            s.name(),
+            f.name(),
+            wanted.name(),
+            interface.name()
+        ),
+        _ => illegal_call_message(f, s),
+    }
+}
+
 /// The illegal-call message for `f` in state `s`.
 pub fn illegal_call_message(f: Function, s: State) -> String {
     let mut m = format!("{}: illegal call in state {}", f.name(), s.name());
@@ -56,12 +72,23 @@ pub fn illegal_call_message(f: Function, s: State) -> String {
             " (fmi2CancelStep is only legal while an asynchronous fmi2DoStep is pending; this FMU steps synchronously)",
         );
     }
+    if let (Some(wanted), Some(current)) = (f.interface(), s.interface()) {
+        if wanted != current {
+            let _ = write!(
+                m,
+                " ({} is a {} function; this instance was instantiated for {})",
+                f.name(),
+                wanted.name(),
+                current.name()
+            );
+        }
+    }
     m
 }
 
 /// Run `body` on the instance behind `c` after the null, magic and state checks, with
 /// panics caught (see the module documentation).
-unsafe fn guarded<M: CoSimModel>(
+pub(crate) unsafe fn guarded<M: CoSimModel>(
     c: fmi2Component,
     f: Function,
     body: impl FnOnce(&mut Instance<M>) -> fmi2Status,
@@ -71,8 +98,8 @@ unsafe fn guarded<M: CoSimModel>(
     }
     let result = catch_unwind(AssertUnwindSafe(|| {
         let inst = &mut *(c as *mut Instance<M>);
-        if !f.allowed_in(inst.state) {
-            return inst.error(illegal_call_message(f, inst.state));
+        if !f.legal(inst.state, inst.interface) {
+            return inst.error(illegal_call_message_for(f, inst.state, inst.interface));
         }
         // call tracing only for models that declare the "logCalls" category
         if inst.logs_calls() {
@@ -99,7 +126,7 @@ unsafe fn guarded<M: CoSimModel>(
 
 /// `p[..n]` as a slice; NULL with `n > 0` is an error (NULL with `n == 0` is fine).
 #[inline]
-unsafe fn in_slice<'a, T, M: CoSimModel>(
+pub(crate) unsafe fn in_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
     what: &str,
@@ -116,7 +143,7 @@ unsafe fn in_slice<'a, T, M: CoSimModel>(
 }
 
 #[inline]
-unsafe fn out_slice<'a, T, M: CoSimModel>(
+pub(crate) unsafe fn out_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
     what: &str,
@@ -193,7 +220,7 @@ pub fn check_get(fname: &str, v: &Variable, state: State) -> Result<(), String> 
 
 /// Whether `v` may be set in `state`: no outputs or locals; fixed parameters only in
 /// `instantiated` and `initializationMode`; tunable parameters and inputs also in
-/// `stepComplete`.
+/// `stepComplete` and (Model Exchange) `eventMode`; inputs also in `continuousTimeMode`.
 #[inline]
 pub fn check_set(fname: &str, v: &Variable, state: State) -> Result<(), String> {
     let early = matches!(state, State::Instantiated | State::InitializationMode);
@@ -206,7 +233,16 @@ pub fn check_set(fname: &str, v: &Variable, state: State) -> Result<(), String> 
                 causality_name(v.causality)
             ))
         }
-        (Causality::Parameter, Variability::Tunable) | (Causality::Input, _) => early || state == State::StepComplete,
+        (Causality::Parameter, Variability::Tunable) => {
+            early || matches!(state, State::StepComplete | State::EventMode)
+        }
+        (Causality::Input, _) => {
+            early
+                || matches!(
+                    state,
+                    State::StepComplete | State::EventMode | State::ContinuousTimeMode
+                )
+        }
         (Causality::Parameter, _) => early,
     };
     if ok {
@@ -236,7 +272,8 @@ pub fn get_version() -> *const c_char {
 }
 
 /// `fmi2Instantiate`. Returns NULL (after logging, when a logger is available) for a
-/// NULL `functions`, a NULL instance name, a type other than fmi2CoSimulation, or a
+/// NULL `functions`, a NULL instance name, a type other than fmi2CoSimulation (or
+/// fmi2ModelExchange for a model with [`crate::model::ModelInfo::model_exchange`]), or a
 /// GUID other than `M::info().guid()`.
 ///
 /// # Safety
@@ -278,7 +315,8 @@ pub unsafe fn instantiate<M: CoSimModel>(
                 return std::ptr::null_mut();
             }
         };
-        if fmu_type != fmi2CoSimulation {
+        let model_exchange = fmu_type == fmi2ModelExchange && M::info().model_exchange.is_some();
+        if fmu_type != fmi2CoSimulation && !model_exchange {
             let what = if fmu_type == fmi2ModelExchange {
                 "fmi2ModelExchange".to_owned()
             } else {
@@ -303,7 +341,12 @@ pub unsafe fn instantiate<M: CoSimModel>(
             ));
             return std::ptr::null_mut();
         }
-        Instance::new(M::instantiate(), name, Some(&callbacks), logging_on != 0).into_component()
+        let mut instance = Instance::new(M::instantiate(), name, Some(&callbacks), logging_on != 0);
+        if model_exchange {
+            instance.interface = Interface::ModelExchange;
+            instance.model.use_model_exchange();
+        }
+        instance.into_component()
     }));
     match result {
         Ok(c) => c,
@@ -457,7 +500,10 @@ pub unsafe fn exit_initialization_mode<M: CoSimModel>(c: fmi2Component) -> fmi2S
     guarded::<M>(c, Function::ExitInitializationMode, |inst| {
         match inst.model.exit_initialization() {
             Ok(()) => {
-                inst.state = State::StepComplete;
+                inst.state = match inst.interface {
+                    Interface::CoSimulation => State::StepComplete,
+                    Interface::ModelExchange => State::EventMode,
+                };
                 fmi2OK
             }
             Err(m) => inst.error(format!("fmi2ExitInitializationMode: {m}")),
@@ -481,6 +527,9 @@ pub unsafe fn terminate<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
 pub unsafe fn reset<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
     guarded::<M>(c, Function::Reset, |inst| {
         inst.model.reset();
+        if inst.interface == Interface::ModelExchange {
+            inst.model.use_model_exchange();
+        }
         inst.state = State::Instantiated;
         inst.last_successful_time = None;
         fmi2OK
@@ -757,7 +806,7 @@ pub unsafe fn get_fmu_state<M: CoSimModel>(c: fmi2Component, state: *mut fmi2FMU
         if state.is_null() {
             return inst.error(format!("{F}: FMUstate is NULL"));
         }
-        let snap = Snapshot::new::<M>(inst.state, inst.model.serialize());
+        let snap = Snapshot::new::<M>(inst.state, inst.model.serialize()).of_interface(inst.interface);
         store_snapshot(inst, F, state, snap)
     })
 }
@@ -773,6 +822,14 @@ pub unsafe fn set_fmu_state<M: CoSimModel>(c: fmi2Component, state: fmi2FMUstate
             Ok(s) => s,
             Err(m) => return inst.error(m),
         };
+        if snap.interface != inst.interface {
+            return inst.error(format!(
+                "{F}: the FMU state was taken from a {} instance (state {}); this instance is for {}",
+                snap.interface.name(),
+                snap.state.name(),
+                inst.interface.name()
+            ));
+        }
         match inst.model.deserialize(&snap.model_bytes) {
             Ok(()) => {
                 inst.state = snap.state;

@@ -428,13 +428,13 @@ mod tests {
         let literal = exported_items(
             include_str!("../../../src/fmu_exports.rs"),
             "use crate::ExportedModel;",
-            "\u{0}",
+            "// ---- Model Exchange",
         );
         let generated = exported_items(include_str!("exports_macro.rs"), "macro_rules!", "\n    };\n}");
         assert_eq!(
             literal.len(),
             34,
-            "src/fmu_exports.rs should export the 34 FMI 2.0 Co-Simulation functions"
+            "src/fmu_exports.rs should export the 34 FMI 2.0 Co-Simulation functions before its Model Exchange ones"
         );
         assert_eq!(
             literal.len(),

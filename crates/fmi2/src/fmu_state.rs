@@ -8,14 +8,18 @@
 //! | 4 | format version (`u32`, = 1) |
 //! | 4 | GUID length `g` (`u32`) |
 //! | g | GUID (UTF-8) of the model that wrote it |
-//! | 1 | layer state (see [`State::code`]) |
+//! | 1 | layer state (see [`State::code`]), plus [`MODEL_EXCHANGE_BIT`] for an instance of Model Exchange |
 //! | 8 | model byte count `n` (`u64`) |
 //! | n | `CoSimModel::serialize()` |
 //! | 4 | CRC-32 (IEEE, as zlib) of everything before it |
 
 use super::instance::{is_registered_handle, register_handle, unregister_handle, HandleKind};
 use super::model::CoSimModel;
-use super::state::State;
+use super::state::{Interface, State};
+
+/// Set in the layer-state byte of an FMU state taken from a Model Exchange instance (a
+/// Co-Simulation instance's bytes are those of the layer before Model Exchange).
+pub const MODEL_EXCHANGE_BIT: u8 = 0x80;
 
 pub const STATE_MAGIC: &[u8; 8] = b"FMI2STAT";
 pub const FORMAT_VERSION: u32 = 1;
@@ -29,6 +33,8 @@ pub struct Snapshot {
     /// GUID of the model type that made it (rejects states of another FMU in-process).
     pub guid: &'static str,
     pub state: State,
+    /// The interface of the instance it was taken from.
+    pub interface: Interface,
     pub model_bytes: Vec<u8>,
 }
 
@@ -38,8 +44,15 @@ impl Snapshot {
             magic: SNAPSHOT_MAGIC,
             guid: M::info().guid(),
             state,
+            interface: Interface::CoSimulation,
             model_bytes,
         }
+    }
+
+    /// The snapshot, as taken from an instance of `interface`.
+    pub fn of_interface(mut self, interface: Interface) -> Self {
+        self.interface = interface;
+        self
     }
 
     /// Whether `p` is a live FMU state: registered when it was boxed and not yet freed
@@ -80,7 +93,11 @@ impl Snapshot {
         out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
         out.extend_from_slice(&(self.guid.len() as u32).to_le_bytes());
         out.extend_from_slice(self.guid.as_bytes());
-        out.push(self.state.code());
+        let interface_bit = match self.interface {
+            Interface::CoSimulation => 0,
+            Interface::ModelExchange => MODEL_EXCHANGE_BIT,
+        };
+        out.push(self.state.code() | interface_bit);
         out.extend_from_slice(&(self.model_bytes.len() as u64).to_le_bytes());
         out.extend_from_slice(&self.model_bytes);
         let crc = crc32(&out);
@@ -132,16 +149,28 @@ impl Snapshot {
                 String::from_utf8_lossy(guid)
             ));
         }
-        let state =
-            State::from_code(code).ok_or_else(|| format!("invalid layer state code {code} in serialized FMU state"))?;
+        let interface = if code & MODEL_EXCHANGE_BIT != 0 {
+            Interface::ModelExchange
+        } else {
+            Interface::CoSimulation
+        };
+        let state = State::from_code(code & !MODEL_EXCHANGE_BIT)
+            .ok_or_else(|| format!("invalid layer state code {code} in serialized FMU state"))?;
         if state == State::Fatal {
             return Err("serialized FMU state is in the fatal state".to_owned());
+        }
+        if state.interface().map_or(false, |i| i != interface) {
+            return Err(format!(
+                "invalid layer state code {code} in serialized FMU state: state {} of a {} instance",
+                state.name(),
+                interface.name()
+            ));
         }
         let mut probe = M::instantiate();
         probe
             .deserialize(&model_bytes)
             .map_err(|e| format!("serialized FMU state rejected by the model: {e}"))?;
-        Ok(Snapshot::new::<M>(state, model_bytes))
+        Ok(Snapshot::new::<M>(state, model_bytes).of_interface(interface))
     }
 }
 

@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use super::model::{CoSimModel, VarType, Variable};
-use super::state::State;
+use super::state::{Interface, State};
 use super::types::*;
 
 /// Marks a live [`Instance`]; cleared by `fmi2FreeInstance`.
@@ -115,6 +115,8 @@ pub struct Instance<M: CoSimModel> {
     /// references are too large for such a table (then [`Instance::variable`] searches).
     variable_rows: Vec<u16>,
     pub state: State,
+    /// The interface the instance was made for (`fmi2Instantiate`'s `fmuType`).
+    pub interface: Interface,
     /// `last_successful_time` of the last `fmi2DoStep` that returned fmi2Discard (the
     /// model's `time()` is what `fmi2GetRealStatus` reports).
     pub last_successful_time: Option<f64>,
@@ -140,6 +142,7 @@ impl<M: CoSimModel> Instance<M> {
             calls_category: M::info().log_categories.iter().position(|(name, _)| *name == CAT_CALLS),
             variable_rows: variable_rows(M::info().variables),
             state: State::Instantiated,
+            interface: Interface::CoSimulation,
             last_successful_time: None,
             last_error: None,
             #[cfg(test)]

@@ -1,4 +1,4 @@
-//! A generic FMI 2.0 Co-Simulation layer: C ABI, state machine, logging, FMU state.
+//! A generic FMI 2.0 layer, Co-Simulation and (for a model that has it) Model Exchange: C ABI, state machine, logging, FMU state.
 //! It knows nothing about the model behind it: see [`model::CoSimModel`].
 //!
 //! # Using it
@@ -17,6 +17,8 @@
 //!   fmi2Error and fmi2Fatal are always passed to the logger, other statuses only when
 //!   logging is on for their category).
 //! * [`api`]: one generic function per FMI call (argument checks, `catch_unwind`).
+//! * [`model_exchange`]: the Model Exchange calls, for a model that implements
+//!   [`model::ModelExchangeModel`] and declares [`model::ModelInfo::model_exchange`].
 //! * [`fmu_state`]: FMU-state snapshots and their checksummed byte format.
 //! * [`state_bytes`]: the byte format of a model's own state inside it (magic, versions,
 //!   little-endian numbers), with [`state_format!`].
@@ -45,12 +47,15 @@ pub mod fmu_state;
 pub mod instance;
 pub mod model;
 pub mod model_description;
+pub mod model_exchange;
 pub mod state;
 pub mod state_bytes;
 pub mod structure_check;
 pub mod testing;
 pub mod types;
 
+#[cfg(test)]
+mod model_exchange_tests;
 #[cfg(test)]
 mod tests;
 

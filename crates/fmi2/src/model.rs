@@ -166,8 +166,27 @@ pub struct ModelInfo {
     /// Every output's dependencies; an empty list leaves `dependencies` out of the model
     /// description (an importer then assumes that each output depends on every known).
     pub dependencies: &'static [OutputDependencies],
+    /// The Model Exchange interface, when the model has one (`None`: Co-Simulation only).
+    pub model_exchange: Option<&'static ModelExchangeInfo>,
     /// Holds the GUID once computed.
     pub guid_cache: GuidCache,
+}
+
+/// A continuous state of Model Exchange: the value references of the state and of its
+/// derivative (both variables of the table, Real and continuous).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ContinuousState {
+    pub state: u32,
+    pub derivative: u32,
+}
+
+/// What the model description says of a model's Model Exchange interface: `<ModelExchange>`,
+/// the `derivative` attributes, `<Derivatives>` and `numberOfEventIndicators`.
+#[derive(Debug)]
+pub struct ModelExchangeInfo {
+    /// In the order of the state vector of `fmi2GetContinuousStates`.
+    pub states: &'static [ContinuousState],
+    pub event_indicators: usize,
 }
 
 impl ModelInfo {
@@ -276,4 +295,46 @@ pub trait CoSimModel: Send + Sized + 'static {
     /// Restore from `serialize`'s output; reject foreign or corrupted bytes with a
     /// message and leave `self` unchanged.
     fn deserialize(&mut self, bytes: &[u8]) -> Result<(), String>;
+
+    /// Called right after `instantiate` (and after `reset`) for an instance made for Model
+    /// Exchange; only models whose [`ModelInfo::model_exchange`] is set get such instances.
+    fn use_model_exchange(&mut self) {}
+}
+
+/// What `fmi2NewDiscreteStates` reports (`fmi2EventInfo`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EventUpdate {
+    pub values_of_continuous_states_changed: bool,
+    pub nominals_of_continuous_states_changed: bool,
+    pub terminate_simulation: bool,
+    pub next_event_time: Option<f64>,
+}
+
+/// What the Model Exchange layer ([`crate::model_exchange`]) needs beyond [`CoSimModel`]. The
+/// slices have exactly as many elements as [`ModelExchangeInfo`] declares (checked by the
+/// layer); the model is called only in the states the legality table allows.
+pub trait ModelExchangeModel: CoSimModel {
+    /// `fmi2SetTime` (finite, checked by the layer).
+    fn set_time(&mut self, time: f64) -> Result<(), String>;
+    /// `fmi2GetContinuousStates`.
+    fn continuous_states(&self, x: &mut [f64]) -> Result<(), String>;
+    /// `fmi2SetContinuousStates`: refuse values that are not states (NaN, ...) with a message
+    /// and leave the states unchanged.
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String>;
+    /// `fmi2GetDerivatives` at the current time, inputs and states.
+    fn derivatives(&self, dx: &mut [f64]) -> Result<(), String>;
+    /// `fmi2GetEventIndicators` at the current time, inputs and states.
+    fn event_indicators(&self, z: &mut [f64]) -> Result<(), String>;
+    /// `fmi2GetNominalsOfContinuousStates`.
+    fn nominals(&self, nominals: &mut [f64]);
+    /// `fmi2EnterEventMode`.
+    fn enter_event_mode(&mut self) -> Result<(), String> {
+        Ok(())
+    }
+    /// `fmi2NewDiscreteStates`: one event iteration.
+    fn new_discrete_states(&mut self) -> Result<EventUpdate, String>;
+    /// `fmi2CompletedIntegratorStep`: whether to terminate the simulation.
+    fn completed_integrator_step(&mut self) -> Result<bool, String> {
+        Ok(false)
+    }
 }

@@ -1,4 +1,5 @@
-//! `modelDescription.xml` (FMI 2.0 Co-Simulation) generated from a [`ModelInfo`].
+//! `modelDescription.xml` (FMI 2.0 Co-Simulation, and Model Exchange when the model has it)
+//! generated from a [`ModelInfo`].
 
 use std::collections::HashSet;
 use std::fmt::Write;
@@ -76,6 +77,7 @@ pub fn validate_model_info(info: &ModelInfo) -> Result<(), Vec<String>> {
         }
     }
     problems.extend(dependency_problems(info));
+    problems.extend(model_exchange_problems(info));
     let mut cats = HashSet::new();
     for (name, _) in info.log_categories {
         if !cats.insert(*name) {
@@ -140,6 +142,34 @@ fn dependency_problems(info: &ModelInfo) -> Vec<String> {
     for v in info.variables {
         if v.causality == Causality::Output && !seen.contains(&v.value_reference) {
             problems.push(format!("dependencies: output {:?} is not listed", v.name));
+        }
+    }
+    problems
+}
+
+/// What is wrong with `info.model_exchange`: a state or derivative that is not a continuous
+/// Real variable of the table, or that is a parameter or an input, or one listed twice.
+fn model_exchange_problems(info: &ModelInfo) -> Vec<String> {
+    let mut problems = Vec::new();
+    let me = match info.model_exchange {
+        Some(me) => me,
+        None => return problems,
+    };
+    let mut seen = HashSet::new();
+    for (k, s) in me.states.iter().enumerate() {
+        for (what, vr) in [("state", s.state), ("derivative", s.derivative)] {
+            match info.variables.iter().find(|v| v.value_reference == vr) {
+                Some(v)
+                    if v.var_type == VarType::Real
+                        && v.variability == Variability::Continuous
+                        && matches!(v.causality, Causality::Output | Causality::Local) => {}
+                _ => problems.push(format!(
+                    "model exchange: the {what} of state {k} (value reference {vr}) is not a continuous Real output or local"
+                )),
+            }
+            if !seen.insert(vr) {
+                problems.push(format!("model exchange: value reference {vr} is listed twice"));
+            }
         }
     }
     problems
@@ -289,20 +319,35 @@ pub fn sha1(message: &[u8]) -> [u8; 20] {
 /// The XML with the given GUID, unchecked.
 fn write_xml(info: &ModelInfo, guid: &str) -> String {
     let e = xml_escape;
+    let index_of = |vr: u32| {
+        info.variables
+            .iter()
+            .position(|v| v.value_reference == vr)
+            .map(|i| i + 1)
+    };
+    let states = info.model_exchange.map_or(&[][..], |me| me.states);
     let mut x = String::new();
     let w = &mut x;
     // writing to a String cannot fail
     let _ = writeln!(w, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
         w,
-        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{}" description="{}" author="{}" version="{}" generationTool="{}" variableNamingConvention="flat" numberOfEventIndicators="0">"#,
+        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{}" description="{}" author="{}" version="{}" generationTool="{}" variableNamingConvention="flat" numberOfEventIndicators="{}">"#,
         e(info.model_name),
         e(guid),
         e(info.description),
         e(info.author),
         e(info.version),
-        e(info.generation_tool)
+        e(info.generation_tool),
+        info.model_exchange.map_or(0, |me| me.event_indicators)
     );
+    if info.model_exchange.is_some() {
+        let _ = writeln!(
+            w,
+            r#"  <ModelExchange modelIdentifier="{}" completedIntegratorStepNotNeeded="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canNotUseMemoryManagementFunctions="true" providesDirectionalDerivative="false"/>"#,
+            e(info.model_identifier)
+        );
+    }
     let _ = writeln!(
         w,
         r#"  <CoSimulation modelIdentifier="{}" canHandleVariableCommunicationStepSize="true" canInterpolateInputs="{}" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canNotUseMemoryManagementFunctions="true" providesDirectionalDerivative="false"/>"#,
@@ -377,6 +422,10 @@ fn write_xml(info: &ModelInfo, guid: &str) -> String {
                 if let Some(n) = extent.nominal {
                     let _ = write!(attrs, r#" nominal="{}""#, format_double(n));
                 }
+                let state = states.iter().find(|s| s.derivative == v.value_reference);
+                if let Some(j) = state.and_then(|s| index_of(s.state)) {
+                    let _ = write!(attrs, r#" derivative="{j}""#);
+                }
             }
             VarType::Integer => {
                 if has_start(v) {
@@ -408,35 +457,75 @@ fn write_xml(info: &ModelInfo, guid: &str) -> String {
     }
     let _ = writeln!(w, "  </ModelVariables>");
     let _ = writeln!(w, "  <ModelStructure>");
-    let index_of = |vr: u32| {
-        info.variables
-            .iter()
-            .position(|v| v.value_reference == vr)
-            .map(|i| i + 1)
-    };
     let all_knowns: Vec<(u32, DependencyKind)> = info
         .variables
         .iter()
         .filter(|v| matches!(v.causality, Causality::Input | Causality::Parameter))
         .map(|v| (v.value_reference, DependencyKind::Dependent))
         .collect();
+    // Model Exchange: the derivatives, and among the initial unknowns every state and
+    // derivative as well (FMI 2.0, 2.2.8), each depending on every known.
+    let derivatives: Vec<(usize, u32)> = states
+        .iter()
+        .filter_map(|s| index_of(s.derivative).map(|i| (i, s.derivative)))
+        .collect();
+    let mut initial_unknowns = outputs.clone();
+    for s in states {
+        for vr in [s.state, s.derivative] {
+            if let Some(i) = index_of(vr) {
+                if !initial_unknowns.iter().any(|&(j, _)| j == i) {
+                    initial_unknowns.push((i, vr));
+                }
+            }
+        }
+    }
+    initial_unknowns.sort_by_key(|&(i, _)| i);
     for (section, initial) in [("Outputs", false), ("InitialUnknowns", true)] {
-        if outputs.is_empty() {
+        if initial && !derivatives.is_empty() {
+            // between <Outputs> and <InitialUnknowns>, as the schema orders them
+            let _ = writeln!(w, "    <Derivatives>");
+            for &(i, _) in &derivatives {
+                let _ = writeln!(w, r#"      <Unknown index="{i}"/>"#);
+            }
+            let _ = writeln!(w, "    </Derivatives>");
+        }
+        let unknowns = if initial { &initial_unknowns } else { &outputs };
+        if unknowns.is_empty() {
             continue;
         }
         let _ = writeln!(w, "    <{section}>");
-        for &(i, vr) in &outputs {
+        for &(i, vr) in unknowns {
             let listed = info.dependencies.iter().find(|d| d.output == vr);
+            let is_state = states.iter().any(|s| s.state == vr || s.derivative == vr);
             match listed {
+                // a state or a derivative of Model Exchange: after initialisation it depends
+                // on every input and parameter
+                None if initial && is_state && !all_knowns.is_empty() => {
+                    let known: Vec<String> = all_knowns
+                        .iter()
+                        .filter_map(|&(vr, _)| index_of(vr).map(|j| j.to_string()))
+                        .collect();
+                    let _ = writeln!(
+                        w,
+                        r#"      <Unknown index="{i}" dependencies="{}" dependenciesKind="{}"/>"#,
+                        known.join(" "),
+                        vec!["dependent"; known.len()].join(" ")
+                    );
+                }
                 None => {
                     let _ = writeln!(w, r#"      <Unknown index="{i}"/>"#);
                 }
                 Some(d) => {
-                    let list: &[(u32, DependencyKind)] = match (initial, d.initial) {
-                        (false, _) => d.step,
-                        (true, Some(l)) => l,
-                        (true, None) => &all_knowns,
+                    let mut list: Vec<(u32, DependencyKind)> = match (initial, d.initial) {
+                        (false, _) => d.step.to_vec(),
+                        (true, Some(l)) => l.to_vec(),
+                        (true, None) => all_knowns.clone(),
                     };
+                    if !initial {
+                        // With Model Exchange the knowns of an output are the inputs and the
+                        // continuous states: an output may depend on every state.
+                        list.extend(states.iter().map(|s| (s.state, DependencyKind::Dependent)));
+                    }
                     // Ascending indices, as the standard's examples list them.
                     let mut known: Vec<(usize, DependencyKind)> = list
                         .iter()

@@ -1,10 +1,14 @@
-//! The FMI 2.0 Co-Simulation state machine and the explicit table of which function is
-//! legal in which state (after the masks of modelica/Reference-FMUs' `fmi2Functions.c`,
-//! without the Model-Exchange states and without `stepInProgress`: this layer only steps
-//! synchronously).
+//! The FMI 2.0 state machines of Co-Simulation and Model Exchange, and the explicit table of
+//! which function is legal in which state (after the masks of modelica/Reference-FMUs'
+//! `fmi2Functions.c`, without `stepInProgress`: this layer only steps synchronously).
+//!
+//! The two interfaces share `instantiated`, `initializationMode`, `terminated`, `error` and
+//! `fatal`; a Co-Simulation instance leaves initialisation for `stepComplete`, a Model
+//! Exchange instance for `eventMode`, so that the states an instance can reach tell its
+//! interface, and a function of the other interface is illegal in each of them.
 
-/// A state of the FMI 2.0 Co-Simulation state machine. `StartAndEnd` is not represented:
-/// there is no instance in it.
+/// A state of the FMI 2.0 state machines. `StartAndEnd` is not represented: there is no
+/// instance in it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {
     Instantiated,
@@ -15,10 +19,30 @@ pub enum State {
     Terminated,
     Error,
     Fatal,
+    /// Model Exchange: event mode (after initialisation and at each event).
+    EventMode,
+    /// Model Exchange: continuous-time mode (the importer's solver integrates).
+    ContinuousTimeMode,
+}
+
+/// Which FMI 2.0 interface an instance was made for (`fmi2Instantiate`'s `fmuType`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interface {
+    CoSimulation,
+    ModelExchange,
+}
+
+impl Interface {
+    pub const fn name(self) -> &'static str {
+        match self {
+            Interface::CoSimulation => "Co-Simulation",
+            Interface::ModelExchange => "Model Exchange",
+        }
+    }
 }
 
 impl State {
-    pub const ALL: [State; 8] = [
+    pub const ALL: [State; 10] = [
         State::Instantiated,
         State::InitializationMode,
         State::StepComplete,
@@ -27,7 +51,18 @@ impl State {
         State::Terminated,
         State::Error,
         State::Fatal,
+        State::EventMode,
+        State::ContinuousTimeMode,
     ];
+
+    /// The interface whose state machine alone has this state (`None`: both have it).
+    pub const fn interface(self) -> Option<Interface> {
+        match self {
+            State::StepComplete | State::StepFailed | State::StepCanceled => Some(Interface::CoSimulation),
+            State::EventMode | State::ContinuousTimeMode => Some(Interface::ModelExchange),
+            _ => None,
+        }
+    }
 
     /// The bit of this state in a [`Mask`].
     pub const fn bit(self) -> Mask {
@@ -40,6 +75,8 @@ impl State {
             State::Terminated => TERMINATED,
             State::Error => ERROR,
             State::Fatal => FATAL,
+            State::EventMode => EVENT_MODE,
+            State::ContinuousTimeMode => CONTINUOUS_TIME_MODE,
         }
     }
 
@@ -53,6 +90,8 @@ impl State {
             State::Terminated => "terminated",
             State::Error => "error",
             State::Fatal => "fatal",
+            State::EventMode => "eventMode",
+            State::ContinuousTimeMode => "continuousTimeMode",
         }
     }
 
@@ -67,6 +106,8 @@ impl State {
             State::Terminated => 6,
             State::Error => 7,
             State::Fatal => 8,
+            State::EventMode => 9,
+            State::ContinuousTimeMode => 10,
         }
     }
 
@@ -84,12 +125,19 @@ pub const STEP_CANCELED: Mask = 1 << 4;
 pub const TERMINATED: Mask = 1 << 5;
 pub const ERROR: Mask = 1 << 6;
 pub const FATAL: Mask = 1 << 7;
+pub const EVENT_MODE: Mask = 1 << 8;
+pub const CONTINUOUS_TIME_MODE: Mask = 1 << 9;
 
+/// The two states of Model Exchange after initialisation.
+const ME_RUNNING: Mask = EVENT_MODE | CONTINUOUS_TIME_MODE;
 /// Every state except `fatal`.
 const ALL_BUT_FATAL: Mask =
-    INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | STEP_CANCELED | TERMINATED | ERROR;
+    INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | STEP_CANCELED | TERMINATED | ERROR | ME_RUNNING;
 /// States in which values can be read.
-const READABLE: Mask = INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | STEP_CANCELED | TERMINATED | ERROR;
+const READABLE: Mask =
+    INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | STEP_CANCELED | TERMINATED | ERROR | ME_RUNNING;
+/// States in which inputs can be set (per variable: see `api::check_set`).
+const SETTABLE: Mask = INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | ME_RUNNING;
 
 /// An FMI 2.0 function that takes an instance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -125,6 +173,17 @@ pub enum Function {
     GetIntegerStatus,
     GetBooleanStatus,
     GetStringStatus,
+    // Model Exchange
+    EnterEventMode,
+    NewDiscreteStates,
+    EnterContinuousTimeMode,
+    CompletedIntegratorStep,
+    SetTime,
+    SetContinuousStates,
+    GetDerivatives,
+    GetEventIndicators,
+    GetContinuousStates,
+    GetNominalsOfContinuousStates,
 }
 
 /// The table: function, C name, states in which it may be called.
@@ -134,7 +193,15 @@ pub enum Function {
 ///   (checked per variable in the API);
 /// * `fmi2FreeInstance` is also legal in `fatal`, so an importer can release memory;
 /// * `fmi2CancelStep` is legal nowhere (no asynchronous stepping: `stepInProgress` is
-///   never entered). It returns fmi2Error with the illegal-call message.
+///   never entered). It returns fmi2Error with the illegal-call message;
+/// * `fmi2GetDerivatives` is also legal in `initializationMode` (FMI 2.0's state machine
+///   allows it there; Reference-FMUs' mask does not).
+///
+/// The Model Exchange rows are Reference-FMUs' masks: `fmi2SetTime` and `fmi2EnterEventMode`
+/// in `eventMode` and `continuousTimeMode`, `fmi2NewDiscreteStates` and
+/// `fmi2EnterContinuousTimeMode` in `eventMode`, `fmi2SetContinuousStates` and
+/// `fmi2CompletedIntegratorStep` in `continuousTimeMode`, the getters of states, derivatives
+/// and event indicators wherever values exist.
 pub const TABLE: &[(Function, &str, Mask)] = &[
     (Function::SetDebugLogging, "fmi2SetDebugLogging", ALL_BUT_FATAL),
     (Function::FreeInstance, "fmi2FreeInstance", ALL_BUT_FATAL | FATAL),
@@ -149,32 +216,20 @@ pub const TABLE: &[(Function, &str, Mask)] = &[
         "fmi2ExitInitializationMode",
         INITIALIZATION_MODE,
     ),
-    (Function::Terminate, "fmi2Terminate", STEP_COMPLETE | STEP_FAILED),
+    (
+        Function::Terminate,
+        "fmi2Terminate",
+        STEP_COMPLETE | STEP_FAILED | ME_RUNNING,
+    ),
     (Function::Reset, "fmi2Reset", ALL_BUT_FATAL),
     (Function::GetReal, "fmi2GetReal", INSTANTIATED | READABLE),
     (Function::GetInteger, "fmi2GetInteger", INSTANTIATED | READABLE),
     (Function::GetBoolean, "fmi2GetBoolean", INSTANTIATED | READABLE),
     (Function::GetString, "fmi2GetString", INSTANTIATED | READABLE),
-    (
-        Function::SetReal,
-        "fmi2SetReal",
-        INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE,
-    ),
-    (
-        Function::SetInteger,
-        "fmi2SetInteger",
-        INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE,
-    ),
-    (
-        Function::SetBoolean,
-        "fmi2SetBoolean",
-        INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE,
-    ),
-    (
-        Function::SetString,
-        "fmi2SetString",
-        INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE,
-    ),
+    (Function::SetReal, "fmi2SetReal", SETTABLE),
+    (Function::SetInteger, "fmi2SetInteger", SETTABLE),
+    (Function::SetBoolean, "fmi2SetBoolean", SETTABLE),
+    (Function::SetString, "fmi2SetString", SETTABLE),
     (Function::GetFMUstate, "fmi2GetFMUstate", ALL_BUT_FATAL),
     (Function::SetFMUstate, "fmi2SetFMUstate", ALL_BUT_FATAL),
     (Function::FreeFMUstate, "fmi2FreeFMUstate", ALL_BUT_FATAL),
@@ -227,6 +282,44 @@ pub const TABLE: &[(Function, &str, Mask)] = &[
         "fmi2GetStringStatus",
         STEP_COMPLETE | STEP_FAILED | TERMINATED,
     ),
+    (Function::EnterEventMode, "fmi2EnterEventMode", ME_RUNNING),
+    (Function::NewDiscreteStates, "fmi2NewDiscreteStates", EVENT_MODE),
+    (
+        Function::EnterContinuousTimeMode,
+        "fmi2EnterContinuousTimeMode",
+        EVENT_MODE,
+    ),
+    (
+        Function::CompletedIntegratorStep,
+        "fmi2CompletedIntegratorStep",
+        CONTINUOUS_TIME_MODE,
+    ),
+    (Function::SetTime, "fmi2SetTime", ME_RUNNING),
+    (
+        Function::SetContinuousStates,
+        "fmi2SetContinuousStates",
+        CONTINUOUS_TIME_MODE,
+    ),
+    (
+        Function::GetDerivatives,
+        "fmi2GetDerivatives",
+        INITIALIZATION_MODE | ME_RUNNING | TERMINATED | ERROR,
+    ),
+    (
+        Function::GetEventIndicators,
+        "fmi2GetEventIndicators",
+        INITIALIZATION_MODE | ME_RUNNING | TERMINATED | ERROR,
+    ),
+    (
+        Function::GetContinuousStates,
+        "fmi2GetContinuousStates",
+        INITIALIZATION_MODE | ME_RUNNING | TERMINATED | ERROR,
+    ),
+    (
+        Function::GetNominalsOfContinuousStates,
+        "fmi2GetNominalsOfContinuousStates",
+        INSTANTIATED | ME_RUNNING | TERMINATED | ERROR,
+    ),
 ];
 
 impl Function {
@@ -259,8 +352,43 @@ impl Function {
         self.mask() & state.bit() != 0
     }
 
+    /// Whether the call is legal for an instance of `interface` in `state`: the table's row,
+    /// and a function of one interface only is illegal for an instance of the other (also in
+    /// the states the two share, e.g. `fmi2GetDerivatives` in `initializationMode`).
+    #[inline]
+    pub fn legal(self, state: State, interface: Interface) -> bool {
+        self.allowed_in(state) && self.interface().map_or(true, |i| i == interface)
+    }
+
     pub fn all() -> impl Iterator<Item = Function> {
         TABLE.iter().map(|row| row.0)
+    }
+
+    /// The interface this function belongs to alone (`None`: both have it).
+    pub fn interface(self) -> Option<Interface> {
+        use Function::*;
+        match self {
+            EnterEventMode
+            | NewDiscreteStates
+            | EnterContinuousTimeMode
+            | CompletedIntegratorStep
+            | SetTime
+            | SetContinuousStates
+            | GetDerivatives
+            | GetEventIndicators
+            | GetContinuousStates
+            | GetNominalsOfContinuousStates => Some(Interface::ModelExchange),
+            SetRealInputDerivatives
+            | GetRealOutputDerivatives
+            | DoStep
+            | CancelStep
+            | GetStatus
+            | GetRealStatus
+            | GetIntegerStatus
+            | GetBooleanStatus
+            | GetStringStatus => Some(Interface::CoSimulation),
+            _ => None,
+        }
     }
 }
 
@@ -277,7 +405,7 @@ mod tests {
                 row.0
             );
         }
-        assert_eq!(TABLE.len(), 31);
+        assert_eq!(TABLE.len(), 41);
         for s in State::ALL {
             assert_eq!(State::from_code(s.code()), Some(s));
         }

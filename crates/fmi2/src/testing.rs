@@ -154,6 +154,7 @@ pub static DUMMY_INFO: ModelInfo = ModelInfo {
     can_interpolate_inputs: true,
     extent: super::model::no_extent,
     dependencies: &[],
+    model_exchange: None,
     guid_cache: super::model::GuidCache::new(),
 };
 
@@ -373,6 +374,48 @@ pub fn clone_info(i: &ModelInfo) -> ModelInfo {
         can_interpolate_inputs: i.can_interpolate_inputs,
         extent: i.extent,
         dependencies: i.dependencies,
+        model_exchange: i.model_exchange,
         guid_cache: super::model::GuidCache::new(),
+    }
+}
+
+/// The lag's Model Exchange calls, ẏ = (u − y)/τ, for the layer's tests of the Model Exchange
+/// functions in every state. `DUMMY_INFO` declares no Model Exchange (so `fmi2Instantiate`
+/// refuses fmi2ModelExchange and the arrays have no element): the tests reach these calls by
+/// putting an instance in the Model Exchange states.
+impl super::model::ModelExchangeModel for DummyModel {
+    fn set_time(&mut self, time: f64) -> Result<(), String> {
+        self.time = time;
+        Ok(())
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) -> Result<(), String> {
+        x.iter_mut().for_each(|v| *v = self.y);
+        Ok(())
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        if let Some(&y) = x.first() {
+            self.y = y;
+        }
+        Ok(())
+    }
+
+    fn derivatives(&self, dx: &mut [f64]) -> Result<(), String> {
+        dx.iter_mut().for_each(|v| *v = (self.u - self.y) / self.tau);
+        Ok(())
+    }
+
+    fn event_indicators(&self, z: &mut [f64]) -> Result<(), String> {
+        z.iter_mut().for_each(|v| *v = self.u - self.y);
+        Ok(())
+    }
+
+    fn nominals(&self, nominals: &mut [f64]) {
+        nominals.iter_mut().for_each(|v| *v = 1.0);
+    }
+
+    fn new_discrete_states(&mut self) -> Result<super::model::EventUpdate, String> {
+        Ok(super::model::EventUpdate::default())
     }
 }

@@ -70,6 +70,18 @@ pub struct fmi2CallbackFunctions {
     pub componentEnvironment: fmi2ComponentEnvironment,
 }
 
+/// `fmi2EventInfo` (Model Exchange).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct fmi2EventInfo {
+    pub newDiscreteStatesNeeded: fmi2Boolean,
+    pub terminateSimulation: fmi2Boolean,
+    pub nominalsOfContinuousStatesChanged: fmi2Boolean,
+    pub valuesOfContinuousStatesChanged: fmi2Boolean,
+    pub nextEventTimeDefined: fmi2Boolean,
+    pub nextEventTime: fmi2Real,
+}
+
 /// `fmi2TypesPlatform`.
 // Byte strings, not c"" literals: the win64 build compiles with rustc 1.63.
 // SAFETY: one NUL, at the end.
@@ -105,5 +117,7 @@ mod tests {
         assert_eq!(size_of::<fmi2Status>(), 4);
         assert_eq!(size_of::<fmi2ValueReference>(), 4);
         assert_eq!(size_of::<fmi2Byte>(), 1);
+        // five ints, padding to the double's alignment, the double
+        assert_eq!(size_of::<fmi2EventInfo>(), 32);
     }
 }

@@ -54,6 +54,7 @@ macro_rules! model_info {
                 extent
             },
             dependencies: $dependencies,
+            model_exchange: None,
             guid_cache: $crate::__fmi2::model::GuidCache::new(),
         }
     };

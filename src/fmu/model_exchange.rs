@@ -1,0 +1,488 @@
+//! The actuator as an FMI 2.0 Model Exchange model: the six states of (4.1),
+//! [i, x_jp, ẋ_jp, ẍ_jp, P1, P2], their derivatives from `Actuator::derivatives` (the
+//! equations the Co-Simulation step integrates), and event indicators where the right-hand
+//! side is not smooth.
+//!
+//! What Model Exchange does not have, and why:
+//! * effects with a memory of the past, which the Co-Simulation step updates at
+//!   communication points or keeps in a history buffer (the jet pipe's hysteresis, the
+//!   transport delay, the command stage's lag, filter and slew limit, the transducers' lags,
+//!   delays, plays and filters, and the forces that read the stopper's motion over the last
+//!   intervals) are refused, each named, when set and when initialisation ends; they stay
+//!   available in Co-Simulation;
+//! * the gas volumes behind restrictions, a lagging stopper mount and the constants that vary
+//!   in time are refused too (ODEs, not yet states of Model Exchange).
+//!
+//! The stopper: a new x_s set in event mode moves it at once as in Co-Simulation (the air in
+//! each chamber conserved, P V^γ constant), and `fmi2NewDiscreteStates` reports the changed
+//! pressures. FMI 2.0 Model Exchange has no input derivatives: an x_s that an importer moves
+//! continuously in continuous-time mode changes the volumes without the compression term of
+//! ẋ_s; Co-Simulation (with `fmi2SetRealInputDerivatives`) is the form for a moving stopper.
+
+use super::ActuatorFmu;
+use crate::variables::{me_vr, vr};
+use fmi2::model::{EventUpdate, ModelExchangeModel};
+use jetpipe_model::physics::actuator::{index, Actuator, Inputs, State};
+use jetpipe_model::physics::chambers::pressure_after_volume_jump;
+use jetpipe_model::physics::command_stage;
+use jetpipe_model::physics::jet_pipe;
+use jetpipe_model::physics::parameters::{table_start, variable_name, Parameters};
+use jetpipe_model::physics::sensors::{Channel, SensorLaw};
+use jetpipe_model::physics::time_varying;
+
+/// The number of event indicators (see [`event_indicators`]).
+pub const EVENT_INDICATORS: usize = 7;
+
+/// A running Model Exchange instance: the model built when initialisation ended, the time and
+/// the states the importer set.
+#[derive(Clone, Debug)]
+pub(super) struct MeState {
+    model: Actuator,
+    time: f64,
+    x: State,
+    /// Where the stopper is: the last x_s set that is inside the cylinder (see
+    /// [`ActuatorFmu::exit_initialization_model_exchange`]).
+    x_s: f64,
+    /// The stopper moved since the last `fmi2NewDiscreteStates`: the pressures jumped.
+    states_changed: bool,
+}
+
+/// Why an effect is refused in Model Exchange, and the parameters that switch it on.
+struct Refused {
+    effect: &'static str,
+    why: &'static str,
+    parameters: &'static [u32],
+}
+
+const MEMORY: &str =
+    "it is not an ODE: the Co-Simulation step keeps a memory of the past for it, updated at communication points";
+
+/// The effects that Model Exchange refuses, each with its parameters (any of them away from
+/// its default switches the effect on).
+const REFUSED: &[Refused] = &[
+    Refused {
+        effect: "jet_pipe_hysteresis",
+        why: "it is not an ODE: a play-operator memory that follows the history of the input",
+        parameters: &[vr::HYSTERESIS_WIDTH],
+    },
+    Refused {
+        effect: "transport_delay",
+        why: "it is not an ODE: a history buffer of the command",
+        parameters: &[vr::COMMAND_DELAY],
+    },
+    Refused {
+        effect: "the command stage's lag, filter and slew limit",
+        why: MEMORY,
+        parameters: &[vr::COMMAND_LAG, vr::COMMAND_FILTER_FREQUENCY, vr::CURRENT_SLEW_LIMIT],
+    },
+    Refused {
+        effect: "the transducers' lags, delays, plays and filters",
+        why: MEMORY,
+        parameters: &[
+            vr::FORCE_SENSOR_LAG,
+            vr::FORCE_SENSOR_DELAY,
+            vr::FORCE_SENSOR_PLAY,
+            vr::FORCE_SENSOR_FILTER_FREQUENCY,
+            vr::P1_SENSOR_LAG,
+            vr::P1_SENSOR_DELAY,
+            vr::P1_SENSOR_FILTER_FREQUENCY,
+            vr::P2_SENSOR_LAG,
+            vr::P2_SENSOR_DELAY,
+            vr::P2_SENSOR_FILTER_FREQUENCY,
+        ],
+    },
+    Refused {
+        effect: "piston_friction and the forces on the stopper's motion",
+        why: "it is not an ODE: the stopper's velocity and acceleration are formed from its positions at the last communication points",
+        parameters: &[
+            vr::FRICTION_COULOMB,
+            vr::FRICTION_STRIBECK,
+            vr::VISCOUS_FRICTION,
+            vr::EXTRA_FORCE_ACCELERATION,
+            vr::EXTRA_FORCE_VELOCITY_SQUARED,
+            vr::EXTRA_FORCE_SIGN_PRESSURE,
+        ],
+    },
+    Refused {
+        effect: "the gas volumes behind restrictions and the lagging stopper mount",
+        why: "their states are not yet states of Model Exchange",
+        parameters: &[
+            vr::SUPPLY_PLENUM_VOLUME,
+            vr::RETURN_PLENUM_VOLUME,
+            vr::PORT_LINE_VOLUME_1,
+            vr::PORT_LINE_VOLUME_2,
+            vr::STOPPER_MOUNT_LAG,
+        ],
+    },
+    Refused {
+        effect: "the constants that vary in time",
+        why: "they are not yet part of Model Exchange",
+        parameters: &[
+            vr::SUPPLY_DRIFT,
+            vr::SUPPLY_RIPPLE_SINE,
+            vr::SUPPLY_RIPPLE_COSINE,
+            vr::X_JP_OFFSET_DRIFT,
+            vr::T_DRIFT,
+        ],
+    },
+];
+
+fn refusal_message(r: &Refused, switched_on: &str) -> String {
+    format!(
+        "{switched_on} switches on {} ({}), which Model Exchange does not have ({}); use the Co-Simulation interface of this FMU for it",
+        r.effect,
+        r.parameters
+            .iter()
+            .map(|&v| variable_name(v))
+            .collect::<Vec<_>>()
+            .join(", "),
+        r.why
+    )
+}
+
+/// Whether setting `value_reference` to `value` switches on an effect Model Exchange refuses:
+/// the message that names it.
+pub(super) fn refused_setting(value_reference: u32, value: f64) -> Result<(), String> {
+    for r in REFUSED {
+        if r.parameters.contains(&value_reference) && value != table_start(value_reference) {
+            let what = format!("{} = {value}", variable_name(value_reference));
+            return Err(refusal_message(r, &what));
+        }
+    }
+    Ok(())
+}
+
+/// The effects a model has that Model Exchange refuses, named with the parameters that
+/// switch them on; also what the model's own flags say is on (whatever parameter did it).
+fn refused_effects(model: &Actuator) -> Result<(), String> {
+    let p = &model.params;
+    let mut problems = Vec::new();
+    for r in REFUSED {
+        let on: Vec<String> = r
+            .parameters
+            .iter()
+            .filter_map(|&v| {
+                let value = p.get(v)?;
+                (value != table_start(v)).then(|| format!("{} = {value}", variable_name(v)))
+            })
+            .collect();
+        if !on.is_empty() {
+            problems.push(refusal_message(r, &on.join(", ")));
+        }
+    }
+    let flags = [
+        (model.hysteresis.is_active(), "jet_pipe_hysteresis"),
+        (p.command_delay != 0.0, "transport_delay"),
+        (
+            p.command_lag > 0.0 || p.command_filter_frequency > 0.0 || p.current_slew_limit > 0.0,
+            "the command stage's memory",
+        ),
+        (
+            Channel::ALL.iter().any(|&c| SensorLaw::of(p, c).filters()),
+            "a transducer's memory",
+        ),
+        (model.reads_stopper_motion, "a force on the stopper's motion"),
+        (model.has_volume_states(), "states beyond the six of (4.1)"),
+        (time_varying::varies(p), "constants that vary in time"),
+    ];
+    if problems.is_empty() {
+        if let Some((_, what)) = flags.iter().find(|(on, _)| *on) {
+            problems.push(format!(
+                "the parameters switch on {what}, which Model Exchange does not have; use the Co-Simulation interface of this FMU"
+            ));
+        }
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "Model Exchange refuses these parameters: {}",
+            problems.join("; ")
+        ))
+    }
+}
+
+/// The inputs of the right-hand side: v_DA through the command stage's static part (its
+/// curve, cubic and limits; its memories are refused), the stopper held.
+fn inputs(model: &Actuator, v_da: f64, x_s: f64) -> Inputs {
+    let p = &model.params;
+    let v_da = if command_stage::is_active(p) {
+        command_stage::static_map(p, v_da)
+    } else {
+        v_da
+    };
+    Inputs {
+        v_da,
+        x_s,
+        x_s_rate: 0.0,
+        plays: None,
+    }
+}
+
+/// The event indicators: where the right-hand side or the force is not smooth.
+/// * z0 = P1 − P2 − F_spring/A_p: the spring floor of the force (2.38) (and the switch of a
+///   compliant stopper's law);
+/// * z1 = P1 − P2: the leakage past the piston reverses (2.23), √|Δp| there;
+/// * z2, z3 = P_s − P1, P_s − P2: a supply flow reverses (2.18);
+/// * z4, z5 = P1 − P_r, P2 − P_r: a return flow reverses;
+/// * z6 = sin(π x_abs/D_jp): the jet pipe crosses a tangency of the orifice geometry, where
+///   the areas (2.8)–(2.17) stop being analytic (every multiple of D_jp).
+fn event_indicators(model: &Actuator, x: &State, x_s: f64, z: &mut [f64]) {
+    let p = &model.params;
+    let (p1, p2) = (x[index::P1], x[index::P2]);
+    let floor = model.spring_force(x_s) / model.piston_area;
+    let x_abs = jet_pipe::absolute_position(x[index::JET_POSITION], p.x_jp_offset);
+    let values = [
+        p1 - p2 - floor,
+        p1 - p2,
+        p.p_s - p1,
+        p.p_s - p2,
+        p1 - p.p_r,
+        p2 - p.p_r,
+        (std::f64::consts::PI * x_abs / p.d_jp).sin(),
+    ];
+    z.copy_from_slice(&values);
+}
+
+/// The value of a variable of Model Exchange (a state or a derivative beyond the table's
+/// outputs) at a state; `None` for any other value reference.
+pub(super) fn state_variable(model: &Actuator, x: &State, v_da: f64, x_s: f64, value_reference: u32) -> Option<f64> {
+    let derivative = |k: usize| model.derivatives(x, &inputs(model, v_da, x_s))[k];
+    Some(match value_reference {
+        me_vr::X_JP_VELOCITY => x[index::JET_VELOCITY],
+        me_vr::X_JP_ACCELERATION => x[index::JET_ACCELERATION],
+        me_vr::DER_I => derivative(index::CURRENT),
+        me_vr::DER_X_JP => derivative(index::JET_POSITION),
+        me_vr::DER_X_JP_VELOCITY => derivative(index::JET_VELOCITY),
+        me_vr::DER_X_JP_ACCELERATION => derivative(index::JET_ACCELERATION),
+        me_vr::DER_P1 => derivative(index::P1),
+        me_vr::DER_P2 => derivative(index::P2),
+        _ => return None,
+    })
+}
+
+impl ActuatorFmu {
+    /// `fmi2ExitInitializationMode` of Model Exchange: the refusals, then the state the
+    /// Co-Simulation would start from (the same equilibrium, or P1_start and P2_start). As in
+    /// Co-Simulation, an x_s outside the cylinder set during initialisation (an importer that
+    /// starts its connectors at 0) leaves the stopper at the last valid x_s set (or the start
+    /// value), and the derivatives are refused until a valid x_s is set.
+    pub(super) fn exit_initialization_model_exchange(&mut self) -> Result<(), String> {
+        refused_effects(&Actuator::new(self.params.clone())?)?;
+        let me = match self.params.check_stopper(self.x_s) {
+            Ok(()) => self.initial_me_state()?,
+            Err(e) => {
+                let mut fallback = self.clone();
+                fallback.x_s = self.x_s_valid;
+                fallback.params.check_stopper(fallback.x_s).map_err(|_| e)?;
+                fallback.initial_me_state()?
+            }
+        };
+        self.me = Some(me);
+        Ok(())
+    }
+
+    /// An error while the x_s set during initialisation is outside the cylinder.
+    fn check_stopper_set(&self, me: &MeState) -> Result<(), String> {
+        if self.x_s == me.x_s {
+            return Ok(());
+        }
+        match self.params.check_stopper(self.x_s) {
+            Err(e) => Err(format!(
+                "{e} (the x_s set during initialisation; set a valid x_s in event mode)"
+            )),
+            Ok(()) => Ok(()),
+        }
+    }
+
+    /// The Model Exchange state at the end of initialisation.
+    fn initial_me_state(&self) -> Result<MeState, String> {
+        let simulation = self.initial_simulation()?;
+        Ok(MeState {
+            model: simulation.model().clone(),
+            time: self.start_time,
+            x: *simulation.state(),
+            x_s: simulation.x_s(),
+            states_changed: false,
+        })
+    }
+
+    /// The running state, or (before initialisation has ended) the one it would start from.
+    fn me_view(&self) -> Result<std::borrow::Cow<'_, MeState>, String> {
+        match &self.me {
+            Some(me) => Ok(std::borrow::Cow::Borrowed(me)),
+            None => self.initial_me_state().map(std::borrow::Cow::Owned),
+        }
+    }
+
+    /// `fmi2GetReal` of a running Model Exchange instance: the states, the outputs at them and
+    /// the inputs; `None` for what the parameters answer.
+    pub(super) fn me_real(&self, value_reference: u32) -> Option<f64> {
+        let me = self.me.as_ref()?;
+        let x = &me.x;
+        Some(match value_reference {
+            vr::V_DA => self.v_da,
+            vr::X_S => me.x_s,
+            vr::P1 => x[index::P1],
+            vr::P2 => x[index::P2],
+            vr::I => x[index::CURRENT],
+            vr::X_JP => x[index::JET_POSITION],
+            vr::F_ACT | vr::F_MEAS | vr::P1_MEAS | vr::P2_MEAS => {
+                let y = me.model.outputs_at(x, me.x_s, 0.0, me.time);
+                match value_reference {
+                    vr::F_ACT => y.f_act,
+                    vr::F_MEAS => y.f_meas,
+                    vr::P1_MEAS => y.p1_meas,
+                    _ => y.p2_meas,
+                }
+            }
+            _ => return state_variable(&me.model, x, self.v_da, me.x_s, value_reference),
+        })
+    }
+
+    /// A new x_s in a running Model Exchange instance: checked against the cylinder, and the
+    /// stopper moved at once as in Co-Simulation (the pressures jump, conserving the air).
+    pub(super) fn move_stopper_model_exchange(&mut self, x_s: f64) -> Result<(), String> {
+        self.params.check_stopper(x_s)?;
+        if let Some(me) = self.me.as_mut() {
+            let before = me.x_s;
+            if x_s != before {
+                let gamma = me.model.polytropic_exponent;
+                let (v1_before, v2_before) = me.model.cylinder.volumes(before);
+                let (v1_after, v2_after) = me.model.cylinder.volumes(x_s);
+                me.x[index::P1] = pressure_after_volume_jump(gamma, me.x[index::P1], v1_before, v1_after);
+                me.x[index::P2] = pressure_after_volume_jump(gamma, me.x[index::P2], v2_before, v2_after);
+                me.states_changed = true;
+            }
+            me.x_s = x_s;
+        }
+        self.x_s = x_s;
+        Ok(())
+    }
+
+    pub(super) fn me_time(&self) -> Option<f64> {
+        self.me.as_ref().map(|me| me.time)
+    }
+
+    /// The Model Exchange part of the serialized state: the interface, then (when running)
+    /// time, states and whether the states changed.
+    pub(super) fn serialize_model_exchange(&self, w: &mut fmi2::state_bytes::ByteWriter) {
+        w.bool(self.model_exchange);
+        match &self.me {
+            None => w.bool(false),
+            Some(me) => {
+                w.bool(true);
+                w.f64(me.time);
+                w.f64s(me.x.as_slice());
+                w.f64(me.x_s);
+                w.bool(me.states_changed);
+            }
+        }
+    }
+
+    /// Read what [`Self::serialize_model_exchange`] wrote into `restored` (whose parameters
+    /// are already read).
+    /// (The layer refuses an FMU state of the other interface before the bytes reach here.)
+    pub(super) fn deserialize_model_exchange(
+        r: &mut fmi2::state_bytes::ByteReader<'_>,
+        restored: &mut ActuatorFmu,
+    ) -> Result<(), String> {
+        restored.model_exchange = r.bool("modelExchange")?;
+        if r.bool("modelExchangeRunning")? {
+            let time = r.f64()?;
+            let values = r.f64s_at_most(6, "continuous states")?;
+            if values.len() != 6 {
+                return Err(format!("{} continuous states, not 6", values.len()));
+            }
+            let x_s = r.f64()?;
+            restored.params.check_stopper(x_s)?;
+            let states_changed = r.bool("statesChanged")?;
+            restored.me = Some(MeState {
+                model: Actuator::new(restored.params.clone())?,
+                time,
+                x: State::from_column_slice(&values),
+                x_s,
+                states_changed,
+            });
+        }
+        Ok(())
+    }
+}
+
+impl ModelExchangeModel for ActuatorFmu {
+    fn set_time(&mut self, time: f64) -> Result<(), String> {
+        match self.me.as_mut() {
+            Some(me) => {
+                me.time = time;
+                Ok(())
+            }
+            None => Err("the model is not initialised".to_string()),
+        }
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) -> Result<(), String> {
+        x.copy_from_slice(self.me_view()?.x.as_slice());
+        Ok(())
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        let me = self
+            .me
+            .as_mut()
+            .ok_or_else(|| "the model is not initialised".to_string())?;
+        for k in [index::P1, index::P2] {
+            if x[k] <= 0.0 {
+                return Err(format!(
+                    "x[{k}] = {} Pa is not an absolute pressure of {} (must be > 0)",
+                    x[k],
+                    if k == index::P1 { "P1" } else { "P2" }
+                ));
+            }
+        }
+        me.x = State::from_column_slice(x);
+        Ok(())
+    }
+
+    fn derivatives(&self, dx: &mut [f64]) -> Result<(), String> {
+        let me = self.me_view()?;
+        self.check_stopper_set(&me)?;
+        let d = me.model.derivatives(&me.x, &inputs(&me.model, self.v_da, me.x_s));
+        if let Some(k) = d.iter().position(|v| !v.is_finite()) {
+            return Err(format!(
+                "the derivative of state {k} is {} at the states {:?}",
+                d[k],
+                me.x.as_slice()
+            ));
+        }
+        dx.copy_from_slice(d.as_slice());
+        Ok(())
+    }
+
+    fn event_indicators(&self, z: &mut [f64]) -> Result<(), String> {
+        let me = self.me_view()?;
+        self.check_stopper_set(&me)?;
+        event_indicators(&me.model, &me.x, me.x_s, z);
+        Ok(())
+    }
+
+    fn nominals(&self, nominals: &mut [f64]) {
+        // The scales of the Co-Simulation's tolerances: 0.1 A, 0.1 mm and its natural-frequency
+        // derivatives, 1 bar.
+        let scales = match Actuator::new(self.params.clone()) {
+            Ok(model) => model.state_scales(),
+            Err(_) => Actuator::new(Parameters::default()).map_or(State::repeat(1.0), |m| m.state_scales()),
+        };
+        nominals.copy_from_slice(scales.as_slice());
+    }
+
+    fn new_discrete_states(&mut self) -> Result<EventUpdate, String> {
+        let changed = self
+            .me
+            .as_mut()
+            .map_or(false, |me| std::mem::replace(&mut me.states_changed, false));
+        Ok(EventUpdate {
+            values_of_continuous_states_changed: changed,
+            ..EventUpdate::default()
+        })
+    }
+}

@@ -1,0 +1,356 @@
+//! Issue 44: the actuator through the exported Model Exchange symbols. Its derivatives are the
+//! model's own, an explicit integration of them follows the Co-Simulation step, a stopper moved
+//! in event mode jumps the pressures as in Co-Simulation, the effects with a memory are refused
+//! with their names, and FMU states keep the interface and the states.
+
+#[path = "common/mod.rs"]
+mod common;
+
+use std::ptr::{null, null_mut};
+
+use common::*;
+use fmi2::state::State;
+use fmi2::types::*;
+use jetpipe::fmu_exports::*;
+use jetpipe::variables::{me_vr, vr};
+use jetpipe_model::physics::actuator::{Actuator, Inputs, State as ModelState};
+use jetpipe_model::physics::parameters::Parameters;
+
+const NX: usize = 6;
+const NZ: usize = 7;
+
+unsafe fn states(c: fmi2Component) -> [f64; NX] {
+    let mut x = [f64::NAN; NX];
+    assert_eq!(fmi2GetContinuousStates(c, x.as_mut_ptr(), NX), fmi2OK);
+    x
+}
+
+unsafe fn derivatives(c: fmi2Component) -> [f64; NX] {
+    let mut dx = [f64::NAN; NX];
+    assert_eq!(fmi2GetDerivatives(c, dx.as_mut_ptr(), NX), fmi2OK);
+    dx
+}
+
+/// A Model Exchange instance initialised at the equilibrium of `v_da`, `x_s`, in
+/// continuous-time mode.
+unsafe fn running(sink: &Sink, v_da: f64, x_s: f64) -> fmi2Component {
+    let c = instantiate_model_exchange(sink, "me");
+    initialise(c, None, &[], v_da, x_s);
+    assert_eq!(layer_state(c), State::EventMode);
+    let mut info = fmi2EventInfo::default();
+    assert_eq!(fmi2NewDiscreteStates(c, &mut info), fmi2OK);
+    assert_eq!(info, fmi2EventInfo::default(), "nothing happens at the start");
+    assert_eq!(fmi2EnterContinuousTimeMode(c), fmi2OK);
+    assert_eq!(layer_state(c), State::ContinuousTimeMode);
+    c
+}
+
+fn last_error(sink: &Sink, from: usize) -> String {
+    sink.since(from)
+        .into_iter()
+        .rev()
+        .find(|m| m.status == fmi2Error)
+        .map(|m| m.message)
+        .unwrap_or_default()
+}
+
+#[test]
+fn the_states_start_at_the_co_simulations_equilibrium_and_the_derivatives_are_the_models() {
+    let sink = Sink::default();
+    unsafe {
+        let c = running(&sink, 2.5, 0.054);
+        let cs = instantiate(&sink, "cs");
+        initialise(cs, None, &[], 2.5, 0.054);
+        let x = states(c);
+        let (_, y) = get_reals(cs, &[vr::I, vr::X_JP, vr::P1, vr::P2]);
+        assert_eq!([x[0], x[1], x[4], x[5]], [y[0], y[1], y[2], y[3]]);
+        // at rest: every rate vanishes (the pressures' to the equilibrium solver's tolerance)
+        let dx = derivatives(c);
+        assert!(dx[..4].iter().all(|d| d.abs() < 1e-9), "{dx:?}");
+        assert!(dx[4].abs() < 1.0 && dx[5].abs() < 1.0, "{dx:?}");
+        // away from rest: Actuator::derivatives itself
+        let moved = [0.12, 1.5e-4, 0.02, -30.0, 4.1e5, 1.9e5];
+        assert_eq!(fmi2SetContinuousStates(c, moved.as_ptr(), NX), fmi2OK);
+        let v_da = 3.0;
+        assert_eq!(fmi2SetReal(c, &vr::V_DA, 1, &v_da), fmi2OK);
+        let model = Actuator::new(Parameters::default()).unwrap();
+        let expected = model.derivatives(
+            &ModelState::from(moved),
+            &Inputs {
+                v_da,
+                x_s: 0.054,
+                x_s_rate: 0.0,
+                plays: None,
+            },
+        );
+        assert_eq!(derivatives(c).to_vec(), expected.as_slice().to_vec());
+        // the derivative variables read the same
+        let (_, d) = get_reals(c, &[me_vr::DER_I, me_vr::DER_P1, me_vr::X_JP_ACCELERATION]);
+        assert_eq!(d, vec![expected[0], expected[4], moved[3]]);
+        free(c);
+        free(cs);
+    }
+}
+
+#[test]
+fn an_explicit_integration_of_the_derivatives_follows_the_co_simulation_step() {
+    let sink = Sink::default();
+    unsafe {
+        let c = running(&sink, 2.5, 0.054);
+        let cs = instantiate(&sink, "cs");
+        initialise(cs, Some(1e-8), &[], 2.5, 0.054);
+        // a command step, then 4 ms of classical Runge–Kutta at 0.5 µs through the C ABI
+        assert_eq!(fmi2EnterEventMode(c), fmi2OK);
+        set_inputs(c, 6.0, 0.054);
+        set_inputs(cs, 6.0, 0.054);
+        let mut info = fmi2EventInfo::default();
+        assert_eq!(fmi2NewDiscreteStates(c, &mut info), fmi2OK);
+        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2False);
+        assert_eq!(fmi2EnterContinuousTimeMode(c), fmi2OK);
+        let h = 0.5e-6;
+        let mut x = states(c);
+        let rate = |t: f64, x: &[f64; NX]| {
+            assert_eq!(fmi2SetTime(c, t), fmi2OK);
+            assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
+            derivatives(c)
+        };
+        let add = |x: &[f64; NX], k: &[f64; NX], s: f64| {
+            let mut y = *x;
+            for i in 0..NX {
+                y[i] += s * k[i];
+            }
+            y
+        };
+        for n in 0..8000 {
+            let t = n as f64 * h;
+            let k1 = rate(t, &x);
+            let k2 = rate(t + h / 2.0, &add(&x, &k1, h / 2.0));
+            let k3 = rate(t + h / 2.0, &add(&x, &k2, h / 2.0));
+            let k4 = rate(t + h, &add(&x, &k3, h));
+            for i in 0..NX {
+                x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
+        assert_eq!(fmi2DoStep(cs, 0.0, 4e-3, fmi2True), fmi2OK);
+        let (_, me) = get_reals(c, &[vr::F_ACT, vr::P1, vr::P2]);
+        let (_, co) = get_reals(cs, &[vr::F_ACT, vr::P1, vr::P2]);
+        assert!((me[0] - co[0]).abs() < 1e-4, "F_act {} vs {}", me[0], co[0]);
+        assert!(
+            (me[1] - co[1]).abs() < 1.0 && (me[2] - co[2]).abs() < 1.0,
+            "{me:?} vs {co:?}"
+        );
+        free(c);
+        free(cs);
+    }
+}
+
+#[test]
+fn a_stopper_moved_in_event_mode_jumps_the_pressures_as_in_co_simulation_and_is_reported() {
+    let sink = Sink::default();
+    unsafe {
+        let c = running(&sink, 2.5, 0.054);
+        let cs = instantiate(&sink, "cs");
+        initialise(cs, None, &[], 2.5, 0.054);
+        assert_eq!(fmi2EnterEventMode(c), fmi2OK);
+        set_inputs(c, 2.5, 0.06);
+        set_inputs(cs, 2.5, 0.06);
+        let mut info = fmi2EventInfo::default();
+        assert_eq!(fmi2NewDiscreteStates(c, &mut info), fmi2OK);
+        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2True);
+        assert_eq!(info.newDiscreteStatesNeeded, fmi2False);
+        assert_eq!(fmi2NewDiscreteStates(c, &mut info), fmi2OK);
+        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2False, "reported once");
+        assert_eq!(outputs(c), outputs(cs));
+        // outside the cylinder: refused, nothing moved
+        let before = states(c);
+        let from = sink.len();
+        assert_eq!(fmi2SetReal(c, &vr::X_S, 1, &0.2), fmi2Error);
+        assert!(
+            last_error(&sink, from).contains("x_s = 0.2 m"),
+            "{}",
+            last_error(&sink, from)
+        );
+        assert_eq!(states(c), before);
+        free(c);
+        free(cs);
+    }
+}
+
+#[test]
+fn an_effect_with_a_memory_is_refused_in_model_exchange_by_name_and_stays_in_co_simulation() {
+    let sink = Sink::default();
+    unsafe {
+        for (parameter, value, effect) in [
+            (vr::COMMAND_DELAY, 2e-3, "transport_delay"),
+            (vr::HYSTERESIS_WIDTH, 1e-5, "jet_pipe_hysteresis"),
+            (vr::FORCE_SENSOR_LAG, 1e-3, "the transducers' lags"),
+            (vr::FRICTION_COULOMB, 1.0, "piston_friction"),
+            (vr::PORT_LINE_VOLUME_1, 1e-6, "the gas volumes behind restrictions"),
+        ] {
+            let c = instantiate_model_exchange(&sink, "me");
+            assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+            let from = sink.len();
+            assert_eq!(fmi2SetReal(c, &parameter, 1, &value), fmi2Error);
+            let e = last_error(&sink, from);
+            assert!(
+                e.starts_with("fmi2SetReal: ") && e.contains(effect) && e.contains("Model Exchange does not have"),
+                "{e}"
+            );
+            // not applied: initialisation ends with the thesis model
+            assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+            free(c);
+            // Co-Simulation takes it (the gas volume needs its restriction)
+            let cs = instantiate(&sink, "cs");
+            let mut params = vec![(parameter, value)];
+            if parameter == vr::PORT_LINE_VOLUME_1 {
+                params.push((vr::PORT_RESTRICTION_AREA_1, 1e-6));
+            }
+            initialise(cs, None, &params, 2.5, 0.054);
+            assert_eq!(fmi2DoStep(cs, 0.0, 1e-3, fmi2True), fmi2OK);
+            free(cs);
+        }
+        // a term without a memory (here a dead volume) is Model Exchange's as well
+        let c = instantiate_model_exchange(&sink, "me");
+        initialise(c, None, &[(vr::DEAD_VOLUME_1, 2e-6)], 2.5, 0.054);
+        assert_eq!(layer_state(c), State::EventMode);
+        free(c);
+    }
+}
+
+#[test]
+fn fmu_states_keep_the_continuous_states_and_the_interface() {
+    let sink = Sink::default();
+    unsafe {
+        let c = running(&sink, 2.5, 0.054);
+        let moved = [0.11, 1.4e-4, 0.01, -20.0, 4.0e5, 2.0e5];
+        assert_eq!(fmi2SetContinuousStates(c, moved.as_ptr(), NX), fmi2OK);
+        assert_eq!(fmi2SetTime(c, 0.125), fmi2OK);
+        let mut p: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut p), fmi2OK);
+        let mut size = 0;
+        assert_eq!(fmi2SerializedFMUstateSize(c, p, &mut size), fmi2OK);
+        let mut bytes = vec![0 as fmi2Byte; size];
+        assert_eq!(fmi2SerializeFMUstate(c, p, bytes.as_mut_ptr(), size), fmi2OK);
+        // elsewhere, then back
+        assert_eq!(fmi2EnterEventMode(c), fmi2OK);
+        set_inputs(c, 4.0, 0.05);
+        let mut q: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut q), fmi2OK);
+        assert_eq!(fmi2SetFMUstate(c, q), fmi2OK);
+        assert_eq!(layer_state(c), State::ContinuousTimeMode);
+        assert_eq!(states(c), moved);
+        assert_eq!(model_time(c), 0.125);
+        let (_, inputs) = get_reals(c, &[vr::V_DA, vr::X_S]);
+        assert_eq!(inputs, vec![2.5, 0.054]);
+        // a Co-Simulation instance refuses it, and a Model Exchange instance a Co-Simulation one
+        let cs = instantiate(&sink, "cs");
+        let from = sink.len();
+        assert_eq!(fmi2SetFMUstate(cs, q), fmi2Error);
+        assert!(
+            last_error(&sink, from).contains("taken from a Model Exchange instance"),
+            "{}",
+            last_error(&sink, from)
+        );
+        let mut r: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(cs, &mut r), fmi2OK);
+        assert_eq!(fmi2SetFMUstate(c, r), fmi2Error);
+        for mut s in [p, q, r] {
+            assert_eq!(fmi2FreeFMUstate(c, &mut s), fmi2OK);
+        }
+        free(c);
+        free(cs);
+    }
+}
+
+#[test]
+fn wrong_lengths_null_arrays_and_non_states_are_errors_that_change_nothing() {
+    let sink = Sink::default();
+    unsafe {
+        let c = running(&sink, 2.5, 0.054);
+        let before = states(c);
+        let mut x = [0.0; NX + 1];
+        let mut z = [0.0; NZ];
+        let cases: [(&str, fmi2Status, &str); 7] = [
+            (
+                "nx",
+                fmi2GetContinuousStates(c, x.as_mut_ptr(), NX + 1),
+                "nx = 7, but the model description declares 6",
+            ),
+            (
+                "ni",
+                fmi2GetEventIndicators(c, z.as_mut_ptr(), NZ - 1),
+                "ni = 6, but the model description declares 7",
+            ),
+            ("NULL", fmi2GetDerivatives(c, null_mut(), NX), "is NULL"),
+            ("NULL x", fmi2SetContinuousStates(c, null(), NX), "x[] is NULL"),
+            (
+                "NaN",
+                {
+                    let mut y = before;
+                    y[2] = f64::NAN;
+                    fmi2SetContinuousStates(c, y.as_ptr(), NX)
+                },
+                "x[2] = NaN is not finite",
+            ),
+            (
+                "P1 <= 0",
+                {
+                    let mut y = before;
+                    y[4] = 0.0;
+                    fmi2SetContinuousStates(c, y.as_ptr(), NX)
+                },
+                "x[4] = 0 Pa is not an absolute pressure of P1",
+            ),
+            ("time", fmi2SetTime(c, f64::INFINITY), "time = inf is not finite"),
+        ];
+        for (what, status, needle) in cases {
+            assert_eq!(status, fmi2Error, "{what}");
+            assert!(
+                sink.since(0)
+                    .iter()
+                    .any(|m| m.status == fmi2Error && m.message.contains(needle)),
+                "{what}: no message with {needle:?}"
+            );
+        }
+        assert_eq!(states(c), before);
+        assert_eq!(fmi2GetEventIndicators(c, z.as_mut_ptr(), NZ), fmi2OK);
+        // P1 above the floor; the supply and return flows forward
+        assert!(
+            z[0] > 0.0 && z[2] > 0.0 && z[3] > 0.0 && z[4] > 0.0 && z[5] > 0.0,
+            "{z:?}"
+        );
+        // Co-Simulation calls are illegal here, with the interface in the message
+        let from = sink.len();
+        assert_eq!(fmi2DoStep(c, 0.0, 1e-3, fmi2True), fmi2Error);
+        assert!(last_error(&sink, from).contains("fmi2DoStep: illegal call in state continuousTimeMode"));
+        free(c);
+    }
+}
+
+#[test]
+fn an_x_s_outside_the_cylinder_set_during_initialisation_starts_at_the_last_valid_one_and_refuses_derivatives_until_corrected(
+) {
+    let sink = Sink::default();
+    unsafe {
+        let c = instantiate_model_exchange(&sink, "me");
+        assert_eq!(fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+        set_inputs(c, 2.5, 0.0);
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+        let reference = running(&sink, 2.5, 0.054);
+        assert_eq!(states(c), states(reference));
+        let from = sink.len();
+        let mut dx = [0.0; NX];
+        assert_eq!(fmi2GetDerivatives(c, dx.as_mut_ptr(), NX), fmi2Error);
+        let e = last_error(&sink, from);
+        assert!(
+            e.contains("x_s = 0 m") && e.contains("set a valid x_s in event mode"),
+            "{e}"
+        );
+        set_inputs(c, 2.5, 0.054);
+        assert_eq!(derivatives(c), derivatives(reference));
+        free(c);
+        free(reference);
+    }
+}
