@@ -11,13 +11,15 @@ record_results diagnosis_recordings "Diagnosis of the synthetic bench's recordin
 cargo build --release --bin jetpipe --bin benchgen
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-./target/release/benchgen --out "$work/friction.csv" --seed 7 --friction-coulomb 2.0 >/dev/null
-./target/release/benchgen --out "$work/supply.csv" --seed 107 --supply-resistance 5e8 >/dev/null
-./target/release/benchgen --out "$work/hysteresis_and_friction.csv" --seed 109 --hysteresis-width 0.12e-3 --friction-coulomb 2 >/dev/null
+# Copies of the programs: a build during the run (cargo in another shell) does not change them.
+cp target/release/jetpipe target/release/benchgen "$work/"
+"$work/benchgen" --out "$work/friction.csv" --seed 7 --friction-coulomb 2.0 >/dev/null
+"$work/benchgen" --out "$work/supply.csv" --seed 107 --supply-resistance 5e8 >/dev/null
+"$work/benchgen" --out "$work/hysteresis_and_friction.csv" --seed 109 --hysteresis-width 0.12e-3 --friction-coulomb 2 >/dev/null
 if [ "${JETPIPE_BENCH_UNDECLARED:-1}" != 0 ]; then
-    ./target/release/benchgen --out "$work/list.txt" --list-undeclared > "$work/names.txt"
+    "$work/benchgen" --out "$work/list.txt" --list-undeclared > "$work/names.txt"
     for name in $(awk '{print $1}' "$work/names.txt"); do
-        ./target/release/benchgen --out "$work/u_$name.csv" --seed 7 --undeclared "$name" >/dev/null
+        "$work/benchgen" --out "$work/u_$name.csv" --seed 7 --undeclared "$name" >/dev/null
     done
 fi
 echo "| recording | verdict | named | discovered (location, family: parameters) | held-out before → after (N) | wall (s) on $(nproc) cores |"
@@ -25,7 +27,7 @@ echo "|---|---|---|---|---|---|"
 for rec in "$work"/*.csv ../shared/bench/rec_0*.csv ../shared/bench/undeclared/*.csv; do
     [ -f "$rec" ] || continue
     start=$(date +%s%N)
-    ./target/release/jetpipe diagnose "$rec" --report "$work/report.json" >/dev/null 2>&1
+    "$work/jetpipe" diagnose "$rec" --report "$work/report.json" >/dev/null 2>&1
     end=$(date +%s%N)
     ms=$(( (end - start) / 1000000 ))
     row=$(python3 - "$work/report.json" <<'PY'

@@ -16,6 +16,8 @@ seconds="${1:-40}"
 cargo build --release --bin jetpipe --bin benchgen >/dev/null 2>&1
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
+# Copies of the programs: a build during the run (cargo in another shell) does not change them.
+cp target/release/jetpipe target/release/benchgen "$work/"
 
 # name|benchgen protocol options
 protocols=(
@@ -108,9 +110,9 @@ for p in "${plist[@]}"; do
         chosen "$mname" "${JETPIPE_BENCH_MECHANISMS:-}" || continue
         rec="$work/${pname}_${mname}.csv"
         # shellcheck disable=SC2086
-        ./target/release/benchgen --out "$rec" --seed 5 --duration "$seconds" $popts $mopts >/dev/null 2>&1
+        "$work/benchgen" --out "$rec" --seed 5 --duration "$seconds" $popts $mopts >/dev/null 2>&1
         start=$(date +%s%N)
-        ./target/release/jetpipe diagnose "$rec" --report "$work/report.json" >/dev/null 2>&1 || true
+        "$work/jetpipe" diagnose "$rec" --report "$work/report.json" >/dev/null 2>&1 || true
         end=$(date +%s%N)
         ms=$(((end - start) / 1000000))
         row=$(python3 - "$work/report.json" "$mloc" "$mfam" <<'PY'

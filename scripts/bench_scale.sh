@@ -10,14 +10,16 @@ cd "$(dirname "$0")/.."
 source scripts/results.sh
 record_results diagnosis_scale "Diagnosis time and memory against the recording's length" "$@"
 cargo build --release --bin jetpipe --bin benchgen
-jetpipe="${JETPIPE_SCALE_JETPIPE:-./target/release/jetpipe}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
+# Copies of the programs: a build during the run (cargo in another shell) does not change them.
+cp target/release/jetpipe target/release/benchgen "$work/"
+jetpipe="${JETPIPE_SCALE_JETPIPE:-$work/jetpipe}"
 echo "| length (s) | samples | rows fitted | wall (s) | CPU (s) | peak memory (MB) | verdict | held-out after / noise floor |"
 echo "|---|---|---|---|---|---|---|---|"
 for duration in ${JETPIPE_SCALE_DURATIONS:-80 600 3600}; do
     rec="$work/staircase_${duration}s.csv"
-    ./target/release/benchgen --out "$rec" --protocol staircase --duration "$duration" --seed 3 \
+    "$work/benchgen" --out "$rec" --protocol staircase --duration "$duration" --seed 3 \
         --undeclared return_back_pressure >/dev/null
     /usr/bin/time -v "$jetpipe" diagnose "$rec" --report "$work/report.json" --jobs 2 \
         >/dev/null 2>"$work/time.txt"

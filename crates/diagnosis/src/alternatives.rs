@@ -68,6 +68,7 @@ impl Check<'_> {
             heldout_after: force,
             share: 1.0 - (force / before).powi(2),
             pressures_heldout: None,
+            tied_locations: vec![],
         }
     }
 }

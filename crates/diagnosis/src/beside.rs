@@ -198,6 +198,7 @@ pub(crate) fn best_beside_earlier(
         heldout_after: after,
         share: 1.0 - (after / force_before).powi(2),
         pressures_heldout: None,
+        tied_locations: vec![],
     };
     Ok(Some((term, trial)))
 }

@@ -126,6 +126,7 @@ mod tests {
             time,
             v_da,
             full_rate: None,
+            fast_replay_step: crate::replay::MAX_FAST_STEP,
         }
     }
 

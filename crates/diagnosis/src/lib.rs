@@ -19,6 +19,7 @@
 //! The recordings themselves are [`recording`]; [`replay`](mod@replay) runs their inputs
 //! through the model (crate `jetpipe-model`).
 
+pub mod agreement;
 mod alternatives;
 mod beside;
 pub mod blocks;
@@ -63,6 +64,9 @@ use localize::{
 pub const BLOCK_SECONDS: f64 = 2.0;
 /// The verdict is "explained" when the held-out force error is within this many noise floors.
 pub const EXPLAINED_WITHIN_NOISE: f64 = 1.5;
+
+/// The most places a report names as not told apart (`tied_locations`).
+pub const MOST_TIED_LOCATIONS: usize = 3;
 /// A named effect must lower the held-out force error by this fraction…
 pub const MIN_RELATIVE_GAIN: f64 = 0.1;
 /// …and by at least this many noise floors (the pressures' judgement, in their RMS).
@@ -260,6 +264,20 @@ impl Localization {
         ))
     }
 
+    /// The places a term added at `added` cannot be told apart from on this recording
+    /// ([`Self::alternatives`] and the located place), `added` first and at most three in
+    /// all; empty when the recording tells the place.
+    pub fn tied_with(&self, added: &'static str) -> Vec<&'static str> {
+        let others: Vec<&'static str> = std::iter::once(self.location)
+            .chain(self.alternatives())
+            .filter(|l| *l != added)
+            .collect();
+        if others.is_empty() {
+            return vec![];
+        }
+        std::iter::once(added).chain(others).take(MOST_TIED_LOCATIONS).collect()
+    }
+
     /// Places that explain nearly as much as the best: they leave at most a quarter more
     /// of the held-out misfit than it does. Measured on what is left, not on the share
     /// explained: where the model is far off, 99 % explained can leave seven noise floors
@@ -320,6 +338,9 @@ pub struct DiscoveredTerm {
     /// For a term on the pressure transducers, which the force does not see: the held-out
     /// RMS of each pressure, Pa, before and after.
     pub pressures_heldout: Option<([f64; 2], [f64; 2])>,
+    /// The places this recording cannot tell the term's from, its own first (at most
+    /// [`MOST_TIED_LOCATIONS`]); empty when it tells the place.
+    pub tied_locations: Vec<&'static str>,
 }
 
 /// What is left when the verdict is not "explained".
@@ -367,6 +388,8 @@ pub struct Diagnosis {
     /// diagnosis started from: taken out again, so that the report never hands back a worse
     /// model than it was given.
     pub withdrawn: Option<Withdrawn>,
+    /// The fits' fixed-step replay against the error-controlled one, and the step they used.
+    pub fast_replay: agreement::FastReplayCheck,
 }
 
 pub use withdraw::Withdrawn;
@@ -730,9 +753,19 @@ pub fn diagnose_with(
 ) -> Result<Diagnosis, String> {
     // 1. The file's checks and the noise floors.
     let mut input_checks = checks::check_file(recording, base)?;
-    let smoothed = recording.with_stopper_smoothed();
-    let fitted = smoothed.rows_for_fits(recording::MAX_FIT_ROWS);
+    let mut smoothed = recording.with_stopper_smoothed();
     let before_model = Actuator::new(base.clone())?;
+    // The fits' fixed-step replay, checked against the error-controlled one of the starting
+    // model, which the verdict compares the final model with.
+    progress("the starting model replayed with the error-controlled integrator");
+    let before_accurate = replay(&before_model, &smoothed, 1e-5, smoothed.len())?;
+    let fast_replay = agreement::fast_step_that_agrees(&before_model, &smoothed, &before_accurate)?;
+    smoothed.fast_replay_step = fast_replay.step;
+    if let Some(sentence) = fast_replay.sentence() {
+        progress(&sentence);
+        input_checks.push(sentence);
+    }
+    let fitted = smoothed.rows_for_fits(recording::MAX_FIT_ROWS);
     let cx = Context::measure(&smoothed, &fitted, &before_model, options, &mut input_checks, progress)?;
     let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
     input_checks.extend(checks::check_against_model(
@@ -755,7 +788,7 @@ pub fn diagnose_with(
     // 6. The verdict, from the accurate replays.
     conclude(
         &cx,
-        before_model,
+        (before_model, before_accurate, fast_replay),
         found,
         joint_refit,
         input_checks,
@@ -909,7 +942,7 @@ fn retire_switched_off(found: &mut rounds::Findings, progress: &mut dyn FnMut(&s
 /// The final accurate replays, the verdict (step 6) and the tests of the residual.
 fn conclude(
     cx: &Context,
-    before_model: Actuator,
+    (before_model, before, fast_replay): (Actuator, Replay, agreement::FastReplayCheck),
     found: rounds::Findings,
     joint_refit: Option<(f64, f64)>,
     input_checks: Vec<String>,
@@ -922,12 +955,7 @@ fn conclude(
     progress("final replays with the error-controlled integrator");
     let final_model = Actuator::new(found.params.clone())?;
     let n = full.len();
-    let (before, after) = std::thread::scope(|scope| {
-        let b = scope.spawn(|| replay(&before_model, full, 1e-5, n));
-        let a = replay(&final_model, full, 1e-5, n);
-        (b.join().unwrap_or_else(|_| Err("replay panicked".to_string())), a)
-    });
-    let (before, after) = (before?, after?);
+    let after = replay(&final_model, full, 1e-5, n)?;
     let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
     let full_blocks = match thinned {
         Some(_) => blocks::blocks(&full.time, cx.settled_from),
@@ -1012,6 +1040,7 @@ fn conclude(
         after_force: after.force,
         replays,
         withdrawn,
+        fast_replay,
     })
 }
 

@@ -365,6 +365,7 @@ pub(crate) fn best_pair(
         heldout_after: after,
         share,
         pressures_heldout: None,
+        tied_locations: vec![],
     };
     Ok(Some((vec![term(a, set_a), term(b, set_b)], trial)))
 }

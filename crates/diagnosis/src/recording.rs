@@ -17,6 +17,10 @@ pub struct Recording {
     /// the inputs at every sample of the longer one, which the replays integrate, and which of
     /// its samples the rows are. `None` for a recording as read.
     pub full_rate: Option<std::sync::Arc<FullRateInputs>>,
+    /// The longest step of the fixed-step replays the fits use ([`crate::replay::replay_fast`]):
+    /// [`crate::replay::MAX_FAST_STEP`], or shorter where that replay departs from the
+    /// error-controlled one ([`crate::replay::fast_step_that_agrees`]).
+    pub fast_replay_step: f64,
 }
 
 /// The inputs of a recording at every sample, and the samples a thinned view keeps.
@@ -138,6 +142,7 @@ impl Recording {
                 x_s: self.x_s.clone(),
                 rows,
             })),
+            fast_replay_step: self.fast_replay_step,
         }
     }
 
@@ -292,6 +297,7 @@ impl Recording {
             p1: has_pressures.then_some(p1),
             p2: has_pressures.then_some(p2),
             full_rate: None,
+            fast_replay_step: crate::replay::MAX_FAST_STEP,
         })
     }
 }

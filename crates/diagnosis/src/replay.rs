@@ -195,7 +195,7 @@ pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, hel
         }
         sim.set_command(v_da[k])?;
         // the stopper moves linearly between samples
-        let parts = ((t[k + 1] - t[k]) / MAX_FAST_STEP).ceil().max(1.0) as usize;
+        let parts = ((t[k + 1] - t[k]) / recording.fast_replay_step).ceil().max(1.0) as usize;
         sim.step_to_in_parts(t[k + 1], x_s[k + 1], parts)
             .map_err(|e| describe(e, k + 1))?;
     }
@@ -243,6 +243,7 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
+            fast_replay_step: crate::replay::MAX_FAST_STEP,
         }
     }
 

@@ -161,6 +161,7 @@ impl Diagnosis {
                 "share_of_heldout_explained": d.share,
                 "pressures_heldout_before_rms_Pa": d.pressures_heldout.map(|(b, _)| b.to_vec()),
                 "pressures_heldout_after_rms_Pa": d.pressures_heldout.map(|(_, a)| a.to_vec()),
+                "tied_locations": d.tied_locations,
             })).collect::<Vec<_>>(),
             "calibrated": self.calibrated.iter().map(|c| (c.name.to_string(), json!({
                 "value": c.value,
@@ -191,6 +192,13 @@ impl Diagnosis {
                 "whole_with_rms_N": w.whole_with,
             })),
             "replays": self.replays,
+            "fast_replay": {
+                "step_s": self.fast_replay.step,
+                "force_departure_rms_N": self.fast_replay.force_departure,
+                "force_departure_ratio_to_noise": self.fast_replay.force_ratio,
+                "pressure_departure_rms_Pa": self.fast_replay.pressure_departure.map(|p| p.to_vec()),
+                "agrees": self.fast_replay.agrees,
+            },
         });
         let object = report.as_object_mut().expect("a JSON object");
         if let Some(p) = self.pressure_noise {
@@ -205,6 +213,11 @@ impl Diagnosis {
                     "location": u.location,
                     "family": u.family,
                     "alternatives": u.alternatives,
+                    "tied_locations": if u.alternatives.is_empty() || u.location == "unknown" {
+                        vec![]
+                    } else {
+                        std::iter::once(u.location).chain(u.alternatives.iter().copied()).take(MOST_TIED_LOCATIONS).collect::<Vec<_>>()
+                    },
                     "signature": u.signature.to_json("N"),
                     "sentence": u.sentence,
                     "channel": if self.force_explained() { "pressures" } else { "force" },

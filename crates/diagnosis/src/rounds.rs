@@ -667,6 +667,7 @@ fn discover_term(
                 heldout_after: after,
                 share: 1.0 - (after / force_before).powi(2),
                 pressures_heldout: pressures,
+                tied_locations: found.tied_with(candidate.location),
             };
             return Ok(Some((term, trial, s.clone())));
         }
@@ -856,6 +857,7 @@ mod tests {
             heldout_after: 0.5,
             share: 0.75,
             pressures_heldout: None,
+            tied_locations: vec![],
         }
     }
 

@@ -88,6 +88,7 @@ mod tests {
                 heldout_after: 0.09,
                 share: 0.2,
                 pressures_heldout: None,
+                tied_locations: vec![],
             }],
             first_candidates: vec![],
             localization: None,
