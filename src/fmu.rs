@@ -174,8 +174,12 @@ pub static MODEL_INFO: ModelInfo = ModelInfo {
     guid_cache: GuidCache::new(),
 };
 
-/// Model Exchange: the six states of (4.1) and the event indicators of
+/// Model Exchange: the eleven states (the six of (4.1), the volumes' pressures and the mount's
+/// load) and the event indicators of
 /// the private module `model_exchange`.
+// The state vector of `model_exchange` is the model description's.
+const _: () = assert!(model_exchange::STATES == CONTINUOUS_STATES.len());
+
 pub static MODEL_EXCHANGE: ModelExchangeInfo = ModelExchangeInfo {
     states: &CONTINUOUS_STATES,
     event_indicators: model_exchange::EVENT_INDICATORS,
@@ -248,7 +252,7 @@ impl ActuatorFmu {
         if let Some(x) = self.me_real(value_reference) {
             return Ok(x);
         }
-        if (me_vr::X_JP_VELOCITY..=me_vr::DER_P2).contains(&value_reference) {
+        if (me_vr::FIRST..=me_vr::LAST).contains(&value_reference) {
             let computed;
             let simulation = match &self.simulation {
                 Some(s) => s,
@@ -260,6 +264,7 @@ impl ActuatorFmu {
             return model_exchange::state_variable(
                 simulation.model(),
                 simulation.state(),
+                &model_exchange::nodes_of(simulation),
                 simulation.v_da(),
                 simulation.x_s(),
                 value_reference,

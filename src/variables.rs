@@ -314,6 +314,19 @@ pub mod me_vr {
     pub const DER_X_JP_ACCELERATION: u32 = 905;
     pub const DER_P1: u32 = 906;
     pub const DER_P2: u32 = 907;
+    pub const P_SUPPLY_PLENUM: u32 = 908;
+    pub const P_RETURN_PLENUM: u32 = 909;
+    pub const P_PORT_LINE_1: u32 = 910;
+    pub const P_PORT_LINE_2: u32 = 911;
+    pub const STOPPER_MOUNT_LOAD: u32 = 912;
+    pub const DER_P_SUPPLY_PLENUM: u32 = 913;
+    pub const DER_P_RETURN_PLENUM: u32 = 914;
+    pub const DER_P_PORT_LINE_1: u32 = 915;
+    pub const DER_P_PORT_LINE_2: u32 = 916;
+    pub const DER_STOPPER_MOUNT_LOAD: u32 = 917;
+    /// The first and the last of them.
+    pub const FIRST: u32 = X_JP_VELOCITY;
+    pub const LAST: u32 = DER_STOPPER_MOUNT_LOAD;
 }
 
 /// A continuous local of Model Exchange.
@@ -333,8 +346,10 @@ const fn local(name: &'static str, value_reference: u32, unit: &'static str, des
 }
 
 /// The continuous states of Model Exchange and their derivatives, after the table's rows: the
-/// six states of (4.1), [i, x_jp, ẋ_jp, ẍ_jp, P1, P2] (i, x_jp, P1 and P2 are outputs).
-pub const MODEL_EXCHANGE_VARIABLES: [Variable; 8] = [
+/// six states of (4.1), [i, x_jp, ẋ_jp, ẍ_jp, P1, P2] (i, x_jp, P1 and P2 are outputs), then
+/// the pressures of the gas volumes behind restrictions and the lagging stopper mount's load
+/// (each constant, its derivative 0, while its effect is off).
+pub const MODEL_EXCHANGE_VARIABLES: [Variable; 18] = [
     local(
         "x_jp_velocity",
         me_vr::X_JP_VELOCITY,
@@ -373,16 +388,61 @@ pub const MODEL_EXCHANGE_VARIABLES: [Variable; 8] = [
         "Pa/s",
         "rate of the chamber 2 pressure, (2.29)",
     ),
+    local(
+        "p_supply_plenum",
+        me_vr::P_SUPPLY_PLENUM,
+        "Pa",
+        "pressure in the supply plenum behind its restriction (a state of Model Exchange; constant without supply_plenum_volume)",
+    ),
+    local(
+        "p_return_plenum",
+        me_vr::P_RETURN_PLENUM,
+        "Pa",
+        "pressure in the return plenum behind its restriction (a state of Model Exchange; constant without return_plenum_volume)",
+    ),
+    local(
+        "p_port_line_1",
+        me_vr::P_PORT_LINE_1,
+        "Pa",
+        "pressure in port line 1 behind its restriction (a state of Model Exchange; constant without port_line_volume_1)",
+    ),
+    local(
+        "p_port_line_2",
+        me_vr::P_PORT_LINE_2,
+        "Pa",
+        "pressure in port line 2 behind its restriction (a state of Model Exchange; constant without port_line_volume_2)",
+    ),
+    local(
+        "stopper_mount_load",
+        me_vr::STOPPER_MOUNT_LOAD,
+        "Pa",
+        "the pressure difference the lagging stopper mount has followed (a state of Model Exchange; constant without stopper_mount_lag)",
+    ),
+    local("der(p_supply_plenum)", me_vr::DER_P_SUPPLY_PLENUM, "Pa/s", "rate of the supply plenum's pressure"),
+    local("der(p_return_plenum)", me_vr::DER_P_RETURN_PLENUM, "Pa/s", "rate of the return plenum's pressure"),
+    local("der(p_port_line_1)", me_vr::DER_P_PORT_LINE_1, "Pa/s", "rate of port line 1's pressure"),
+    local("der(p_port_line_2)", me_vr::DER_P_PORT_LINE_2, "Pa/s", "rate of port line 2's pressure"),
+    local(
+        "der(stopper_mount_load)",
+        me_vr::DER_STOPPER_MOUNT_LOAD,
+        "Pa/s",
+        "rate of the lagging stopper mount's load",
+    ),
 ];
 
 /// The states' value references in the order of the state vector, with their derivatives'.
-pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 6] = [
+pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 11] = [
     state(vr::I, me_vr::DER_I),
     state(vr::X_JP, me_vr::DER_X_JP),
     state(me_vr::X_JP_VELOCITY, me_vr::DER_X_JP_VELOCITY),
     state(me_vr::X_JP_ACCELERATION, me_vr::DER_X_JP_ACCELERATION),
     state(vr::P1, me_vr::DER_P1),
     state(vr::P2, me_vr::DER_P2),
+    state(me_vr::P_SUPPLY_PLENUM, me_vr::DER_P_SUPPLY_PLENUM),
+    state(me_vr::P_RETURN_PLENUM, me_vr::DER_P_RETURN_PLENUM),
+    state(me_vr::P_PORT_LINE_1, me_vr::DER_P_PORT_LINE_1),
+    state(me_vr::P_PORT_LINE_2, me_vr::DER_P_PORT_LINE_2),
+    state(me_vr::STOPPER_MOUNT_LOAD, me_vr::DER_STOPPER_MOUNT_LOAD),
 ];
 
 const fn state(state: u32, derivative: u32) -> fmi2::model::ContinuousState {

@@ -1,7 +1,8 @@
 //! Issue 44: the actuator through the exported Model Exchange symbols. Its derivatives are the
-//! model's own, an explicit integration of them follows the Co-Simulation step, a stopper moved
-//! in event mode jumps the pressures as in Co-Simulation, the effects with a memory are refused
-//! with their names, and FMU states keep the interface and the states.
+//! model's own (also with gas volumes behind restrictions and a lagging stopper mount), an
+//! explicit integration of them follows the Co-Simulation step, a stopper moved in event mode
+//! jumps the pressures as in Co-Simulation, the effects with a memory are refused with their
+//! names, and FMU states keep the interface and the states.
 
 #[path = "common/mod.rs"]
 mod common;
@@ -16,7 +17,7 @@ use jetpipe::variables::{me_vr, vr};
 use jetpipe_model::physics::actuator::{Actuator, Inputs, State as ModelState};
 use jetpipe_model::physics::parameters::Parameters;
 
-const NX: usize = 6;
+const NX: usize = 11;
 const NZ: usize = 7;
 
 unsafe fn states(c: fmi2Component) -> [f64; NX] {
@@ -68,9 +69,13 @@ fn the_states_start_at_the_co_simulations_equilibrium_and_the_derivatives_are_th
         let dx = derivatives(c);
         assert!(dx[..4].iter().all(|d| d.abs() < 1e-9), "{dx:?}");
         assert!(dx[4].abs() < 1.0 && dx[5].abs() < 1.0, "{dx:?}");
+        // without volumes or a lagging mount the five states beyond the six stay put
+        assert_eq!(dx[6..], [0.0; 5]);
         // away from rest: Actuator::derivatives itself
         let moved = [0.12, 1.5e-4, 0.02, -30.0, 4.1e5, 1.9e5];
-        assert_eq!(fmi2SetContinuousStates(c, moved.as_ptr(), NX), fmi2OK);
+        let mut all = x;
+        all[..6].copy_from_slice(&moved);
+        assert_eq!(fmi2SetContinuousStates(c, all.as_ptr(), NX), fmi2OK);
         let v_da = 3.0;
         assert_eq!(fmi2SetReal(c, &vr::V_DA, 1, &v_da), fmi2OK);
         let model = Actuator::new(Parameters::default()).unwrap();
@@ -83,7 +88,7 @@ fn the_states_start_at_the_co_simulations_equilibrium_and_the_derivatives_are_th
                 plays: None,
             },
         );
-        assert_eq!(derivatives(c).to_vec(), expected.as_slice().to_vec());
+        assert_eq!(derivatives(c)[..6].to_vec(), expected.as_slice().to_vec());
         // the derivative variables read the same
         let (_, d) = get_reals(c, &[me_vr::DER_I, me_vr::DER_P1, me_vr::X_JP_ACCELERATION]);
         assert_eq!(d, vec![expected[0], expected[4], moved[3]]);
@@ -186,7 +191,6 @@ fn an_effect_with_a_memory_is_refused_in_model_exchange_by_name_and_stays_in_co_
             (vr::HYSTERESIS_WIDTH, 1e-5, "jet_pipe_hysteresis"),
             (vr::FORCE_SENSOR_LAG, 1e-3, "the transducers' lags"),
             (vr::FRICTION_COULOMB, 1.0, "piston_friction"),
-            (vr::PORT_LINE_VOLUME_1, 1e-6, "the gas volumes behind restrictions"),
         ] {
             let c = instantiate_model_exchange(&sink, "me");
             assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
@@ -200,13 +204,9 @@ fn an_effect_with_a_memory_is_refused_in_model_exchange_by_name_and_stays_in_co_
             // not applied: initialisation ends with the thesis model
             assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
             free(c);
-            // Co-Simulation takes it (the gas volume needs its restriction)
+            // Co-Simulation takes it
             let cs = instantiate(&sink, "cs");
-            let mut params = vec![(parameter, value)];
-            if parameter == vr::PORT_LINE_VOLUME_1 {
-                params.push((vr::PORT_RESTRICTION_AREA_1, 1e-6));
-            }
-            initialise(cs, None, &params, 2.5, 0.054);
+            initialise(cs, None, &[(parameter, value)], 2.5, 0.054);
             assert_eq!(fmi2DoStep(cs, 0.0, 1e-3, fmi2True), fmi2OK);
             free(cs);
         }
@@ -223,7 +223,8 @@ fn fmu_states_keep_the_continuous_states_and_the_interface() {
     let sink = Sink::default();
     unsafe {
         let c = running(&sink, 2.5, 0.054);
-        let moved = [0.11, 1.4e-4, 0.01, -20.0, 4.0e5, 2.0e5];
+        let mut moved = states(c);
+        moved[..6].copy_from_slice(&[0.11, 1.4e-4, 0.01, -20.0, 4.0e5, 2.0e5]);
         assert_eq!(fmi2SetContinuousStates(c, moved.as_ptr(), NX), fmi2OK);
         assert_eq!(fmi2SetTime(c, 0.125), fmi2OK);
         let mut p: fmi2FMUstate = null_mut();
@@ -275,7 +276,7 @@ fn wrong_lengths_null_arrays_and_non_states_are_errors_that_change_nothing() {
             (
                 "nx",
                 fmi2GetContinuousStates(c, x.as_mut_ptr(), NX + 1),
-                "nx = 7, but the model description declares 6",
+                "nx = 12, but the model description declares 11",
             ),
             (
                 "ni",
@@ -352,5 +353,51 @@ fn an_x_s_outside_the_cylinder_set_during_initialisation_starts_at_the_last_vali
         assert_eq!(derivatives(c), derivatives(reference));
         free(c);
         free(reference);
+    }
+}
+
+/// The gas volumes behind restrictions and the lagging stopper mount are ODEs: their states
+/// follow the states of (4.1), with the rates the Co-Simulation step integrates them with.
+#[test]
+fn the_gas_volumes_and_the_lagging_mount_are_states_with_the_co_simulations_rates() {
+    use jetpipe_model::physics::restrictions::PRESSURES_WITH_VOLUMES;
+    let sink = Sink::default();
+    let params = [
+        (vr::PORT_RESTRICTION_AREA_1, 0.5e-6),
+        (vr::PORT_LINE_VOLUME_1, 1e-6),
+        (vr::SUPPLY_RESTRICTION_AREA, 2e-6),
+        (vr::SUPPLY_PLENUM_VOLUME, 5e-6),
+        (vr::STOPPER_COMPLIANCE, 2e-5),
+        (vr::STOPPER_MOUNT_LAG, 2e-3),
+    ];
+    unsafe {
+        let c = instantiate_model_exchange(&sink, "me volumes");
+        initialise(c, None, &params, 2.5, 0.054);
+        let cs = instantiate(&sink, "cs volumes");
+        initialise(cs, None, &params, 2.5, 0.054);
+        assert_eq!(outputs(c), outputs(cs), "the same start");
+        assert_eq!(fmi2EnterContinuousTimeMode(c), fmi2OK);
+        let mut x = states(c);
+        x[4] *= 1.01;
+        x[6] *= 0.99; // the supply plenum
+        x[8] *= 1.02; // port line 1
+        assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
+        let mut p = Parameters::default();
+        for &(r, v) in &params {
+            p.set(r, v).unwrap();
+        }
+        let model = Actuator::new(p).unwrap();
+        assert!(model.has_volume_states());
+        let mut pressures = [0.0; PRESSURES_WITH_VOLUMES];
+        pressures[0] = x[4];
+        pressures[1] = x[5];
+        pressures[2..].copy_from_slice(&x[6..]);
+        let expected = model.pressure_rates_with_volumes(&model.areas(x[1]), &pressures, 0.054, 0.0);
+        let dx = derivatives(c);
+        assert_eq!(dx[4..].to_vec(), expected.to_vec());
+        assert!(dx[6] != 0.0 && dx[8] != 0.0 && dx[10] != 0.0, "{dx:?}");
+        assert_eq!(dx[7], 0.0, "no return plenum");
+        free(c);
+        free(cs);
     }
 }

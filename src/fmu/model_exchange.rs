@@ -1,7 +1,9 @@
-//! The actuator as an FMI 2.0 Model Exchange model: the six states of (4.1),
-//! [i, x_jp, ẋ_jp, ẍ_jp, P1, P2], their derivatives from `Actuator::derivatives` (the
-//! equations the Co-Simulation step integrates), and event indicators where the right-hand
-//! side is not smooth.
+//! The actuator as an FMI 2.0 Model Exchange model: eleven states, the six of (4.1),
+//! [i, x_jp, ẋ_jp, ẍ_jp, P1, P2], then the pressures of the four gas volumes behind
+//! restrictions and the lagging stopper mount's load (constant while their effects are off);
+//! their derivatives from `Actuator::derivatives` and `Actuator::pressure_rates_with_volumes`
+//! (the equations the Co-Simulation step integrates), and event indicators where the
+//! right-hand side is not smooth.
 //!
 //! What Model Exchange does not have, and why:
 //! * effects with a memory of the past, which the Co-Simulation step updates at
@@ -10,8 +12,7 @@
 //!   delays, plays and filters, and the forces that read the stopper's motion over the last
 //!   intervals) are refused, each named, when set and when initialisation ends; they stay
 //!   available in Co-Simulation;
-//! * the gas volumes behind restrictions, a lagging stopper mount and the constants that vary
-//!   in time are refused too (ODEs, not yet states of Model Exchange).
+//! * the constants that vary in time are refused too (not yet part of Model Exchange).
 //!
 //! The stopper: a new x_s set in event mode moves it at once as in Co-Simulation (the air in
 //! each chamber conserved, P V^γ constant), and `fmi2NewDiscreteStates` reports the changed
@@ -27,11 +28,35 @@ use jetpipe_model::physics::chambers::pressure_after_volume_jump;
 use jetpipe_model::physics::command_stage;
 use jetpipe_model::physics::jet_pipe;
 use jetpipe_model::physics::parameters::{table_start, variable_name, Parameters};
+use jetpipe_model::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 use jetpipe_model::physics::time_varying;
+use jetpipe_model::simulation::Simulation;
 
 /// The number of event indicators (see [`event_indicators`]).
 pub const EVENT_INDICATORS: usize = 7;
+
+/// The number of continuous states: the six of (4.1) and the [`node::STATES`] beyond them.
+pub const STATES: usize = 6 + node::STATES;
+
+/// The states beyond the six of (4.1), in the order of [`node`]: the volumes' pressures, the
+/// mount's load.
+pub(super) type Nodes = [f64; node::STATES];
+
+/// The states beyond the six of a simulation: the places' pressures (the state where a place
+/// has a volume, else its quasi-static or valve-side pressure, which stays constant in Model
+/// Exchange), the mount's load (its state when it lags, else the load it carries).
+pub(super) fn nodes_of(simulation: &Simulation) -> Nodes {
+    let mut nodes = [0.0; node::STATES];
+    nodes[..node::COUNT].copy_from_slice(&simulation.node_pressures());
+    let s = simulation.state();
+    nodes[node::MOUNT] = simulation.stopper_mount_state().unwrap_or_else(|| {
+        simulation
+            .model()
+            .mount_load(s[index::P1], s[index::P2], simulation.x_s())
+    });
+    nodes
+}
 
 /// A running Model Exchange instance: the model built when initialisation ended, the time and
 /// the states the importer set.
@@ -40,6 +65,7 @@ pub(super) struct MeState {
     model: Actuator,
     time: f64,
     x: State,
+    nodes: Nodes,
     /// Where the stopper is: the last x_s set that is inside the cylinder (see
     /// [`ActuatorFmu::exit_initialization_model_exchange`]).
     x_s: f64,
@@ -101,17 +127,6 @@ const REFUSED: &[Refused] = &[
             vr::EXTRA_FORCE_ACCELERATION,
             vr::EXTRA_FORCE_VELOCITY_SQUARED,
             vr::EXTRA_FORCE_SIGN_PRESSURE,
-        ],
-    },
-    Refused {
-        effect: "the gas volumes behind restrictions and the lagging stopper mount",
-        why: "their states are not yet states of Model Exchange",
-        parameters: &[
-            vr::SUPPLY_PLENUM_VOLUME,
-            vr::RETURN_PLENUM_VOLUME,
-            vr::PORT_LINE_VOLUME_1,
-            vr::PORT_LINE_VOLUME_2,
-            vr::STOPPER_MOUNT_LAG,
         ],
     },
     Refused {
@@ -182,7 +197,6 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
             "a transducer's memory",
         ),
         (model.reads_stopper_motion, "a force on the stopper's motion"),
-        (model.has_volume_states(), "states beyond the six of (4.1)"),
         (time_varying::varies(p), "constants that vary in time"),
     ];
     if problems.is_empty() {
@@ -228,6 +242,8 @@ fn inputs(model: &Actuator, v_da: f64, x_s: f64) -> Inputs {
 /// * z6 = sin(π x_abs/D_jp): the jet pipe crosses a tangency of the orifice geometry, where
 ///   the areas (2.8)–(2.17) stop being analytic (every multiple of D_jp).
 fn event_indicators(model: &Actuator, x: &State, x_s: f64, z: &mut [f64]) {
+    // (the places' pressures with restrictions do not reverse the flows the valve sees
+    // between them and the chambers: the same indicators)
     let p = &model.params;
     let (p1, p2) = (x[index::P1], x[index::P2]);
     let floor = model.spring_force(x_s) / model.piston_area;
@@ -244,21 +260,66 @@ fn event_indicators(model: &Actuator, x: &State, x_s: f64, z: &mut [f64]) {
     z.copy_from_slice(&values);
 }
 
+/// The rates of the [`STATES`] states: (4.1) from `Actuator::derivatives`; with gas volumes
+/// behind restrictions or a lagging mount, the pressures' from
+/// `Actuator::pressure_rates_with_volumes` (the law the Co-Simulation step integrates them
+/// with), else 0 for the states beyond the six.
+fn rates(model: &Actuator, x: &State, nodes: &Nodes, v_da: f64, x_s: f64) -> [f64; STATES] {
+    let d = model.derivatives(x, &inputs(model, v_da, x_s));
+    let mut out = [0.0; STATES];
+    out[..6].copy_from_slice(d.as_slice());
+    if model.has_volume_states() {
+        let mut p = [0.0; PRESSURES_WITH_VOLUMES];
+        p[0] = x[index::P1];
+        p[1] = x[index::P2];
+        p[2..].copy_from_slice(nodes);
+        let r = model.pressure_rates_with_volumes(&model.areas(x[index::JET_POSITION]), &p, x_s, 0.0);
+        out[index::P1..].copy_from_slice(&r);
+    }
+    out
+}
+
 /// The value of a variable of Model Exchange (a state or a derivative beyond the table's
 /// outputs) at a state; `None` for any other value reference.
-pub(super) fn state_variable(model: &Actuator, x: &State, v_da: f64, x_s: f64, value_reference: u32) -> Option<f64> {
-    let derivative = |k: usize| model.derivatives(x, &inputs(model, v_da, x_s))[k];
-    Some(match value_reference {
-        me_vr::X_JP_VELOCITY => x[index::JET_VELOCITY],
-        me_vr::X_JP_ACCELERATION => x[index::JET_ACCELERATION],
-        me_vr::DER_I => derivative(index::CURRENT),
-        me_vr::DER_X_JP => derivative(index::JET_POSITION),
-        me_vr::DER_X_JP_VELOCITY => derivative(index::JET_VELOCITY),
-        me_vr::DER_X_JP_ACCELERATION => derivative(index::JET_ACCELERATION),
-        me_vr::DER_P1 => derivative(index::P1),
-        me_vr::DER_P2 => derivative(index::P2),
-        _ => return None,
-    })
+pub(super) fn state_variable(
+    model: &Actuator,
+    x: &State,
+    nodes: &Nodes,
+    v_da: f64,
+    x_s: f64,
+    value_reference: u32,
+) -> Option<f64> {
+    let states = [
+        me_vr::P_SUPPLY_PLENUM,
+        me_vr::P_RETURN_PLENUM,
+        me_vr::P_PORT_LINE_1,
+        me_vr::P_PORT_LINE_2,
+        me_vr::STOPPER_MOUNT_LOAD,
+    ];
+    if let Some(k) = states.iter().position(|&v| v == value_reference) {
+        return Some(nodes[k]);
+    }
+    let derivatives = [
+        me_vr::DER_I,
+        me_vr::DER_X_JP,
+        me_vr::DER_X_JP_VELOCITY,
+        me_vr::DER_X_JP_ACCELERATION,
+        me_vr::DER_P1,
+        me_vr::DER_P2,
+        me_vr::DER_P_SUPPLY_PLENUM,
+        me_vr::DER_P_RETURN_PLENUM,
+        me_vr::DER_P_PORT_LINE_1,
+        me_vr::DER_P_PORT_LINE_2,
+        me_vr::DER_STOPPER_MOUNT_LOAD,
+    ];
+    if let Some(k) = derivatives.iter().position(|&v| v == value_reference) {
+        return Some(rates(model, x, nodes, v_da, x_s)[k]);
+    }
+    match value_reference {
+        me_vr::X_JP_VELOCITY => Some(x[index::JET_VELOCITY]),
+        me_vr::X_JP_ACCELERATION => Some(x[index::JET_ACCELERATION]),
+        _ => None,
+    }
 }
 
 impl ActuatorFmu {
@@ -302,6 +363,7 @@ impl ActuatorFmu {
             model: simulation.model().clone(),
             time: self.start_time,
             x: *simulation.state(),
+            nodes: nodes_of(&simulation),
             x_s: simulation.x_s(),
             states_changed: false,
         })
@@ -336,7 +398,7 @@ impl ActuatorFmu {
                     _ => y.p2_meas,
                 }
             }
-            _ => return state_variable(&me.model, x, self.v_da, me.x_s, value_reference),
+            _ => return state_variable(&me.model, x, &me.nodes, self.v_da, me.x_s, value_reference),
         })
     }
 
@@ -374,6 +436,7 @@ impl ActuatorFmu {
                 w.bool(true);
                 w.f64(me.time);
                 w.f64s(me.x.as_slice());
+                w.f64s(&me.nodes);
                 w.f64(me.x_s);
                 w.bool(me.states_changed);
             }
@@ -391,9 +454,17 @@ impl ActuatorFmu {
         if r.bool("modelExchangeRunning")? {
             let time = r.f64()?;
             let values = r.f64s_at_most(6, "continuous states")?;
-            if values.len() != 6 {
-                return Err(format!("{} continuous states, not 6", values.len()));
+            let node_values = r.f64s_at_most(node::STATES, "states beyond the six")?;
+            if values.len() != 6 || node_values.len() != node::STATES {
+                return Err(format!(
+                    "{} + {} continuous states, not 6 + {}",
+                    values.len(),
+                    node_values.len(),
+                    node::STATES
+                ));
             }
+            let mut nodes = [0.0; node::STATES];
+            nodes.copy_from_slice(&node_values);
             let x_s = r.f64()?;
             restored.params.check_stopper(x_s)?;
             let states_changed = r.bool("statesChanged")?;
@@ -401,6 +472,7 @@ impl ActuatorFmu {
                 model: Actuator::new(restored.params.clone())?,
                 time,
                 x: State::from_column_slice(&values),
+                nodes,
                 x_s,
                 states_changed,
             });
@@ -421,7 +493,9 @@ impl ModelExchangeModel for ActuatorFmu {
     }
 
     fn continuous_states(&self, x: &mut [f64]) -> Result<(), String> {
-        x.copy_from_slice(self.me_view()?.x.as_slice());
+        let me = self.me_view()?;
+        x[..6].copy_from_slice(me.x.as_slice());
+        x[6..].copy_from_slice(&me.nodes);
         Ok(())
     }
 
@@ -439,14 +513,15 @@ impl ModelExchangeModel for ActuatorFmu {
                 ));
             }
         }
-        me.x = State::from_column_slice(x);
+        me.x = State::from_column_slice(&x[..6]);
+        me.nodes.copy_from_slice(&x[6..]);
         Ok(())
     }
 
     fn derivatives(&self, dx: &mut [f64]) -> Result<(), String> {
         let me = self.me_view()?;
         self.check_stopper_set(&me)?;
-        let d = me.model.derivatives(&me.x, &inputs(&me.model, self.v_da, me.x_s));
+        let d = rates(&me.model, &me.x, &me.nodes, self.v_da, me.x_s);
         if let Some(k) = d.iter().position(|v| !v.is_finite()) {
             return Err(format!(
                 "the derivative of state {k} is {} at the states {:?}",
@@ -454,7 +529,7 @@ impl ModelExchangeModel for ActuatorFmu {
                 me.x.as_slice()
             ));
         }
-        dx.copy_from_slice(d.as_slice());
+        dx.copy_from_slice(&d);
         Ok(())
     }
 
@@ -467,12 +542,13 @@ impl ModelExchangeModel for ActuatorFmu {
 
     fn nominals(&self, nominals: &mut [f64]) {
         // The scales of the Co-Simulation's tolerances: 0.1 A, 0.1 mm and its natural-frequency
-        // derivatives, 1 bar.
+        // derivatives, 1 bar (also for the volumes' pressures and the mount's load).
         let scales = match Actuator::new(self.params.clone()) {
             Ok(model) => model.state_scales(),
             Err(_) => Actuator::new(Parameters::default()).map_or(State::repeat(1.0), |m| m.state_scales()),
         };
-        nominals.copy_from_slice(scales.as_slice());
+        nominals[..6].copy_from_slice(scales.as_slice());
+        nominals[6..].iter_mut().for_each(|n| *n = scales[index::P1]);
     }
 
     fn new_discrete_states(&mut self) -> Result<EventUpdate, String> {

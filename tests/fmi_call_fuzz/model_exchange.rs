@@ -25,7 +25,7 @@ use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 
-const NX: usize = 6;
+const NX: usize = 11;
 const NZ: usize = 7;
 
 /// The states a Model Exchange instance reaches.
@@ -50,7 +50,7 @@ pub unsafe fn call(c: fmi2Component, f: Function, valid: bool) -> (String, fmi2S
         }
         Function::SetContinuousStates => {
             if fmi2GetContinuousStates(c, x.as_mut_ptr(), NX) != fmi2OK {
-                x = [0.1, 1e-4, 0.0, 0.0, 3e5, 2e5];
+                x = [0.1, 1e-4, 0.0, 0.0, 3e5, 2e5, 6e5, 1e5, 3e5, 2e5, 1e5];
             }
             if valid {
                 x[4] *= 1.0 + 1e-6;
@@ -92,9 +92,9 @@ pub unsafe fn call(c: fmi2Component, f: Function, valid: bool) -> (String, fmi2S
                 _ => fmi2GetNominalsOfContinuousStates,
             };
             if valid {
-                (format!("{}(nx 6)", f.name()), get(c, x.as_mut_ptr(), NX))
+                (format!("{}(nx {NX})", f.name()), get(c, x.as_mut_ptr(), NX))
             } else if x.as_ptr() as usize % 16 == 0 {
-                (format!("{}(nx 7)", f.name()), get(c, z.as_mut_ptr(), NZ))
+                (format!("{}(nx {NZ})", f.name()), get(c, z.as_mut_ptr(), NZ))
             } else {
                 (format!("{}(NULL)", f.name()), get(c, null_mut(), NX))
             }
@@ -107,7 +107,7 @@ pub unsafe fn call(c: fmi2Component, f: Function, valid: bool) -> (String, fmi2S
                 )
             } else {
                 (
-                    "fmi2GetEventIndicators(ni 6)".into(),
+                    "fmi2GetEventIndicators(ni 11)".into(),
                     fmi2GetEventIndicators(c, x.as_mut_ptr(), NX),
                 )
             }
