@@ -401,3 +401,48 @@ fn the_gas_volumes_and_the_lagging_mount_are_states_with_the_co_simulations_rate
         free(cs);
     }
 }
+
+/// A benchmark, not a test (`cargo test --release --test model_exchange -- --ignored
+/// --nocapture`): right-hand-side evaluations per second through the exported
+/// `fmi2SetContinuousStates` + `fmi2GetDerivatives`, as an importer's solver calls them, for
+/// the thesis model and with gas volumes and a lagging mount.
+#[test]
+#[ignore]
+fn right_hand_side_evaluations_per_second_through_fmi2_get_derivatives() {
+    let sink = Sink::default();
+    let volumes = [
+        (vr::PORT_RESTRICTION_AREA_1, 0.5e-6),
+        (vr::PORT_LINE_VOLUME_1, 1e-6),
+        (vr::STOPPER_COMPLIANCE, 2e-5),
+        (vr::STOPPER_MOUNT_LAG, 2e-3),
+    ];
+    for (label, params) in [
+        ("thesis model", &[][..]),
+        ("gas volume and lagging mount", &volumes[..]),
+    ] {
+        unsafe {
+            let c = instantiate_model_exchange(&sink, "bench");
+            initialise(c, None, params, 2.5, 0.054);
+            assert_eq!(fmi2EnterContinuousTimeMode(c), fmi2OK);
+            let x0 = states(c);
+            let mut dx = [0.0; NX];
+            let n = 200_000;
+            let started = std::time::Instant::now();
+            for k in 0..n {
+                // a state that moves a little, so that nothing can be cached
+                let mut x = x0;
+                x[4] += (k % 97) as f64;
+                x[1] += (k % 89) as f64 * 1e-9;
+                assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
+                assert_eq!(fmi2GetDerivatives(c, dx.as_mut_ptr(), NX), fmi2OK);
+            }
+            let seconds = started.elapsed().as_secs_f64();
+            println!(
+                "{label}: {:.2e} right-hand-side evaluations per second through fmi2GetDerivatives ({:.0} ns each, with fmi2SetContinuousStates)",
+                n as f64 / seconds,
+                1e9 * seconds / n as f64
+            );
+            free(c);
+        }
+    }
+}
