@@ -446,3 +446,64 @@ fn right_hand_side_evaluations_per_second_through_fmi2_get_derivatives() {
         }
     }
 }
+
+/// Every parameter at the extremes (NaN, ±inf, 0, −1, 1e300) in a Model Exchange instance:
+/// refused when set or when initialisation ends with a message, or taken, and then the states,
+/// derivatives, event indicators and outputs are finite or refused with fmi2Error and a
+/// message; never fmi2Fatal, never a non-finite value handed out.
+#[test]
+fn every_parameter_at_every_extreme_gives_finite_rates_or_an_error_in_model_exchange() {
+    let sink = Sink::default();
+    let (mut taken, mut refused) = (0, 0);
+    for &r in Parameters::VALUE_REFERENCES.iter().chain(&[vr::P1_START, vr::P2_START]) {
+        for x in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 0.0, -1.0, 1e300] {
+            unsafe {
+                let c = instantiate_model_exchange(&sink, "abuse");
+                assert_eq!(fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
+                assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+                let from = sink.len();
+                let set = fmi2SetReal(c, &r, 1, &x);
+                set_inputs(c, 2.5, 0.054);
+                let exit = fmi2ExitInitializationMode(c);
+                let label = format!("vr {r} = {x:e}");
+                for s in [set, exit] {
+                    assert!(s == fmi2OK || s == fmi2Error, "{label}: {}", status_name(s));
+                    if s == fmi2Error {
+                        assert!(!last_error(&sink, from).is_empty(), "{label}: no message");
+                    }
+                }
+                if set != fmi2OK || exit != fmi2OK {
+                    refused += 1;
+                }
+                if exit != fmi2OK {
+                    free(c);
+                    continue;
+                }
+                if set == fmi2OK {
+                    taken += 1;
+                }
+                assert_eq!(fmi2EnterContinuousTimeMode(c), fmi2OK, "{label}");
+                let mut x = [f64::NAN; NX];
+                let mut dx = [f64::NAN; NX];
+                let mut z = [f64::NAN; NZ];
+                let statuses = [
+                    (fmi2GetContinuousStates(c, x.as_mut_ptr(), NX), &x[..]),
+                    (fmi2GetDerivatives(c, dx.as_mut_ptr(), NX), &dx[..]),
+                    (fmi2GetEventIndicators(c, z.as_mut_ptr(), NZ), &z[..]),
+                ];
+                for (s, values) in statuses {
+                    assert!(s == fmi2OK || s == fmi2Error, "{label}: {}", status_name(s));
+                    if s == fmi2OK {
+                        assert!(values.iter().all(|v| v.is_finite()), "{label}: {values:?}");
+                    }
+                }
+                let (s, y) = get_reals(c, &OUTPUTS);
+                assert!(s == fmi2OK || s == fmi2Error, "{label}: {}", status_name(s));
+                assert!(s != fmi2OK || y.iter().all(|v| v.is_finite()), "{label}: {y:?}");
+                free(c);
+            }
+        }
+    }
+    println!("model exchange abuse: {taken} values taken, {refused} refused (when set or when initialisation ends)");
+    assert!(taken > 0 && refused > 0);
+}
