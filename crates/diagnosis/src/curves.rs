@@ -885,15 +885,44 @@ fn describe(prefix: &str, c: &StaticCurve) -> String {
         .map(|k| (k, c.y[k] - c.x[k]))
         .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
         .expect("a curve has knots");
+    let slopes = (0..n - 1)
+        .map(|j| format!("{:.3}", slope(c, j)))
+        .collect::<Vec<_>>()
+        .join(", ");
+    // A curve that is a shift over most of its range headlines the shift, not the end
+    // where it parts from it.
+    if let Some(shift) = main_shift(c) {
+        return format!(
+            "{place} is shifted by {:+.3} {shown} over most of its range (the median departure from the identity at its knots; the largest, {:+.3} {shown}, at a {quantity} of {:.2} {shown}; slopes {slopes})",
+            scale * shift,
+            scale * d,
+            scale * c.x[k],
+        );
+    }
     format!(
-        "{place} departs most from the identity by {:+.3} {shown} at a {quantity} of {:.2} {shown} (slopes {})",
+        "{place} departs most from the identity by {:+.3} {shown} at a {quantity} of {:.2} {shown} (slopes {slopes})",
         scale * d,
         scale * c.x[k],
-        (0..n - 1)
-            .map(|j| format!("{:.3}", slope(c, j)))
-            .collect::<Vec<_>>()
-            .join(", ")
     )
+}
+
+/// The curve's departure from the identity when it is nearly the same at most knots (all but
+/// at most one within a fifth of the median departure from it) and that departure is at least
+/// half the largest: the shift that describes it; `None` for a curve that bends.
+fn main_shift(c: &StaticCurve) -> Option<f64> {
+    let n = c.len();
+    if n < 4 {
+        return None;
+    }
+    let mut departures: Vec<f64> = (0..n).map(|k| c.y[k] - c.x[k]).collect();
+    let largest = departures.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    departures.sort_by(f64::total_cmp);
+    let median = departures[n / 2];
+    let near = departures
+        .iter()
+        .filter(|d| (*d - median).abs() <= 0.2 * median.abs())
+        .count();
+    (median != 0.0 && near + 1 >= n && median.abs() >= 0.5 * largest).then_some(median)
 }
 
 /// The reading of a discovered term whose parameters turn a curve on, or `None`.
@@ -917,6 +946,30 @@ pub fn reading(set: &[(&'static str, f64)]) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_command_curve_that_is_an_offset_but_at_one_end_reads_as_the_offset() {
+        // 0.35 V over the range, 0.506 V at -10 V.
+        let x = [-10.0, -7.0, -4.0, -1.0, 2.0, 5.0, 8.0, 10.0];
+        let y: Vec<f64> = x.iter().map(|v| v + if *v == -10.0 { 0.506 } else { 0.35 }).collect();
+        let sentence = describe("command_curve", &StaticCurve::through(&x, &y));
+        assert!(sentence.starts_with("the command is shifted by +0.350 V"), "{sentence}");
+        assert!(
+            sentence.contains("the largest, +0.506 V, at a command of -10.00 V"),
+            "{sentence}"
+        );
+    }
+
+    #[test]
+    fn a_command_curve_that_bends_reads_as_its_largest_departure() {
+        let x = [-10.0, -5.0, 0.0, 5.0, 10.0];
+        let y: Vec<f64> = x.iter().map(|v: &f64| v + 0.02 * v * v).collect();
+        let sentence = describe("command_curve", &StaticCurve::through(&x, &y));
+        assert!(
+            sentence.starts_with("the command departs most from the identity by +2.000 V"),
+            "{sentence}"
+        );
+    }
 
     /// A reading that follows its quantity to 40 and stays there, fitted with a chord from
     /// (26, 26) to (41.5, 40) because no training sample lies between 27 and 85.
