@@ -11,11 +11,27 @@ started=$SECONDS
 run() {
     echo
     echo "==> $*"
+    local step_started=$SECONDS
     "$@"
+    echo "<== $(( SECONDS - step_started )) s"
 }
 
+# The Python environment (mostly downloads) is made while cargo builds the command-line tool.
+mkdir -p target
+venv_log=target/demo-venv.log
+echo "==> bash scripts/venv.sh (beside the build; output in $venv_log)"
+bash scripts/venv.sh >"$venv_log" 2>&1 </dev/null &
+venv_pid=$!
+trap 'kill "$venv_pid" 2>/dev/null || true' EXIT
+run cargo build --release --bin jetpipe
+if ! wait "$venv_pid"; then
+    cat "$venv_log" >&2
+    echo "demo.sh: scripts/venv.sh failed" >&2
+    exit 1
+fi
+trap - EXIT
+cat "$venv_log"
 run bash scripts/package.sh
-run bash scripts/venv.sh
 run .venv/bin/python fmu_tests/run_standard_scenario.py dist/JetPipeActuator.fmu
 run cargo run --release -p antagonistic -- package
 run .venv/bin/python fmu_tests/antagonistic/run_example.py --out dist/antagonistic_joint.png
