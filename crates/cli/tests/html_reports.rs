@@ -266,24 +266,22 @@ fn example_recording(name: &str) -> PathBuf {
 }
 
 #[test]
-fn one_recording_without_a_report_path_gets_its_report_and_its_page_in_the_current_directory() {
+fn one_recording_with_a_report_path_gets_its_page_beside_the_report_and_chromium_renders_it() {
     let root = std::env::temp_dir().join(format!("jetpipe-one-page-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
-    std::fs::create_dir_all(&root).unwrap();
+    std::fs::create_dir_all(root.join("reports")).unwrap();
     let recording = example_recording("hysteresis.csv");
+    let report_path = root.join("reports").join("r.json");
     let run = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
-        .current_dir(&root)
         .args(["diagnose", recording.to_str().unwrap(), "--jobs", "2"])
+        .args(["--report", report_path.to_str().unwrap()])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    assert!(
-        stdout.contains("report: hysteresis.json") && stdout.contains("page: hysteresis.html"),
-        "{stdout}"
-    );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(root.join("hysteresis.json")).unwrap()).unwrap();
+    let page = root.join("reports").join("r.html");
+    assert!(stdout.contains(&format!("page: {}", page.display())), "{stdout}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report_path).unwrap()).unwrap();
     // What examples/recordings/README.md says the demo finds in this recording.
     assert_eq!(report["verdict"], "explained", "{}", report["summary"]);
     assert_eq!(
@@ -292,12 +290,8 @@ fn one_recording_without_a_report_path_gets_its_report_and_its_page_in_the_curre
         report["summary"]
     );
 
-    let page = root.join("hysteresis.html");
     let html = std::fs::read_to_string(&page).unwrap();
-    assert!(
-        html.contains("href=\"hysteresis.json\""),
-        "the page does not link its report"
-    );
+    assert!(html.contains("href=\"r.json\""), "the page does not link its report");
     assert!(
         !html.contains("index.html"),
         "a page of one recording links an index that does not exist"
@@ -318,7 +312,7 @@ fn one_recording_without_a_report_path_gets_its_report_and_its_page_in_the_curre
     ] {
         assert!(dom.contains(figure), "no {figure}");
     }
-    let screenshot = root.join("hysteresis.png");
+    let screenshot = root.join("r.png");
     render(
         &page,
         &root.join("chromium-profile"),
@@ -349,20 +343,21 @@ fn a_report_named_html_is_refused_before_any_work_since_its_page_would_overwrite
 }
 
 #[test]
-fn no_html_writes_the_report_alone() {
+fn without_a_report_path_the_report_is_named_after_the_recording_in_the_current_directory_and_no_html_leaves_the_page_out(
+) {
     let root = std::env::temp_dir().join(format!("jetpipe-no-html-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
-    std::fs::create_dir_all(&root).unwrap();
+    std::fs::create_dir_all(root.join("work")).unwrap();
     // A clean recording: the thesis model explains it at once.
     write_recording(&root, "clean.csv", &BenchEffects::default(), 3);
-    let report = root.join("clean-report.json");
     let run = Command::new(env!("CARGO_BIN_EXE_jetpipe"))
+        .current_dir(root.join("work"))
         .args(["diagnose", root.join("clean.csv").to_str().unwrap(), "--no-html"])
-        .args(["--report", report.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    assert!(report.is_file());
-    assert!(!root.join("clean-report.html").exists(), "--no-html wrote a page");
+    assert!(String::from_utf8_lossy(&run.stdout).contains("report: clean.json"));
+    assert!(root.join("work").join("clean.json").is_file());
+    assert!(!root.join("work").join("clean.html").exists(), "--no-html wrote a page");
     let _ = std::fs::remove_dir_all(&root);
 }
