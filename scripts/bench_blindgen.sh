@@ -32,6 +32,8 @@ export NUMBA_CACHE_DIR="$PWD/target/blindgen-numba-cache"
 cargo build --release --bin jetpipe >&2
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
+# A copy of the program: a build during the run (cargo in another shell) does not change it.
+cp target/release/jetpipe "$work/"
 "$venv/bin/python" "$blindgen" draw --seed "$seed" --count "$count" --out "$work/draws" >&2
 mkdir -p "$work/reports"
 echo "| draw | rate (Hz) | length (s) | pressures | verdict | found (location, family) | held-out after / noise floor | wall (s) | wall per sample (ms) |"
@@ -39,7 +41,7 @@ echo "|---|---|---|---|---|---|---|---|---|"
 for rec in "$work"/draws/*.csv; do
     name="$(basename "$rec" .csv)"
     start=$(date +%s%N)
-    ./target/release/jetpipe diagnose "$rec" --report "$work/reports/$name.json" --no-html --jobs 2 \
+    "$work/jetpipe" diagnose "$rec" --report "$work/reports/$name.json" --no-html --jobs 2 \
         >"$work/$name.log" 2>&1 || true
     end=$(date +%s%N)
     python3 - "$rec" "$work/reports/$name.json" "$(( (end - start) / 1000000 ))" <<'PY'
