@@ -939,12 +939,13 @@ fn retire_switched_off(found: &mut rounds::Findings, progress: &mut dyn FnMut(&s
     }
 }
 
-/// The final accurate replays, the verdict (step 6) and the tests of the residual.
+/// The final accurate replay, the verdict (step 6) and the tests of the residual; `start` is
+/// the starting model, its accurate replay and the check of the fits' replay against it.
 fn conclude(
     cx: &Context,
-    (before_model, before, fast_replay): (Actuator, Replay, agreement::FastReplayCheck),
-    found: rounds::Findings,
-    joint_refit: Option<(f64, f64)>,
+    start: (Actuator, Replay, agreement::FastReplayCheck),
+    mut found: rounds::Findings,
+    mut joint_refit: Option<(f64, f64)>,
     input_checks: Vec<String>,
     calibrated: Vec<Calibrated>,
     replays: usize,
@@ -953,9 +954,10 @@ fn conclude(
     let (full, noise) = (cx.full, cx.noise);
     // The reported figures come from the accurate, error-controlled replay of every sample.
     progress("final replays with the error-controlled integrator");
-    let final_model = Actuator::new(found.params.clone())?;
+    let (before_model, before, fast_replay) = start;
+    let mut final_model = Actuator::new(found.params.clone())?;
     let n = full.len();
-    let after = replay(&final_model, full, 1e-5, n)?;
+    let mut after = replay(&final_model, full, 1e-5, n)?;
     let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
     let full_blocks = match thinned {
         Some(_) => blocks::blocks(&full.time, cx.settled_from),
@@ -964,8 +966,6 @@ fn conclude(
     let blocks = &full_blocks;
     let before_errors = errors(&before, full, blocks);
     let mut after_errors = errors(&after, full, blocks);
-    let mut found = found;
-    let (mut final_model, mut after, mut joint_refit) = (final_model, after, joint_refit);
     let withdrawn = withdraw::withdraw_if_worse(&mut found, &before_model.params, &before_errors, &after_errors);
     if let Some(w) = &withdrawn {
         progress(&format!(
