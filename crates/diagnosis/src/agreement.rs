@@ -14,7 +14,7 @@ use jetpipe_model::physics::actuator::Actuator;
 pub const AGREEMENT_WITHIN_NOISE: f64 = 0.2;
 
 /// How many times the step may be halved: [`MAX_FAST_STEP`] down to a sixteenth of it.
-const MOST_HALVINGS: u32 = 4;
+pub const MOST_HALVINGS: u32 = 4;
 
 /// The outcome of the check: the step the fits use and how far that replay departs.
 #[derive(Clone, Debug, PartialEq)]

@@ -19,7 +19,7 @@ pub struct Recording {
     pub full_rate: Option<std::sync::Arc<FullRateInputs>>,
     /// The longest step of the fixed-step replays the fits use ([`crate::replay::replay_fast`]):
     /// [`crate::replay::MAX_FAST_STEP`], or shorter where that replay departs from the
-    /// error-controlled one ([`crate::replay::fast_step_that_agrees`]).
+    /// error-controlled one ([`crate::agreement::fast_step_that_agrees`]).
     pub fast_replay_step: f64,
 }
 
