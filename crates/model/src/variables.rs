@@ -4,6 +4,8 @@
 
 pub use crate::variable::{Causality, VarType, Variability, Variable};
 
+mod modulation;
+
 /// Value references, named so code never uses bare numbers.
 pub mod vr {
     pub const V_DA: u32 = 1;
@@ -171,6 +173,9 @@ pub mod vr {
     pub const DISCHARGE_CURVE_X_LAST: u32 = DISCHARGE_CURVE_X + 7;
     pub const DISCHARGE_CURVE_Y: u32 = 691;
     pub const DISCHARGE_CURVE_Y_LAST: u32 = DISCHARGE_CURVE_Y + 7;
+
+    // Modulation slots (crate::physics::modulation), off with no constant named.
+    pub use super::modulation::vr::*;
 }
 
 /// The D/A converter's range: a command outside it is refused.
@@ -374,7 +379,14 @@ const CURVE_DISCHARGE: &str = "a discharge coefficient lies between 0 (closed) a
 
 /// Every variable of the FMU, one row each: name, value reference, unit, start, limits,
 /// description and thesis reference. Defaults: Table 3.1 of the thesis and docs/model.md.
-pub const TABLE: &[Row] = &[
+/// The modulation slots' rows come last (`variables/modulation.rs`).
+pub const TABLE: &[Row] = &TABLE_ARRAY;
+const TABLE_LENGTH: usize = ROWS_BEFORE_THE_SLOTS.len() + modulation::SLOT_1.len() + modulation::SLOT_2.len();
+#[allow(clippy::large_const_arrays)]
+const TABLE_ARRAY: [Row; TABLE_LENGTH] =
+    modulation::concatenated([ROWS_BEFORE_THE_SLOTS, &modulation::SLOT_1, &modulation::SLOT_2]);
+
+const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     input("v_DA", vr::V_DA, "V", 0.0, "D/A command voltage to the current driver").cite("(2.3)"),
     input(
         "x_s",

@@ -129,7 +129,7 @@ pub struct Actuator {
     pub discharge: [f64; 4],
     /// The area factor of each orifice, in the order of [`Self::discharge`]: with the
     /// discharge curve on, C_d(r) takes the place of C_d.
-    area_scales: [f64; 4],
+    pub(super) area_scales: [f64; 4],
     /// C_d as a function of the pressure ratio across each valve orifice
     /// (`discharge_curve_*`), when on.
     discharge_curve: Option<super::static_curve::StaticCurve>,
@@ -235,8 +235,10 @@ impl Actuator {
             || params.extra_force_sign_pressure != 0.0
             || params.friction_coulomb != 0.0
             || params.friction_stribeck != 0.0
-            || params.viscous_friction != 0.0;
-        let thesis_outputs = params.friction_coulomb == 0.0
+            || params.viscous_friction != 0.0
+            || super::modulation::modulates_friction(&params);
+        let thesis_outputs = !super::modulation::modulates_output_law(&params)
+            && params.friction_coulomb == 0.0
             && params.friction_stribeck == 0.0
             && params.viscous_friction == 0.0
             && params.position_force_rate == 0.0

@@ -20,6 +20,7 @@
 //! | what the force and pressure transducers read | [`sensors`] | docs/model.md |
 //! | static curves at the command and the transducers (off by default) | [`static_curve`] | docs/model.md |
 //! | constants that vary in time (off by default) | [`time_varying`] | docs/model.md |
+//! | a constant that varies with a signal of the chain: the modulation slots (off by default) | [`modulation`] | docs/model.md |
 //! | the assembled six-state model | [`actuator`] | (4.1) |
 
 pub mod actuator;
@@ -29,6 +30,7 @@ pub mod current_driver;
 pub mod effects;
 pub mod extra_force;
 pub mod jet_pipe;
+pub mod modulation;
 pub mod orifice_flow;
 pub mod orifice_geometry;
 pub mod parameters;

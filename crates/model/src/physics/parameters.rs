@@ -2,6 +2,7 @@
 //! FMU's variable table, so the two cannot disagree).
 
 use super::chambers::CylinderGeometry;
+use super::modulation::{Slot, SLOTS};
 use super::orifice_flow::FlowConstants;
 use super::static_curve::StaticCurve;
 use crate::variables::{number, vr, VARIABLES};
@@ -136,6 +137,9 @@ pub struct Parameters {
     /// The valve orifices' discharge coefficient as a function of the pressure ratio
     /// P_down/P_up across each (in place of `c_d`; off with no knots).
     pub discharge_curve: StaticCurve,
+    /// The modulation slots: a constant that varies with a signal of the chain (off with
+    /// no constant named; see [`super::modulation`]).
+    pub modulation: [Slot; SLOTS],
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -269,6 +273,7 @@ impl Default for Parameters {
             p1_sensor_curve: StaticCurve::default(),
             p2_sensor_curve: StaticCurve::default(),
             discharge_curve: StaticCurve::default(),
+            modulation: [Slot::default(); SLOTS],
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -478,9 +483,41 @@ impl Parameters {
         vr::DISCHARGE_CURVE_Y + 5,
         vr::DISCHARGE_CURVE_Y + 6,
         vr::DISCHARGE_CURVE_Y + 7,
+        vr::MODULATION_1_PARAMETER,
+        vr::MODULATION_1_SIGNAL,
+        vr::MODULATION_1_FREQUENCY,
+        vr::MODULATION_1_KNOTS,
+        vr::MODULATION_1_X,
+        vr::MODULATION_1_X + 1,
+        vr::MODULATION_1_X + 2,
+        vr::MODULATION_1_X + 3,
+        vr::MODULATION_1_X + 4,
+        vr::MODULATION_1_X + 5,
+        vr::MODULATION_1_Y,
+        vr::MODULATION_1_Y + 1,
+        vr::MODULATION_1_Y + 2,
+        vr::MODULATION_1_Y + 3,
+        vr::MODULATION_1_Y + 4,
+        vr::MODULATION_1_Y + 5,
+        vr::MODULATION_2_PARAMETER,
+        vr::MODULATION_2_SIGNAL,
+        vr::MODULATION_2_FREQUENCY,
+        vr::MODULATION_2_KNOTS,
+        vr::MODULATION_2_X,
+        vr::MODULATION_2_X + 1,
+        vr::MODULATION_2_X + 2,
+        vr::MODULATION_2_X + 3,
+        vr::MODULATION_2_X + 4,
+        vr::MODULATION_2_X + 5,
+        vr::MODULATION_2_Y,
+        vr::MODULATION_2_Y + 1,
+        vr::MODULATION_2_Y + 2,
+        vr::MODULATION_2_Y + 3,
+        vr::MODULATION_2_Y + 4,
+        vr::MODULATION_2_Y + 5,
     ];
 
-    fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
+    pub(crate) fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
         Some(match value_reference {
             vr::P_S => &mut self.p_s,
             vr::P_R => &mut self.p_r,
@@ -630,6 +667,9 @@ impl Parameters {
             r @ vr::DISCHARGE_CURVE_Y..=vr::DISCHARGE_CURVE_Y_LAST => {
                 &mut self.discharge_curve.y[(r - vr::DISCHARGE_CURVE_Y) as usize]
             }
+            r @ vr::MODULATION_1_PARAMETER..=vr::MODULATION_LAST => {
+                return super::modulation::field_mut(&mut self.modulation, r)
+            }
             _ => return None,
         })
     }
@@ -656,6 +696,7 @@ impl Parameters {
             .field_mut(value_reference)
             .ok_or_else(|| format!("value reference {value_reference} is not a parameter of the model"))?;
         crate::variables::check(value_reference, value)?;
+        super::modulation::check_setting(value_reference, value)?;
         *field = value;
         Ok(())
     }
@@ -710,7 +751,8 @@ impl Parameters {
                 self.l_cyl, self.l_p
             ));
         }
-        Ok(())
+        // Last: it validates the model with each slot's constant at each of its knots.
+        super::modulation::validate(self)
     }
 
     pub fn cylinder(&self) -> CylinderGeometry {

@@ -116,16 +116,37 @@ impl FixedStep {
             .check_stopper(x_s)
             .map_err(StepFailure::InvalidRequest)?;
         let rate = (x_s - self.simulation.x_s) / step;
+        // The slots' signals at the interval's start, the time signals at mid-interval.
+        let signals = self
+            .simulation
+            .plan
+            .modulated
+            .then(|| self.simulation.modulation_signals(0.5 * (t0 + time)));
         if let Some(nominal) = &self.nominal {
             // Held at mid-interval over the step, as `Simulation::step` holds them.
             time_varying::set_model_at(&mut self.simulation.model, nominal, 0.5 * (t0 + time))
                 .map_err(StepFailure::InvalidRequest)?;
+        }
+        let mut held = None;
+        if let Some(signals) = &signals {
+            match self.simulation.hold_modulated(signals) {
+                Ok(h) => held = Some(h),
+                Err(e) => {
+                    if let Some(nominal) = &self.nominal {
+                        time_varying::reset_model(&mut self.simulation.model, nominal);
+                    }
+                    return Err(StepFailure::InvalidRequest(e));
+                }
+            }
         }
         let result = if self.simulation.model.has_volume_states() {
             advance(&mut self.simulation, &mut self.with_volumes, step, rate)
         } else {
             advance(&mut self.simulation, &mut self.chambers, step, rate)
         };
+        if let Some(held) = held {
+            self.simulation.release_modulated(held);
+        }
         if let Some(nominal) = &self.nominal {
             time_varying::reset_model(&mut self.simulation.model, nominal);
         }
@@ -150,13 +171,7 @@ impl FixedStep {
                 sim.stopper_acceleration = sim.stopper_motion.advance((x_s - x_start) / length, length);
             }
         }
-        let mut y = sim.model.outputs_in_motion(
-            &sim.state,
-            x_s,
-            sim.stopper_velocity_at_sample(),
-            sim.stopper_acceleration,
-            time,
-        );
+        let mut y = sim.outputs_at_sample();
         sim.record_transducers(&mut y);
         self.outputs = y;
         Ok(())

@@ -19,13 +19,16 @@ mod commands;
 mod effect_tests;
 mod equilibrium;
 mod fixed_step;
+mod modulated;
 mod monolithic;
 mod snapshot;
 mod stepping;
 
 pub use commands::CommandChange;
 
-pub use equilibrium::{balance_with_volumes, equilibrium, equilibrium_at, equilibrium_of_electromechanics};
+pub use equilibrium::{
+    balance_with_volumes, equilibrium, equilibrium_at, equilibrium_of_electromechanics, modulated_equilibrium,
+};
 pub use fixed_step::FixedStep;
 pub use snapshot::{SimulationSnapshot, SNAPSHOT_LAYOUT};
 
@@ -38,6 +41,7 @@ use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::modulation;
 use crate::physics::extra_force::{self, StopperMotion};
 use crate::physics::restrictions::node;
 use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
@@ -157,6 +161,14 @@ pub struct Simulation {
 struct StepPlan {
     /// Constants vary in time ([`crate::physics::time_varying`]).
     varying_constants: bool,
+    /// A modulation slot is on ([`crate::physics::modulation`]): its constant is held over
+    /// each step at the signals at the step's start. A slot on a friction or a transducer's
+    /// term switches that on in the model (the stopper's motion is then formed, the outputs'
+    /// general law used), as the constant away from its default would.
+    modulated: bool,
+    /// A slot modulates a constant the outputs read: they are formed with it at the sample's
+    /// signals.
+    modulated_outputs: bool,
     /// The command reaches the driver through the command stage or the transport delay.
     command_path: bool,
     /// A transducer filters its reading (and so has a memory, which records the reading after
@@ -176,6 +188,8 @@ impl StepPlan {
         let p = &model.params;
         StepPlan {
             varying_constants: time_varying::varies(p),
+            modulated: modulation::any_on(p),
+            modulated_outputs: modulation::modulates_outputs(p),
             command_path: command_stage::is_active(p) || p.command_delay != 0.0,
             filtering_transducers: transducers.iter().any(Option::is_some),
             hysteresis: model.hysteresis.is_active(),
@@ -210,7 +224,12 @@ impl Simulation {
         if !model.has_volume_states() {
             return Ok(Self::from_state(model, state, v_da, x_s, time, relative_tolerance));
         }
-        let (state, nodes) = balance_with_volumes(&model, &state, x_s, time)?;
+        // With the slots' constants at the equilibrium's signals (the drifts then added).
+        let at = match modulation::any_on(&model.params) {
+            true => modulation::model_at(&model, &modulated::signals_at(&model, &state, v_da, x_s, 0.0, 0.0, time))?,
+            false => model.clone(),
+        };
+        let (state, nodes) = balance_with_volumes(&at, &state, x_s, time)?;
         let mut simulation = Self::from_state(model, state, v_da, x_s, time, relative_tolerance);
         if simulation.propagator.is_none() {
             return Err(volumes_need_the_split_method(&simulation.model));
@@ -224,7 +243,7 @@ impl Simulation {
         let propagator = ElectromechanicalPropagator::new(&model.params);
         let plays = model.initial_hysteresis_memory(state[index::CURRENT]);
         let command_stage = CommandStage::at_rest(&model.params, time, v_da);
-        let readings = model.outputs_at(&state, x_s, 0.0, time).readings();
+        let readings = modulated::outputs_in_motion(&model, &state, x_s, 0.0, 0.0, time, v_da).readings();
         let transducers = [0, 1, 2].map(|k| {
             SensorLaw::of(&model.params, Channel::ALL[k])
                 .filters()
@@ -385,13 +404,7 @@ impl Simulation {
     }
 
     pub fn outputs(&self) -> Outputs {
-        let mut y = self.model.outputs_in_motion(
-            &self.state,
-            self.x_s,
-            self.stopper_velocity_at_sample(),
-            self.stopper_acceleration,
-            self.time,
-        );
+        let mut y = self.outputs_at_sample();
         if !self.plan.filtering_transducers {
             return y;
         }

@@ -71,6 +71,9 @@ impl Simulation {
 
     /// Advance by `step` seconds.
     pub fn step(&mut self, step: f64) -> Result<(), StepFailure> {
+        if self.plan.modulated {
+            return self.step_modulated(step);
+        }
         if !self.plan.varying_constants {
             return self.step_with_constants_held(step);
         }
@@ -85,6 +88,42 @@ impl Simulation {
         let result = self.step_with_constants_held(step);
         time_varying::reset_model(&mut self.model, &nominal);
         self.model.params = nominal;
+        self.chamber_rates_at_end = None;
+        result
+    }
+
+    /// [`Self::step`] with modulation slots: the signals at the step's start (the time signals
+    /// at mid-step), the drifting constants at mid-step, the slots' increments added to them,
+    /// all held over the step and restored after it.
+    fn step_modulated(&mut self, step: f64) -> Result<(), StepFailure> {
+        if !(step.is_finite() && step > 0.0) {
+            return self.step_with_constants_held(step);
+        }
+        let mid = self.time + 0.5 * step;
+        let signals = self.modulation_signals(mid);
+        let nominal = self.plan.varying_constants.then(|| self.model.params.clone());
+        let mut held = Ok(None);
+        if let Some(nominal) = &nominal {
+            held = time_varying::set_model_at(&mut self.model, nominal, mid).map(|_| None);
+        }
+        if held.is_ok() {
+            held = self.hold_modulated(&signals).map(Some);
+        }
+        let result = match held {
+            Ok(held) => {
+                self.chamber_rates_at_end = None;
+                let result = self.step_with_constants_held(step);
+                if let Some(held) = held {
+                    self.release_modulated(held);
+                }
+                result
+            }
+            Err(e) => Err(StepFailure::InvalidRequest(e)),
+        };
+        if let Some(nominal) = nominal {
+            time_varying::reset_model(&mut self.model, &nominal);
+            self.model.params = nominal;
+        }
         self.chamber_rates_at_end = None;
         result
     }
@@ -135,13 +174,7 @@ impl Simulation {
             self.stopper_acceleration = self.stopper_motion.advance(self.stopper_velocity, step);
         }
         if self.plan.filtering_transducers {
-            let mut y = self.model.outputs_in_motion(
-                &self.state,
-                self.x_s,
-                self.stopper_velocity_at_sample(),
-                self.stopper_acceleration,
-                self.time,
-            );
+            let mut y = self.outputs_at_sample();
             self.record_transducers(&mut y);
         }
     }

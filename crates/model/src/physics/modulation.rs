@@ -1,0 +1,661 @@
+//! Modulation slots (all off by default): a constant of the parameter table that varies with
+//! a signal of the chain. Slot k (k = 1, 2) names the constant by its value reference
+//! (`modulation_k_parameter`, one of [`MODULATABLE`]), the signal by a code
+//! (`modulation_k_signal`, [`ModulationSignal`]) and up to [`MAX_KNOTS`] knots
+//! (`modulation_k_x_j`, `modulation_k_y_j`): the constant is its nominal value plus the
+//! piecewise linear interpolation of the increments y at the signal's value, held at the first
+//! and last knots' increments beyond them. One knot is a constant increment.
+//!
+//! Like the constants that vary in time ([`super::time_varying`]), a simulation holds each
+//! modulated constant over a step: at the signals at the step's start (the time signals at
+//! mid-step, as the time-varying constants are), with what the model derives from it
+//! (the valve's discharge factors, the orifices' 1/√T, the current driver's and jet pipe's
+//! propagator), then restores it. The outputs at a communication point read the constants at
+//! that point's signals (the ones the next step holds). A modulation on top of a drift adds to
+//! the drifted value.
+//!
+//! The chamber volumes' constants are not modulatable: [`NOT_MODULATABLE`] says why.
+
+use super::actuator::Actuator;
+use super::parameters::{variable_name, Parameters};
+use crate::variables::{self, number, vr};
+
+/// The slots.
+pub const SLOTS: usize = 2;
+
+/// The most knots a slot has.
+pub const MAX_KNOTS: usize = 6;
+
+/// The constants a slot may modulate, as value references.
+pub const MODULATABLE: &[u32] = &[
+    vr::K_CD,
+    vr::I_OFFSET,
+    vr::OMEGA_CD,
+    vr::K_M,
+    vr::OMEGA_1,
+    vr::OMEGA_2,
+    vr::ZETA_2,
+    vr::X_JP_OFFSET,
+    vr::X_JP_SAT,
+    vr::F_JP_SAT,
+    vr::D_JP,
+    vr::C_D,
+    vr::C_DM_A_LPP,
+    vr::C_DB_A_LPP,
+    vr::SUPPLY_AREA_SCALE_1,
+    vr::SUPPLY_AREA_SCALE_2,
+    vr::RETURN_AREA_SCALE_1,
+    vr::RETURN_AREA_SCALE_2,
+    vr::P_S,
+    vr::P_R,
+    vr::T_GAS,
+    vr::K_SPRING,
+    vr::FRICTION_COULOMB,
+    vr::VISCOUS_FRICTION,
+    vr::FORCE_SENSOR_OFFSET,
+    vr::FORCE_SENSOR_GAIN,
+    vr::P1_SENSOR_OFFSET,
+    vr::P1_SENSOR_GAIN,
+    vr::P2_SENSOR_OFFSET,
+    vr::P2_SENSOR_GAIN,
+];
+
+const VOLUME_JUMP: &str = "a chamber volume that changed from one step to the next would keep its pressure, creating or destroying air, where a moved stopper conserves it (P V^gamma); the model has no such jump for a constant";
+
+/// Constants one might expect in [`MODULATABLE`] that the model cannot modulate correctly, with
+/// the reason.
+pub const NOT_MODULATABLE: &[(u32, &str)] = &[
+    (vr::D_CYL, VOLUME_JUMP),
+    (vr::DEAD_VOLUME_1, VOLUME_JUMP),
+    (vr::DEAD_VOLUME_2, VOLUME_JUMP),
+];
+
+/// The constants the current driver's and jet pipe's propagator is built from.
+const ELECTROMECHANICAL: &[u32] = &[
+    vr::K_CD,
+    vr::I_OFFSET,
+    vr::OMEGA_CD,
+    vr::K_M,
+    vr::OMEGA_1,
+    vr::OMEGA_2,
+    vr::ZETA_2,
+    vr::X_JP_SAT,
+    vr::F_JP_SAT,
+];
+
+/// The constants of the valve's discharge factors ([`Actuator::discharge`]).
+const DISCHARGE: &[u32] = &[
+    vr::C_D,
+    vr::SUPPLY_AREA_SCALE_1,
+    vr::SUPPLY_AREA_SCALE_2,
+    vr::RETURN_AREA_SCALE_1,
+    vr::RETURN_AREA_SCALE_2,
+];
+
+/// The constants that switch on the outputs' general law (friction and the transducers').
+const OUTPUT_LAW: &[u32] = &[
+    vr::FRICTION_COULOMB,
+    vr::VISCOUS_FRICTION,
+    vr::FORCE_SENSOR_OFFSET,
+    vr::FORCE_SENSOR_GAIN,
+    vr::P1_SENSOR_OFFSET,
+    vr::P1_SENSOR_GAIN,
+    vr::P2_SENSOR_OFFSET,
+    vr::P2_SENSOR_GAIN,
+];
+
+/// The constants the outputs at a communication point read, beyond the states: those of
+/// [`OUTPUT_LAW`], the spring and the return pressure (the extra force's pressure terms).
+const OUTPUTS: &[u32] = &[
+    vr::FRICTION_COULOMB,
+    vr::VISCOUS_FRICTION,
+    vr::FORCE_SENSOR_OFFSET,
+    vr::FORCE_SENSOR_GAIN,
+    vr::P1_SENSOR_OFFSET,
+    vr::P1_SENSOR_GAIN,
+    vr::P2_SENSOR_OFFSET,
+    vr::P2_SENSOR_GAIN,
+    vr::K_SPRING,
+    vr::P_R,
+];
+
+/// The stopper velocity at which the sign signal, tanh(v / this), is 0.76.
+pub const SIGN_VELOCITY: f64 = 1e-3;
+
+/// A signal of the chain a slot follows, by its code (`modulation_k_signal`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModulationSignal {
+    None,
+    Time,
+    Command,
+    Current,
+    JetPosition,
+    StopperPosition,
+    StopperVelocity,
+    StopperVelocitySign,
+    Force,
+    P1,
+    P2,
+    PressureDifference,
+    Sine,
+    Cosine,
+}
+
+impl ModulationSignal {
+    /// Every signal, in the order of their codes (0 to 13).
+    pub const ALL: [ModulationSignal; 14] = [
+        ModulationSignal::None,
+        ModulationSignal::Time,
+        ModulationSignal::Command,
+        ModulationSignal::Current,
+        ModulationSignal::JetPosition,
+        ModulationSignal::StopperPosition,
+        ModulationSignal::StopperVelocity,
+        ModulationSignal::StopperVelocitySign,
+        ModulationSignal::Force,
+        ModulationSignal::P1,
+        ModulationSignal::P2,
+        ModulationSignal::PressureDifference,
+        ModulationSignal::Sine,
+        ModulationSignal::Cosine,
+    ];
+
+    /// The code `modulation_k_signal` takes for it.
+    pub fn code(self) -> u32 {
+        ModulationSignal::ALL.iter().position(|&s| s == self).unwrap_or(0) as u32
+    }
+
+    /// The signal of a code, if it is one (a whole number from 0 to 13).
+    pub fn from_code(code: f64) -> Option<Self> {
+        if code.fract() != 0.0 || !(0.0..=13.0).contains(&code) {
+            return None;
+        }
+        Some(ModulationSignal::ALL[code as usize])
+    }
+
+    /// Its name, as a reading writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModulationSignal::None => "none",
+            ModulationSignal::Time => "t",
+            ModulationSignal::Command => "v_DA",
+            ModulationSignal::Current => "i",
+            ModulationSignal::JetPosition => "x_jp",
+            ModulationSignal::StopperPosition => "x_s",
+            ModulationSignal::StopperVelocity => "stopper velocity",
+            ModulationSignal::StopperVelocitySign => "sign of the stopper velocity",
+            ModulationSignal::Force => "F_act",
+            ModulationSignal::P1 => "P1",
+            ModulationSignal::P2 => "P2",
+            ModulationSignal::PressureDifference => "P1 - P2",
+            ModulationSignal::Sine => "sin(2 pi f t)",
+            ModulationSignal::Cosine => "cos(2 pi f t)",
+        }
+    }
+
+    /// Its SI unit ("1" for a number).
+    pub fn unit(self) -> &'static str {
+        match self {
+            ModulationSignal::None => "1",
+            ModulationSignal::Time => "s",
+            ModulationSignal::Command => "V",
+            ModulationSignal::Current => "A",
+            ModulationSignal::JetPosition | ModulationSignal::StopperPosition => "m",
+            ModulationSignal::StopperVelocity => "m/s",
+            ModulationSignal::StopperVelocitySign => "1",
+            ModulationSignal::Force => "N",
+            ModulationSignal::P1 | ModulationSignal::P2 | ModulationSignal::PressureDifference => "Pa",
+            ModulationSignal::Sine | ModulationSignal::Cosine => "1",
+        }
+    }
+
+    /// Whether it is a function of time alone (held at mid-step over a step).
+    pub fn of_time(self) -> bool {
+        matches!(
+            self,
+            ModulationSignal::Time | ModulationSignal::Sine | ModulationSignal::Cosine
+        )
+    }
+
+    /// Its value at `signals`, with `frequency` (Hz) for the sine and cosine.
+    pub fn value(self, signals: &Signals, frequency: f64) -> f64 {
+        let phase = || 2.0 * std::f64::consts::PI * frequency * signals.time;
+        match self {
+            ModulationSignal::None => 0.0,
+            ModulationSignal::Time => signals.time,
+            ModulationSignal::Command => signals.v_da,
+            ModulationSignal::Current => signals.current,
+            ModulationSignal::JetPosition => signals.x_jp,
+            ModulationSignal::StopperPosition => signals.x_s,
+            ModulationSignal::StopperVelocity => signals.stopper_velocity,
+            ModulationSignal::StopperVelocitySign => (signals.stopper_velocity / SIGN_VELOCITY).tanh(),
+            ModulationSignal::Force => signals.f_act,
+            ModulationSignal::P1 => signals.p1,
+            ModulationSignal::P2 => signals.p2,
+            ModulationSignal::PressureDifference => signals.p1 - signals.p2,
+            ModulationSignal::Sine => phase().sin(),
+            ModulationSignal::Cosine => phase().cos(),
+        }
+    }
+}
+
+/// The signals of the chain at one instant, in SI units. `f_act` is the actuator force with
+/// the constants at their nominal values (a friction modulated by the force reads the force
+/// without its own modulation: no algebraic loop).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Signals {
+    pub time: f64,
+    pub v_da: f64,
+    pub current: f64,
+    pub x_jp: f64,
+    pub x_s: f64,
+    pub stopper_velocity: f64,
+    pub f_act: f64,
+    pub p1: f64,
+    pub p2: f64,
+}
+
+/// One slot's parameters, as the FMU sets them (codes and counts as floats).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Slot {
+    /// The value reference of the modulated constant (0 = off).
+    pub parameter: f64,
+    /// The signal's code ([`ModulationSignal`]).
+    pub signal: f64,
+    /// Hz, for the sine and the cosine.
+    pub frequency: f64,
+    /// The knots in use (0 to [`MAX_KNOTS`]).
+    pub knots: f64,
+    /// The knots' signal values, in the signal's unit.
+    pub x: [f64; MAX_KNOTS],
+    /// The constant's increments at the knots, in the constant's unit.
+    pub y: [f64; MAX_KNOTS],
+}
+
+impl Slot {
+    /// A slot that adds to constant `parameter` the increments `y` at the values `x` of
+    /// `signal` (at most [`MAX_KNOTS`] knots).
+    pub fn through(parameter: u32, signal: ModulationSignal, x: &[f64], y: &[f64]) -> Self {
+        let mut s = Slot {
+            parameter: parameter as f64,
+            signal: signal.code() as f64,
+            ..Slot::default()
+        };
+        let n = x.len().min(y.len()).min(MAX_KNOTS);
+        s.knots = n as f64;
+        s.x[..n].copy_from_slice(&x[..n]);
+        s.y[..n].copy_from_slice(&y[..n]);
+        s
+    }
+
+    /// The number of knots in use.
+    pub fn len(&self) -> usize {
+        if self.knots >= 1.0 {
+            (self.knots as usize).min(MAX_KNOTS)
+        } else {
+            0
+        }
+    }
+
+    /// Whether no knot is in use.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Whether the slot modulates a constant: one named and a knot in use.
+    pub fn is_on(&self) -> bool {
+        self.parameter != 0.0 && !self.is_empty()
+    }
+
+    /// The modulated constant's value reference (0 when off).
+    pub fn constant(&self) -> u32 {
+        if self.is_on() {
+            self.parameter as u32
+        } else {
+            0
+        }
+    }
+
+    /// The signal (none for a code that is not one: [`Parameters::validate`] refuses it).
+    pub fn signal(&self) -> ModulationSignal {
+        ModulationSignal::from_code(self.signal).unwrap_or(ModulationSignal::None)
+    }
+
+    /// The increment at signal value `s`: linear between knots, held beyond the end ones.
+    pub fn increment(&self, s: f64) -> f64 {
+        let n = self.len();
+        if n == 0 {
+            return 0.0;
+        }
+        if n == 1 || s <= self.x[0] {
+            return self.y[0];
+        }
+        if s >= self.x[n - 1] {
+            return self.y[n - 1];
+        }
+        let mut k = 0;
+        while k + 2 < n && s > self.x[k + 1] {
+            k += 1;
+        }
+        let (x0, x1, y0, y1) = (self.x[k], self.x[k + 1], self.y[k], self.y[k + 1]);
+        y0 + (s - x0) * (y1 - y0) / (x1 - x0)
+    }
+
+    /// The increment at `signals`.
+    pub fn increment_at(&self, signals: &Signals) -> f64 {
+        self.increment(self.signal().value(signals, self.frequency))
+    }
+}
+
+/// Whether any slot is on.
+pub fn any_on(p: &Parameters) -> bool {
+    p.modulation.iter().any(Slot::is_on)
+}
+
+/// Whether a slot that is on modulates one of `constants`.
+fn modulates_any_of(p: &Parameters, constants: &[u32]) -> bool {
+    p.modulation
+        .iter()
+        .any(|slot| slot.is_on() && constants.contains(&slot.constant()))
+}
+
+/// Whether a slot modulates the current driver or the jet pipe (their propagator is then
+/// rebuilt for each step).
+pub fn modulates_electromechanics(p: &Parameters) -> bool {
+    modulates_any_of(p, ELECTROMECHANICAL)
+}
+
+/// Whether a slot modulates friction or a transducer's offset or gain: the outputs' general
+/// law is then on, as that constant away from its default would put it.
+pub fn modulates_output_law(p: &Parameters) -> bool {
+    modulates_any_of(p, OUTPUT_LAW)
+}
+
+/// Whether a slot modulates a friction: the stopper's motion is then formed at each sample.
+pub fn modulates_friction(p: &Parameters) -> bool {
+    modulates_any_of(p, &[vr::FRICTION_COULOMB, vr::VISCOUS_FRICTION])
+}
+
+/// Whether a slot modulates a constant the outputs read.
+pub fn modulates_outputs(p: &Parameters) -> bool {
+    modulates_any_of(p, OUTPUTS)
+}
+
+/// Whether a slot follows the force F_act (the signals then need it).
+pub fn follows_the_force(p: &Parameters) -> bool {
+    p.modulation
+        .iter()
+        .any(|slot| slot.is_on() && slot.signal() == ModulationSignal::Force)
+}
+
+/// For the Model Exchange interface, which does not have the slots: an error naming each
+/// slot that is on, or Ok.
+pub fn refuse_in_model_exchange(p: &Parameters) -> Result<(), String> {
+    let on: Vec<String> = (0..SLOTS)
+        .filter(|&k| p.modulation[k].is_on())
+        .map(|k| {
+            format!(
+                "modulation_{}_parameter = {} ({})",
+                k + 1,
+                p.modulation[k].parameter,
+                variable_name(p.modulation[k].constant())
+            )
+        })
+        .collect();
+    if on.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} switches on a modulation slot, which Model Exchange does not have (the constant is held over each communication step at the signals at its start); use the Co-Simulation interface of this FMU for it",
+            on.join(", ")
+        ))
+    }
+}
+
+/// The slot (0-based) and the field of a slot's value reference.
+pub fn field_mut(slots: &mut [Slot; SLOTS], value_reference: u32) -> Option<&mut f64> {
+    if !(vr::MODULATION_1_PARAMETER..=vr::MODULATION_LAST).contains(&value_reference) {
+        return None;
+    }
+    let offset = value_reference - vr::MODULATION_1_PARAMETER;
+    let slot = &mut slots[(offset / vr::MODULATION_STRIDE) as usize];
+    let j = (offset % vr::MODULATION_STRIDE) as usize;
+    match j {
+        0 => Some(&mut slot.parameter),
+        1 => Some(&mut slot.signal),
+        2 => Some(&mut slot.frequency),
+        3 => Some(&mut slot.knots),
+        4..=9 => Some(&mut slot.x[j - 4]),
+        10..=15 => Some(&mut slot.y[j - 10]),
+        _ => None,
+    }
+}
+
+/// The value references of every slot's variables, in the table's order.
+pub fn value_references() -> impl Iterator<Item = u32> {
+    (0..SLOTS as u32).flat_map(|k| {
+        let base = vr::MODULATION_1_PARAMETER + k * vr::MODULATION_STRIDE;
+        base..base + 4 + 2 * MAX_KNOTS as u32
+    })
+}
+
+fn allowed() -> String {
+    MODULATABLE
+        .iter()
+        .map(|&r| format!("{} ({r})", variable_name(r)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The checks of one setting beyond its row's limits: the constant one of [`MODULATABLE`],
+/// the signal and the knots whole numbers. `slot` is 1-based, for the message.
+fn check_field(slot: usize, field: usize, value: f64) -> Result<(), String> {
+    match field {
+        0 => {
+            if value == 0.0 {
+                return Ok(());
+            }
+            let code = value as u32;
+            if value.fract() == 0.0 && MODULATABLE.contains(&code) {
+                return Ok(());
+            }
+            let why = match NOT_MODULATABLE.iter().find(|(r, _)| value.fract() == 0.0 && *r == code) {
+                Some((r, reason)) => format!(" ({} is not: {reason})", variable_name(*r)),
+                None => String::new(),
+            };
+            Err(format!(
+                "modulation_{slot}_parameter = {} is invalid: must be 0 (off) or the value reference of a modulatable constant{why}: {}",
+                number(value),
+                allowed()
+            ))
+        }
+        1 if ModulationSignal::from_code(value).is_none() => Err(format!(
+            "modulation_{slot}_signal = {} is invalid: must be a whole number from 0 to 13 ({})",
+            number(value),
+            ModulationSignal::ALL
+                .iter()
+                .map(|s| format!("{} {} ({})", s.code(), s.name(), s.unit()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+        3 if value.fract() != 0.0 => Err(format!(
+            "modulation_{slot}_knots = {} is invalid: must be a whole number from 0 to {MAX_KNOTS}",
+            number(value)
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The checks of [`Parameters::set`] beyond the row's limits, for a slot's variable.
+pub fn check_setting(value_reference: u32, value: f64) -> Result<(), String> {
+    if !(vr::MODULATION_1_PARAMETER..=vr::MODULATION_LAST).contains(&value_reference) {
+        return Ok(());
+    }
+    let offset = value_reference - vr::MODULATION_1_PARAMETER;
+    check_field(
+        (offset / vr::MODULATION_STRIDE) as usize + 1,
+        (offset % vr::MODULATION_STRIDE) as usize,
+        value,
+    )
+}
+
+/// The slots' checks (run with [`Parameters::validate`]): each setting as
+/// [`check_setting`] has it; for a slot that is on, the knots in use strictly increasing and,
+/// at every knot, its constant within the constant's limits and the model's constraints
+/// between constants met (those of [`Parameters::validate`], with that slot's constant at the
+/// knot and the other slot's at its nominal value).
+pub fn validate(p: &Parameters) -> Result<(), String> {
+    for (k, slot) in p.modulation.iter().enumerate() {
+        let n = k + 1;
+        check_field(n, 0, slot.parameter)?;
+        check_field(n, 1, slot.signal)?;
+        check_field(n, 3, slot.knots)?;
+        if !slot.is_on() {
+            continue;
+        }
+        let constant = slot.constant();
+        let name = variable_name(constant);
+        let unit = slot.signal().unit();
+        for j in 1..slot.len() {
+            if slot.x[j] <= slot.x[j - 1] {
+                return Err(format!(
+                    "modulation_{n}_x_{} = {} {unit} is invalid: must exceed modulation_{n}_x_{} = {} {unit} (the knots' signal values increase)",
+                    j + 1,
+                    number(slot.x[j]),
+                    j,
+                    number(slot.x[j - 1])
+                ));
+            }
+        }
+        let nominal = p.get(constant).expect("a modulatable constant is a parameter");
+        for j in 0..slot.len() {
+            let value = nominal + slot.y[j];
+            let at_knot = |e: String| {
+                format!(
+                    "modulation_{n}_y_{} = {} takes {name} from {} to {} at knot {} ({} = {} {unit}): {e}",
+                    j + 1,
+                    number(slot.y[j]),
+                    number(nominal),
+                    number(value),
+                    j + 1,
+                    slot.signal().name(),
+                    number(slot.x[j])
+                )
+            };
+            variables::check(constant, value).map_err(at_knot)?;
+            if constant == vr::ZETA_2 && nominal < 1.0 && value >= 1.0 {
+                return Err(at_knot(
+                    "zeta_2 must stay below 1, where the current driver and jet pipe are propagated in the jet pipe's modes".into(),
+                ));
+            }
+            let mut at = p.clone();
+            at.modulation = [Slot::default(); SLOTS];
+            at.set(constant, value).map_err(at_knot)?;
+            at.validate().map_err(at_knot)?;
+        }
+    }
+    Ok(())
+}
+
+/// What [`apply`] changed, for [`restore`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Held {
+    /// The constants' values before, in the order set.
+    values: [(u32, f64); SLOTS],
+    count: usize,
+    discharge: [f64; 4],
+    area_scales: [f64; 4],
+    inv_sqrt_temperature: f64,
+}
+
+/// Each slot's constant set to its value plus the slot's increment at `signals`, with what
+/// the model derives from it (the discharge factors, 1/√T; the propagator is the
+/// simulation's); an error, with the model unchanged, when a constant would leave its limits
+/// (a drift adding to a modulation) or the supply fall below the return pressure.
+pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, String> {
+    let mut held = Held {
+        values: [(0, 0.0); SLOTS],
+        count: 0,
+        discharge: model.discharge,
+        area_scales: model.area_scales,
+        inv_sqrt_temperature: model.flow.inv_sqrt_temperature,
+    };
+    let slots = model.params.modulation;
+    for (k, slot) in slots.iter().enumerate() {
+        if !slot.is_on() {
+            continue;
+        }
+        let constant = slot.constant();
+        let x = slot.signal().value(signals, slot.frequency);
+        let field = model.params.field_mut(constant).expect("a modulatable constant is a parameter");
+        let before = *field;
+        let value = before + slot.increment(x);
+        held.values[held.count] = (constant, before);
+        held.count += 1;
+        *field = value;
+        let refused = if !value.is_finite() {
+            Some(format!("{} = {value} is invalid: must be finite", variable_name(constant)))
+        } else if constant == vr::T_GAS || constant == vr::P_S || constant == vr::P_R {
+            variables::check(constant, value).err()
+        } else {
+            None
+        };
+        if let Some(e) = refused {
+            restore(model, held);
+            return Err(format!(
+                "modulation slot {} at {} = {} {} (t = {} s): {e}",
+                k + 1,
+                slot.signal().name(),
+                number(x),
+                slot.signal().unit(),
+                signals.time
+            ));
+        }
+    }
+    let p = &model.params;
+    if p.p_s < p.p_r {
+        let e = format!(
+            "the modulation slots take P_s to {} Pa and P_r to {} Pa at t = {} s: P_s must stay >= P_r",
+            number(p.p_s),
+            number(p.p_r),
+            signals.time
+        );
+        restore(model, held);
+        return Err(e);
+    }
+    if modulates_any_of(p, DISCHARGE) {
+        model.area_scales = [
+            p.supply_area_scale_1,
+            p.return_area_scale_1,
+            p.supply_area_scale_2,
+            p.return_area_scale_2,
+        ];
+        let c_d = p.c_d;
+        model.discharge = model.area_scales.map(|scale| c_d * scale);
+    }
+    if modulates_any_of(p, &[vr::T_GAS]) {
+        model.flow.inv_sqrt_temperature = 1.0 / p.temperature.sqrt();
+    }
+    Ok(held)
+}
+
+/// Undo [`apply`].
+pub(crate) fn restore(model: &mut Actuator, held: Held) {
+    for &(constant, before) in held.values[..held.count].iter().rev() {
+        *model.params.field_mut(constant).expect("a modulatable constant is a parameter") = before;
+    }
+    model.discharge = held.discharge;
+    model.area_scales = held.area_scales;
+    model.flow.inv_sqrt_temperature = held.inv_sqrt_temperature;
+}
+
+/// A copy of `model` with the slots' constants at `signals` (for the outputs and the
+/// equilibrium, which do not restore).
+pub(crate) fn model_at(model: &Actuator, signals: &Signals) -> Result<Actuator, String> {
+    let mut at = model.clone();
+    apply(&mut at, signals)?;
+    Ok(at)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,404 @@
+//! The modulation slots: their parameters and refusals, and simulations with them against
+//! the model with the constant set by hand, against the time-varying constants, and against a
+//! current driver stepped here by hand.
+
+use super::*;
+use crate::physics::actuator::index;
+use crate::simulation::{equilibrium_at, FixedStep, Simulation};
+
+fn with_slot(slot: Slot) -> Parameters {
+    Parameters {
+        modulation: [slot, Slot::default()],
+        ..Parameters::default()
+    }
+}
+
+/// The command of the runs below: steps and a ramp over 0.3 s, a sample each millisecond.
+fn command(k: usize) -> f64 {
+    match k {
+        0..=49 => 1.0,
+        50..=149 => 4.0,
+        150..=249 => -2.0 + 0.05 * (k - 150) as f64,
+        _ => 0.5,
+    }
+}
+
+/// (time, F_meas, P1, P2, i) at each sample of a 0.3 s run at 1 kHz of the error-controlled
+/// simulation, the stopper moving sinusoidally by ±5 mm.
+fn run(p: &Parameters) -> Vec<[f64; 5]> {
+    let model = Actuator::new(p.clone()).unwrap();
+    let mut sim = Simulation::at_equilibrium(model, command(0), 0.054, 0.0, 1e-8).unwrap();
+    let mut out = Vec::new();
+    for k in 0..300 {
+        sim.set_command(command(k)).unwrap();
+        let t_next = (k + 1) as f64 * 1e-3;
+        let x_next = 0.054 + 0.005 * (2.0 * std::f64::consts::PI * 5.0 * t_next).sin();
+        sim.set_stopper_rate((x_next - sim.x_s()) / 1e-3).unwrap();
+        sim.step(1e-3).unwrap();
+        sim.land_stopper_at(x_next);
+        let y = sim.outputs();
+        out.push([sim.time(), y.f_meas, y.p1, y.p2, y.current]);
+    }
+    out
+}
+
+/// The same samples through the fixed-step replay.
+fn replay(p: &Parameters) -> Vec<[f64; 5]> {
+    let model = Actuator::new(p.clone()).unwrap();
+    let mut fixed = FixedStep::at_equilibrium(model, command(0), 0.054, 0.0).unwrap().unwrap();
+    let mut out = Vec::new();
+    for k in 0..300 {
+        fixed.set_command(command(k)).unwrap();
+        let t_next = (k + 1) as f64 * 1e-3;
+        let x_next = 0.054 + 0.005 * (2.0 * std::f64::consts::PI * 5.0 * t_next).sin();
+        fixed.step_to(t_next, x_next).unwrap();
+        let y = fixed.outputs();
+        out.push([t_next, y.f_meas, y.p1, y.p2, y.current]);
+    }
+    out
+}
+
+/// The largest difference of each column, relative to the column's largest magnitude.
+fn relative_gap(a: &[[f64; 5]], b: &[[f64; 5]]) -> f64 {
+    let mut worst = 0.0_f64;
+    for c in 1..5 {
+        let scale = a.iter().fold(0.0_f64, |m, r| m.max(r[c].abs())).max(1e-12);
+        for (ra, rb) in a.iter().zip(b) {
+            worst = worst.max((ra[c] - rb[c]).abs() / scale);
+        }
+    }
+    worst
+}
+
+#[test]
+fn the_signal_codes_run_from_0_to_13_in_the_order_of_the_interface_with_si_units() {
+    let expected = [
+        ("none", "1"),
+        ("t", "s"),
+        ("v_DA", "V"),
+        ("i", "A"),
+        ("x_jp", "m"),
+        ("x_s", "m"),
+        ("stopper velocity", "m/s"),
+        ("sign of the stopper velocity", "1"),
+        ("F_act", "N"),
+        ("P1", "Pa"),
+        ("P2", "Pa"),
+        ("P1 - P2", "Pa"),
+        ("sin(2 pi f t)", "1"),
+        ("cos(2 pi f t)", "1"),
+    ];
+    for (code, (signal, (name, unit))) in ModulationSignal::ALL.iter().zip(expected).enumerate() {
+        assert_eq!(signal.code(), code as u32);
+        assert_eq!((signal.name(), signal.unit()), (name, unit));
+        assert_eq!(ModulationSignal::from_code(code as f64), Some(*signal));
+    }
+    assert_eq!(ModulationSignal::from_code(14.0), None);
+    assert_eq!(ModulationSignal::from_code(2.5), None);
+    let s = Signals {
+        time: 0.125,
+        p1: 4e5,
+        p2: 1.5e5,
+        stopper_velocity: -1e-3,
+        ..Signals::default()
+    };
+    assert_eq!(ModulationSignal::PressureDifference.value(&s, 0.0), 2.5e5);
+    assert!((ModulationSignal::StopperVelocitySign.value(&s, 0.0) - (-1.0_f64).tanh()).abs() < 1e-15);
+    // 2 Hz at 0.125 s: a quarter turn.
+    assert!((ModulationSignal::Sine.value(&s, 2.0) - 1.0).abs() < 1e-15);
+    assert!(ModulationSignal::Cosine.value(&s, 2.0).abs() < 1e-15);
+}
+
+#[test]
+fn the_increment_is_linear_between_knots_and_held_beyond_the_first_and_last() {
+    let slot = Slot::through(vr::P_S, ModulationSignal::P1, &[1e5, 2e5, 4e5], &[10.0, 30.0, -10.0]);
+    assert_eq!(slot.increment(0.0), 10.0);
+    assert_eq!(slot.increment(1e5), 10.0);
+    assert_eq!(slot.increment(1.5e5), 20.0);
+    assert_eq!(slot.increment(3e5), 10.0);
+    assert_eq!(slot.increment(4e5), -10.0);
+    assert_eq!(slot.increment(9e5), -10.0);
+    let one = Slot::through(vr::P_S, ModulationSignal::Time, &[7.0], &[-500.0]);
+    for s in [-1e6, 0.0, 7.0, 1e6] {
+        assert_eq!(one.increment(s), -500.0, "one knot is a constant increment");
+    }
+    assert!(!Slot::default().is_on());
+    assert!(!Slot { knots: 0.0, ..one }.is_on(), "no knot in use: off");
+}
+
+#[test]
+fn every_variable_of_both_slots_is_a_parameter_of_the_table_that_sets_its_own_field() {
+    let names: Vec<&str> = value_references().map(variable_name).collect();
+    assert_eq!(names.len(), 32);
+    assert_eq!(names[0], "modulation_1_parameter");
+    assert_eq!(names[15], "modulation_1_y_6");
+    assert_eq!(names[16], "modulation_2_parameter");
+    assert_eq!(names[17], "modulation_2_signal");
+    assert_eq!(names[18], "modulation_2_frequency");
+    assert_eq!(names[19], "modulation_2_knots");
+    assert_eq!(names[20], "modulation_2_x_1");
+    assert_eq!(names[26], "modulation_2_y_1");
+    for (j, r) in value_references().enumerate() {
+        assert!(Parameters::VALUE_REFERENCES.contains(&r), "{}", names[j]);
+        let mut p = Parameters::default();
+        // A value every field accepts, told apart from every other field's.
+        let value = if j % 16 == 0 { vr::K_CD as f64 } else { (j % 16).min(6) as f64 };
+        p.set(r, value).unwrap_or_else(|e| panic!("{}: {e}", names[j]));
+        assert_eq!(p.get(r), Some(value));
+        let changed: Vec<u32> = value_references()
+            .filter(|&other| p.get(other) != Parameters::default().get(other))
+            .collect();
+        assert_eq!(changed, vec![r], "{} sets only itself", names[j]);
+    }
+}
+
+#[test]
+fn a_constant_that_is_not_modulatable_is_refused_naming_the_slot_the_value_and_what_is_allowed() {
+    let mut p = Parameters::default();
+    let e = p.set(vr::MODULATION_2_PARAMETER, vr::GAMMA as f64).unwrap_err();
+    assert!(
+        e.starts_with("modulation_2_parameter = 103 is invalid: must be 0 (off) or the value reference of a modulatable constant"),
+        "{e}"
+    );
+    assert!(e.contains("k_cd (110)") && e.contains("p2_sensor_gain (511)"), "{e}");
+    let e = p.set(vr::MODULATION_1_PARAMETER, vr::D_CYL as f64).unwrap_err();
+    assert!(e.contains("D_cyl is not") && e.contains("conserves"), "{e}");
+    assert_eq!(p, Parameters::default(), "a refused setting changes nothing");
+    // validate refuses it too, when the field was written directly.
+    let mut q = with_slot(Slot::through(vr::P_S, ModulationSignal::Time, &[0.0], &[1.0]));
+    q.modulation[0].parameter = vr::R_GAS as f64;
+    let e = q.validate().unwrap_err();
+    assert!(e.starts_with("modulation_1_parameter = 104 is invalid"), "{e}");
+    let e = p.set(vr::MODULATION_1_SIGNAL, 2.5).unwrap_err();
+    assert!(e.starts_with("modulation_1_signal = 2.5 is invalid") && e.contains("8 F_act (N)"), "{e}");
+    assert!(p.set(vr::MODULATION_1_SIGNAL, 14.0).is_err());
+    assert!(p.set(vr::MODULATION_1_KNOTS, 7.0).is_err());
+    assert!(p.set(vr::MODULATION_1_KNOTS, 1.5).is_err());
+}
+
+#[test]
+fn knots_that_do_not_increase_are_refused_naming_the_slot_the_knot_and_the_values() {
+    let p = with_slot(Slot::through(
+        vr::K_CD,
+        ModulationSignal::P1,
+        &[1e5, 3e5, 3e5],
+        &[0.0, 0.0, 0.0],
+    ));
+    let e = p.validate().unwrap_err();
+    assert!(
+        e.starts_with("modulation_1_x_3 = 300000 Pa is invalid: must exceed modulation_1_x_2 = 300000 Pa"),
+        "{e}"
+    );
+    assert!(Actuator::new(p).is_err());
+}
+
+#[test]
+fn a_knot_that_takes_the_constant_outside_its_limits_is_refused_naming_the_knot_the_value_and_the_limit() {
+    let nominal = Parameters::default().c_d;
+    let p = with_slot(Slot::through(
+        vr::C_D,
+        ModulationSignal::Command,
+        &[-5.0, 0.0, 5.0],
+        &[0.0, 0.1, 1.0],
+    ));
+    let e = p.validate().unwrap_err();
+    assert!(e.starts_with("modulation_1_y_3 = 1 takes C_d from "), "{e}");
+    assert!(e.contains(&format!("to {}", number(nominal + 1.0))), "{e}");
+    assert!(e.contains("at knot 3 (v_DA = 5 V)") && e.contains("must be in (0, 1]"), "{e}");
+    // A constraint between constants: the supply below the return pressure at a knot.
+    let q = with_slot(Slot::through(vr::P_R, ModulationSignal::Time, &[0.0, 1.0], &[0.0, 6e5]));
+    let e = q.validate().unwrap_err();
+    assert!(e.starts_with("modulation_1_y_2 = 600000 takes P_r") && e.contains("must be >= P_r"), "{e}");
+    // zeta_2 at 1 or above leaves the jet pipe no modal form.
+    let z = with_slot(Slot::through(vr::ZETA_2, ModulationSignal::Time, &[0.0], &[2.0]));
+    assert!(z.validate().unwrap_err().contains("zeta_2 must stay below 1"));
+}
+
+#[test]
+fn a_slot_whose_increments_are_zero_changes_no_bit_of_the_outputs() {
+    let thesis = run(&Parameters::default());
+    for constant in [vr::P_S, vr::K_CD, vr::C_D, vr::FORCE_SENSOR_GAIN] {
+        let p = with_slot(Slot::through(constant, ModulationSignal::P1, &[2e5, 4e5], &[0.0, 0.0]));
+        let modulated = run(&p);
+        for (a, b) in thesis.iter().zip(&modulated) {
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{}", variable_name(constant));
+        }
+    }
+}
+
+#[test]
+fn a_slot_with_one_knot_equals_the_model_with_the_constant_set_to_its_value_plus_the_increment() {
+    let cases: [(u32, f64); 8] = [
+        (vr::K_CD, 0.004),
+        (vr::OMEGA_2, -150.0),
+        (vr::P_S, -4e4),
+        (vr::T_GAS, 25.0),
+        (vr::RETURN_AREA_SCALE_2, 0.2),
+        (vr::FORCE_SENSOR_GAIN, 0.05),
+        (vr::FRICTION_COULOMB, 1.5),
+        (vr::K_SPRING, 300.0),
+    ];
+    for (constant, delta) in cases {
+        let slotted = with_slot(Slot::through(constant, ModulationSignal::StopperPosition, &[0.05], &[delta]));
+        let mut by_hand = Parameters::default();
+        by_hand.set(constant, by_hand.get(constant).unwrap() + delta).unwrap();
+        let name = variable_name(constant);
+        let (a, b) = (run(&slotted), run(&by_hand));
+        assert!(relative_gap(&a, &b) < 1e-9, "{name}: {}", relative_gap(&a, &b));
+        let (c, d) = (replay(&slotted), replay(&by_hand));
+        assert!(relative_gap(&c, &d) < 1e-12, "{name} replayed: {}", relative_gap(&c, &d));
+        // And the slot does change the run (the comparison could fail).
+        assert!(relative_gap(&a, &run(&Parameters::default())) > 1e-6, "{name} changed nothing");
+    }
+}
+
+#[test]
+fn a_slot_on_the_supply_pressure_linear_in_time_equals_the_supply_drift() {
+    let drift = -2e5; // Pa/s: 60 kPa over the run
+    let slotted = with_slot(Slot::through(vr::P_S, ModulationSignal::Time, &[0.0, 1.0], &[0.0, drift]));
+    let drifting = Parameters {
+        supply_drift: drift,
+        ..Parameters::default()
+    };
+    let (a, b) = (run(&slotted), run(&drifting));
+    assert!(relative_gap(&a, &b) < 1e-9, "{}", relative_gap(&a, &b));
+    let (c, d) = (replay(&slotted), replay(&drifting));
+    assert!(relative_gap(&c, &d) < 1e-12, "{}", relative_gap(&c, &d));
+    assert!(relative_gap(&a, &run(&Parameters::default())) > 1e-4);
+}
+
+#[test]
+fn a_slot_on_k_cd_by_p1_steps_the_current_as_a_driver_stepped_by_hand_with_k_cd_at_the_step_start() {
+    let slot = Slot::through(vr::K_CD, ModulationSignal::P1, &[5.2e5, 5.6e5, 6e5], &[-0.004, 0.002, 0.006]);
+    let p = with_slot(slot);
+    let model = Actuator::new(p.clone()).unwrap();
+    let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
+    let mut fixed = FixedStep::at_equilibrium(model, 1.0, 0.054, 0.0).unwrap().unwrap();
+    let h = 1e-3;
+    let mut worst = 0.0_f64;
+    let mut spread = (f64::INFINITY, f64::NEG_INFINITY);
+    // The closed form of di/dt = ω_cd (k_cd v + i_offset − i) over a held command, k_cd read
+    // off the knots by hand at the P1 of the step's start.
+    let by_hand = |state: &crate::physics::actuator::State, v: f64| {
+        let (i0, p1) = (state[index::CURRENT], state[index::P1]);
+        let k_cd = p.k_cd
+            + if p1 <= 5.2e5 {
+                -0.004
+            } else if p1 <= 5.6e5 {
+                -0.004 + (p1 - 5.2e5) / 4e4 * 0.006
+            } else if p1 <= 6e5 {
+                0.002 + (p1 - 5.6e5) / 4e4 * 0.004
+            } else {
+                0.006
+            };
+        let target = k_cd * v + p.i_offset;
+        (target + (i0 - target) * (-p.omega_cd * h).exp(), p1)
+    };
+    for k in 0..300 {
+        let v = command(k);
+        let (expected, p1) = by_hand(sim.state(), v);
+        let (expected_fixed, _) = by_hand(fixed.simulation().state(), v);
+        sim.set_command(v).unwrap();
+        sim.step(h).unwrap();
+        fixed.set_command(v).unwrap();
+        fixed.step_to((k + 1) as f64 * h, 0.054).unwrap();
+        worst = worst.max((sim.outputs().current - expected).abs());
+        worst = worst.max((fixed.outputs().current - expected_fixed).abs());
+        spread = (spread.0.min(p1), spread.1.max(p1));
+    }
+    assert!(worst < 1e-12, "{worst} A");
+    assert!(spread.0 < 5.2e5 && spread.1 > 6e5, "P1 crossed every knot: {spread:?}");
+}
+
+#[test]
+fn the_equilibrium_with_i_offset_modulated_by_the_jet_position_is_its_own_signals_fixed_point() {
+    let slot = Slot::through(vr::I_OFFSET, ModulationSignal::JetPosition, &[-1e-4, 1e-4], &[-0.01, 0.01]);
+    let p = with_slot(slot);
+    let model = Actuator::new(p.clone()).unwrap();
+    let v = 2.0;
+    let state = equilibrium_at(&model, v, 0.054, 0.0).unwrap();
+    let (current, x_jp) = (state[index::CURRENT], state[index::JET_POSITION]);
+    let increment = slot.increment(x_jp);
+    assert!(increment.abs() > 1e-3, "the slot acts here: {increment} A at x_jp = {x_jp} m");
+    // The equilibrium's own signals give the increment used: the static current of (2.3)
+    // with i_offset plus that increment, and the jet pipe where f3 puts it.
+    assert!((current - (p.k_cd * v + p.i_offset + increment)).abs() < 1e-12, "{current}");
+    let at = Actuator::new(Parameters {
+        i_offset: p.i_offset + increment,
+        ..Parameters::default()
+    })
+    .unwrap();
+    assert!((x_jp - at.static_jet_position(current)).abs() < 1e-15, "{x_jp}");
+    // It differs from the nominal equilibrium, and a simulation started there stays put.
+    let nominal = equilibrium_at(&Actuator::new(Parameters::default()).unwrap(), v, 0.054, 0.0).unwrap();
+    assert!((nominal[index::CURRENT] - current).abs() > 1e-3);
+    let mut sim = Simulation::at_equilibrium(model, v, 0.054, 0.0, 1e-8).unwrap();
+    let start = sim.outputs();
+    for _ in 0..50 {
+        sim.step(1e-3).unwrap();
+    }
+    let end = sim.outputs();
+    assert!((end.current - start.current).abs() < 1e-12, "{} A", end.current - start.current);
+    assert!((end.p1 - start.p1).abs() < 1.0, "{} Pa", end.p1 - start.p1);
+}
+
+#[test]
+fn a_slot_on_friction_switches_the_friction_on_and_acts_where_its_knots_say() {
+    // Coulomb friction of 3 N between 52 and 56 mm of stopper position, none elsewhere.
+    let slot = Slot::through(
+        vr::FRICTION_COULOMB,
+        ModulationSignal::StopperPosition,
+        &[0.0515, 0.052, 0.056, 0.0565],
+        &[0.0, 3.0, 3.0, 0.0],
+    );
+    let p = Parameters {
+        friction_velocity: 1e-3,
+        ..with_slot(slot)
+    };
+    let model = Actuator::new(p.clone()).unwrap();
+    assert!(model.reads_stopper_motion, "friction by a slot forms the stopper's motion");
+    assert!(!Actuator::new(Parameters::default()).unwrap().reads_stopper_motion);
+    let plain = run(&Parameters {
+        friction_velocity: 1e-3,
+        ..Parameters::default()
+    });
+    let modulated = run(&p);
+    let x = |t: f64| 0.054 + 0.005 * (2.0 * std::f64::consts::PI * 5.0 * t).sin();
+    let (mut inside, mut outside) = (0.0_f64, 0.0_f64);
+    for (a, b) in plain.iter().zip(&modulated) {
+        let gap = (a[1] - b[1]).abs();
+        if (0.0525..0.0555).contains(&x(a[0])) {
+            inside = inside.max(gap);
+        } else if !(0.0510..0.0570).contains(&x(a[0])) {
+            outside = outside.max(gap);
+        }
+    }
+    assert!(inside > 2.0, "the friction acts inside: {inside} N");
+    assert_eq!(outside, 0.0, "and nowhere beyond its knots");
+}
+
+#[test]
+fn a_transducer_gain_modulated_by_the_pressure_reads_with_the_gain_at_the_sample() {
+    let slot = Slot::through(vr::P1_SENSOR_GAIN, ModulationSignal::P1, &[1e5, 6e5], &[0.0, 0.05]);
+    let model = Actuator::new(with_slot(slot)).unwrap();
+    let mut sim = Simulation::at_equilibrium(model, 1.0, 0.054, 0.0, 1e-8).unwrap();
+    let mut checked = 0;
+    for k in 0..200 {
+        sim.set_command(command(k)).unwrap();
+        sim.step(1e-3).unwrap();
+        let y = sim.outputs();
+        let gain = 1.0 + 0.05 * ((y.p1 - 1e5) / 5e5).clamp(0.0, 1.0);
+        assert!((y.p1_meas - gain * y.p1).abs() < 1e-6, "{} vs {}", y.p1_meas, gain * y.p1);
+        checked += usize::from(gain > 1.01);
+    }
+    assert!(checked > 10, "the gain moved from 1 at {checked} samples");
+}
+
+#[test]
+fn model_exchange_is_told_which_slot_it_refuses() {
+    assert!(refuse_in_model_exchange(&Parameters::default()).is_ok());
+    let mut p = Parameters::default();
+    p.modulation[1] = Slot::through(vr::P_S, ModulationSignal::Time, &[0.0], &[1.0]);
+    let e = refuse_in_model_exchange(&p).unwrap_err();
+    assert!(e.starts_with("modulation_2_parameter = 100 (P_s) switches on a modulation slot"), "{e}");
+}

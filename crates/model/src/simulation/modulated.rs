@@ -1,0 +1,136 @@
+//! The modulation slots ([`crate::physics::modulation`]) in a simulation: the signals at a
+//! sample, the slots' constants held over a step (with the propagator rebuilt when they are
+//! the current driver's or the jet pipe's) and released after it, and the outputs at a sample
+//! with the constants at its signals.
+
+use super::Simulation;
+use crate::electromechanics::ElectromechanicalPropagator;
+use crate::physics::actuator::{index, Actuator, Outputs, State};
+use crate::physics::modulation::{self, Held, Signals};
+
+/// What [`Simulation::hold_modulated`] changed, for [`Simulation::release_modulated`].
+pub(super) struct HeldModulation {
+    constants: Held,
+    /// The simulation's own propagator, when the step has one of its own.
+    propagator: Option<Option<ElectromechanicalPropagator>>,
+}
+
+/// The signals of the chain at a sample: `state`, the command, the stopper and its motion as
+/// the outputs there read them, and the force F_act of the nominal constants (formed only
+/// when a slot follows it).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn signals_at(
+    model: &Actuator,
+    state: &State,
+    v_da: f64,
+    x_s: f64,
+    stopper_velocity: f64,
+    stopper_acceleration: f64,
+    time: f64,
+) -> Signals {
+    let f_act = if modulation::follows_the_force(&model.params) {
+        model
+            .outputs_in_motion(state, x_s, stopper_velocity, stopper_acceleration, time)
+            .f_act
+    } else {
+        0.0
+    };
+    Signals {
+        time,
+        v_da,
+        current: state[index::CURRENT],
+        x_jp: state[index::JET_POSITION],
+        x_s,
+        stopper_velocity,
+        f_act,
+        p1: state[index::P1],
+        p2: state[index::P2],
+    }
+}
+
+/// [`Actuator::outputs_in_motion`] with the slots' constants at the sample's signals (the
+/// nominal outputs when no slot modulates a constant the outputs read, or when the
+/// constants at these signals are refused, which a step from here reports).
+pub(super) fn outputs_in_motion(
+    model: &Actuator,
+    state: &State,
+    x_s: f64,
+    stopper_velocity: f64,
+    stopper_acceleration: f64,
+    time: f64,
+    v_da: f64,
+) -> Outputs {
+    if modulation::modulates_outputs(&model.params) {
+        let signals = signals_at(model, state, v_da, x_s, stopper_velocity, stopper_acceleration, time);
+        if let Ok(at) = modulation::model_at(model, &signals) {
+            return at.outputs_in_motion(state, x_s, stopper_velocity, stopper_acceleration, time);
+        }
+    }
+    model.outputs_in_motion(state, x_s, stopper_velocity, stopper_acceleration, time)
+}
+
+impl Simulation {
+    /// The signals at the last sample, the time signals at `time`.
+    pub(super) fn modulation_signals(&self, time: f64) -> Signals {
+        signals_at(
+            &self.model,
+            &self.state,
+            self.v_da,
+            self.x_s,
+            self.stopper_velocity_at_sample(),
+            self.stopper_acceleration,
+            time,
+        )
+    }
+
+    /// The slots' constants set at `signals` for a step, with the propagator of those
+    /// constants when they are the current driver's or the jet pipe's.
+    pub(super) fn hold_modulated(&mut self, signals: &Signals) -> Result<HeldModulation, String> {
+        let constants = modulation::apply(&mut self.model, signals)?;
+        let propagator = if self.propagator.is_some() && modulation::modulates_electromechanics(&self.model.params) {
+            match ElectromechanicalPropagator::new(&self.model.params) {
+                Some(rebuilt) => Some(self.propagator.replace(rebuilt)),
+                None => {
+                    modulation::restore(&mut self.model, constants);
+                    return Err(format!(
+                        "the modulation slots give the jet pipe no modal form at t = {} s (zeta_2 >= 1)",
+                        signals.time
+                    ));
+                }
+            }
+        } else {
+            None
+        };
+        self.chamber_rates_at_end = None;
+        Ok(HeldModulation { constants, propagator })
+    }
+
+    /// Undo [`Self::hold_modulated`].
+    pub(super) fn release_modulated(&mut self, held: HeldModulation) {
+        modulation::restore(&mut self.model, held.constants);
+        if let Some(propagator) = held.propagator {
+            self.propagator = propagator;
+        }
+        self.chamber_rates_at_end = None;
+    }
+
+    /// The outputs at the last sample (the transducers' static readings), with the slots'
+    /// constants at its signals.
+    pub(super) fn outputs_at_sample(&self) -> Outputs {
+        let (velocity, acceleration) = (self.stopper_velocity_at_sample(), self.stopper_acceleration);
+        if !self.plan.modulated_outputs {
+            return self
+                .model
+                .outputs_in_motion(&self.state, self.x_s, velocity, acceleration, self.time);
+        }
+        outputs_in_motion(
+            &self.model,
+            &self.state,
+            self.x_s,
+            velocity,
+            acceleration,
+            self.time,
+            self.v_da,
+        )
+    }
+}
