@@ -225,6 +225,47 @@ pub fn balance_with_volumes(
     Ok((balanced, nodes))
 }
 
+/// The most equilibria [`modulated_equilibrium`] computes.
+const MODULATED_EQUILIBRIUM_ROUNDS: usize = 50;
+
+/// The equilibrium with the modulation slots' constants at the equilibrium's own signals
+/// (time `time`, the stopper at rest), and the model with the constants there. A fixed
+/// point: the equilibrium of the nominal constants, the slots' increments at its signals, the
+/// equilibrium again with the constants so modulated, until the increments at the
+/// equilibrium's signals are those it was computed with (to 1e-9 of the constant's scale, its
+/// nominal value plus its largest increment). The constants that vary in time are at their
+/// values at `time`, the increments added to them. An error names the slots when the
+/// increments do not settle (a modulation so steep that it has no equilibrium, or several).
+pub fn modulated_equilibrium(model: &Actuator, v_da: f64, x_s: f64, time: f64) -> Result<(State, Actuator), String> {
+    let mut base = model.clone();
+    if time_varying::varies(&model.params) {
+        time_varying::set_model_at(&mut base, &model.params, time)?;
+    }
+    let slots = model.params.modulation;
+    let scales = slots.map(|slot| {
+        let nominal = base.params.get(slot.constant()).unwrap_or(0.0).abs();
+        let largest = slot.y[..slot.len()].iter().fold(0.0_f64, |m, y| m.max(y.abs()));
+        1e-9 * (nominal + largest).max(f64::MIN_POSITIVE)
+    });
+    let mut state = equilibrium(&base, v_da, x_s)?;
+    let mut at = base.clone();
+    let mut used = [0.0; SLOTS];
+    for _ in 0..MODULATED_EQUILIBRIUM_ROUNDS {
+        let signals = super::modulated::signals_at(&base, &state, v_da, x_s, 0.0, 0.0, time);
+        let next = slots.map(|slot| if slot.is_on() { slot.increment_at(&signals) } else { 0.0 });
+        if (0..SLOTS).all(|k| (next[k] - used[k]).abs() <= scales[k]) {
+            return Ok((state, at));
+        }
+        at = modulation::model_at(&base, &signals)?;
+        state = equilibrium(&at, v_da, x_s)?;
+        used = next;
+    }
+    Err(format!(
+        "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m with the modulation slots (modulation_1_parameter = {}, modulation_2_parameter = {}): the increments at the equilibrium's signals did not settle in {MODULATED_EQUILIBRIUM_ROUNDS} rounds",
+        slots[0].parameter, slots[1].parameter
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::tests::thesis_model;
@@ -279,45 +320,4 @@ mod tests {
             );
         }
     }
-}
-
-/// The most equilibria [`modulated_equilibrium`] computes.
-const MODULATED_EQUILIBRIUM_ROUNDS: usize = 50;
-
-/// The equilibrium with the modulation slots' constants at the equilibrium's own signals
-/// (time `time`, the stopper at rest), and the model with the constants there. A fixed
-/// point: the equilibrium of the nominal constants, the slots' increments at its signals, the
-/// equilibrium again with the constants so modulated, until the increments at the
-/// equilibrium's signals are those it was computed with (to 1e-9 of the constant's scale, its
-/// nominal value plus its largest increment). The constants that vary in time are at their
-/// values at `time`, the increments added to them. An error names the slots when the
-/// increments do not settle (a modulation so steep that it has no equilibrium, or several).
-pub fn modulated_equilibrium(model: &Actuator, v_da: f64, x_s: f64, time: f64) -> Result<(State, Actuator), String> {
-    let mut base = model.clone();
-    if time_varying::varies(&model.params) {
-        time_varying::set_model_at(&mut base, &model.params, time)?;
-    }
-    let slots = model.params.modulation;
-    let scales = slots.map(|slot| {
-        let nominal = base.params.get(slot.constant()).unwrap_or(0.0).abs();
-        let largest = slot.y[..slot.len()].iter().fold(0.0_f64, |m, y| m.max(y.abs()));
-        1e-9 * (nominal + largest).max(f64::MIN_POSITIVE)
-    });
-    let mut state = equilibrium(&base, v_da, x_s)?;
-    let mut at = base.clone();
-    let mut used = [0.0; SLOTS];
-    for _ in 0..MODULATED_EQUILIBRIUM_ROUNDS {
-        let signals = super::modulated::signals_at(&base, &state, v_da, x_s, 0.0, 0.0, time);
-        let next = slots.map(|slot| if slot.is_on() { slot.increment_at(&signals) } else { 0.0 });
-        if (0..SLOTS).all(|k| (next[k] - used[k]).abs() <= scales[k]) {
-            return Ok((state, at));
-        }
-        at = modulation::model_at(&base, &signals)?;
-        state = equilibrium(&at, v_da, x_s)?;
-        used = next;
-    }
-    Err(format!(
-        "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m with the modulation slots (modulation_1_parameter = {}, modulation_2_parameter = {}): the increments at the equilibrium's signals did not settle in {MODULATED_EQUILIBRIUM_ROUNDS} rounds",
-        slots[0].parameter, slots[1].parameter
-    ))
 }

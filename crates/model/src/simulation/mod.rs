@@ -151,6 +151,9 @@ pub struct Simulation {
     stage_areas: std::cell::RefCell<chambers::StageAreas>,
     /// Which of a step's optional stages the model has, decided once from its parameters.
     plan: StepPlan,
+    /// The propagator of the last step whose modulation slots changed the current driver's or
+    /// the jet pipe's constants, kept for the next step with the same constants.
+    modulated_propagator: Option<modulated::PropagatorOf>,
 }
 
 /// The optional stages of a step, decided once when a simulation is built from its model (its
@@ -305,6 +308,7 @@ impl Simulation {
             chamber_rates_at_end: None,
             stage_areas: std::cell::RefCell::new(chambers::StageAreas::default()),
             plan,
+            modulated_propagator: None,
         }
     }
 

@@ -11,8 +11,23 @@ use crate::physics::modulation::{self, Held, Signals};
 /// What [`Simulation::hold_modulated`] changed, for [`Simulation::release_modulated`].
 pub(super) struct HeldModulation {
     constants: Held,
-    /// The simulation's own propagator, when the step has one of its own.
-    propagator: Option<Option<ElectromechanicalPropagator>>,
+    /// The simulation's own propagator, when the step has one of its own, and the
+    /// constants of the step's.
+    propagator: Option<(Option<ElectromechanicalPropagator>, [f64; 9])>,
+}
+
+/// A propagator and the current driver's and jet pipe's constants it was built from.
+#[derive(Clone, Debug)]
+pub(super) struct PropagatorOf {
+    constants: [f64; 9],
+    propagator: ElectromechanicalPropagator,
+}
+
+/// The constants [`ElectromechanicalPropagator::new`] reads that a slot may modulate.
+fn electromechanical_constants(p: &crate::physics::parameters::Parameters) -> [f64; 9] {
+    [
+        p.k_cd, p.i_offset, p.omega_cd, p.k_m, p.omega_1, p.omega_2, p.zeta_2, p.x_jp_sat, p.f_jp_sat,
+    ]
 }
 
 /// The signals of the chain at a sample: `state`, the command, the stopper and its motion as
@@ -88,8 +103,16 @@ impl Simulation {
     pub(super) fn hold_modulated(&mut self, signals: &Signals) -> Result<HeldModulation, String> {
         let constants = modulation::apply(&mut self.model, signals)?;
         let propagator = if self.propagator.is_some() && modulation::modulates_electromechanics(&self.model.params) {
-            match ElectromechanicalPropagator::new(&self.model.params) {
-                Some(rebuilt) => Some(self.propagator.replace(rebuilt)),
+            // The last step's when its constants are these (a signal beyond the end knots, a
+            // constant increment): building one costs about three fixed steps.
+            let key = electromechanical_constants(&self.model.params);
+            let kept = self
+                .modulated_propagator
+                .take()
+                .filter(|kept| kept.constants == key)
+                .map(|kept| kept.propagator);
+            match kept.or_else(|| ElectromechanicalPropagator::new(&self.model.params)) {
+                Some(rebuilt) => Some((self.propagator.replace(rebuilt), key)),
                 None => {
                     modulation::restore(&mut self.model, constants);
                     return Err(format!(
@@ -108,8 +131,10 @@ impl Simulation {
     /// Undo [`Self::hold_modulated`].
     pub(super) fn release_modulated(&mut self, held: HeldModulation) {
         modulation::restore(&mut self.model, held.constants);
-        if let Some(propagator) = held.propagator {
-            self.propagator = propagator;
+        if let Some((own, constants)) = held.propagator {
+            if let Some(propagator) = std::mem::replace(&mut self.propagator, own) {
+                self.modulated_propagator = Some(PropagatorOf { constants, propagator });
+            }
         }
         self.chamber_rates_at_end = None;
     }
