@@ -486,7 +486,10 @@ fn check_field(slot: usize, field: usize, value: f64) -> Result<(), String> {
     }
 }
 
-/// The checks of [`Parameters::set`] beyond the row's limits, for a slot's variable.
+/// The checks of one slot variable's value beyond its row's limits, as [`validate`] makes them
+/// (the constant one of [`MODULATABLE`], the signal and the knots whole numbers). Like the
+/// static curves' knot counts, they are not made when a value is set but when the model is
+/// built, so that a setter takes any value within the declared limits.
 pub fn check_setting(value_reference: u32, value: f64) -> Result<(), String> {
     if !(vr::MODULATION_1_PARAMETER..=vr::MODULATION_LAST).contains(&value_reference) {
         return Ok(());

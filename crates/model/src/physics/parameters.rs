@@ -696,7 +696,6 @@ impl Parameters {
             .field_mut(value_reference)
             .ok_or_else(|| format!("value reference {value_reference} is not a parameter of the model"))?;
         crate::variables::check(value_reference, value)?;
-        super::modulation::check_setting(value_reference, value)?;
         *field = value;
         Ok(())
     }

@@ -154,26 +154,37 @@ fn every_variable_of_both_slots_is_a_parameter_of_the_table_that_sets_its_own_fi
 
 #[test]
 fn a_constant_that_is_not_modulatable_is_refused_naming_the_slot_the_value_and_what_is_allowed() {
-    let mut p = Parameters::default();
-    let e = p.set(vr::MODULATION_2_PARAMETER, vr::GAMMA as f64).unwrap_err();
+    let refused = |value_reference: u32, value: f64| {
+        let mut p = Parameters::default();
+        // Taken within the row's limits; refused when the model is built.
+        p.set(value_reference, value).unwrap();
+        let e = p.validate().unwrap_err();
+        assert_eq!(check_setting(value_reference, value).unwrap_err(), e);
+        assert!(Actuator::new(p).is_err());
+        e
+    };
+    let e = refused(vr::MODULATION_2_PARAMETER, vr::GAMMA as f64);
     assert!(
         e.starts_with("modulation_2_parameter = 103 is invalid: must be 0 (off) or the value reference of a modulatable constant"),
         "{e}"
     );
     assert!(e.contains("k_cd (110)") && e.contains("p2_sensor_gain (511)"), "{e}");
-    let e = p.set(vr::MODULATION_1_PARAMETER, vr::D_CYL as f64).unwrap_err();
+    let e = refused(vr::MODULATION_1_PARAMETER, vr::D_CYL as f64);
     assert!(e.contains("D_cyl is not") && e.contains("conserves"), "{e}");
-    assert_eq!(p, Parameters::default(), "a refused setting changes nothing");
-    // validate refuses it too, when the field was written directly.
-    let mut q = with_slot(Slot::through(vr::P_S, ModulationSignal::Time, &[0.0], &[1.0]));
-    q.modulation[0].parameter = vr::R_GAS as f64;
-    let e = q.validate().unwrap_err();
-    assert!(e.starts_with("modulation_1_parameter = 104 is invalid"), "{e}");
-    let e = p.set(vr::MODULATION_1_SIGNAL, 2.5).unwrap_err();
+    let e = refused(vr::MODULATION_1_PARAMETER, vr::K_CD as f64 + 0.5);
+    assert!(e.starts_with("modulation_1_parameter = 110.5 is invalid"), "{e}");
+    let e = refused(vr::MODULATION_1_SIGNAL, 2.5);
     assert!(e.starts_with("modulation_1_signal = 2.5 is invalid") && e.contains("8 F_act (N)"), "{e}");
-    assert!(p.set(vr::MODULATION_1_SIGNAL, 14.0).is_err());
+    let e = refused(vr::MODULATION_2_KNOTS, 1.5);
+    assert!(e.starts_with("modulation_2_knots = 1.5 is invalid"), "{e}");
+    let mut p = Parameters::default();
+    assert!(p.set(vr::MODULATION_1_SIGNAL, 14.0).is_err(), "beyond the row's limits");
     assert!(p.set(vr::MODULATION_1_KNOTS, 7.0).is_err());
-    assert!(p.set(vr::MODULATION_1_KNOTS, 1.5).is_err());
+    assert!(p.set(vr::MODULATION_1_PARAMETER, 1001.0).is_err());
+    assert_eq!(p, Parameters::default(), "a refused setting changes nothing");
+    for &constant in MODULATABLE {
+        assert!(check_setting(vr::MODULATION_1_PARAMETER, constant as f64).is_ok());
+    }
 }
 
 #[test]
