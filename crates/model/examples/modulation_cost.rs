@@ -52,14 +52,28 @@ fn main() {
     };
     let cases = [
         ("slots off", Parameters::default()),
-        ("P_s by P1", slot(vr::P_S, ModulationSignal::P1, &[2e5, 6e5], &[0.0, -3e4])),
-        ("k_cd by P1", slot(vr::K_CD, ModulationSignal::P1, &[2e5, 6e5], &[0.0, 0.004])),
+        (
+            "P_s by P1",
+            slot(vr::P_S, ModulationSignal::P1, &[2e5, 6e5], &[0.0, -3e4]),
+        ),
+        (
+            "k_cd by P1",
+            slot(vr::K_CD, ModulationSignal::P1, &[2e5, 6e5], &[0.0, 0.004]),
+        ),
         (
             "force_sensor_gain by F_act",
-            slot(vr::FORCE_SENSOR_GAIN, ModulationSignal::Force, &[0.0, 100.0], &[0.0, 0.02]),
+            slot(
+                vr::FORCE_SENSOR_GAIN,
+                ModulationSignal::Force,
+                &[0.0, 100.0],
+                &[0.0, 0.02],
+            ),
         ),
     ];
-    println!("{:<28} {:>16} {:>22}", "case", "FixedStep µs/step", "Simulation::step µs/step");
+    println!(
+        "{:<28} {:>16} {:>22}",
+        "case", "FixedStep µs/step", "Simulation::step µs/step"
+    );
     for (name, p) in &cases {
         println!("{name:<28} {:>16.2} {:>22.2}", per_step(p, true), per_step(p, false));
     }

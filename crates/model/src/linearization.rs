@@ -67,6 +67,14 @@ pub fn command_for_force(model: &Actuator, force: f64, x_s: f64) -> Result<f64, 
 
 /// Linearise at the equilibrium of command `v_da` and stopper position `x_s`.
 pub fn linearize(model: &Actuator, v_da: f64, x_s: f64) -> Result<LinearModel, String> {
+    if let Some(slot) = model.params.modulation.iter().position(|slot| slot.is_on()) {
+        // The constant's dependence on the signals would add terms to every row it enters.
+        return Err(format!(
+            "modulation_{}_parameter = {}: the linearisation does not carry the modulation slots; switch them off (0) to linearise the model without them",
+            slot + 1,
+            model.params.modulation[slot].parameter
+        ));
+    }
     let y0 = equilibrium(model, v_da, x_s)?;
     let u = Inputs {
         v_da,

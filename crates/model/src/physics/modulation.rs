@@ -590,14 +590,20 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         }
         let constant = slot.constant();
         let x = slot.signal().value(signals, slot.frequency);
-        let field = model.params.field_mut(constant).expect("a modulatable constant is a parameter");
+        let field = model
+            .params
+            .field_mut(constant)
+            .expect("a modulatable constant is a parameter");
         let before = *field;
         let value = before + slot.increment(x);
         held.values[held.count] = (constant, before);
         held.count += 1;
         *field = value;
         let refused = if !value.is_finite() {
-            Some(format!("{} = {value} is invalid: must be finite", variable_name(constant)))
+            Some(format!(
+                "{} = {value} is invalid: must be finite",
+                variable_name(constant)
+            ))
         } else if constant == vr::T_GAS || constant == vr::P_S || constant == vr::P_R {
             variables::check(constant, value).err()
         } else {
@@ -645,7 +651,10 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
 /// Undo [`apply`].
 pub(crate) fn restore(model: &mut Actuator, held: Held) {
     for &(constant, before) in held.values[..held.count].iter().rev() {
-        *model.params.field_mut(constant).expect("a modulatable constant is a parameter") = before;
+        *model
+            .params
+            .field_mut(constant)
+            .expect("a modulatable constant is a parameter") = before;
     }
     model.discharge = held.discharge;
     model.area_scales = held.area_scales;

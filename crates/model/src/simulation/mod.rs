@@ -41,8 +41,8 @@ use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
 use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
-use crate::physics::modulation;
 use crate::physics::extra_force::{self, StopperMotion};
+use crate::physics::modulation;
 use crate::physics::restrictions::node;
 use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
 use crate::physics::time_varying;
@@ -229,7 +229,10 @@ impl Simulation {
         }
         // With the slots' constants at the equilibrium's signals (the drifts then added).
         let at = match modulation::any_on(&model.params) {
-            true => modulation::model_at(&model, &modulated::signals_at(&model, &state, v_da, x_s, 0.0, 0.0, time))?,
+            true => modulation::model_at(
+                &model,
+                &modulated::signals_at(&model, &state, v_da, x_s, 0.0, 0.0, time),
+            )?,
             false => model.clone(),
         };
         let (state, nodes) = balance_with_volumes(&at, &state, x_s, time)?;

@@ -50,22 +50,76 @@ const INCREMENT: &str = "1e9 exceeds every constant's own limits; those are chec
 macro_rules! slot_rows {
     ($k:literal, $base:expr) => {
         [
-            parameter(concat!("modulation_", $k, "_parameter"), $base, "1", 0.0, PARAMETER).at_least(0.0).at_most(1000.0).because(CODE),
-            parameter(concat!("modulation_", $k, "_signal"), $base + 1, "1", 0.0, SIGNAL).at_least(0.0).at_most(13.0).because(CODES),
-            parameter(concat!("modulation_", $k, "_frequency"), $base + 2, "Hz", 0.0, FREQUENCY).at_least(0.0).at_most(1e5).because(HERTZ),
-            parameter(concat!("modulation_", $k, "_knots"), $base + 3, "1", 0.0, KNOTS).at_least(0.0).at_most(6.0).because(AT_MOST_SIX),
-            parameter(concat!("modulation_", $k, "_x_1"), $base + 4, "1", 0.0, X).at_least(-1e9).at_most(1e9).because(SIGNAL_VALUE),
-            parameter(concat!("modulation_", $k, "_x_2"), $base + 5, "1", 0.0, X).at_least(-1e9).at_most(1e9).because(SIGNAL_VALUE),
-            parameter(concat!("modulation_", $k, "_x_3"), $base + 6, "1", 0.0, X).at_least(-1e9).at_most(1e9).because(SIGNAL_VALUE),
-            parameter(concat!("modulation_", $k, "_x_4"), $base + 7, "1", 0.0, X).at_least(-1e9).at_most(1e9).because(SIGNAL_VALUE),
-            parameter(concat!("modulation_", $k, "_x_5"), $base + 8, "1", 0.0, X).at_least(-1e9).at_most(1e9).because(SIGNAL_VALUE),
-            parameter(concat!("modulation_", $k, "_x_6"), $base + 9, "1", 0.0, X).at_least(-1e9).at_most(1e9).because(SIGNAL_VALUE),
-            parameter(concat!("modulation_", $k, "_y_1"), $base + 10, "1", 0.0, Y).at_least(-1e9).at_most(1e9).because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_2"), $base + 11, "1", 0.0, Y).at_least(-1e9).at_most(1e9).because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_3"), $base + 12, "1", 0.0, Y).at_least(-1e9).at_most(1e9).because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_4"), $base + 13, "1", 0.0, Y).at_least(-1e9).at_most(1e9).because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_5"), $base + 14, "1", 0.0, Y).at_least(-1e9).at_most(1e9).because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_6"), $base + 15, "1", 0.0, Y).at_least(-1e9).at_most(1e9).because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_parameter"), $base, "1", 0.0, PARAMETER)
+                .at_least(0.0)
+                .at_most(1000.0)
+                .because(CODE),
+            parameter(concat!("modulation_", $k, "_signal"), $base + 1, "1", 0.0, SIGNAL)
+                .at_least(0.0)
+                .at_most(13.0)
+                .because(CODES),
+            parameter(
+                concat!("modulation_", $k, "_frequency"),
+                $base + 2,
+                "Hz",
+                0.0,
+                FREQUENCY,
+            )
+            .at_least(0.0)
+            .at_most(1e5)
+            .because(HERTZ),
+            parameter(concat!("modulation_", $k, "_knots"), $base + 3, "1", 0.0, KNOTS)
+                .at_least(0.0)
+                .at_most(6.0)
+                .because(AT_MOST_SIX),
+            parameter(concat!("modulation_", $k, "_x_1"), $base + 4, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_2"), $base + 5, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_3"), $base + 6, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_4"), $base + 7, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_5"), $base + 8, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_6"), $base + 9, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_y_1"), $base + 10, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_2"), $base + 11, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_3"), $base + 12, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_4"), $base + 13, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_5"), $base + 14, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_6"), $base + 15, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
         ]
     };
 }

@@ -45,7 +45,9 @@ fn run(p: &Parameters) -> Vec<[f64; 5]> {
 /// The same samples through the fixed-step replay.
 fn replay(p: &Parameters) -> Vec<[f64; 5]> {
     let model = Actuator::new(p.clone()).unwrap();
-    let mut fixed = FixedStep::at_equilibrium(model, command(0), 0.054, 0.0).unwrap().unwrap();
+    let mut fixed = FixedStep::at_equilibrium(model, command(0), 0.054, 0.0)
+        .unwrap()
+        .unwrap();
     let mut out = Vec::new();
     for k in 0..300 {
         fixed.set_command(command(k)).unwrap();
@@ -142,7 +144,11 @@ fn every_variable_of_both_slots_is_a_parameter_of_the_table_that_sets_its_own_fi
         assert!(Parameters::VALUE_REFERENCES.contains(&r), "{}", names[j]);
         let mut p = Parameters::default();
         // A value every field accepts, told apart from every other field's.
-        let value = if j % 16 == 0 { vr::K_CD as f64 } else { (j % 16).min(6) as f64 };
+        let value = if j % 16 == 0 {
+            vr::K_CD as f64
+        } else {
+            (j % 16).min(6) as f64
+        };
         p.set(r, value).unwrap_or_else(|e| panic!("{}: {e}", names[j]));
         assert_eq!(p.get(r), Some(value));
         let changed: Vec<u32> = value_references()
@@ -165,7 +171,9 @@ fn a_constant_that_is_not_modulatable_is_refused_naming_the_slot_the_value_and_w
     };
     let e = refused(vr::MODULATION_2_PARAMETER, vr::GAMMA as f64);
     assert!(
-        e.starts_with("modulation_2_parameter = 103 is invalid: must be 0 (off) or the value reference of a modulatable constant"),
+        e.starts_with(
+            "modulation_2_parameter = 103 is invalid: must be 0 (off) or the value reference of a modulatable constant"
+        ),
         "{e}"
     );
     assert!(e.contains("k_cd (110)") && e.contains("p2_sensor_gain (511)"), "{e}");
@@ -174,7 +182,10 @@ fn a_constant_that_is_not_modulatable_is_refused_naming_the_slot_the_value_and_w
     let e = refused(vr::MODULATION_1_PARAMETER, vr::K_CD as f64 + 0.5);
     assert!(e.starts_with("modulation_1_parameter = 110.5 is invalid"), "{e}");
     let e = refused(vr::MODULATION_1_SIGNAL, 2.5);
-    assert!(e.starts_with("modulation_1_signal = 2.5 is invalid") && e.contains("8 F_act (N)"), "{e}");
+    assert!(
+        e.starts_with("modulation_1_signal = 2.5 is invalid") && e.contains("8 F_act (N)"),
+        "{e}"
+    );
     let e = refused(vr::MODULATION_2_KNOTS, 1.5);
     assert!(e.starts_with("modulation_2_knots = 1.5 is invalid"), "{e}");
     let mut p = Parameters::default();
@@ -215,11 +226,17 @@ fn a_knot_that_takes_the_constant_outside_its_limits_is_refused_naming_the_knot_
     let e = p.validate().unwrap_err();
     assert!(e.starts_with("modulation_1_y_3 = 1 takes C_d from "), "{e}");
     assert!(e.contains(&format!("to {}", number(nominal + 1.0))), "{e}");
-    assert!(e.contains("at knot 3 (v_DA = 5 V)") && e.contains("must be in (0, 1]"), "{e}");
+    assert!(
+        e.contains("at knot 3 (v_DA = 5 V)") && e.contains("must be in (0, 1]"),
+        "{e}"
+    );
     // A constraint between constants: the supply below the return pressure at a knot.
     let q = with_slot(Slot::through(vr::P_R, ModulationSignal::Time, &[0.0, 1.0], &[0.0, 6e5]));
     let e = q.validate().unwrap_err();
-    assert!(e.starts_with("modulation_1_y_2 = 600000 takes P_r") && e.contains("must be >= P_r"), "{e}");
+    assert!(
+        e.starts_with("modulation_1_y_2 = 600000 takes P_r") && e.contains("must be >= P_r"),
+        "{e}"
+    );
     // zeta_2 at 1 or above leaves the jet pipe no modal form.
     let z = with_slot(Slot::through(vr::ZETA_2, ModulationSignal::Time, &[0.0], &[2.0]));
     assert!(z.validate().unwrap_err().contains("zeta_2 must stay below 1"));
@@ -250,23 +267,40 @@ fn a_slot_with_one_knot_equals_the_model_with_the_constant_set_to_its_value_plus
         (vr::K_SPRING, 300.0),
     ];
     for (constant, delta) in cases {
-        let slotted = with_slot(Slot::through(constant, ModulationSignal::StopperPosition, &[0.05], &[delta]));
+        let slotted = with_slot(Slot::through(
+            constant,
+            ModulationSignal::StopperPosition,
+            &[0.05],
+            &[delta],
+        ));
         let mut by_hand = Parameters::default();
         by_hand.set(constant, by_hand.get(constant).unwrap() + delta).unwrap();
         let name = variable_name(constant);
         let (a, b) = (run(&slotted), run(&by_hand));
         assert!(relative_gap(&a, &b) < 1e-9, "{name}: {}", relative_gap(&a, &b));
         let (c, d) = (replay(&slotted), replay(&by_hand));
-        assert!(relative_gap(&c, &d) < 1e-12, "{name} replayed: {}", relative_gap(&c, &d));
+        assert!(
+            relative_gap(&c, &d) < 1e-12,
+            "{name} replayed: {}",
+            relative_gap(&c, &d)
+        );
         // And the slot does change the run (the comparison could fail).
-        assert!(relative_gap(&a, &run(&Parameters::default())) > 1e-6, "{name} changed nothing");
+        assert!(
+            relative_gap(&a, &run(&Parameters::default())) > 1e-6,
+            "{name} changed nothing"
+        );
     }
 }
 
 #[test]
 fn a_slot_on_the_supply_pressure_linear_in_time_equals_the_supply_drift() {
     let drift = -2e5; // Pa/s: 60 kPa over the run
-    let slotted = with_slot(Slot::through(vr::P_S, ModulationSignal::Time, &[0.0, 1.0], &[0.0, drift]));
+    let slotted = with_slot(Slot::through(
+        vr::P_S,
+        ModulationSignal::Time,
+        &[0.0, 1.0],
+        &[0.0, drift],
+    ));
     let drifting = Parameters {
         supply_drift: drift,
         ..Parameters::default()
@@ -280,7 +314,12 @@ fn a_slot_on_the_supply_pressure_linear_in_time_equals_the_supply_drift() {
 
 #[test]
 fn a_slot_on_k_cd_by_p1_steps_the_current_as_a_driver_stepped_by_hand_with_k_cd_at_the_step_start() {
-    let slot = Slot::through(vr::K_CD, ModulationSignal::P1, &[5.2e5, 5.6e5, 6e5], &[-0.004, 0.002, 0.006]);
+    let slot = Slot::through(
+        vr::K_CD,
+        ModulationSignal::P1,
+        &[5.2e5, 5.6e5, 6e5],
+        &[-0.004, 0.002, 0.006],
+    );
     let p = with_slot(slot);
     let model = Actuator::new(p.clone()).unwrap();
     let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
@@ -323,17 +362,28 @@ fn a_slot_on_k_cd_by_p1_steps_the_current_as_a_driver_stepped_by_hand_with_k_cd_
 
 #[test]
 fn the_equilibrium_with_i_offset_modulated_by_the_jet_position_is_its_own_signals_fixed_point() {
-    let slot = Slot::through(vr::I_OFFSET, ModulationSignal::JetPosition, &[-1e-4, 1e-4], &[-0.01, 0.01]);
+    let slot = Slot::through(
+        vr::I_OFFSET,
+        ModulationSignal::JetPosition,
+        &[-1e-4, 1e-4],
+        &[-0.01, 0.01],
+    );
     let p = with_slot(slot);
     let model = Actuator::new(p.clone()).unwrap();
     let v = 2.0;
     let state = equilibrium_at(&model, v, 0.054, 0.0).unwrap();
     let (current, x_jp) = (state[index::CURRENT], state[index::JET_POSITION]);
     let increment = slot.increment(x_jp);
-    assert!(increment.abs() > 1e-3, "the slot acts here: {increment} A at x_jp = {x_jp} m");
+    assert!(
+        increment.abs() > 1e-3,
+        "the slot acts here: {increment} A at x_jp = {x_jp} m"
+    );
     // The equilibrium's own signals give the increment used: the static current of (2.3)
     // with i_offset plus that increment, and the jet pipe where f3 puts it.
-    assert!((current - (p.k_cd * v + p.i_offset + increment)).abs() < 1e-12, "{current}");
+    assert!(
+        (current - (p.k_cd * v + p.i_offset + increment)).abs() < 1e-12,
+        "{current}"
+    );
     let at = Actuator::new(Parameters {
         i_offset: p.i_offset + increment,
         ..Parameters::default()
@@ -349,7 +399,11 @@ fn the_equilibrium_with_i_offset_modulated_by_the_jet_position_is_its_own_signal
         sim.step(1e-3).unwrap();
     }
     let end = sim.outputs();
-    assert!((end.current - start.current).abs() < 1e-12, "{} A", end.current - start.current);
+    assert!(
+        (end.current - start.current).abs() < 1e-12,
+        "{} A",
+        end.current - start.current
+    );
     assert!((end.p1 - start.p1).abs() < 1.0, "{} Pa", end.p1 - start.p1);
 }
 
@@ -367,7 +421,10 @@ fn a_slot_on_friction_switches_the_friction_on_and_acts_where_its_knots_say() {
         ..with_slot(slot)
     };
     let model = Actuator::new(p.clone()).unwrap();
-    assert!(model.reads_stopper_motion, "friction by a slot forms the stopper's motion");
+    assert!(
+        model.reads_stopper_motion,
+        "friction by a slot forms the stopper's motion"
+    );
     assert!(!Actuator::new(Parameters::default()).unwrap().reads_stopper_motion);
     let plain = run(&Parameters {
         friction_velocity: 1e-3,
@@ -399,7 +456,12 @@ fn a_transducer_gain_modulated_by_the_pressure_reads_with_the_gain_at_the_sample
         sim.step(1e-3).unwrap();
         let y = sim.outputs();
         let gain = 1.0 + 0.05 * ((y.p1 - 1e5) / 5e5).clamp(0.0, 1.0);
-        assert!((y.p1_meas - gain * y.p1).abs() < 1e-6, "{} vs {}", y.p1_meas, gain * y.p1);
+        assert!(
+            (y.p1_meas - gain * y.p1).abs() < 1e-6,
+            "{} vs {}",
+            y.p1_meas,
+            gain * y.p1
+        );
         checked += usize::from(gain > 1.01);
     }
     assert!(checked > 10, "the gain moved from 1 at {checked} samples");
@@ -411,5 +473,8 @@ fn model_exchange_is_told_which_slot_it_refuses() {
     let mut p = Parameters::default();
     p.modulation[1] = Slot::through(vr::P_S, ModulationSignal::Time, &[0.0], &[1.0]);
     let e = refuse_in_model_exchange(&p).unwrap_err();
-    assert!(e.starts_with("modulation_2_parameter = 100 (P_s) switches on a modulation slot"), "{e}");
+    assert!(
+        e.starts_with("modulation_2_parameter = 100 (P_s) switches on a modulation slot"),
+        "{e}"
+    );
 }
