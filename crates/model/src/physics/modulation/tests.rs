@@ -468,7 +468,7 @@ fn a_transducer_gain_modulated_by_the_pressure_reads_with_the_gain_at_the_sample
 }
 
 #[test]
-fn model_exchange_is_told_which_slot_it_refuses() {
+fn model_exchange_and_the_linearisation_are_told_which_slot_they_refuse() {
     assert!(refuse_in_model_exchange(&Parameters::default()).is_ok());
     let mut p = Parameters::default();
     p.modulation[1] = Slot::through(vr::P_S, ModulationSignal::Time, &[0.0], &[1.0]);
@@ -477,4 +477,10 @@ fn model_exchange_is_told_which_slot_it_refuses() {
         e.starts_with("modulation_2_parameter = 100 (P_s) switches on a modulation slot"),
         "{e}"
     );
+    let e = crate::linearize(&Actuator::new(p).unwrap(), 2.0, 0.054).unwrap_err();
+    assert!(
+        e.starts_with("modulation_2_parameter = 100: the linearisation does not carry"),
+        "{e}"
+    );
+    assert!(crate::linearize(&Actuator::new(Parameters::default()).unwrap(), 2.0, 0.054).is_ok());
 }
