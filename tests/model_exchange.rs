@@ -191,6 +191,7 @@ fn an_effect_with_a_memory_is_refused_in_model_exchange_by_name_and_stays_in_co_
             (vr::HYSTERESIS_WIDTH, 1e-5, "jet_pipe_hysteresis"),
             (vr::FORCE_SENSOR_LAG, 1e-3, "the transducers' lags"),
             (vr::FRICTION_COULOMB, 1.0, "piston_friction"),
+            (vr::MODULATION_1_PARAMETER, vr::P_S as f64, "the modulation slots"),
         ] {
             let c = instantiate_model_exchange(&sink, "me");
             assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);

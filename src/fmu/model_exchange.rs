@@ -27,6 +27,7 @@ use jetpipe_model::physics::actuator::{index, Actuator, Inputs, State};
 use jetpipe_model::physics::chambers::pressure_after_volume_jump;
 use jetpipe_model::physics::command_stage;
 use jetpipe_model::physics::jet_pipe;
+use jetpipe_model::physics::modulation;
 use jetpipe_model::physics::parameters::{table_start, variable_name, Parameters};
 use jetpipe_model::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
@@ -140,6 +141,11 @@ const REFUSED: &[Refused] = &[
             vr::T_DRIFT,
         ],
     },
+    Refused {
+        effect: "the modulation slots",
+        why: "a slot's constant is held over each communication step at the signals at its start",
+        parameters: &[vr::MODULATION_1_PARAMETER, vr::MODULATION_2_PARAMETER],
+    },
 ];
 
 fn refusal_message(r: &Refused, switched_on: &str) -> String {
@@ -198,6 +204,7 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
         ),
         (model.reads_stopper_motion, "a force on the stopper's motion"),
         (time_varying::varies(p), "constants that vary in time"),
+        (modulation::any_on(p), "a modulation slot"),
     ];
     if problems.is_empty() {
         if let Some((_, what)) = flags.iter().find(|(on, _)| *on) {
