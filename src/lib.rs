@@ -13,6 +13,7 @@
 //!   description.
 
 pub mod fmu;
+pub mod fmu3_exports;
 pub mod fmu_exports;
 pub mod variables;
 

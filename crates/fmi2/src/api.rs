@@ -26,13 +26,13 @@ use std::fmt::Write;
 use std::os::raw::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use super::fmu_state::Snapshot;
 use super::instance::*;
 use super::model::{Causality, CoSimModel, StepError, VarType, Variability, Variable};
-use super::state::{Function, Interface, State};
+use super::state::{Call, Function, Interface, State, Version};
 use super::types::*;
 
-fn panic_message(payload: &(dyn Any + Send)) -> String {
+/// The text of a panic's payload.
+pub fn panic_message(payload: &(dyn Any + Send)) -> String {
     if let Some(s) = payload.downcast_ref::<&str>() {
         (*s).to_owned()
     } else if let Some(s) = payload.downcast_ref::<String>() {
@@ -43,7 +43,7 @@ fn panic_message(payload: &(dyn Any + Send)) -> String {
 }
 
 /// Drop a panic payload without letting a panic in its destructor escape.
-fn drop_payload(payload: Box<dyn Any + Send>) {
+pub fn drop_payload(payload: Box<dyn Any + Send>) {
     if let Err(again) = catch_unwind(AssertUnwindSafe(move || drop(payload))) {
         std::mem::forget(again);
     }
@@ -86,11 +86,15 @@ pub fn illegal_call_message(f: Function, s: State) -> String {
     m
 }
 
-/// Run `body` on the instance behind `c` after the null, magic and state checks, with
-/// panics caught (see the module documentation).
-pub(crate) unsafe fn guarded<M: CoSimModel>(
+/// Run `body` on the instance behind `c` after the null, magic, version and state checks,
+/// with panics caught (see the module documentation). `f` is a function of either version's
+/// table ([`Call`]): the FMI 3.0 layer runs its calls through here too.
+///
+/// # Safety
+/// `c` must be NULL or a handle given to the importer (see [`Instance::is_live`]).
+pub unsafe fn guarded<M: CoSimModel, F: Call>(
     c: fmi2Component,
-    f: Function,
+    f: F,
     body: impl FnOnce(&mut Instance<M>) -> fmi2Status,
 ) -> fmi2Status {
     if !Instance::<M>::is_live(c) {
@@ -98,8 +102,15 @@ pub(crate) unsafe fn guarded<M: CoSimModel>(
     }
     let result = catch_unwind(AssertUnwindSafe(|| {
         let inst = &mut *(c as *mut Instance<M>);
+        if inst.version != f.version() {
+            return inst.error(format!(
+                "{}: the instance was made by {}Instantiate*, not by this version's",
+                f.name(),
+                inst.version.prefix()
+            ));
+        }
         if !f.legal(inst.state, inst.interface) {
-            return inst.error(illegal_call_message_for(f, inst.state, inst.interface));
+            return inst.error(f.illegal_call_message(inst.state, inst.interface));
         }
         // call tracing only for models that declare the "logCalls" category
         if inst.logs_calls() {
@@ -125,8 +136,11 @@ pub(crate) unsafe fn guarded<M: CoSimModel>(
 }
 
 /// `p[..n]` as a slice; NULL with `n > 0` is an error (NULL with `n == 0` is fine).
+///
+/// # Safety
+/// `p` must be NULL or hold `n` elements.
 #[inline]
-pub(crate) unsafe fn in_slice<'a, T, M: CoSimModel>(
+pub unsafe fn in_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
     what: &str,
@@ -142,8 +156,12 @@ pub(crate) unsafe fn in_slice<'a, T, M: CoSimModel>(
     }
 }
 
+/// `p[..n]` as a mutable slice; NULL with `n > 0` is an error.
+///
+/// # Safety
+/// `p` must be NULL or hold `n` elements.
 #[inline]
-pub(crate) unsafe fn out_slice<'a, T, M: CoSimModel>(
+pub unsafe fn out_slice<'a, T, M: CoSimModel>(
     inst: &mut Instance<M>,
     fname: &str,
     what: &str,
@@ -159,35 +177,19 @@ pub(crate) unsafe fn out_slice<'a, T, M: CoSimModel>(
     }
 }
 
-fn type_name(t: VarType) -> &'static str {
-    match t {
-        VarType::Real => "Real",
-        VarType::Integer => "Integer",
-        VarType::Boolean => "Boolean",
-    }
-}
-
-fn causality_name(c: Causality) -> &'static str {
-    match c {
-        Causality::Parameter => "parameter",
-        Causality::Input => "input",
-        Causality::Output => "output",
-        Causality::Local => "local",
-    }
-}
-
-fn variability_name(v: Variability) -> &'static str {
-    match v {
-        Variability::Fixed => "fixed",
-        Variability::Tunable => "tunable",
-        Variability::Discrete => "discrete",
-        Variability::Continuous => "continuous",
-    }
-}
-
 /// The variable with value reference `vr` and type `ty`, or a message naming the VR.
 #[inline]
 pub fn lookup<M: CoSimModel>(fname: &str, vr: u32, ty: VarType) -> Result<&'static Variable, String> {
+    lookup_in::<M>(fname, vr, ty, Version::Fmi2)
+}
+
+/// [`lookup`] with the types named as `version` names them.
+pub fn lookup_in<M: CoSimModel>(
+    fname: &str,
+    vr: u32,
+    ty: VarType,
+    version: Version,
+) -> Result<&'static Variable, String> {
     let vars = M::info().variables;
     if let Some(v) = vars.iter().find(|v| v.value_reference == vr && v.var_type == ty) {
         return Ok(v);
@@ -196,8 +198,8 @@ pub fn lookup<M: CoSimModel>(fname: &str, vr: u32, ty: VarType) -> Result<&'stat
         Some(v) => Err(format!(
             "{fname}: value reference {vr} ({}) is a {} variable, not {}",
             v.name,
-            type_name(v.var_type),
-            type_name(ty)
+            v.var_type.name_in(version),
+            ty.name_in(version)
         )),
         None => Err(format!("{fname}: unknown value reference {vr}")),
     }
@@ -206,13 +208,19 @@ pub fn lookup<M: CoSimModel>(fname: &str, vr: u32, ty: VarType) -> Result<&'stat
 /// Whether `v` may be read in `state`: in `instantiated` only parameters and inputs.
 #[inline]
 pub fn check_get(fname: &str, v: &Variable, state: State) -> Result<(), String> {
+    check_get_in(fname, v, state, Version::Fmi2)
+}
+
+/// [`check_get`] with the state named as `version` names it.
+#[inline]
+pub fn check_get_in(fname: &str, v: &Variable, state: State, version: Version) -> Result<(), String> {
     if state == State::Instantiated && !matches!(v.causality, Causality::Parameter | Causality::Input) {
         return Err(format!(
             "{fname}: {} (value reference {}) is an {} and has no value in state {}",
             v.name,
             v.value_reference,
-            causality_name(v.causality),
-            state.name()
+            v.causality.name(),
+            state.name_in(version)
         ));
     }
     Ok(())
@@ -223,6 +231,12 @@ pub fn check_get(fname: &str, v: &Variable, state: State) -> Result<(), String> 
 /// `stepComplete` and (Model Exchange) `eventMode`; inputs also in `continuousTimeMode`.
 #[inline]
 pub fn check_set(fname: &str, v: &Variable, state: State) -> Result<(), String> {
+    check_set_in(fname, v, state, Version::Fmi2)
+}
+
+/// [`check_set`] with the state named as `version` names it.
+#[inline]
+pub fn check_set_in(fname: &str, v: &Variable, state: State, version: Version) -> Result<(), String> {
     let early = matches!(state, State::Instantiated | State::InitializationMode);
     let ok = match (v.causality, v.variability) {
         (Causality::Output | Causality::Local, _) => {
@@ -230,7 +244,7 @@ pub fn check_set(fname: &str, v: &Variable, state: State) -> Result<(), String> 
                 "{fname}: {} (value reference {}) is an {} and cannot be set",
                 v.name,
                 v.value_reference,
-                causality_name(v.causality)
+                v.causality.name()
             ))
         }
         (Causality::Parameter, Variability::Tunable) => {
@@ -252,9 +266,9 @@ pub fn check_set(fname: &str, v: &Variable, state: State) -> Result<(), String> 
             "{fname}: {} (value reference {}) is a {} {} and cannot be set in state {}",
             v.name,
             v.value_reference,
-            variability_name(v.variability),
-            causality_name(v.causality),
-            state.name()
+            v.variability.name(),
+            v.causality.name(),
+            state.name_in(version)
         ))
     }
 }
@@ -379,10 +393,18 @@ pub unsafe fn instantiate<M: CoSimModel>(
 /// # Safety
 /// `c` must be NULL or come from [`instantiate`] for `M`; see [`Instance::is_live`].
 pub unsafe fn free_instance<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
+    free_instance_as::<M, _>(c, Function::FreeInstance)
+}
+
+/// [`free_instance`] for either version's table of functions.
+///
+/// # Safety
+/// See [`free_instance`].
+pub unsafe fn free_instance_as<M: CoSimModel, K: Call>(c: fmi2Component, call: K) -> fmi2Status {
     if c.is_null() {
         return fmi2OK;
     }
-    guarded::<M>(c, Function::FreeInstance, |inst| {
+    guarded::<M, K>(c, call, |inst| {
         inst.kill();
         unregister_handle(c, HandleKind::Instance);
         drop(Box::from_raw(inst as *mut Instance<M>));
@@ -406,10 +428,23 @@ pub unsafe fn set_debug_logging<M: CoSimModel>(
     n_categories: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::SetDebugLogging, |inst| {
-        const F: &str = "fmi2SetDebugLogging";
-        let on = logging_on != 0;
-        let cats = match in_slice(inst, F, "categories[]", categories, n_categories) {
+    set_debug_logging_as::<M, _>(c, Function::SetDebugLogging, logging_on != 0, n_categories, categories)
+}
+
+/// [`set_debug_logging`] for either version's table of functions.
+///
+/// # Safety
+/// See [`set_debug_logging`].
+pub unsafe fn set_debug_logging_as<M: CoSimModel, K: Call>(
+    c: fmi2Component,
+    call: K,
+    on: bool,
+    n_categories: usize,
+    categories: *const fmi2String,
+) -> fmi2Status {
+    guarded::<M, K>(c, call, |inst| {
+        let fname = call.name();
+        let cats = match in_slice(inst, fname, "categories[]", categories, n_categories) {
             Ok(s) => s,
             Err(s) => return s,
         };
@@ -417,7 +452,7 @@ pub unsafe fn set_debug_logging<M: CoSimModel>(
         let mut indices = Vec::with_capacity(cats.len());
         for &cat in cats {
             if cat.is_null() {
-                return inst.error(format!("{F}: a category is NULL"));
+                return inst.error(format!("{fname}: a category is NULL"));
             }
             let cat = CStr::from_ptr(cat).to_string_lossy();
             match known.iter().position(|(name, _)| *name == cat) {
@@ -425,7 +460,7 @@ pub unsafe fn set_debug_logging<M: CoSimModel>(
                 None => {
                     let list: Vec<&str> = known.iter().map(|(n, _)| *n).collect();
                     return inst.error(format!(
-                        "{F}: unknown log category \"{cat}\" (known: {})",
+                        "{fname}: unknown log category \"{cat}\" (known: {})",
                         list.join(", ")
                     ));
                 }
@@ -456,7 +491,7 @@ pub unsafe fn setup_experiment<M: CoSimModel>(
     stop_time_defined: fmi2Boolean,
     stop_time: fmi2Real,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::SetupExperiment, |inst| {
+    guarded::<M, _>(c, Function::SetupExperiment, |inst| {
         const F: &str = "fmi2SetupExperiment";
         if !start_time.is_finite() {
             return inst.error(format!("{F}: startTime = {start_time} is not finite"));
@@ -483,7 +518,7 @@ pub unsafe fn setup_experiment<M: CoSimModel>(
 /// # Safety
 /// See the module documentation.
 pub unsafe fn enter_initialization_mode<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
-    guarded::<M>(c, Function::EnterInitializationMode, |inst| {
+    guarded::<M, _>(c, Function::EnterInitializationMode, |inst| {
         match inst.model.enter_initialization() {
             Ok(()) => {
                 inst.state = State::InitializationMode;
@@ -497,7 +532,7 @@ pub unsafe fn enter_initialization_mode<M: CoSimModel>(c: fmi2Component) -> fmi2
 /// # Safety
 /// See the module documentation.
 pub unsafe fn exit_initialization_mode<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
-    guarded::<M>(c, Function::ExitInitializationMode, |inst| {
+    guarded::<M, _>(c, Function::ExitInitializationMode, |inst| {
         match inst.model.exit_initialization() {
             Ok(()) => {
                 inst.state = match inst.interface {
@@ -514,7 +549,7 @@ pub unsafe fn exit_initialization_mode<M: CoSimModel>(c: fmi2Component) -> fmi2S
 /// # Safety
 /// See the module documentation.
 pub unsafe fn terminate<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
-    guarded::<M>(c, Function::Terminate, |inst| {
+    guarded::<M, _>(c, Function::Terminate, |inst| {
         inst.state = State::Terminated;
         fmi2OK
     })
@@ -525,7 +560,7 @@ pub unsafe fn terminate<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
 /// # Safety
 /// See the module documentation.
 pub unsafe fn reset<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
-    guarded::<M>(c, Function::Reset, |inst| {
+    guarded::<M, _>(c, Function::Reset, |inst| {
         inst.model.reset();
         if inst.interface == Interface::ModelExchange {
             inst.model.use_model_exchange();
@@ -540,17 +575,20 @@ pub unsafe fn reset<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
 // Getters and setters
 // ------------------------------------------------------------------------------------
 
-/// Shared body of the getters: check every VR, then read each value.
-unsafe fn get_values<M: CoSimModel, T>(
+/// Shared body of the getters of both versions: check every VR, then read each value.
+///
+/// # Safety
+/// `vr` and `value` hold `nvr` elements.
+pub unsafe fn get_values<M: CoSimModel, T, K: Call>(
     c: fmi2Component,
-    f: Function,
+    f: K,
     ty: VarType,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut T,
     read: impl Fn(&M, u32) -> Result<T, String>,
 ) -> fmi2Status {
-    guarded::<M>(c, f, |inst| {
+    guarded::<M, K>(c, f, |inst| {
         let fname = f.name();
         let vrs = match in_slice(inst, fname, "vr[]", vr, nvr) {
             Ok(s) => s,
@@ -566,7 +604,7 @@ unsafe fn get_values<M: CoSimModel, T>(
             if restricted || inst.tabled_variable(r, ty).is_none() {
                 let checked = inst
                     .variable(fname, r, ty)
-                    .and_then(|v| check_get(fname, v, inst.state));
+                    .and_then(|v| check_get_in(fname, v, inst.state, inst.version));
                 if let Err(m) = checked {
                     return inst.error(m);
                 }
@@ -580,17 +618,20 @@ unsafe fn get_values<M: CoSimModel, T>(
     })
 }
 
-/// Shared body of the setters: check every VR first, then write each value.
-unsafe fn set_values<M: CoSimModel, T: Copy>(
+/// Shared body of the setters of both versions: check every VR first, then write each value.
+///
+/// # Safety
+/// `vr` and `value` hold `nvr` elements.
+pub unsafe fn set_values<M: CoSimModel, T: Copy, K: Call>(
     c: fmi2Component,
-    f: Function,
+    f: K,
     ty: VarType,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const T,
     write: impl Fn(&mut M, u32, T) -> Result<(), String>,
 ) -> fmi2Status {
-    guarded::<M>(c, f, |inst| {
+    guarded::<M, K>(c, f, |inst| {
         let fname = f.name();
         let vrs = match in_slice(inst, fname, "vr[]", vr, nvr) {
             Ok(s) => s,
@@ -603,7 +644,7 @@ unsafe fn set_values<M: CoSimModel, T: Copy>(
         for &r in vrs {
             if let Err(m) = inst
                 .variable(fname, r, ty)
-                .and_then(|v| check_set(fname, v, inst.state))
+                .and_then(|v| check_set_in(fname, v, inst.state, inst.version))
             {
                 return inst.error(m);
             }
@@ -625,7 +666,7 @@ pub unsafe fn get_real<M: CoSimModel>(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    get_values::<M, f64>(c, Function::GetReal, VarType::Real, vr, nvr, value, |m, r| {
+    get_values::<M, f64, _>(c, Function::GetReal, VarType::Real, vr, nvr, value, |m, r| {
         m.get_real(r)
     })
 }
@@ -638,7 +679,7 @@ pub unsafe fn get_integer<M: CoSimModel>(
     nvr: usize,
     value: *mut fmi2Integer,
 ) -> fmi2Status {
-    get_values::<M, fmi2Integer>(c, Function::GetInteger, VarType::Integer, vr, nvr, value, |m, r| {
+    get_values::<M, fmi2Integer, _>(c, Function::GetInteger, VarType::Integer, vr, nvr, value, |m, r| {
         m.get_integer(r)
     })
 }
@@ -651,20 +692,23 @@ pub unsafe fn get_boolean<M: CoSimModel>(
     nvr: usize,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
-    get_values::<M, fmi2Boolean>(c, Function::GetBoolean, VarType::Boolean, vr, nvr, value, |m, r| {
+    get_values::<M, fmi2Boolean, _>(c, Function::GetBoolean, VarType::Boolean, vr, nvr, value, |m, r| {
         m.get_boolean(r).map(|b| if b { fmi2True } else { fmi2False })
     })
 }
 
 /// There are no String variables: `nvr == 0` is fine, anything else an error.
-unsafe fn no_strings<M: CoSimModel, T>(
+///
+/// # Safety
+/// `vr` and `value` hold `nvr` elements.
+pub unsafe fn no_strings<M: CoSimModel, T, K: Call>(
     c: fmi2Component,
-    f: Function,
+    f: K,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const T,
 ) -> fmi2Status {
-    guarded::<M>(c, f, |inst| {
+    guarded::<M, K>(c, f, |inst| {
         let fname = f.name();
         let vrs = match in_slice(inst, fname, "vr[]", vr, nvr) {
             Ok(s) => s,
@@ -680,7 +724,7 @@ unsafe fn no_strings<M: CoSimModel, T>(
                     Some(v) => format!(
                         "{fname}: value reference {r} ({}) is a {} variable, not String",
                         v.name,
-                        type_name(v.var_type)
+                        v.var_type.name()
                     ),
                     None => format!("{fname}: unknown value reference {r} (this FMU has no String variables)"),
                 };
@@ -698,7 +742,7 @@ pub unsafe fn get_string<M: CoSimModel>(
     nvr: usize,
     value: *mut fmi2String,
 ) -> fmi2Status {
-    no_strings::<M, fmi2String>(c, Function::GetString, vr, nvr, value)
+    no_strings::<M, fmi2String, _>(c, Function::GetString, vr, nvr, value)
 }
 
 /// # Safety
@@ -709,7 +753,7 @@ pub unsafe fn set_real<M: CoSimModel>(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    set_values::<M, f64>(c, Function::SetReal, VarType::Real, vr, nvr, value, |m, r, x| {
+    set_values::<M, f64, _>(c, Function::SetReal, VarType::Real, vr, nvr, value, |m, r, x| {
         m.set_real(r, x)
     })
 }
@@ -722,7 +766,7 @@ pub unsafe fn set_integer<M: CoSimModel>(
     nvr: usize,
     value: *const fmi2Integer,
 ) -> fmi2Status {
-    set_values::<M, fmi2Integer>(c, Function::SetInteger, VarType::Integer, vr, nvr, value, |m, r, x| {
+    set_values::<M, fmi2Integer, _>(c, Function::SetInteger, VarType::Integer, vr, nvr, value, |m, r, x| {
         m.set_integer(r, x)
     })
 }
@@ -735,7 +779,7 @@ pub unsafe fn set_boolean<M: CoSimModel>(
     nvr: usize,
     value: *const fmi2Boolean,
 ) -> fmi2Status {
-    set_values::<M, fmi2Boolean>(c, Function::SetBoolean, VarType::Boolean, vr, nvr, value, |m, r, x| {
+    set_values::<M, fmi2Boolean, _>(c, Function::SetBoolean, VarType::Boolean, vr, nvr, value, |m, r, x| {
         m.set_boolean(r, x != fmi2False)
     })
 }
@@ -748,196 +792,16 @@ pub unsafe fn set_string<M: CoSimModel>(
     nvr: usize,
     value: *const fmi2String,
 ) -> fmi2Status {
-    no_strings::<M, fmi2String>(c, Function::SetString, vr, nvr, value)
+    no_strings::<M, fmi2String, _>(c, Function::SetString, vr, nvr, value)
 }
 
 // ------------------------------------------------------------------------------------
-// FMU state
+// FMU state: see `crate::fmu_state_calls`
 // ------------------------------------------------------------------------------------
 
-/// Store `snap` into `*slot`: reuse the live snapshot `*slot` points to, or allocate a
-/// new one when `*slot` is NULL.
-unsafe fn store_snapshot<M: CoSimModel>(
-    inst: &mut Instance<M>,
-    fname: &str,
-    slot: *mut fmi2FMUstate,
-    snap: Snapshot,
-) -> fmi2Status {
-    let old = *slot;
-    if old.is_null() {
-        *slot = snap.into_raw();
-        fmi2OK
-    } else if Snapshot::is_live(old) {
-        *(old as *mut Snapshot) = snap;
-        fmi2OK
-    } else {
-        inst.error(format!(
-            "{fname}: *FMUstate is neither NULL nor an FMU state of this FMU"
-        ))
-    }
-}
-
-/// The live snapshot behind `s` made for model `M`, or an error message.
-unsafe fn snapshot_ref<'a, M: CoSimModel>(fname: &str, s: fmi2FMUstate) -> Result<&'a Snapshot, String> {
-    if s.is_null() {
-        return Err(format!("{fname}: FMUstate is NULL"));
-    }
-    if !Snapshot::is_live(s) {
-        return Err(format!("{fname}: FMUstate is not a live FMU state (freed or foreign)"));
-    }
-    let snap = &*(s as *const Snapshot);
-    if snap.guid != M::info().guid() {
-        return Err(format!(
-            "{fname}: FMUstate belongs to another FMU: GUID mismatch: expected {}, got {}",
-            M::info().guid(),
-            snap.guid
-        ));
-    }
-    Ok(snap)
-}
-
-/// `fmi2GetFMUstate`: a boxed snapshot of the layer state and `CoSimModel::serialize`.
-///
-/// # Safety
-/// `state` must point to NULL or to an FMU state returned earlier.
-pub unsafe fn get_fmu_state<M: CoSimModel>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
-    guarded::<M>(c, Function::GetFMUstate, |inst| {
-        const F: &str = "fmi2GetFMUstate";
-        if state.is_null() {
-            return inst.error(format!("{F}: FMUstate is NULL"));
-        }
-        let snap = Snapshot::new::<M>(inst.state, inst.model.serialize()).of_interface(inst.interface);
-        store_snapshot(inst, F, state, snap)
-    })
-}
-
-/// `fmi2SetFMUstate`: `CoSimModel::deserialize` and the stored layer state.
-///
-/// # Safety
-/// `state` must be an FMU state returned by this FMU.
-pub unsafe fn set_fmu_state<M: CoSimModel>(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
-    guarded::<M>(c, Function::SetFMUstate, |inst| {
-        const F: &str = "fmi2SetFMUstate";
-        let snap = match snapshot_ref::<M>(F, state) {
-            Ok(s) => s,
-            Err(m) => return inst.error(m),
-        };
-        if snap.interface != inst.interface {
-            return inst.error(format!(
-                "{F}: the FMU state was taken from a {} instance (state {}); this instance is for {}",
-                snap.interface.name(),
-                snap.state.name(),
-                inst.interface.name()
-            ));
-        }
-        match inst.model.deserialize(&snap.model_bytes) {
-            Ok(()) => {
-                inst.state = snap.state;
-                inst.last_successful_time = None;
-                fmi2OK
-            }
-            Err(m) => inst.error(format!("{F}: {m}")),
-        }
-    })
-}
-
-/// `fmi2FreeFMUstate`: frees `*state` and sets it to NULL; NULL or `*state == NULL` is a
-/// no-op.
-///
-/// # Safety
-/// `state` must be NULL or point to NULL or to an FMU state returned by this FMU.
-pub unsafe fn free_fmu_state<M: CoSimModel>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
-    guarded::<M>(c, Function::FreeFMUstate, |inst| {
-        const F: &str = "fmi2FreeFMUstate";
-        if state.is_null() || (*state).is_null() {
-            return fmi2OK;
-        }
-        if let Err(m) = snapshot_ref::<M>(F, *state) {
-            return inst.error(m);
-        }
-        Snapshot::free_raw(*state);
-        *state = std::ptr::null_mut();
-        fmi2OK
-    })
-}
-
-/// # Safety
-/// `size` must be writable.
-pub unsafe fn serialized_fmu_state_size<M: CoSimModel>(
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    size: *mut usize,
-) -> fmi2Status {
-    guarded::<M>(c, Function::SerializedFMUstateSize, |inst| {
-        const F: &str = "fmi2SerializedFMUstateSize";
-        if size.is_null() {
-            return inst.error(format!("{F}: size is NULL"));
-        }
-        match snapshot_ref::<M>(F, state) {
-            Ok(snap) => {
-                *size = snap.to_bytes().len();
-                fmi2OK
-            }
-            Err(m) => inst.error(m),
-        }
-    })
-}
-
-/// `fmi2SerializeFMUstate`: `size` must equal what `fmi2SerializedFMUstateSize` returned.
-///
-/// # Safety
-/// `bytes` must hold `size` bytes.
-pub unsafe fn serialize_fmu_state<M: CoSimModel>(
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    bytes: *mut fmi2Byte,
-    size: usize,
-) -> fmi2Status {
-    guarded::<M>(c, Function::SerializeFMUstate, |inst| {
-        const F: &str = "fmi2SerializeFMUstate";
-        let data = match snapshot_ref::<M>(F, state) {
-            Ok(snap) => snap.to_bytes(),
-            Err(m) => return inst.error(m),
-        };
-        if size != data.len() {
-            return inst.error(format!(
-                "{F}: size = {size} but the serialized FMU state has {} bytes (see fmi2SerializedFMUstateSize)",
-                data.len()
-            ));
-        }
-        if bytes.is_null() {
-            return inst.error(format!("{F}: serializedState is NULL"));
-        }
-        std::ptr::copy_nonoverlapping(data.as_ptr(), bytes as *mut u8, size);
-        fmi2OK
-    })
-}
-
-/// `fmi2DeSerializeFMUstate`: parse and check the bytes (see [`crate::fmu_state`]).
-///
-/// # Safety
-/// `bytes` must hold `size` bytes; `state` must point to NULL or to an FMU state.
-pub unsafe fn deserialize_fmu_state<M: CoSimModel>(
-    c: fmi2Component,
-    bytes: *const fmi2Byte,
-    size: usize,
-    state: *mut fmi2FMUstate,
-) -> fmi2Status {
-    guarded::<M>(c, Function::DeSerializeFMUstate, |inst| {
-        const F: &str = "fmi2DeSerializeFMUstate";
-        if state.is_null() {
-            return inst.error(format!("{F}: FMUstate is NULL"));
-        }
-        let data = match in_slice(inst, F, "serializedState", bytes as *const u8, size) {
-            Ok(s) => s,
-            Err(s) => return s,
-        };
-        match Snapshot::from_bytes::<M>(data) {
-            Ok(snap) => store_snapshot(inst, F, state, snap),
-            Err(m) => inst.error(format!("{F}: {m}")),
-        }
-    })
-}
+pub use super::fmu_state_calls::{
+    deserialize_fmu_state, free_fmu_state, get_fmu_state, serialize_fmu_state, serialized_fmu_state_size, set_fmu_state,
+};
 
 // ------------------------------------------------------------------------------------
 // Derivatives
@@ -956,7 +820,7 @@ pub unsafe fn get_directional_derivative<M: CoSimModel>(
     _dv_known: *const fmi2Real,
     _dv_unknown: *mut fmi2Real,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::GetDirectionalDerivative, |inst| {
+    guarded::<M, _>(c, Function::GetDirectionalDerivative, |inst| {
         inst.error("fmi2GetDirectionalDerivative: not supported (providesDirectionalDerivative=\"false\")")
     })
 }
@@ -973,7 +837,7 @@ pub unsafe fn set_real_input_derivatives<M: CoSimModel>(
     order: *const fmi2Integer,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::SetRealInputDerivatives, |inst| {
+    guarded::<M, _>(c, Function::SetRealInputDerivatives, |inst| {
         const F: &str = "fmi2SetRealInputDerivatives";
         let vrs = match in_slice(inst, F, "vr[]", vr, nvr) {
             Ok(s) => s,
@@ -1027,7 +891,7 @@ pub unsafe fn get_real_output_derivatives<M: CoSimModel>(
     _order: *const fmi2Integer,
     _value: *mut fmi2Real,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::GetRealOutputDerivatives, |inst| {
+    guarded::<M, _>(c, Function::GetRealOutputDerivatives, |inst| {
         inst.error("fmi2GetRealOutputDerivatives: not supported (maxOutputDerivativeOrder=\"0\")")
     })
 }
@@ -1048,7 +912,7 @@ pub unsafe fn do_step<M: CoSimModel>(
     h: fmi2Real,
     _no_set_prior: fmi2Boolean,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::DoStep, |inst| {
+    guarded::<M, _>(c, Function::DoStep, |inst| {
         const F: &str = "fmi2DoStep";
         if !(h.is_finite() && h > 0.0) {
             return inst.error(format!("{F}: communicationStepSize = {h:e} must be finite and > 0"));
@@ -1094,7 +958,7 @@ pub unsafe fn do_step<M: CoSimModel>(
 /// See the module documentation.
 pub unsafe fn cancel_step<M: CoSimModel>(c: fmi2Component) -> fmi2Status {
     // illegal in every state (see the table); the body is never reached
-    guarded::<M>(c, Function::CancelStep, |inst| {
+    guarded::<M, _>(c, Function::CancelStep, |inst| {
         inst.error("fmi2CancelStep: no asynchronous step to cancel")
     })
 }
@@ -1118,7 +982,7 @@ unsafe fn get_status_of<M: CoSimModel, T>(
     value: *mut T,
     answer: impl FnOnce(&Instance<M>, fmi2StatusKind) -> Option<T>,
 ) -> fmi2Status {
-    guarded::<M>(c, f, |inst| {
+    guarded::<M, _>(c, f, |inst| {
         let fname = f.name();
         let kind_name = match status_kind_name(kind) {
             Some(kind_name) => kind_name,

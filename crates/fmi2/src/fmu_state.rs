@@ -8,18 +8,22 @@
 //! | 4 | format version (`u32`, = 1) |
 //! | 4 | GUID length `g` (`u32`) |
 //! | g | GUID (UTF-8) of the model that wrote it |
-//! | 1 | layer state (see [`State::code`]), plus [`MODEL_EXCHANGE_BIT`] for an instance of Model Exchange |
+//! | 1 | layer state (see [`State::code`]), plus [`MODEL_EXCHANGE_BIT`] for an instance of Model Exchange and [`FMI3_BIT`] for an instance of FMI 3.0 |
 //! | 8 | model byte count `n` (`u64`) |
 //! | n | `CoSimModel::serialize()` |
 //! | 4 | CRC-32 (IEEE, as zlib) of everything before it |
 
 use super::instance::{is_registered_handle, register_handle, unregister_handle, HandleKind};
 use super::model::CoSimModel;
-use super::state::{Interface, State};
+use super::state::{Interface, State, Version};
 
 /// Set in the layer-state byte of an FMU state taken from a Model Exchange instance (a
 /// Co-Simulation instance's bytes are those of the layer before Model Exchange).
 pub const MODEL_EXCHANGE_BIT: u8 = 0x80;
+
+/// Set in the layer-state byte of an FMU state taken from an FMI 3.0 instance (the FMI 2.0
+/// bytes are those of the layer before FMI 3.0).
+pub const FMI3_BIT: u8 = 0x40;
 
 pub const STATE_MAGIC: &[u8; 8] = b"FMI2STAT";
 pub const FORMAT_VERSION: u32 = 1;
@@ -35,6 +39,8 @@ pub struct Snapshot {
     pub state: State,
     /// The interface of the instance it was taken from.
     pub interface: Interface,
+    /// The FMI version of the instance it was taken from.
+    pub version: Version,
     pub model_bytes: Vec<u8>,
 }
 
@@ -45,6 +51,7 @@ impl Snapshot {
             guid: M::info().guid(),
             state,
             interface: Interface::CoSimulation,
+            version: Version::Fmi2,
             model_bytes,
         }
     }
@@ -52,6 +59,12 @@ impl Snapshot {
     /// The snapshot, as taken from an instance of `interface`.
     pub fn of_interface(mut self, interface: Interface) -> Self {
         self.interface = interface;
+        self
+    }
+
+    /// The snapshot, as taken from an instance of `version`.
+    pub fn of_version(mut self, version: Version) -> Self {
+        self.version = version;
         self
     }
 
@@ -97,7 +110,11 @@ impl Snapshot {
             Interface::CoSimulation => 0,
             Interface::ModelExchange => MODEL_EXCHANGE_BIT,
         };
-        out.push(self.state.code() | interface_bit);
+        let version_bit = match self.version {
+            Version::Fmi2 => 0,
+            Version::Fmi3 => FMI3_BIT,
+        };
+        out.push(self.state.code() | interface_bit | version_bit);
         out.extend_from_slice(&(self.model_bytes.len() as u64).to_le_bytes());
         out.extend_from_slice(&self.model_bytes);
         let crc = crc32(&out);
@@ -154,7 +171,12 @@ impl Snapshot {
         } else {
             Interface::CoSimulation
         };
-        let state = State::from_code(code & !MODEL_EXCHANGE_BIT)
+        let version = if code & FMI3_BIT != 0 {
+            Version::Fmi3
+        } else {
+            Version::Fmi2
+        };
+        let state = State::from_code(code & !(MODEL_EXCHANGE_BIT | FMI3_BIT))
             .ok_or_else(|| format!("invalid layer state code {code} in serialized FMU state"))?;
         if state == State::Fatal {
             return Err("serialized FMU state is in the fatal state".to_owned());
@@ -170,7 +192,9 @@ impl Snapshot {
         probe
             .deserialize(&model_bytes)
             .map_err(|e| format!("serialized FMU state rejected by the model: {e}"))?;
-        Ok(Snapshot::new::<M>(state, model_bytes).of_interface(interface))
+        Ok(Snapshot::new::<M>(state, model_bytes)
+            .of_interface(interface)
+            .of_version(version))
     }
 }
 

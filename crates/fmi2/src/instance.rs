@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use super::model::{CoSimModel, VarType, Variable};
-use super::state::{Interface, State};
+use super::state::{Interface, State, Version};
 use super::types::*;
 
 /// Marks a live [`Instance`]; cleared by `fmi2FreeInstance`.
@@ -91,7 +91,18 @@ pub const CAT_DISCARD: &str = "logStatusDiscard";
 pub const CAT_WARNING: &str = "logStatusWarning";
 pub const CAT_CALLS: &str = "logCalls";
 
-/// An FMU instance. `fmi2Component` points to one of these (boxed).
+/// FMI 3.0's `fmi3LogMessageCallback`: not variadic, no instance name (the status is the same
+/// `c_int` numbering as `fmi2Status`: OK 0 ... Fatal 4).
+pub type LogMessageCallback = Option<
+    unsafe extern "C" fn(
+        instance_environment: *mut c_void,
+        status: std::os::raw::c_int,
+        category: *const std::os::raw::c_char,
+        message: *const std::os::raw::c_char,
+    ),
+>;
+
+/// An FMU instance. `fmi2Component` (and `fmi3Instance`) points to one of these (boxed).
 ///
 /// `#[repr(C)]` with `magic` first, so the magic number sits at offset 0 whatever `M`
 /// is, and can be checked through a pointer before the instance is otherwise used.
@@ -103,6 +114,10 @@ pub struct Instance<M: CoSimModel> {
     instance_name_c: CString,
     pub logger: fmi2CallbackLogger,
     pub component_environment: fmi2ComponentEnvironment,
+    /// The logger of an FMI 3.0 instance (`logger` is then `None`).
+    pub log_message: LogMessageCallback,
+    /// The FMI version whose calls made the instance and may use it.
+    pub version: Version,
     /// The last `loggingOn` given to `fmi2Instantiate` or `fmi2SetDebugLogging`.
     pub logging_on: bool,
     /// One flag per entry of `M::info().log_categories`.
@@ -137,6 +152,8 @@ impl<M: CoSimModel> Instance<M> {
             instance_name_c: to_cstring(instance_name),
             logger: callbacks.and_then(|c| c.logger),
             component_environment: callbacks.map_or(std::ptr::null_mut(), |c| c.componentEnvironment),
+            log_message: None,
+            version: Version::Fmi2,
             logging_on,
             categories_enabled: vec![logging_on; n],
             calls_category: M::info().log_categories.iter().position(|(name, _)| *name == CAT_CALLS),
@@ -150,6 +167,26 @@ impl<M: CoSimModel> Instance<M> {
         }
     }
 
+    /// An instance for FMI 3.0: its logger is `log_message`, called with `environment`.
+    pub fn new_fmi3(
+        model: M,
+        instance_name: &str,
+        environment: *mut c_void,
+        log_message: LogMessageCallback,
+        logging_on: bool,
+    ) -> Self {
+        let mut instance = Self::new(model, instance_name, None, logging_on);
+        instance.component_environment = environment;
+        instance.log_message = log_message;
+        instance.version = Version::Fmi3;
+        instance
+    }
+
+    /// The state's name in the instance's version (see [`State::name_in`]).
+    pub fn state_name(&self) -> &'static str {
+        self.state.name_in(self.version)
+    }
+
     /// The variable with value reference `vr` and type `ty`: what [`crate::api::lookup`]
     /// finds (the first such row), looked up in the table of rows when the first row with
     /// `vr` has that type, searched for otherwise (and for the message when there is none).
@@ -157,7 +194,7 @@ impl<M: CoSimModel> Instance<M> {
     pub fn variable(&self, fname: &str, vr: u32, ty: VarType) -> Result<&'static Variable, String> {
         match self.tabled_variable(vr, ty) {
             Some(v) => Ok(v),
-            None => crate::api::lookup::<M>(fname, vr, ty),
+            None => crate::api::lookup_in::<M>(fname, vr, ty, self.version),
         }
     }
 
@@ -226,6 +263,11 @@ impl<M: CoSimModel> Instance<M> {
         }
         #[cfg(test)]
         self.captured.push((status, category.to_owned(), message.to_owned()));
+        if self.version == Version::Fmi3 {
+            // SAFETY: the callback and environment come from the importer's fmi3Instantiate*.
+            unsafe { call_log_message(self.log_message, self.component_environment, status, category, message) };
+            return;
+        }
         // SAFETY: the logger and environment come from the importer's callbacks.
         unsafe {
             call_logger(
@@ -277,6 +319,25 @@ fn variable_rows(variables: &[Variable]) -> Vec<u16> {
 /// A `CString` from arbitrary text (interior NULs become U+FFFD).
 pub fn to_cstring(s: &str) -> CString {
     CString::new(s.replace('\0', "\u{FFFD}")).expect("no interior NUL left")
+}
+
+/// Call an FMI 3.0 importer's `fmi3LogMessageCallback` (the message is passed as text, never
+/// as a format).
+///
+/// # Safety
+/// `log_message` and `env` must be what the importer passed to `fmi3Instantiate*`.
+pub unsafe fn call_log_message(
+    log_message: LogMessageCallback,
+    env: *mut c_void,
+    status: fmi2Status,
+    category: &str,
+    message: &str,
+) {
+    if let Some(log_message) = log_message {
+        let category = to_cstring(category);
+        let message = to_cstring(message);
+        log_message(env, status, category.as_ptr(), message.as_ptr());
+    }
 }
 
 /// Call an importer's variadic logger as `logger(env, name, status, category, "%s", message)`.

@@ -1,6 +1,13 @@
 //! A generic FMI 2.0 layer, Co-Simulation and (for a model that has it) Model Exchange: C ABI, state machine, logging, FMU state.
 //! It knows nothing about the model behind it: see [`model::CoSimModel`].
 //!
+//! It is also the common part of the FMI 3.0 layer (crate `fmi3`): the model traits and the
+//! variable table, instances and the registry of live handles, [`api::guarded`] (run with
+//! either version's table of functions, a [`state::Call`]), the per-variable checks, the
+//! getters' and setters' loops, the FMU-state calls and bytes, the Model Exchange calls
+//! (`*_as` with the version's function). An instance records its [`state::Version`] and is
+//! refused by the other version's calls.
+//!
 //! # Using it
 //! * Implement [`model::CoSimModel`] (variable table in a [`model::ModelInfo`]).
 //! * Export the `fmi2*` C symbols as forwarders to [`api`] instantiated for the type: with
@@ -19,7 +26,9 @@
 //! * [`api`]: one generic function per FMI call (argument checks, `catch_unwind`).
 //! * [`model_exchange`]: the Model Exchange calls, for a model that implements
 //!   [`model::ModelExchangeModel`] and declares [`model::ModelInfo::model_exchange`].
-//! * [`fmu_state`]: FMU-state snapshots and their checksummed byte format.
+//! * [`fmu_state`]: FMU-state snapshots and their checksummed byte format (which records the
+//!   FMI version and the interface of the instance).
+//! * [`fmu_state_calls`]: get, set, free and (de)serialize FMU states, for either version.
 //! * [`state_bytes`]: the byte format of a model's own state inside it (magic, versions,
 //!   little-endian numbers), with [`state_format!`].
 //! * [`model_description`]: the XML generator and table validation.
@@ -44,6 +53,7 @@
 pub mod api;
 mod exports_macro;
 pub mod fmu_state;
+pub mod fmu_state_calls;
 pub mod instance;
 pub mod model;
 pub mod model_description;

@@ -13,6 +13,18 @@ pub enum Causality {
     Local,
 }
 
+impl Causality {
+    /// The attribute's value, e.g. `"parameter"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Causality::Parameter => "parameter",
+            Causality::Input => "input",
+            Causality::Output => "output",
+            Causality::Local => "local",
+        }
+    }
+}
+
 /// FMI 2.0 variability of a variable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Variability {
@@ -22,6 +34,18 @@ pub enum Variability {
     Continuous,
 }
 
+impl Variability {
+    /// The attribute's value, e.g. `"tunable"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Variability::Fixed => "fixed",
+            Variability::Tunable => "tunable",
+            Variability::Discrete => "discrete",
+            Variability::Continuous => "continuous",
+        }
+    }
+}
+
 /// FMI 2.0 base type of a variable. Boolean and Integer values travel as `f64` in
 /// `start` (0/1 for Boolean).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,6 +53,26 @@ pub enum VarType {
     Real,
     Integer,
     Boolean,
+}
+
+impl VarType {
+    /// The FMI 2.0 type name, e.g. `"Real"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            VarType::Real => "Real",
+            VarType::Integer => "Integer",
+            VarType::Boolean => "Boolean",
+        }
+    }
+
+    /// The type's name in `version`: FMI 3.0 calls Real `Float64` and Integer `Int32`.
+    pub const fn name_in(self, version: crate::state::Version) -> &'static str {
+        match (version, self) {
+            (crate::state::Version::Fmi3, VarType::Real) => "Float64",
+            (crate::state::Version::Fmi3, VarType::Integer) => "Int32",
+            _ => self.name(),
+        }
+    }
 }
 
 /// One row of the variable table: the single source of the model description and of

@@ -16,12 +16,12 @@
 use super::api::{guarded, in_slice, out_slice};
 use super::instance::Instance;
 use super::model::{CoSimModel, ModelExchangeInfo, ModelExchangeModel};
-use super::state::{Function, State};
+use super::state::{Call, Function, State};
 use super::types::*;
 
 /// What [`crate::model::ModelInfo::model_exchange`] declares (a model without it never gets a
 /// Model Exchange instance, so the empty description is only a fallback).
-fn me_info<M: CoSimModel>() -> &'static ModelExchangeInfo {
+pub fn me_info<M: CoSimModel>() -> &'static ModelExchangeInfo {
     static NONE: ModelExchangeInfo = ModelExchangeInfo {
         states: &[],
         event_indicators: 0,
@@ -47,15 +47,15 @@ fn length_error<M: CoSimModel>(
 ///
 /// # Safety
 /// See the module documentation.
-pub unsafe fn set_time<M: ModelExchangeModel>(c: fmi2Component, time: fmi2Real) -> fmi2Status {
-    guarded::<M>(c, Function::SetTime, |inst| {
-        const F: &str = "fmi2SetTime";
+pub unsafe fn set_time_as<M: ModelExchangeModel, K: Call>(c: fmi2Component, call: K, time: fmi2Real) -> fmi2Status {
+    guarded::<M, _>(c, call, |inst| {
+        let fname = call.name();
         if !time.is_finite() {
-            return inst.error(format!("{F}: time = {time} is not finite"));
+            return inst.error(format!("{fname}: time = {time} is not finite"));
         }
         match inst.model.set_time(time) {
             Ok(()) => fmi2OK,
-            Err(m) => inst.error(format!("{F}: {m}")),
+            Err(m) => inst.error(format!("{fname}: {m}")),
         }
     })
 }
@@ -64,43 +64,47 @@ pub unsafe fn set_time<M: ModelExchangeModel>(c: fmi2Component, time: fmi2Real) 
 ///
 /// # Safety
 /// `x` must hold `nx` values.
-pub unsafe fn set_continuous_states<M: ModelExchangeModel>(
+pub unsafe fn set_continuous_states_as<M: ModelExchangeModel, K: Call>(
     c: fmi2Component,
+    call: K,
     x: *const fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::SetContinuousStates, |inst| {
-        const F: &str = "fmi2SetContinuousStates";
+    guarded::<M, _>(c, call, |inst| {
+        let fname = call.name();
         let declared = me_info::<M>().states.len();
         if nx != declared {
-            return length_error(inst, F, "nx", nx, declared);
+            return length_error(inst, fname, "nx", nx, declared);
         }
-        let values = match in_slice(inst, F, "x[]", x, nx) {
+        let values = match in_slice(inst, fname, "x[]", x, nx) {
             Ok(s) => s,
             Err(s) => return s,
         };
         if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-            return inst.error(format!("{F}: x[{k}] = {} is not finite", values[k]));
+            return inst.error(format!("{fname}: x[{k}] = {} is not finite", values[k]));
         }
         match inst.model.set_continuous_states(values) {
             Ok(()) => fmi2OK,
-            Err(m) => inst.error(format!("{F}: {m}")),
+            Err(m) => inst.error(format!("{fname}: {m}")),
         }
     })
 }
 
 /// The getters of states, derivatives, event indicators and nominals: check the length
 /// against `declared` and the pointer, then let `read` fill the array.
-unsafe fn get_array<M: ModelExchangeModel>(
+///
+/// # Safety
+/// `p` holds `n` values.
+pub unsafe fn get_array<M: ModelExchangeModel, K: Call>(
     c: fmi2Component,
-    f: Function,
+    f: K,
     what: &str,
     p: *mut fmi2Real,
     n: usize,
     declared: usize,
     read: impl FnOnce(&mut M, &mut [f64]) -> Result<(), String>,
 ) -> fmi2Status {
-    guarded::<M>(c, f, |inst| {
+    guarded::<M, _>(c, f, |inst| {
         let fname = f.name();
         if n != declared {
             return length_error(inst, fname, what, n, declared);
@@ -118,70 +122,66 @@ unsafe fn get_array<M: ModelExchangeModel>(
 
 /// # Safety
 /// `x` must hold `nx` values.
-pub unsafe fn get_continuous_states<M: ModelExchangeModel>(
+pub unsafe fn get_continuous_states_as<M: ModelExchangeModel, K: Call>(
     c: fmi2Component,
+    call: K,
     x: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
     let declared = me_info::<M>().states.len();
-    get_array::<M>(c, Function::GetContinuousStates, "nx", x, nx, declared, |m, x| {
-        m.continuous_states(x)
-    })
+    get_array::<M, K>(c, call, "nx", x, nx, declared, |m, x| m.continuous_states(x))
 }
 
 /// # Safety
 /// `dx` must hold `nx` values.
-pub unsafe fn get_derivatives<M: ModelExchangeModel>(c: fmi2Component, dx: *mut fmi2Real, nx: usize) -> fmi2Status {
+pub unsafe fn get_derivatives_as<M: ModelExchangeModel, K: Call>(
+    c: fmi2Component,
+    call: K,
+    dx: *mut fmi2Real,
+    nx: usize,
+) -> fmi2Status {
     let declared = me_info::<M>().states.len();
-    get_array::<M>(c, Function::GetDerivatives, "nx", dx, nx, declared, |m, dx| {
-        m.derivatives(dx)
-    })
+    get_array::<M, K>(c, call, "nx", dx, nx, declared, |m, dx| m.derivatives(dx))
 }
 
 /// # Safety
 /// `z` must hold `nz` values.
-pub unsafe fn get_event_indicators<M: ModelExchangeModel>(c: fmi2Component, z: *mut fmi2Real, nz: usize) -> fmi2Status {
+pub unsafe fn get_event_indicators_as<M: ModelExchangeModel, K: Call>(
+    c: fmi2Component,
+    call: K,
+    z: *mut fmi2Real,
+    nz: usize,
+) -> fmi2Status {
     let declared = me_info::<M>().event_indicators;
-    get_array::<M>(c, Function::GetEventIndicators, "ni", z, nz, declared, |m, z| {
-        m.event_indicators(z)
-    })
+    get_array::<M, K>(c, call, "ni", z, nz, declared, |m, z| m.event_indicators(z))
 }
 
 /// # Safety
 /// `nominals` must hold `nx` values.
-pub unsafe fn get_nominals_of_continuous_states<M: ModelExchangeModel>(
+pub unsafe fn get_nominals_of_continuous_states_as<M: ModelExchangeModel, K: Call>(
     c: fmi2Component,
+    call: K,
     nominals: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
     let declared = me_info::<M>().states.len();
-    get_array::<M>(
-        c,
-        Function::GetNominalsOfContinuousStates,
-        "nx",
-        nominals,
-        nx,
-        declared,
-        |m, n| {
-            m.nominals(n);
-            Ok(())
-        },
-    )
+    get_array::<M, K>(c, call, "nx", nominals, nx, declared, |m, n| {
+        m.nominals(n);
+        Ok(())
+    })
 }
 
 /// `fmi2EnterEventMode`: from `continuousTimeMode` (or again in `eventMode`).
 ///
 /// # Safety
 /// See the module documentation.
-pub unsafe fn enter_event_mode<M: ModelExchangeModel>(c: fmi2Component) -> fmi2Status {
-    guarded::<M>(c, Function::EnterEventMode, |inst| {
-        match inst.model.enter_event_mode() {
-            Ok(()) => {
-                inst.state = State::EventMode;
-                fmi2OK
-            }
-            Err(m) => inst.error(format!("fmi2EnterEventMode: {m}")),
+pub unsafe fn enter_event_mode_as<M: ModelExchangeModel, K: Call>(c: fmi2Component, call: K) -> fmi2Status {
+    guarded::<M, _>(c, call, |inst| match inst.model.enter_event_mode() {
+        Ok(()) => {
+            inst.state = State::EventMode;
+            fmi2OK
         }
+        Err(m) => inst.error(format!("{}: {m}", call.name())),
     })
 }
 
@@ -194,7 +194,7 @@ pub unsafe fn new_discrete_states<M: ModelExchangeModel>(
     c: fmi2Component,
     event_info: *mut fmi2EventInfo,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::NewDiscreteStates, |inst| {
+    guarded::<M, _>(c, Function::NewDiscreteStates, |inst| {
         const F: &str = "fmi2NewDiscreteStates";
         if event_info.is_null() {
             return inst.error(format!("{F}: eventInfo is NULL"));
@@ -221,8 +221,8 @@ pub unsafe fn new_discrete_states<M: ModelExchangeModel>(
 ///
 /// # Safety
 /// See the module documentation.
-pub unsafe fn enter_continuous_time_mode<M: ModelExchangeModel>(c: fmi2Component) -> fmi2Status {
-    guarded::<M>(c, Function::EnterContinuousTimeMode, |inst| {
+pub unsafe fn enter_continuous_time_mode_as<M: ModelExchangeModel, K: Call>(c: fmi2Component, call: K) -> fmi2Status {
+    guarded::<M, _>(c, call, |inst| {
         inst.state = State::ContinuousTimeMode;
         fmi2OK
     })
@@ -238,7 +238,7 @@ pub unsafe fn completed_integrator_step<M: ModelExchangeModel>(
     enter_event_mode: *mut fmi2Boolean,
     terminate_simulation: *mut fmi2Boolean,
 ) -> fmi2Status {
-    guarded::<M>(c, Function::CompletedIntegratorStep, |inst| {
+    guarded::<M, _>(c, Function::CompletedIntegratorStep, |inst| {
         const F: &str = "fmi2CompletedIntegratorStep";
         if enter_event_mode.is_null() || terminate_simulation.is_null() {
             return inst.error(format!("{F}: enterEventMode or terminateSimulation is NULL"));
@@ -252,4 +252,80 @@ pub unsafe fn completed_integrator_step<M: ModelExchangeModel>(
             Err(m) => inst.error(format!("{F}: {m}")),
         }
     })
+}
+
+/// [`set_time_as`] for FMI 2.0's `fmi2SetTime`.
+///
+/// # Safety
+/// See [`set_time_as`].
+pub unsafe fn set_time<M: ModelExchangeModel>(c: fmi2Component, time: fmi2Real) -> fmi2Status {
+    set_time_as::<M, _>(c, Function::SetTime, time)
+}
+
+/// [`set_continuous_states_as`] for FMI 2.0's `fmi2SetContinuousStates`.
+///
+/// # Safety
+/// See [`set_continuous_states_as`].
+pub unsafe fn set_continuous_states<M: ModelExchangeModel>(
+    c: fmi2Component,
+    x: *const fmi2Real,
+    nx: usize,
+) -> fmi2Status {
+    set_continuous_states_as::<M, _>(c, Function::SetContinuousStates, x, nx)
+}
+
+/// [`get_continuous_states_as`] for FMI 2.0's `fmi2GetContinuousStates`.
+///
+/// # Safety
+/// See [`get_continuous_states_as`].
+pub unsafe fn get_continuous_states<M: ModelExchangeModel>(
+    c: fmi2Component,
+    x: *mut fmi2Real,
+    nx: usize,
+) -> fmi2Status {
+    get_continuous_states_as::<M, _>(c, Function::GetContinuousStates, x, nx)
+}
+
+/// [`get_derivatives_as`] for FMI 2.0's `fmi2GetDerivatives`.
+///
+/// # Safety
+/// See [`get_derivatives_as`].
+pub unsafe fn get_derivatives<M: ModelExchangeModel>(c: fmi2Component, dx: *mut fmi2Real, nx: usize) -> fmi2Status {
+    get_derivatives_as::<M, _>(c, Function::GetDerivatives, dx, nx)
+}
+
+/// [`get_event_indicators_as`] for FMI 2.0's `fmi2GetEventIndicators`.
+///
+/// # Safety
+/// See [`get_event_indicators_as`].
+pub unsafe fn get_event_indicators<M: ModelExchangeModel>(c: fmi2Component, z: *mut fmi2Real, nz: usize) -> fmi2Status {
+    get_event_indicators_as::<M, _>(c, Function::GetEventIndicators, z, nz)
+}
+
+/// [`get_nominals_of_continuous_states_as`] for FMI 2.0's `fmi2GetNominalsOfContinuousStates`.
+///
+/// # Safety
+/// See [`get_nominals_of_continuous_states_as`].
+pub unsafe fn get_nominals_of_continuous_states<M: ModelExchangeModel>(
+    c: fmi2Component,
+    nominals: *mut fmi2Real,
+    nx: usize,
+) -> fmi2Status {
+    get_nominals_of_continuous_states_as::<M, _>(c, Function::GetNominalsOfContinuousStates, nominals, nx)
+}
+
+/// [`enter_event_mode_as`] for FMI 2.0's `fmi2EnterEventMode`.
+///
+/// # Safety
+/// See [`enter_event_mode_as`].
+pub unsafe fn enter_event_mode<M: ModelExchangeModel>(c: fmi2Component) -> fmi2Status {
+    enter_event_mode_as::<M, _>(c, Function::EnterEventMode)
+}
+
+/// [`enter_continuous_time_mode_as`] for FMI 2.0's `fmi2EnterContinuousTimeMode`.
+///
+/// # Safety
+/// See [`enter_continuous_time_mode_as`].
+pub unsafe fn enter_continuous_time_mode<M: ModelExchangeModel>(c: fmi2Component) -> fmi2Status {
+    enter_continuous_time_mode_as::<M, _>(c, Function::EnterContinuousTimeMode)
 }

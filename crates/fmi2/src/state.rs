@@ -32,6 +32,33 @@ pub enum Interface {
     ModelExchange,
 }
 
+/// The FMI version an instance (or an FMU state) belongs to: the layer serves both with the
+/// same instances, states and FMU-state bytes, and refuses a call of one version on an
+/// instance of the other.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Version {
+    Fmi2,
+    Fmi3,
+}
+
+impl Version {
+    /// `"FMI 2.0"` or `"FMI 3.0"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Version::Fmi2 => "FMI 2.0",
+            Version::Fmi3 => "FMI 3.0",
+        }
+    }
+
+    /// The prefix of the version's C functions, `"fmi2"` or `"fmi3"`.
+    pub const fn prefix(self) -> &'static str {
+        match self {
+            Version::Fmi2 => "fmi2",
+            Version::Fmi3 => "fmi3",
+        }
+    }
+}
+
 impl Interface {
     pub const fn name(self) -> &'static str {
         match self {
@@ -92,6 +119,16 @@ impl State {
             State::Fatal => "fatal",
             State::EventMode => "eventMode",
             State::ContinuousTimeMode => "continuousTimeMode",
+        }
+    }
+
+    /// The state's name in the state machine of `version`: FMI 3.0 calls Co-Simulation's
+    /// `stepComplete` `stepMode` and its `stepFailed` `stepDiscarded`.
+    pub const fn name_in(self, version: Version) -> &'static str {
+        match (version, self) {
+            (Version::Fmi3, State::StepComplete) => "stepMode",
+            (Version::Fmi3, State::StepFailed) => "stepDiscarded",
+            _ => self.name(),
         }
     }
 
@@ -321,6 +358,37 @@ pub const TABLE: &[(Function, &str, Mask)] = &[
         INSTANTIATED | ME_RUNNING | TERMINATED | ERROR,
     ),
 ];
+
+/// A function of one version's legality table, as [`crate::api::guarded`] checks it.
+pub trait Call: Copy {
+    /// The C name, e.g. `"fmi2DoStep"`.
+    fn name(self) -> &'static str;
+    /// The version whose instances the function takes.
+    fn version(self) -> Version;
+    /// Whether the call is legal for an instance of `interface` in `state`.
+    fn legal(self, state: State, interface: Interface) -> bool;
+    /// The message of an illegal call: the function, the state and, when that is the reason,
+    /// the interface.
+    fn illegal_call_message(self, state: State, interface: Interface) -> String;
+}
+
+impl Call for Function {
+    #[inline]
+    fn name(self) -> &'static str {
+        Function::name(self)
+    }
+    #[inline]
+    fn version(self) -> Version {
+        Version::Fmi2
+    }
+    #[inline]
+    fn legal(self, state: State, interface: Interface) -> bool {
+        Function::legal(self, state, interface)
+    }
+    fn illegal_call_message(self, state: State, interface: Interface) -> String {
+        crate::api::illegal_call_message_for(self, state, interface)
+    }
+}
 
 impl Function {
     #[inline]

@@ -1,5 +1,7 @@
-//! Writing `JetPipeActuator.fmu`: model description (from the variable table), the shared
-//! library, and an HTML page documenting the interface.
+//! Writing `JetPipeActuator.fmu` (FMI 2.0) and `JetPipeActuator-fmi3.fmu` (FMI 3.0): model
+//! description (from the variable table), the shared library (one library exports both
+//! versions' symbols, so both archives carry the same binary), and an HTML page documenting
+//! the interface.
 
 use std::io::Write;
 use std::path::Path;
@@ -13,6 +15,11 @@ pub fn actuator_model_description() -> String {
     model_description_xml(&MODEL_INFO)
 }
 
+/// The FMI 3.0 model description of the actuator FMU.
+pub fn actuator_model_description_fmi3() -> String {
+    fmi3::model_description::model_description_xml(&MODEL_INFO)
+}
+
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -23,6 +30,11 @@ fn escape(s: &str) -> String {
 /// `documentation/index.html` of any FMU on the FMI layer: name, description, `notes`
 /// (already HTML) and the interface table, from the variable table.
 pub fn documentation_page(info: &ModelInfo, notes: &str) -> String {
+    documentation_page_for(info, "FMI 2.0 Co-Simulation", notes)
+}
+
+/// [`documentation_page`] naming the standard and interfaces (`"FMI 3.0 Co-Simulation and Model Exchange"`).
+pub fn documentation_page_for(info: &ModelInfo, standard: &str, notes: &str) -> String {
     let mut rows = String::new();
     for v in info.variables {
         let causality = match v.causality {
@@ -57,7 +69,7 @@ pub fn documentation_page(info: &ModelInfo, notes: &str) -> String {
     }
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n\
-<h1>{name}</h1>\n<p>{description}</p>\n<p>FMI 2.0 Co-Simulation, version {version}.</p>\n{notes}\n\
+<h1>{name}</h1>\n<p>{description}</p>\n<p>{standard}, version {version}.</p>\n{notes}\n\
 <table border=\"1\" cellpadding=\"3\"><tr><th>name</th><th>causality</th><th>unit</th><th>start</th>\
 <th>valid range</th><th>description</th></tr>\n{rows}</table>\n</body></html>\n",
         name = info.model_identifier,
@@ -69,17 +81,25 @@ pub fn documentation_page(info: &ModelInfo, notes: &str) -> String {
 /// The actuator's `documentation/index.html`: where the equations come from, and the behaviour
 /// an importer can rely on.
 pub fn documentation_html(info: &ModelInfo) -> String {
-    let notes = format!(
+    documentation_page_for(info, "FMI 2.0 Co-Simulation and Model Exchange", &actuator_notes(info))
+}
+
+/// The FMI 3.0 archive's `documentation/index.html`.
+pub fn documentation_html_fmi3(info: &ModelInfo) -> String {
+    documentation_page_for(info, "FMI 3.0 Co-Simulation and Model Exchange", &actuator_notes(info))
+}
+
+fn actuator_notes(info: &ModelInfo) -> String {
+    format!(
         "<p>Equations and numbers follow P.D. Henri, <i>Study of a Jet Pipe \
 Electropneumatic Actuator</i> (1994): current driver (2.1)&ndash;(2.3), jet pipe (2.4)&ndash;(2.7), orifice areas \
 (2.8)&ndash;(2.17), orifice flow (2.18)&ndash;(2.23), chambers (2.24)&ndash;(2.32), force (2.36)&ndash;(2.38). \
 The FMU starts at the equilibrium of its initial inputs. A stopper position set between communication points \
 moves the stopper instantly and conserves the air in each chamber (P V<sup>&gamma;</sup> constant); with \
-fmi2SetRealInputDerivatives it moves linearly over the step. The tolerance of fmi2SetupExperiment is the \
-relative tolerance of the integrator (default {tolerance:e}).</p>",
+fmi2SetRealInputDerivatives it moves linearly over the step. The tolerance of fmi2SetupExperiment \
+(fmi3EnterInitializationMode) is the relative tolerance of the integrator (default {tolerance:e}).</p>",
         tolerance = info.default_tolerance,
-    );
-    documentation_page(info, &notes)
+    )
 }
 
 /// Write the FMU archive to `out`, taking the compiled shared library from `library`.
@@ -100,12 +120,31 @@ pub fn write_model_fmu(out: &Path, library: &Path, info: &ModelInfo, documentati
     write_model_fmu_platforms(out, &[("linux64", library)], info, documentation)
 }
 
-/// The file name suffix of a shared library on an FMI 2.0 platform.
+/// Write `JetPipeActuator-fmi3.fmu` to `out` with one binary per FMI 3.0 platform
+/// (`x86_64-linux`, `x86_64-windows`).
+pub fn write_fmu3_platforms(out: &Path, binaries: &[(&str, &Path)]) -> Result<(), String> {
+    let model_description = fmi3::model_description::try_model_description_xml(&MODEL_INFO).map_err(|problems| {
+        format!(
+            "invalid variable table of {}: {}",
+            MODEL_INFO.model_name,
+            problems.join("; ")
+        )
+    })?;
+    write_archive(
+        out,
+        &model_description,
+        binaries,
+        &MODEL_INFO,
+        &documentation_html_fmi3(&MODEL_INFO),
+    )
+}
+
+/// The file name suffix of a shared library on an FMI 2.0 or FMI 3.0 platform.
 fn library_suffix(platform: &str) -> Result<&'static str, String> {
     match platform {
-        "linux64" | "linux32" => Ok("so"),
-        "win64" | "win32" => Ok("dll"),
-        "darwin64" => Ok("dylib"),
+        "linux64" | "linux32" | "x86_64-linux" | "aarch64-linux" => Ok("so"),
+        "win64" | "win32" | "x86_64-windows" => Ok("dll"),
+        "darwin64" | "x86_64-darwin" | "aarch64-darwin" => Ok("dylib"),
         _ => Err(format!("unknown FMI platform {platform:?}")),
     }
 }
@@ -119,6 +158,18 @@ pub fn write_model_fmu_platforms(
 ) -> Result<(), String> {
     let model_description = fmi2::model_description::try_model_description_xml(info)
         .map_err(|problems| format!("invalid variable table of {}: {}", info.model_name, problems.join("; ")))?;
+    write_archive(out, &model_description, libraries, info, documentation)
+}
+
+/// An FMU archive: `model_description`, `binaries/<platform>/<modelIdentifier>.<so|dll>`,
+/// `documentation/index.html`; written to a temporary file first.
+fn write_archive(
+    out: &Path,
+    model_description: &str,
+    libraries: &[(&str, &Path)],
+    info: &ModelInfo,
+    documentation: &str,
+) -> Result<(), String> {
     let mut binaries = Vec::new();
     for &(platform, library) in libraries {
         let suffix = library_suffix(platform)?;
@@ -176,6 +227,16 @@ mod tests {
             checked,
             actuator_model_description(),
             "modelDescription.xml is stale: regenerate it with `cargo run --release --bin jetpipe -- model-description > modelDescription.xml`"
+        );
+    }
+
+    #[test]
+    fn checked_in_fmi3_model_description_is_the_generated_one() {
+        let checked = include_str!("../../../modelDescription-fmi3.xml");
+        assert_eq!(
+            checked,
+            actuator_model_description_fmi3(),
+            "modelDescription-fmi3.xml is stale: regenerate it with `cargo run --release --bin jetpipe -- model-description --fmi3 > modelDescription-fmi3.xml`"
         );
     }
 }

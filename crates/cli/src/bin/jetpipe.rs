@@ -25,10 +25,14 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Write dist/JetPipeActuator.fmu (model description, linux64 and optionally win64 binaries, documentation).
+    /// Write dist/JetPipeActuator.fmu (FMI 2.0) and dist/JetPipeActuator-fmi3.fmu (FMI 3.0): model
+    /// description, linux64 and optionally win64 binaries (the same library in both), documentation.
     Package {
         #[arg(long, default_value = "dist/JetPipeActuator.fmu")]
         out: PathBuf,
+        /// Where the FMI 3.0 archive goes.
+        #[arg(long, default_value = "dist/JetPipeActuator-fmi3.fmu")]
+        out_fmi3: PathBuf,
         /// The compiled linux64 shared library; by default libjetpipe.so next to this executable.
         #[arg(long)]
         library: Option<PathBuf>,
@@ -37,7 +41,11 @@ enum Command {
         win64: Option<PathBuf>,
     },
     /// Print the model description generated from the variable table.
-    ModelDescription,
+    ModelDescription {
+        /// The FMI 3.0 model description instead of the FMI 2.0 one.
+        #[arg(long)]
+        fmi3: bool,
+    },
     /// Print every variable with its unit, start value, limits, thesis reference and meaning
     /// (the Markdown table of docs/model.md, from the variable table).
     Parameters,
@@ -172,7 +180,12 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
-        Command::Package { out, library, win64 } => {
+        Command::Package {
+            out,
+            out_fmi3,
+            library,
+            win64,
+        } => {
             let library = match library {
                 Some(path) => path,
                 None => build_shared_library()?,
@@ -183,10 +196,29 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             jetpipe_packaging::write_fmu_platforms(&out, &binaries)?;
             println!("wrote {}", out.display());
+            let binaries3: Vec<(&str, &std::path::Path)> = binaries
+                .iter()
+                .map(|&(platform, path)| {
+                    (
+                        if platform == "win64" {
+                            "x86_64-windows"
+                        } else {
+                            "x86_64-linux"
+                        },
+                        path,
+                    )
+                })
+                .collect();
+            jetpipe_packaging::write_fmu3_platforms(&out_fmi3, &binaries3)?;
+            println!("wrote {}", out_fmi3.display());
             Ok(())
         }
-        Command::ModelDescription => {
-            print!("{}", jetpipe_packaging::actuator_model_description());
+        Command::ModelDescription { fmi3 } => {
+            if fmi3 {
+                print!("{}", jetpipe_packaging::actuator_model_description_fmi3());
+            } else {
+                print!("{}", jetpipe_packaging::actuator_model_description());
+            }
             Ok(())
         }
         Command::Parameters => {
