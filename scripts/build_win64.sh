@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Build target/win64/JetPipeActuator.dll, the actuator FMU for 64-bit Windows, with Debian's
 # rustc and its Windows standard library (rustc 1.63; this machine's rustup toolchain has no
-# Windows target and none can be downloaded) and MinGW-w64 as the linker. The FMU's three
-# crates are compiled here as cargo would: crates/fmi2 and crates/model as rlibs, then
+# Windows target and none can be downloaded) and MinGW-w64 as the linker. The FMU's four
+# crates are compiled here as cargo would: crates/fmi2, crates/fmi3 and crates/model as rlibs, then
 # the root package (src/) as the cdylib; the model's two dependencies, nalgebra (0.32, with its own
 # dependencies, at versions that build on 1.63) and smallvec, are fetched from crates.io by
 # cargo at the versions of tools/win64/Cargo.lock and compiled here with rustc 1.63 one by one. Installs the Debian packages it needs when they are missing (as root),
-# and wine64, on which fmu_tests/test_win64.py runs the DLL.
+# and wine64, on which fmu_tests/test_win64.py runs the DLL. The DLL exports the fmi2* and the
+# fmi3* functions: both archives ship it (binaries/win64 and binaries/x86_64-windows).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -70,13 +71,15 @@ fi
 # The workspace's crates (rebuilt every time: they are what changes).
 VERSION=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)
 OWN=(--edition 2021 "${COMMON[@]}" -C codegen-units=1)
-echo "==> crates/fmi2, crates/model (rlibs)"
+echo "==> crates/fmi2, crates/fmi3, crates/model (rlibs)"
 CARGO_PKG_VERSION="$VERSION" CARGO_PKG_NAME=jetpipe-fmi2 "$RUSTC" --crate-name fmi2 --crate-type rlib "${OWN[@]}" \
     -o "$DEPS/libfmi2.rlib" crates/fmi2/src/lib.rs
+CARGO_PKG_VERSION="$VERSION" CARGO_PKG_NAME=jetpipe-fmi3 "$RUSTC" --crate-name fmi3 --crate-type rlib "${OWN[@]}" \
+    -o "$DEPS/libfmi3.rlib" crates/fmi3/src/lib.rs $(x fmi2)
 CARGO_PKG_VERSION="$VERSION" CARGO_PKG_NAME=jetpipe-model "$RUSTC" --crate-name jetpipe_model --crate-type rlib \
     "${OWN[@]}" -o "$DEPS/libjetpipe_model.rlib" crates/model/src/lib.rs $(x nalgebra) $(x smallvec)
 echo "==> $OUT/JetPipeActuator.dll (src/)"
 CARGO_PKG_VERSION="$VERSION" CARGO_PKG_NAME=jetpipe-fmu "$RUSTC" --crate-name JetPipeActuator --crate-type cdylib \
     "${OWN[@]}" -C linker=x86_64-w64-mingw32-gcc -C strip=symbols \
-    -o "$OUT/JetPipeActuator.dll" src/lib.rs $(x fmi2) $(x jetpipe_model)
+    -o "$OUT/JetPipeActuator.dll" src/lib.rs $(x fmi2) $(x fmi3) $(x jetpipe_model)
 echo "==> wrote $OUT/JetPipeActuator.dll"
