@@ -26,6 +26,7 @@
 mod argument_calls;
 #[path = "../common/mod.rs"]
 mod common;
+mod fmi3;
 mod model_exchange;
 
 use std::collections::BTreeMap;

@@ -173,9 +173,15 @@ fn write_xml(info: &ModelInfo) -> String {
         };
         let _ = writeln!(w, "    <{element} {attrs}/>");
     }
+    // the time's unit only when the table declares the second
+    let unit = if info.units.iter().any(|u| u.name == "s") {
+        r#" unit="s""#
+    } else {
+        ""
+    };
     let _ = writeln!(
         w,
-        r#"    <Float64 name="time" valueReference="{}" causality="independent" variability="continuous" unit="s" description="simulation time"/>"#,
+        r#"    <Float64 name="time" valueReference="{}" causality="independent" variability="continuous"{unit} description="simulation time"/>"#,
         time_value_reference(info)
     );
     for k in 0..n_indicators {
