@@ -10,7 +10,11 @@ call-sequence fuzzer.
   - a negative control (one instance deliberately not freed) shows each checker sees the
     FMU's allocations.
 * the C driver of test_c_driver.py (1 s at 1 ms) under Valgrind;
-* the Rust call-sequence fuzzer (tests/fmi_call_fuzz/), bounded, under Valgrind.
+* fmu_tests/c/leak_cycles_fmi3.c, the same for the FMI 3.0 functions of the library in
+  dist/JetPipeActuator-fmi3.fmu (Co-Simulation and Model Exchange instances each cycle): under
+  LeakSanitizer (JETPIPE_LEAK_CYCLES) and Valgrind (JETPIPE_VALGRIND_CYCLES), with its negative
+  control;
+* the Rust call-sequence fuzzer (tests/fmi_call_fuzz/, FMI 2.0 and 3.0), bounded, under Valgrind.
 
 gcc and valgrind are on the CI image; the tests skip (saying which) only when one is missing.
 """
@@ -74,6 +78,27 @@ def leak_cycles_asan(gcc, tmp_path_factory):
                  extra=("-fsanitize=address", "-fno-omit-frame-pointer"))
 
 
+@pytest.fixture(scope="module")
+def fmi3_library(tmp_path_factory):
+    """The x86_64-linux library of dist/JetPipeActuator-fmi3.fmu ($JETPIPE_FMU3) and its token."""
+    path = Path(os.environ.get("JETPIPE_FMU3", REPO / "dist" / "JetPipeActuator-fmi3.fmu"))
+    if not path.is_file():
+        pytest.fail(f"{path} not found (bash scripts/package.sh)", pytrace=False)
+    d = Path(fmpy.extract(str(path), str(tmp_path_factory.mktemp("fmu3"))))
+    return d / "binaries" / "x86_64-linux" / "JetPipeActuator.so", fmpy.read_model_description(str(path)).guid
+
+
+@pytest.fixture(scope="module")
+def leak_cycles_fmi3(gcc, tmp_path_factory):
+    return build(gcc, HERE / "c" / "leak_cycles_fmi3.c", tmp_path_factory.mktemp("leak3") / "leak_cycles_fmi3")
+
+
+@pytest.fixture(scope="module")
+def leak_cycles_fmi3_asan(gcc, tmp_path_factory):
+    return build(gcc, HERE / "c" / "leak_cycles_fmi3.c", tmp_path_factory.mktemp("leak3_asan") / "leak_cycles_fmi3_asan",
+                 extra=("-fsanitize=address", "-fno-omit-frame-pointer"))
+
+
 def run(cmd, timeout=900, env=None):
     t0 = time.perf_counter()
     proc = subprocess.run([str(c) for c in cmd], capture_output=True, text=True, timeout=timeout,
@@ -123,6 +148,40 @@ def test_valgrind_sees_a_deliberate_leak(valgrind, leak_cycles, unzipdir, model_
     assert proc.returncode == 99 and definite + indirect > 0, proc.stderr[-3000:]
 
 
+def test_fmi3_leak_cycles_lsan(leak_cycles_fmi3_asan, fmi3_library):
+    library, token = fmi3_library
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=0")
+    proc, wall = run([leak_cycles_fmi3_asan, library, token, LEAK_CYCLES], env=env)
+    print(proc.stdout.strip(), f"(FMI 3.0, AddressSanitizer + LeakSanitizer, {wall:.1f} s)")
+    assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout}\n{proc.stderr[-5000:]}"
+    assert "Sanitizer" not in proc.stderr, proc.stderr[-5000:]
+    assert f"cycles={LEAK_CYCLES}" in proc.stdout
+
+
+def test_lsan_sees_a_deliberate_leak_of_an_fmi3_instance(leak_cycles_fmi3_asan, fmi3_library):
+    library, token = fmi3_library
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1")
+    proc, _ = run([leak_cycles_fmi3_asan, library, token, 3, "--leak-one"], env=env)
+    assert proc.returncode != 0 and "detected memory leaks" in proc.stderr, (
+        f"LeakSanitizer did not report the instance leaked on purpose (exit {proc.returncode}):\n{proc.stderr[-3000:]}")
+
+
+def test_fmi3_leak_cycles_valgrind(valgrind, leak_cycles_fmi3, fmi3_library):
+    library, token = fmi3_library
+    proc, wall = run([valgrind, *VALGRIND_ARGS, leak_cycles_fmi3, library, token, VALGRIND_CYCLES])
+    errors, definite, indirect = valgrind_summary(proc.stderr)
+    print(proc.stdout.strip(), f"(FMI 3.0 under Valgrind: {errors} errors, definitely lost {definite} B, "
+          f"indirectly lost {indirect} B, {wall:.1f} s)")
+    assert proc.returncode == 0 and errors == 0 and definite == 0 and indirect == 0, proc.stderr[-6000:]
+
+
+def test_valgrind_sees_a_deliberate_leak_of_an_fmi3_instance(valgrind, leak_cycles_fmi3, fmi3_library):
+    library, token = fmi3_library
+    proc, _ = run([valgrind, *VALGRIND_ARGS, leak_cycles_fmi3, library, token, 2, "--leak-one"])
+    _, definite, indirect = valgrind_summary(proc.stderr)
+    assert proc.returncode == 99 and definite + indirect > 0, proc.stderr[-3000:]
+
+
 def test_c_driver_under_valgrind(valgrind, gcc, tmp_path, unzipdir, model_description):
     exe = build(gcc, HERE / "c" / "driver.c", tmp_path / "driver")
     proc, wall = run([valgrind, *VALGRIND_ARGS, exe, unzipdir, model_description.guid])
@@ -155,7 +214,8 @@ def test_rust_call_fuzz_under_valgrind(valgrind):
     env = dict(os.environ, JETPIPE_FUZZ_SEQUENCES=VALGRIND_FUZZ_SEQUENCES, JETPIPE_FUZZ_CALLS="150")
     # the libtest harness keeps one thread handle "possibly lost": only definite/indirect count
     proc, wall = run([valgrind, *VALGRIND_ARGS, exe, "--test-threads=1", "--nocapture",
-                      "generated_call_sequences_follow_the_state_table", "repeated_free_and_use_after_free"], env=env)
+                      "generated_call_sequences_follow_the_state_table", "repeated_free_and_use_after_free",
+                      "generated_fmi3_call_sequences"], env=env)
     errors, definite, indirect = valgrind_summary(proc.stderr)
     summary = [l[l.index("call fuzz"):] for l in proc.stdout.splitlines() if "call fuzz" in l]
     print(*summary, f"(under Valgrind: {errors} errors, definitely lost {definite} B, {wall:.1f} s)")
