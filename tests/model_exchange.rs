@@ -403,13 +403,16 @@ fn the_gas_volumes_and_the_lagging_mount_are_states_with_the_co_simulations_rate
     }
 }
 
-/// A benchmark, not a test (`cargo test --release --test model_exchange -- --ignored
-/// --nocapture`): right-hand-side evaluations per second through the exported
-/// `fmi2SetContinuousStates` + `fmi2GetDerivatives`, as an importer's solver calls them, for
-/// the thesis model and with gas volumes and a lagging mount.
+/// A benchmark, not a test (`bash scripts/bench_rhs.sh`, or `cargo test --release --test
+/// model_exchange -- --ignored --nocapture`): right-hand-side evaluations per second through
+/// the exported `fmi2SetContinuousStates` + `fmi2GetDerivatives` and
+/// `fmi3SetContinuousStates` + `fmi3GetContinuousStateDerivatives`, as an importer's solver
+/// calls them, for the thesis model and with gas volumes and a lagging mount; the two versions
+/// in alternating rounds, the best round of each.
 #[test]
 #[ignore]
-fn right_hand_side_evaluations_per_second_through_fmi2_get_derivatives() {
+fn right_hand_side_evaluations_per_second_through_fmi2_get_derivatives_and_fmi3_get_continuous_state_derivatives() {
+    use jetpipe::fmu3_exports::*;
     let sink = Sink::default();
     let volumes = [
         (vr::PORT_RESTRICTION_AREA_1, 0.5e-6),
@@ -417,33 +420,72 @@ fn right_hand_side_evaluations_per_second_through_fmi2_get_derivatives() {
         (vr::STOPPER_COMPLIANCE, 2e-5),
         (vr::STOPPER_MOUNT_LAG, 2e-3),
     ];
+    let n = 200_000;
     for (label, params) in [
         ("thesis model", &[][..]),
         ("gas volume and lagging mount", &volumes[..]),
     ] {
         unsafe {
-            let c = instantiate_model_exchange(&sink, "bench");
-            initialise(c, None, params, 2.5, 0.054);
-            assert_eq!(fmi2EnterContinuousTimeMode(c), fmi2OK);
-            let x0 = states(c);
-            let mut dx = [0.0; NX];
-            let n = 200_000;
-            let started = std::time::Instant::now();
-            for k in 0..n {
-                // a state that moves a little, so that nothing can be cached
-                let mut x = x0;
-                x[4] += (k % 97) as f64;
-                x[1] += (k % 89) as f64 * 1e-9;
-                assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
-                assert_eq!(fmi2GetDerivatives(c, dx.as_mut_ptr(), NX), fmi2OK);
-            }
-            let seconds = started.elapsed().as_secs_f64();
-            println!(
-                "{label}: {:.2e} right-hand-side evaluations per second through fmi2GetDerivatives ({:.0} ns each, with fmi2SetContinuousStates)",
-                n as f64 / seconds,
-                1e9 * seconds / n as f64
+            let c2 = instantiate_model_exchange(&sink, "bench2");
+            initialise(c2, None, params, 2.5, 0.054);
+            assert_eq!(fmi2EnterContinuousTimeMode(c2), fmi2OK);
+            let x0 = states(c2);
+            let token = guid();
+            let c3 = fmi3InstantiateModelExchange(
+                b"bench3\0".as_ptr() as *const _,
+                token.as_ptr(),
+                null(),
+                0,
+                0,
+                null_mut(),
+                None,
             );
-            free(c);
+            assert!(!c3.is_null());
+            for &(r, x) in params {
+                assert_eq!(fmi3SetFloat64(c3, &r, 1, &x, 1), 0);
+            }
+            let inputs = [vr::V_DA, vr::X_S];
+            assert_eq!(fmi3SetFloat64(c3, inputs.as_ptr(), 2, [2.5, 0.054].as_ptr(), 2), 0);
+            assert_eq!(fmi3EnterInitializationMode(c3, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi3ExitInitializationMode(c3), 0);
+            assert_eq!(fmi3EnterContinuousTimeMode(c3), 0);
+            let mut dx2 = [0.0; NX];
+            let mut dx3 = [0.0; NX];
+            let (mut best2, mut best3) = (f64::INFINITY, f64::INFINITY);
+            for _round in 0..3 {
+                let started = std::time::Instant::now();
+                for k in 0..n {
+                    // a state that moves a little, so that nothing can be cached
+                    let mut x = x0;
+                    x[4] += (k % 97) as f64;
+                    x[1] += (k % 89) as f64 * 1e-9;
+                    assert_eq!(fmi2SetContinuousStates(c2, x.as_ptr(), NX), fmi2OK);
+                    assert_eq!(fmi2GetDerivatives(c2, dx2.as_mut_ptr(), NX), fmi2OK);
+                }
+                best2 = best2.min(started.elapsed().as_secs_f64());
+                let started = std::time::Instant::now();
+                for k in 0..n {
+                    let mut x = x0;
+                    x[4] += (k % 97) as f64;
+                    x[1] += (k % 89) as f64 * 1e-9;
+                    assert_eq!(fmi3SetContinuousStates(c3, x.as_ptr(), NX), 0);
+                    assert_eq!(fmi3GetContinuousStateDerivatives(c3, dx3.as_mut_ptr(), NX), 0);
+                }
+                best3 = best3.min(started.elapsed().as_secs_f64());
+            }
+            assert_eq!(dx2, dx3, "the two versions' right-hand sides at the same state");
+            for (name, seconds) in [
+                ("fmi2GetDerivatives", best2),
+                ("fmi3GetContinuousStateDerivatives", best3),
+            ] {
+                println!(
+                    "{label}: {:.2e} right-hand-side evaluations per second through {name} ({:.0} ns each, with the SetContinuousStates)",
+                    n as f64 / seconds,
+                    1e9 * seconds / n as f64
+                );
+            }
+            free(c2);
+            fmi3FreeInstance(c3);
         }
     }
 }
