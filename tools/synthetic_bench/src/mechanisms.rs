@@ -232,6 +232,10 @@ pub struct UndeclaredEffects {
     /// `mechanics`/`extra_force`: quadratic damping q v|v| (N·s²/m²) opposing the stopper's
     /// velocity; 0 = none.
     pub quadratic_damping: f64,
+    /// `mechanics`/`extra_force`: a Coulomb friction over a band of the bore, F_b b(x_s)
+    /// tanh(v / 0.2 mm/s) with b = ½[tanh((x_s − 60 mm)/0.5 mm) − tanh((x_s − 66 mm)/0.5 mm)]
+    /// (a scored stretch of the cylinder wall), F_b in N; 0 = none.
+    pub friction_band: f64,
     /// `pressure_sensors`/`limit`: the chamber 1 pressure transducer's range ends at this
     /// absolute pressure (Pa): it reads min(P1, this), before noise and quantisation; 0 = none.
     pub pressure_sensor_saturation_1: f64,

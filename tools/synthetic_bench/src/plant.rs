@@ -411,6 +411,10 @@ impl Model {
         if u.quadratic_damping != 0.0 {
             fp -= u.quadratic_damping * xs_dot * xs_dot.abs();
         }
+        if u.friction_band != 0.0 {
+            let band = 0.5 * (((xs - 0.060) / 0.5e-3).tanh() - ((xs - 0.066) / 0.5e-3).tanh());
+            fp -= u.friction_band * band * (xs_dot / 0.2e-3).tanh();
+        }
         if u.seal_pressure_friction != 0.0 {
             // seals pressed harder by the chambers' gauge pressures; v_ε as the Coulomb seal's
             let gauge = y[S_P1] + y[S_P2] - 2.0 * self.p.p_return;

@@ -159,6 +159,10 @@ struct Cli {
     /// Quadratic damping on the stopper velocity, N.s2/m2 (e.g. 100): q v|v|.
     #[arg(long)]
     quadratic_damping: Option<f64>,
+    /// A Coulomb friction over the band 60-66 mm of stopper position (smooth edges of 0.5 mm), N
+    /// (e.g. 2.5). Move the stopper across it (--stopper) for it to show.
+    #[arg(long)]
+    friction_band: Option<f64>,
     /// The chamber 1 pressure transducer's range ends at this absolute pressure, Pa (e.g. 4.5e5).
     #[arg(long)]
     pressure_sensor_saturation: Option<f64>,
@@ -270,6 +274,7 @@ fn main() -> ExitCode {
     set(&mut und.moving_mass, cli.moving_mass);
     set(&mut und.seal_pressure_friction, cli.seal_pressure_friction);
     set(&mut und.quadratic_damping, cli.quadratic_damping);
+    set(&mut und.friction_band, cli.friction_band);
     set(&mut und.pressure_sensor_saturation_1, cli.pressure_sensor_saturation);
     set(&mut und.pressure_sensor_quadratic_2, cli.pressure_sensor_quadratic);
     set(&mut und.stopper_position_offset, cli.stopper_position_offset);
@@ -307,6 +312,7 @@ fn main() -> ExitCode {
         und.moving_mass,
         und.seal_pressure_friction,
         und.quadratic_damping,
+        und.friction_band,
         und.pressure_sensor_saturation_1,
         und.contact_lag,
         und.discharge_ratio_rise,
