@@ -133,6 +133,12 @@ pub(crate) fn alternative_at_place(
         .filter(|s| s.fit.candidate.label != scored.fit.candidate.label)
         .filter(|s| s.explained >= LOCATED_SHARE && used_terms(s) > 0.0)
         .filter(|s| used_terms(s) <= added_terms || added.named)
+        // A modulation can take any shape: it is no simpler form of a written term, and it
+        // replaces only another modulation.
+        .filter(|s| {
+            !crate::modulation::is_modulation(&s.fit.candidate)
+                || crate::modulation::is_modulation(&scored.fit.candidate)
+        })
         .collect();
     if alternatives.is_empty() {
         return Ok(None);

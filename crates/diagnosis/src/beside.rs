@@ -47,11 +47,7 @@ pub(crate) fn earlier_constants(f: &Findings) -> Vec<&'static str> {
         .flat_map(|e| e.parameters.iter())
         .chain(f.discovered.iter().flat_map(|d| d.parameters.iter()))
     {
-        if parameter_value(&f.params, name) != 0.0
-            && !name.ends_with("_curve_knots")
-            && !name.contains("_curve_x_")
-            && !names.contains(name)
-        {
+        if parameter_value(&f.params, name) != 0.0 && crate::refittable(name) && !names.contains(name) {
             names.push(name);
         }
     }
@@ -72,7 +68,7 @@ pub(crate) fn best_beside_earlier(
     force_before: f64,
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
-) -> Result<Option<(DiscoveredTerm, Parameters)>, String> {
+) -> Result<Option<(Option<DiscoveredTerm>, Parameters)>, String> {
     let params = &f.params;
     let earlier = earlier_constants(f);
     if earlier.is_empty() {
@@ -170,7 +166,11 @@ pub(crate) fn best_beside_earlier(
     {
         return Ok(None);
     }
-    let used = set.len().min(candidate.terms.len()) as f64;
+    let used = own
+        .iter()
+        .zip(&candidate.terms)
+        .filter(|(v, t)| **v != t.neutral)
+        .count() as f64;
     let judged = crate::pairs::Replayed::judge(cx, problem, &trial, heldout_before, replays)?;
     progress(&format!(
         "  the {} with the earlier constants refitted, in the model: force held-out {force_before:.4} -> {:.4} N, misfit {:.0} + penalty {:.0} against {:.0} before and the best candidate's {single_score:.0}",
@@ -184,6 +184,15 @@ pub(crate) fn best_beside_earlier(
         return Ok(None);
     }
     let after = judged.after;
+    if used == 0.0 {
+        // The new term stayed off: what was gained is the earlier additions' refit alone, and
+        // they report it, not a term of zero size.
+        progress(&format!(
+            "the earlier additions refitted (the {} stays off)",
+            candidate.label
+        ));
+        return Ok(Some((None, trial)));
+    }
     progress(&format!(
         "adding a {} at the {}, the earlier additions refitted beside it",
         candidate.label, candidate.location
@@ -200,7 +209,7 @@ pub(crate) fn best_beside_earlier(
         pressures_heldout: None,
         tied_locations: vec![],
     };
-    Ok(Some((term, trial)))
+    Ok(Some((Some(term), trial)))
 }
 
 #[cfg(test)]

@@ -288,6 +288,9 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
     if let Some(discharge) = crate::discharge::reading(set, before) {
         return discharge;
     }
+    if let Some(modulation) = crate::modulation::reading(set, before) {
+        return format!("At the {location} ({family}): {modulation}.");
+    }
     if let Some(filter) = second_order_reading(location, family, set) {
         return filter;
     }

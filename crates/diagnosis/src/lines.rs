@@ -72,7 +72,7 @@ fn is_local_peak(power: &[f64], k: usize) -> bool {
 }
 
 /// Power of `x` at frequency `f` (Goertzel), per sample squared.
-fn power_at(x: &[f64], f: f64, sample_rate: f64) -> f64 {
+pub(crate) fn power_at(x: &[f64], f: f64, sample_rate: f64) -> f64 {
     let w = 2.0 * std::f64::consts::PI * f / sample_rate;
     let c = 2.0 * w.cos();
     let (mut s1, mut s2) = (0.0, 0.0);

@@ -141,6 +141,7 @@ pub(crate) fn localize(
     base_replay: &Replay,
     candidates: &[Candidate],
     options: &Options,
+    screen: Option<crate::modulation::Screen>,
     progress: &mut dyn FnMut(&str),
 ) -> (Localization, usize) {
     let jobs = options.jobs;
@@ -168,6 +169,14 @@ pub(crate) fn localize(
             if let Some((name, step)) = name {
                 wanted.add(name, step);
             }
+        }
+    }
+    if screen.is_some() {
+        for name in crate::modulation::modulatable() {
+            wanted.add(
+                name,
+                crate::modulation::sensitivity_step(name, problem.base, candidates),
+            );
         }
     }
     progress(&format!(
@@ -206,6 +215,38 @@ pub(crate) fn localize(
     });
     let mut scored: Vec<Scored> = first.into_iter().flatten().collect();
     replays += scored.iter().map(|s| s.fit.replays).sum::<usize>();
+    if let Some(screen) = screen {
+        let penalty = discovery_penalty_per_term(heldout_count(problem.blocks) as f64);
+        let started = std::time::Instant::now();
+        let found = crate::modulation::screen(problem, base_replay, &shared, screen.periodic_hz, penalty, jobs);
+        progress(&format!(
+            "modulations screened in {:.1} s: {}",
+            started.elapsed().as_secs_f64(),
+            if found.is_empty() {
+                "none beats a constant".to_string()
+            } else {
+                found
+                    .iter()
+                    .map(|s| format!("{} with {:?}", s.constant, s.follows))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        ));
+        for s in &found {
+            if let (Some(c), Some(sensitivity)) = (
+                crate::modulation::candidate(s, problem.base, candidates),
+                shared(s.constant),
+            ) {
+                scored.push(score(crate::modulation::first_order_fit(
+                    problem,
+                    base_replay,
+                    s,
+                    c,
+                    &sensitivity,
+                )));
+            }
+        }
+    }
     scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
     // Refine the leaders (and every named effect near them) with more iterations.
     let leaders: Vec<Candidate> = scored

@@ -31,6 +31,8 @@ struct Round {
     force_before: f64,
     pressures_agree: bool,
     candidates: Vec<Candidate>,
+    /// The force residual's spectral line, if it has one.
+    periodic: Option<f64>,
 }
 
 /// What a round adds to the model.
@@ -84,7 +86,10 @@ pub(crate) fn run_rounds(
                 rank(&mut kept)
             }
             None => {
-                let (found, used) = localize(&problem, &r.current, &r.candidates, cx.options, progress);
+                let screen = crate::modulation::Screen {
+                    periodic_hz: r.periodic,
+                };
+                let (found, used) = localize(&problem, &r.current, &r.candidates, cx.options, Some(screen), progress);
                 *replays += used;
                 found
             }
@@ -174,8 +179,11 @@ pub(crate) fn run_rounds(
                 reusable = None;
             }
             Some(Addition::Pair(terms, trial)) => {
-                f.discovered.extend(terms);
-                f.newest = Some((false, f.discovered.len() - 1));
+                // No terms: the earlier additions refitted beside a candidate that stayed off.
+                if !terms.is_empty() {
+                    f.discovered.extend(terms);
+                    f.newest = Some((false, f.discovered.len() - 1));
+                }
                 f.params = *trial;
                 // A term added beside the earlier ones moved their constants.
                 sync_earlier(&mut f);
@@ -323,6 +331,7 @@ fn replay_round(
         force_before,
         pressures_agree,
         candidates,
+        periodic,
     }))
 }
 
@@ -422,7 +431,7 @@ fn find_addition(
         replays,
         progress,
     )? {
-        return Ok(Some(Addition::Pair(vec![term], Box::new(trial))));
+        return Ok(Some(Addition::Pair(term.into_iter().collect(), Box::new(trial))));
     }
     Ok(None)
 }
@@ -438,7 +447,13 @@ fn named_at_place(
     progress: &mut dyn FnMut(&str),
 ) -> Option<(Scored, String)> {
     let (place, count, force_before, noise) = (found.location, r.count, r.force_before, cx.noise);
-    let place_share = found.best_at(place).map_or(0.0, |s| s.explained);
+    // Against the written candidates: a modulation can take any shape, a named effect's too.
+    let place_share = found
+        .candidates
+        .iter()
+        .filter(|s| s.fit.candidate.location == place && !crate::modulation::is_modulation(&s.fit.candidate))
+        .map(|s| s.explained)
+        .fold(0.0, f64::max);
     let mut named: Vec<&Scored> = found
         .candidates
         .iter()
@@ -507,7 +522,7 @@ fn named_downstream(
         .cloned()
         .collect();
     progress("the force departs from the pressures too: the mechanics and the force sensor on their own");
-    let (side, used) = localize(&downstream, &through, &near, cx.options, progress);
+    let (side, used) = localize(&downstream, &through, &near, cx.options, None, progress);
     *replays += used;
     let side_share = side.best_at(side.location).map_or(0.0, |s| s.explained);
     let mut named: Vec<&Scored> = side
@@ -580,15 +595,49 @@ fn discover_term(
             .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
             .filter(|s| s.explained >= LOCATED_SHARE)
             .collect();
-        at.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
+        // A modulation goes behind the written candidates at its place that leave nearly as
+        // little, or that are adequate on their own (the force within the verdict's bar).
+        let written: Vec<&&Scored> = at
+            .iter()
+            .filter(|s| !crate::modulation::is_modulation(&s.fit.candidate))
+            .collect();
+        let written_best = written
+            .iter()
+            .map(|s| s.fit.heldout_total())
+            .fold(f64::INFINITY, f64::min);
+        let written_adequate = written
+            .iter()
+            .any(|s| s.force_heldout_rms <= crate::modulation::WRITTEN_ADEQUATE_WITHIN * noise);
+        let behind = |s: &Scored| {
+            crate::modulation::is_modulation(&s.fit.candidate)
+                && (written_adequate || written_best <= crate::modulation::WRITTEN_FIRST_WITHIN * s.fit.heldout_total())
+        };
+        at.sort_by(|a, b| {
+            behind(a)
+                .cmp(&behind(b))
+                .then(discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)))
+        });
         at.truncate(DISCOVERY_TRIALS);
         at
     };
     let mut others: Vec<&Scored> = tied.iter().flat_map(|place| unnamed_at(place)).collect();
     others.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
     others.truncate(DISCOVERY_TRIALS);
-    let at_place: Vec<&Scored> = unnamed_at(found.location).into_iter().chain(others).collect();
+    let mut at_place: Vec<&Scored> = unnamed_at(found.location).into_iter().chain(others).collect();
+    // The written candidates at the place that the trials leave out, last: a modulation that
+    // earns its place is added only when none of them does nearly as well in the model.
+    let mut written: Vec<&Scored> = found
+        .candidates
+        .iter()
+        .filter(|s| s.fit.candidate.location == found.location && s.fit.candidate.named.is_none())
+        .filter(|s| s.explained >= LOCATED_SHARE && !crate::modulation::is_modulation(&s.fit.candidate))
+        .filter(|s| !at_place.iter().any(|a| a.fit.candidate == s.fit.candidate))
+        .collect();
+    written.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
+    written.truncate(DISCOVERY_TRIALS);
+    at_place.extend(written);
     let before_total: f64 = r.heldout.iter().sum();
+    let mut modulation: Option<(DiscoveredTerm, Parameters, Scored)> = None;
     for s in at_place {
         let label = s.fit.candidate.label;
         let penalty = used_terms(s) * discovery_penalty_per_term(count);
@@ -597,6 +646,12 @@ fn discover_term(
         if worse_pressures || before_total - s.fit.heldout_total() < penalty {
             progress(&format!(
                 "  {label}: not better than its parameters' penalty, or worse in a pressure"
+            ));
+            continue;
+        }
+        if crate::modulation::is_modulation(&s.fit.candidate) && crate::modulation::is_flat(&s.fit.values) {
+            progress(&format!(
+                "  {label}: the same change at every knot, a constant's own candidate carries it"
             ));
             continue;
         }
@@ -631,6 +686,7 @@ fn discover_term(
             .any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
             || trial.validate().is_err()
         {
+            progress(&format!("  {label}: its parameters are outside the model's limits"));
             continue;
         }
         let with = replay_fast(&Actuator::new(trial.clone())?, recording, cx.n)?;
@@ -669,11 +725,35 @@ fn discover_term(
                 pressures_heldout: pressures,
                 tied_locations: found.tied_with(candidate.location),
             };
-            return Ok(Some((term, trial, s.clone())));
+            let is_modulation = crate::modulation::is_modulation(candidate);
+            match &modulation {
+                None if is_modulation => {
+                    progress(&format!(
+                        "  {label}: kept unless a written candidate does nearly as well in the model"
+                    ));
+                    modulation = Some((term, trial, s.clone()));
+                }
+                None => return Ok(Some((term, trial, s.clone()))),
+                Some((kept, _, _)) if !is_modulation => {
+                    let bar = (EXPLAINED_WITHIN_NOISE * noise).max(WRITTEN_INSTEAD_WITHIN * kept.heldout_after);
+                    if after <= bar {
+                        progress(&format!(
+                            "  {label} instead of the {}: nearly as good and written",
+                            kept.candidate
+                        ));
+                        return Ok(Some((term, trial, s.clone())));
+                    }
+                }
+                Some(_) => {}
+            }
         }
     }
-    Ok(None)
+    Ok(modulation)
 }
+
+/// A written term that does within this factor of a modulation's held-out force error in the
+/// model (or within the verdict's bar) is added instead of it.
+const WRITTEN_INSTEAD_WITHIN: f64 = 1.1;
 
 /// A discovered term's `reading` (one sentence) with the places it cannot be told apart from.
 fn with_undecided(reading: String, undecided: Option<String>) -> String {
@@ -763,8 +843,11 @@ fn pressures_judgement(
             })
         })
     };
+    // In mean square: two channels at their noise read √2 floors together, so a term that
+    // takes them from 2.0 to their noise gains 0.6 floor of the RMS but 2 of the mean square
+    // (a chamber 1 transducer saturating over its top 5 kPa: 1.98 -> 1.42).
     let better = was - now >= MIN_RELATIVE_GAIN * was
-        && was - now >= MIN_GAIN_IN_NOISE
+        && was * was - now * now >= MIN_GAIN_IN_NOISE
         && after <= r.force_before + 0.05 * cx.noise;
     better.then(|| (rms_pa([&r.current.p1, &r.current.p2]), rms_pa([&with.p1, &with.p2])))
 }

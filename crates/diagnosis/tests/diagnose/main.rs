@@ -7,7 +7,8 @@
 //! * `balance`: an extra force in the piston's balance picked from a library of local signals;
 //! * `curves`: the static-curve class at the command and the transducers;
 //! * `search`: compounds and mechanisms that a search locking in on its first choice missed;
-//! * `constants`: a thesis constant of the plant other than the model's, re-identified.
+//! * `constants`: a thesis constant of the plant other than the model's, re-identified;
+//! * `modulations`: a constant of the model varying with a signal of the chain.
 //!
 //! The test command runs a representative subset: every module, each place of the chain
 //! and each function class at least once. The other cases are `#[ignore]`d with the reason
@@ -22,6 +23,7 @@
 mod balance;
 mod constants;
 mod curves;
+mod modulations;
 mod protocols;
 mod search;
 mod shared;
