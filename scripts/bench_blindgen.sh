@@ -34,11 +34,17 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 # A copy of the program: a build during the run (cargo in another shell) does not change it.
 cp target/release/jetpipe "$work/"
-"$venv/bin/python" "$blindgen" draw --seed "$seed" --count "$count" --out "$work/draws" >&2
+# JETPIPE_BLINDGEN_DRAWS=DIR keeps the draws in DIR and takes them from there when they are
+# already drawn (blindgen is deterministic in the seed): the drawing, several minutes for 30,
+# can run while the program is still being built.
+draws="${JETPIPE_BLINDGEN_DRAWS:-$work/draws}"
+if [ "$(ls "$draws"/bg_"$seed"_*.csv 2>/dev/null | wc -l)" -ne "$count" ]; then
+    "$venv/bin/python" "$blindgen" draw --seed "$seed" --count "$count" --out "$draws" >&2
+fi
 mkdir -p "$work/reports"
 echo "| draw | rate (Hz) | length (s) | pressures | verdict | found (location, family) | held-out after / noise floor | wall (s) | wall per sample (ms) |"
 echo "|---|---|---|---|---|---|---|---|---|"
-for rec in "$work"/draws/*.csv; do
+for rec in "$draws"/bg_"$seed"_*.csv; do
     name="$(basename "$rec" .csv)"
     start=$(date +%s%N)
     "$work/jetpipe" diagnose "$rec" --report "$work/reports/$name.json" --no-html --jobs 2 \
@@ -72,5 +78,5 @@ echo
 echo "The scorer's account (truth revealed only here):"
 echo
 echo '```'
-"$venv/bin/python" "$blindgen" score "$work/draws" --reports "$work/reports"
+"$venv/bin/python" "$blindgen" score "$draws" --reports "$work/reports"
 echo '```'
