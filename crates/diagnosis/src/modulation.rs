@@ -869,10 +869,30 @@ pub fn reading(set: &[(&'static str, f64)], before: &Parameters) -> Option<Strin
             .zip(&ys)
             .map(|(x, y)| format!("{} at {}", shown_signed(*y, unit), shown(*x, signal.unit())))
             .collect();
+        let rising = ys.windows(2).all(|w| w[1] >= w[0]);
+        let falling = ys.windows(2).all(|w| w[1] <= w[0]);
+        let headline = if knots >= 2 && (rising || falling) {
+            // A monotone change reads from end to end (a constant that follows a position
+            // linearly is −5 % at one end and +5 % at the other, not "−5 % at" one end).
+            format!(
+                "{} {} from {} at {} to {} at {} of {}",
+                constant.name,
+                if rising { "rises" } else { "falls" },
+                shown_signed(ys[0], unit),
+                shown(xs[0], signal.unit()),
+                shown_signed(ys[knots - 1], unit),
+                shown(xs[knots - 1], signal.unit()),
+                signal.name()
+            )
+        } else {
+            format!(
+                "{} changes by {}{relative} {at}",
+                constant.name,
+                shown_signed(largest, unit)
+            )
+        };
         sentences.push(format!(
-            "{} changes by {}{relative} {at}; piecewise linear in {} through {}, constant beyond",
-            constant.name,
-            shown_signed(largest, unit),
+            "{headline}; piecewise linear in {} through {}, constant beyond",
             signal.name(),
             points.join(", ")
         ));
@@ -1033,6 +1053,57 @@ mod tests {
         // The step's corners come next: at 3 (the line through the ends passes 1.125 there) or 4.
         assert!(shapes[2].contains(&3) && shapes[2].contains(&4), "{shapes:?}");
         assert_eq!(shapes.len(), MAX_KNOTS - 1);
+    }
+
+    #[test]
+    fn a_constant_that_follows_a_signal_linearly_reads_from_end_to_end_in_units_a_person_reads() {
+        let set = [
+            (
+                "modulation_1_parameter",
+                f64::from(jetpipe_model::variables::vr::F_JP_SAT),
+            ),
+            (
+                "modulation_1_signal",
+                f64::from(ModulationSignal::StopperPosition.code()),
+            ),
+            ("modulation_1_frequency", 0.0),
+            ("modulation_1_knots", 2.0),
+            ("modulation_1_x_1", 0.044),
+            ("modulation_1_x_2", 0.087),
+            ("modulation_1_y_1", -0.0235),
+            ("modulation_1_y_2", 0.0233),
+        ];
+        let text = reading(&set, &Parameters::default()).unwrap();
+        assert!(
+            text.starts_with("F_jp_sat rises from -0.0235 N at 44.00 mm to +0.0233 N at 87.00 mm of x_s"),
+            "{text}"
+        );
+        // A band reads where it is largest.
+        let band = [
+            (
+                "modulation_1_parameter",
+                f64::from(jetpipe_model::variables::vr::FRICTION_COULOMB),
+            ),
+            (
+                "modulation_1_signal",
+                f64::from(ModulationSignal::StopperPosition.code()),
+            ),
+            ("modulation_1_frequency", 0.0),
+            ("modulation_1_knots", 4.0),
+            ("modulation_1_x_1", 0.058),
+            ("modulation_1_x_2", 0.060),
+            ("modulation_1_x_3", 0.066),
+            ("modulation_1_x_4", 0.068),
+            ("modulation_1_y_1", 0.0),
+            ("modulation_1_y_2", 2.5),
+            ("modulation_1_y_3", 2.4),
+            ("modulation_1_y_4", 0.0),
+        ];
+        let text = reading(&band, &Parameters::default()).unwrap();
+        assert!(
+            text.starts_with("friction_coulomb changes by +2.5000 N between 60.00 mm and 66.00 mm of x_s"),
+            "{text}"
+        );
     }
 
     #[test]
