@@ -699,7 +699,9 @@ mod tests {
             message.starts_with("hysteresis_deadband = ")
                 || (message.contains("_curve_knots = ") && message.contains("must be 0 (off) or a whole number"))
                 || (message.starts_with("modulation_")
-                    && ["_parameter = ", "_signal = ", "_knots = "].iter().any(|field| message.contains(field))
+                    && ["_parameter = ", "_signal = ", "_knots = "]
+                        .iter()
+                        .any(|field| message.contains(field))
                     && message.contains("is invalid: must be"))
                 || [
                     "supply_plenum_volume",
