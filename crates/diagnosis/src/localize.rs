@@ -227,7 +227,7 @@ pub(crate) fn localize(
             } else {
                 found
                     .iter()
-                    .map(|s| format!("{} with {:?}", s.constant, s.follows))
+                    .map(|s| format!("{} with {}", s.constant, s.follows))
                     .collect::<Vec<_>>()
                     .join(", ")
             }

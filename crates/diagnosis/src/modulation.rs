@@ -50,6 +50,15 @@ pub enum Follows {
     Periodic(f64),
 }
 
+impl std::fmt::Display for Follows {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Follows::Signal(signal) => write!(f, "{}", signal.name()),
+            Follows::Periodic(hz) => write!(f, "a sinusoid at {hz:.3} Hz"),
+        }
+    }
+}
+
 /// One constant against one signal, screened.
 #[derive(Clone, Debug)]
 pub struct Screened {
@@ -666,7 +675,7 @@ pub fn slot_parameter(slot: usize, field: &str) -> &'static str {
     leaked(format!("modulation_{slot}_{field}"))
 }
 
-/// The first modulation slot that `params` leaves off, if any; two for a periodic one.
+/// The modulation slots that `params` leaves off (a periodic modulation takes two).
 pub fn free_slots(params: &Parameters) -> Vec<usize> {
     (1..=2)
         .filter(|&k| parameter_value(params, slot_parameter(k, "parameter")) == 0.0)
@@ -725,10 +734,7 @@ pub fn candidate(s: &Screened, params: &Parameters, catalogue: &[Candidate]) -> 
             terms.push(term(slot, j + 1));
         }
     }
-    let what = match s.follows {
-        Follows::Signal(signal) => signal.name().to_string(),
-        Follows::Periodic(hz) => format!("a sinusoid at {hz:.3} Hz"),
-    };
+    let what = s.follows.to_string();
     Some(Candidate {
         label: leaked(format!("{} varying with {what}", s.constant)),
         location,
