@@ -304,23 +304,7 @@ pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
             by_location.push((s.fit.candidate.location, s.explained, s.fit.candidate.label));
         }
     }
-    // A modulation can take nearly any shape: it places the departure only where it leaves
-    // well under what the best written candidate leaves (a supply pressure varying with the
-    // pressure difference took 99.3 % where a force sensor curve took 99.0 %, and standing at
-    // the supply, it let a named supply restriction in for a supply set low).
-    let written = scored
-        .iter()
-        .find(|s| !crate::modulation::is_modulation(&s.fit.candidate));
-    let leading = match (scored.first(), written) {
-        (Some(best), Some(written))
-            if crate::modulation::is_modulation(&best.fit.candidate)
-                && crate::modulation::MODULATION_LOCATES_BELOW * (1.0 - best.explained) >= 1.0 - written.explained =>
-        {
-            Some(written)
-        }
-        (best, _) => best,
-    };
-    let (location, family) = match leading {
+    let (location, family) = match scored.first() {
         Some(best) if best.explained >= LOCATED_SHARE => {
             // The family: the simplest candidate at that place that explains nearly as much.
             let place = best.fit.candidate.location;

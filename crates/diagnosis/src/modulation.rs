@@ -656,10 +656,6 @@ pub const WRITTEN_FIRST_WITHIN: f64 = 1.25;
 /// is tried before a modulation at its place: its refit in the model usually gains the rest.
 pub const WRITTEN_ADEQUATE_WITHIN: f64 = 2.0;
 
-/// A modulation places the departure only when the best written candidate leaves at least
-/// this many times its remainder of the held-out misfit.
-pub const MODULATION_LOCATES_BELOW: f64 = 2.0;
-
 /// Whether a modulation's knot values are one change of the constant (all within a tenth of
 /// the largest of one another): then it is no modulation.
 pub fn is_flat(values: &[f64]) -> bool {

@@ -454,6 +454,26 @@ fn named_at_place(
         .filter(|s| s.fit.candidate.location == place && !crate::modulation::is_modulation(&s.fit.candidate))
         .map(|s| s.explained)
         .fold(0.0, f64::max);
+    // Where only a modulation located the place (no written candidate there explains as
+    // much as one elsewhere), a named effect must stand on its own: explain as much as the
+    // best written candidate anywhere (a supply varying with the pressure difference located
+    // a supply set low with the receivers off the null at the supply, where a named supply
+    // restriction at 87 % stood in for the pair).
+    let written_anywhere = found
+        .candidates
+        .iter()
+        .filter(|s| !crate::modulation::is_modulation(&s.fit.candidate))
+        .map(|s| s.explained)
+        .fold(0.0, f64::max);
+    let named_floor = if place_share < written_anywhere
+        && found
+            .best_at(place)
+            .map_or(false, |s| crate::modulation::is_modulation(&s.fit.candidate))
+    {
+        written_anywhere
+    } else {
+        0.0
+    };
     let mut named: Vec<&Scored> = found
         .candidates
         .iter()
@@ -466,7 +486,9 @@ fn named_at_place(
         let gain = force_before - s.force_heldout_rms;
         let worse_pressures =
             (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
-        let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share && s.explained >= NAMED_MIN_SHARE;
+        let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share
+            && s.explained >= NAMED_MIN_SHARE
+            && s.explained >= named_floor;
         let gain_ok = worth_adding(force_before, force_before - gain, noise, false);
         let test = named_signature(
             name,
