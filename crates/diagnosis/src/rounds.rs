@@ -822,7 +822,7 @@ fn command_curve_knots_freed(
         return set;
     };
     *replays += 1;
-    let Ok(fit) = problem.fit_damped(&free, REFINE_ITERATIONS, &start) else {
+    let Ok(fit) = problem.fit_damped(&free, REFINE_ITERATIONS, &start, &|_| None) else {
         return set;
     };
     *replays += fit.replays;

@@ -364,8 +364,14 @@ impl Problem<'_> {
     /// data): when no step along the Gauss–Newton direction lowers the misfit, steps damped in
     /// Marquardt's way (the normal matrix's diagonal scaled by 1 + λ, λ from 0.01 to 100) are
     /// tried from the same columns, one replay each, before the fit stops.
-    pub fn fit_damped(&self, candidate: &Candidate, iterations: usize, base_replay: &Replay) -> Result<Fit, String> {
-        self.fit_with(candidate, iterations, base_replay, &|_| None, true)
+    pub fn fit_damped(
+        &self,
+        candidate: &Candidate,
+        iterations: usize,
+        base_replay: &Replay,
+        shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
+    ) -> Result<Fit, String> {
+        self.fit_with(candidate, iterations, base_replay, shared, true)
     }
 
     fn fit_with(

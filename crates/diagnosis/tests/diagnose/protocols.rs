@@ -556,3 +556,37 @@ fn a_second_order_filter_on_the_command_under_a_multisine_is_found_at_the_comman
         (30.0, 0.6),
     );
 }
+
+/// A closed loop: the controller computes the command from the logged force, so the command
+/// carries the force's noise and answers every departure, and the departure the hysteresis
+/// makes in the force is partly undone by the command. The jet-pipe hysteresis is still named,
+/// with its width, and nothing else is added, at two rates.
+#[test]
+fn the_jet_pipe_hysteresis_is_named_under_force_tracking_that_answers_it() {
+    let effects = BenchEffects {
+        hysteresis_width: 0.12e-3,
+        ..BenchEffects::default()
+    };
+    for (sample_rate, seed) in [(500.0, 11), (1000.0, 12)] {
+        let spec = ProtocolSpec {
+            command: CommandProtocol::ForceTracking,
+            sample_rate,
+            duration: 30.0,
+            force_noise: 0.08,
+            seed,
+            ..ProtocolSpec::default()
+        };
+        let label = format!("hysteresis-tracking-{sample_rate}");
+        let d = diagnosed(&label, &spec, &effects);
+        assert_eq!(
+            names(&d),
+            ["jet_pipe_hysteresis"],
+            "{label}: {}",
+            d.summary().join(" | ")
+        );
+        assert!(d.discovered.is_empty(), "{label}: {}", d.summary().join(" | "));
+        assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
+        let width = d.parameters.get(value_reference("hysteresis_width")).unwrap();
+        assert!((width - 0.12e-3).abs() < 0.012e-3, "{label}: width {width} m");
+    }
+}
