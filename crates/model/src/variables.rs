@@ -82,6 +82,9 @@ pub mod vr {
     pub const CHAMBER_SUPPLY_LEAK_2: u32 = 423;
     pub const CHAMBER_LAMINAR_VENT_1: u32 = 424;
     pub const CHAMBER_LAMINAR_VENT_2: u32 = 425;
+    pub const CHAMBER_LAMINAR_SUPPLY_LEAK_1: u32 = 426;
+    pub const CHAMBER_LAMINAR_SUPPLY_LEAK_2: u32 = 427;
+    pub const CHAMBER_LAMINAR_CROSS_LEAK: u32 = 428;
     pub const PORT_RESISTANCE_1: u32 = 430;
     pub const PORT_RESISTANCE_2: u32 = 431;
     pub const STOPPER_COMPLIANCE: u32 = 440;
@@ -720,6 +723,18 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("chamber_laminar_vent_2", vr::CHAMBER_LAMINAR_VENT_2, "kg/(s.Pa)", 0.0, "chamber leak: chamber 2 loses this times (P2 - P_r) to the return pressure through a long, narrow path (laminar: the flow in proportion to the pressure difference; 0 = off)")
         .at_least(0.0).at_most(1e-6)
         .cite("(2.24)")
+        .because(LAMINAR_CONDUCTANCE),
+    parameter("chamber_laminar_supply_leak_1", vr::CHAMBER_LAMINAR_SUPPLY_LEAK_1, "kg/(s.Pa)", 0.0, "chamber leak: chamber 1 gains this times (P_s - P1) from the supply pressure through a long, narrow path (laminar: the flow in proportion to the pressure difference; 0 = off)")
+        .at_least(0.0).at_most(1e-6)
+        .cite("(2.24)")
+        .because(LAMINAR_CONDUCTANCE),
+    parameter("chamber_laminar_supply_leak_2", vr::CHAMBER_LAMINAR_SUPPLY_LEAK_2, "kg/(s.Pa)", 0.0, "chamber leak: chamber 2 gains this times (P_s - P2) from the supply pressure through a long, narrow path (laminar: the flow in proportion to the pressure difference; 0 = off)")
+        .at_least(0.0).at_most(1e-6)
+        .cite("(2.25)")
+        .because(LAMINAR_CONDUCTANCE),
+    parameter("chamber_laminar_cross_leak", vr::CHAMBER_LAMINAR_CROSS_LEAK, "kg/(s.Pa)", 0.0, "chamber leak: this times (P1 - P2) flows from chamber 1 into chamber 2 through a long, narrow path, beside the leakage past the piston (2.23) (laminar: the flow in proportion to the pressure difference; 0 = off)")
+        .at_least(0.0).at_most(1e-6)
+        .cite("(2.24)-(2.25)")
         .because(LAMINAR_CONDUCTANCE),
     parameter("port_resistance_1", vr::PORT_RESISTANCE_1, "Pa.s/kg", 0.0, "port restriction: the orifices of port 1 see a pressure that differs from chamber 1's by this times the net flow through the port (0 = off)")
         .at_least(0.0).at_most(1e12)

@@ -47,11 +47,13 @@ pub struct MassFlows {
     pub return_1: f64,
     pub supply_2: f64,
     pub return_2: f64,
-    /// From chamber 1 to chamber 2.
+    /// From chamber 1 to chamber 2: past the piston, (2.23), and through the
+    /// `chamber_laminar_cross_leak` path (zero in the thesis model).
     pub leakage: f64,
     /// What each chamber loses through leaks of its own: to the return pressure (the
-    /// `chamber_vent_*` orifices, the `chamber_laminar_vent_*` paths) less what it gains
-    /// from the supply (the `chamber_supply_leak_*` orifices); zero in the thesis model.
+    /// `chamber_vent_*` orifices, the `chamber_laminar_vent_*` paths) less what it gains from
+    /// the supply (the `chamber_supply_leak_*` orifices, the `chamber_laminar_supply_leak_*`
+    /// paths); zero in the thesis model.
     pub vent_1: f64,
     pub vent_2: f64,
 }
@@ -133,8 +135,8 @@ pub struct Actuator {
     /// C_d as a function of the pressure ratio across each valve orifice
     /// (`discharge_curve_*`), when on.
     discharge_curve: Option<super::static_curve::StaticCurve>,
-    /// Whether a chamber has a leak of its own (`chamber_vent_*`, `chamber_supply_leak_*`,
-    /// `chamber_laminar_vent_*`).
+    /// Whether a chamber has a leak of its own or one to the other chamber beside the piston's
+    /// (`chamber_vent_*`, `chamber_supply_leak_*`, `chamber_laminar_*`).
     chamber_leaks: bool,
     /// Restrictions between the valve and the air, and the volumes behind them.
     pub restrictions: Restrictions,
@@ -215,6 +217,9 @@ impl Actuator {
             params.chamber_supply_leak_2,
             params.chamber_laminar_vent_1,
             params.chamber_laminar_vent_2,
+            params.chamber_laminar_supply_leak_1,
+            params.chamber_laminar_supply_leak_2,
+            params.chamber_laminar_cross_leak,
         ]
         .iter()
         .any(|&leak| leak != 0.0);
@@ -321,22 +326,32 @@ impl Actuator {
             return self.network_flows(a, p1, p2, None).flows;
         }
         let p = &self.params;
-        let k = &self.flow;
         let (vent_1, vent_2) = self.chamber_vents(p1, p2);
         MassFlows {
             supply_1: self.valve_flow(SUPPLY_1, a.supply_1, p.p_s, p1),
             return_1: self.valve_flow(RETURN_1, a.return_1, p1, p.p_r),
             supply_2: self.valve_flow(SUPPLY_2, a.supply_2, p.p_s, p2),
             return_2: self.valve_flow(RETURN_2, a.return_2, p2, p.p_r),
-            leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+            leakage: self.leakage(p1, p2),
             vent_1,
             vent_2,
         }
     }
 
+    /// From chamber 1 to chamber 2: past the piston, (2.23), and `chamber_laminar_cross_leak`'s c·(P1 − P2).
+    fn leakage(&self, p1: f64, p2: f64) -> f64 {
+        let p = &self.params;
+        let piston = leakage_flow(&self.flow, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2);
+        match p.chamber_laminar_cross_leak {
+            c if c != 0.0 => piston + c * (p1 - p2),
+            _ => piston,
+        }
+    }
+
     /// The flows each chamber loses through leaks other than the valve's and the piston's:
     /// the `chamber_vent_*` orifices to the return pressure, the `chamber_laminar_vent_*`
-    /// paths to it, less what the `chamber_supply_leak_*` orifices bring in from the supply.
+    /// paths to it, less what the `chamber_supply_leak_*` orifices and the
+    /// `chamber_laminar_supply_leak_*` paths bring in from the supply.
     fn chamber_vents(&self, p1: f64, p2: f64) -> (f64, f64) {
         if !self.chamber_leaks {
             return (0.0, 0.0);
@@ -347,8 +362,10 @@ impl Actuator {
             mass_flow(k, vent, chamber, p.p_r) + laminar * (chamber - p.p_r) - mass_flow(k, supplied, p.p_s, chamber)
         };
         (
-            lost(p.chamber_vent_1, p.chamber_laminar_vent_1, p.chamber_supply_leak_1, p1),
-            lost(p.chamber_vent_2, p.chamber_laminar_vent_2, p.chamber_supply_leak_2, p2),
+            lost(p.chamber_vent_1, p.chamber_laminar_vent_1, p.chamber_supply_leak_1, p1)
+                - p.chamber_laminar_supply_leak_1 * (p.p_s - p1),
+            lost(p.chamber_vent_2, p.chamber_laminar_vent_2, p.chamber_supply_leak_2, p2)
+                - p.chamber_laminar_supply_leak_2 * (p.p_s - p2),
         )
     }
 
@@ -468,7 +485,7 @@ impl Actuator {
                 return_1,
                 supply_2,
                 return_2,
-                leakage: leakage_flow(k, p.c_dm_a_lpp, p.c_db_a_lpp, p1, p2),
+                leakage: self.leakage(p1, p2),
                 vent_1,
                 vent_2,
             },
@@ -1005,10 +1022,14 @@ mod tests {
     #[test]
     fn a_vent_a_restriction_or_a_compliant_stopper_takes_the_general_rates() {
         type Setter = fn(&mut Parameters);
-        let terms: [(&str, Setter); 7] = [
+        let terms: [(&str, Setter); 9] = [
             ("chamber_vent_2", |p| p.chamber_vent_2 = 2e-9),
             ("chamber_supply_leak_1", |p| p.chamber_supply_leak_1 = 2e-9),
             ("chamber_laminar_vent_2", |p| p.chamber_laminar_vent_2 = 1e-11),
+            ("chamber_laminar_supply_leak_1", |p| {
+                p.chamber_laminar_supply_leak_1 = 1e-11
+            }),
+            ("chamber_laminar_cross_leak", |p| p.chamber_laminar_cross_leak = 1e-11),
             ("discharge_curve", |p| {
                 p.discharge_curve = super::super::static_curve::StaticCurve::through(&[0.2, 1.0], &[0.8, 0.6])
             }),
@@ -1085,12 +1106,14 @@ mod tests {
     }
 
     #[test]
-    fn a_chambers_own_leaks_are_an_orifice_to_the_return_a_laminar_path_to_it_and_an_orifice_from_the_supply() {
+    fn a_chambers_leaks_are_orifices_and_laminar_paths_to_the_return_from_the_supply_and_to_the_other_chamber() {
         let params = Parameters {
             chamber_vent_1: 3e-9,
             chamber_laminar_vent_1: 2e-11,
             chamber_supply_leak_1: 1e-9,
             chamber_supply_leak_2: 4e-9,
+            chamber_laminar_supply_leak_2: 5e-12,
+            chamber_laminar_cross_leak: 3e-11,
             ..Parameters::default()
         };
         let k = params.flow_constants();
@@ -1099,7 +1122,7 @@ mod tests {
         let flows = model.mass_flows(0.02e-3, p1, p2);
         let lost_1 =
             mass_flow(&k, 3e-9, p1, params.p_r) + 2e-11 * (p1 - params.p_r) - mass_flow(&k, 1e-9, params.p_s, p1);
-        let lost_2 = -mass_flow(&k, 4e-9, params.p_s, p2);
+        let lost_2 = -mass_flow(&k, 4e-9, params.p_s, p2) - 5e-12 * (params.p_s - p2);
         assert!(
             (flows.vent_1 - lost_1).abs() <= 1e-15 * lost_1.abs(),
             "{} against {lost_1}",
@@ -1116,6 +1139,9 @@ mod tests {
             .unwrap()
             .mass_flows(0.02e-3, p1, p2);
         assert_eq!((thesis.vent_1, thesis.vent_2), (0.0, 0.0));
+        let across = thesis.leakage + 3e-11 * (p1 - p2); // (2.23) beside the laminar path between the chambers
+        let off = (flows.leakage - across).abs();
+        assert!(off <= 1e-15 * across, "leakage {} against {across}", flows.leakage);
     }
 
     #[test]
