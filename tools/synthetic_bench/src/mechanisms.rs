@@ -124,6 +124,11 @@
 //!   any supply restriction) into chamber 2, the same compressible law, inflow at T.
 //! * `laminar_leak_1` (`chambers`/`extra_flow`, g): chamber 1 loses g (P1 − 101 325 Pa) to
 //!   atmosphere (a long, narrow path, laminar).
+//! * `laminar_supply_leak_2` (`chambers`/`extra_flow`, g): chamber 2 gains g (P_s − P2) from
+//!   the supply (after any supply restriction) through a long, narrow path, inflow at T.
+//! * `laminar_cross_leak` (`chambers`/`extra_flow`, g): g (P1 − P2) flows from chamber 1 into
+//!   chamber 2 beside the leakage past the piston (a scored bore), at the upstream chamber's
+//!   temperature.
 //! * `force_sensor_filter_frequency` (`force_sensor`/`dynamics`, f_n, with
 //!   `force_sensor_filter_damping` ζ): the force reading passes, after any lag, through
 //!   y'' + 2ζω y' + ω² y = ω² u, ω = 2π f_n (an amplifier's anti-aliasing filter; ζ = 1/√2
@@ -260,6 +265,12 @@ pub struct UndeclaredEffects {
     /// `chambers`/`extra_flow`: laminar conductance (kg/(s·Pa)) from chamber 1 to atmosphere,
     /// the flow (P1 − 101 325 Pa) times this (a porous seal); 0 = none.
     pub laminar_leak_1: f64,
+    /// `chambers`/`extra_flow`: laminar conductance (kg/(s·Pa)) from the supply into chamber
+    /// 2, the flow (P_s − P2) times this (a porous seal at the supply); 0 = none.
+    pub laminar_supply_leak_2: f64,
+    /// `chambers`/`extra_flow`: laminar conductance (kg/(s·Pa)) between the chambers, the flow
+    /// (P1 − P2) times this from chamber 1 into chamber 2 (a scored bore); 0 = none.
+    pub laminar_cross_leak: f64,
     /// `force_sensor`/`dynamics`: natural frequency (Hz) of a second-order low-pass filter
     /// (the bridge amplifier's anti-aliasing filter) after any force sensor lag; 0 = none.
     pub force_sensor_filter_frequency: f64,

@@ -432,6 +432,30 @@ fn a_leak_from_the_supply_raises_chamber_2_and_a_laminar_leak_to_atmosphere_lowe
 }
 
 #[test]
+fn a_laminar_leak_from_the_supply_raises_chamber_2_and_one_between_the_chambers_narrows_their_difference() {
+    let spec = ProtocolSpec {
+        duration: 20.0,
+        sample_rate: 500.0,
+        ..ProtocolSpec::default()
+    };
+    let with = |undeclared: synthetic_bench::UndeclaredEffects| {
+        late_mean_pressures(&generate_protocol(&spec, &with_undeclared(undeclared)).unwrap())
+    };
+    let clean = late_mean_pressures(&generate_protocol(&spec, &BenchEffects::default()).unwrap());
+    let supplied = with(synthetic_bench::UndeclaredEffects {
+        laminar_supply_leak_2: 2e-11,
+        ..Default::default()
+    });
+    let crossed = with(synthetic_bench::UndeclaredEffects {
+        laminar_cross_leak: 2e-11,
+        ..Default::default()
+    });
+    assert!(supplied.1 > clean.1 + 1e3, "P2 {} against {}", supplied.1, clean.1);
+    let (gap, clean_gap) = ((crossed.0 - crossed.1).abs(), (clean.0 - clean.1).abs());
+    assert!(gap < clean_gap - 1e3, "|P1 - P2| {gap} against {clean_gap}");
+}
+
+#[test]
 fn a_discharge_coefficient_rising_as_the_flow_chokes_changes_the_pressures_and_zero_changes_nothing() {
     let spec = ProtocolSpec {
         duration: 20.0,

@@ -188,6 +188,12 @@ struct Cli {
     /// A laminar leak from chamber 1 to atmosphere: its conductance, kg/(s·Pa) (e.g. 2e-11).
     #[arg(long)]
     laminar_leak_1: Option<f64>,
+    /// A laminar leak from the supply into chamber 2: its conductance, kg/(s·Pa) (e.g. 4e-12).
+    #[arg(long)]
+    laminar_supply_leak_2: Option<f64>,
+    /// A laminar leak from chamber 1 into chamber 2: its conductance, kg/(s·Pa) (e.g. 4e-12).
+    #[arg(long)]
+    laminar_cross_leak: Option<f64>,
     /// The force reading passes through a second-order low-pass filter of this natural
     /// frequency, Hz (e.g. 40).
     #[arg(long)]
@@ -283,6 +289,8 @@ fn main() -> ExitCode {
     set(&mut und.discharge_ratio_rise, cli.discharge_ratio_rise);
     set(&mut und.supply_leak_2, cli.supply_leak_2);
     set(&mut und.laminar_leak_1, cli.laminar_leak_1);
+    set(&mut und.laminar_supply_leak_2, cli.laminar_supply_leak_2);
+    set(&mut und.laminar_cross_leak, cli.laminar_cross_leak);
     set(&mut und.force_sensor_filter_frequency, cli.force_sensor_filter);
     set(&mut und.force_sensor_filter_damping, cli.force_sensor_filter_damping);
     set(&mut und.pressure_sensor_filter_1, cli.pressure_sensor_filter_1);
@@ -318,6 +326,8 @@ fn main() -> ExitCode {
         und.discharge_ratio_rise,
         und.supply_leak_2,
         und.laminar_leak_1,
+        und.laminar_supply_leak_2,
+        und.laminar_cross_leak,
         und.force_sensor_filter_frequency,
         und.force_sensor_filter_damping,
         und.pressure_sensor_filter_1,
