@@ -53,6 +53,8 @@ mechanisms=(
     "discharge_ratio_rise|valve|nonlinearity|--discharge-ratio-rise 0.3"
     "supply_leak_2|chambers|extra_flow|--supply-leak-2 1e-8"
     "laminar_leak_1|chambers|extra_flow|--laminar-leak-1 3e-11"
+    "laminar_supply_leak_2|chambers|extra_flow|--laminar-supply-leak-2 4e-12"
+    "laminar_cross_leak|chambers|extra_flow|--laminar-cross-leak 4e-12"
     "force_filter_40hz|force_sensor|dynamics|--force-sensor-filter 40 --force-sensor-filter-damping 0.5"
     "p1_filter_30hz|pressure_sensors|dynamics|--pressure-sensor-filter-1 30 --pressure-sensor-filter-damping-1 1"
     "spring_rate_150|mechanics|parameter_offset|--plant k_spring=150"

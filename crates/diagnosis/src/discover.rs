@@ -417,6 +417,15 @@ fn physical_reading(name: &str, added: f64) -> Option<String> {
             &name[name.len() - 1..],
             added * 3e5 * 1e6
         ),
+        "chamber_laminar_supply_leak_1" | "chamber_laminar_supply_leak_2" if added > 0.0 => format!(
+            "Chamber {} gains {added:.3e} kg/(s·Pa) × the supply's pressure above its own through a laminar path: {:.2} mg/s at 3 bar of difference.",
+            &name[name.len() - 1..],
+            added * 3e5 * 1e6
+        ),
+        "chamber_laminar_cross_leak" if added > 0.0 => format!(
+            "Chamber 1 passes {added:.3e} kg/(s·Pa) × its pressure above chamber 2's into it through a laminar path beside the piston's leakage: {:.2} mg/s at 3 bar of difference.",
+            added * 3e5 * 1e6
+        ),
         _ => return None,
     })
 }

@@ -579,7 +579,8 @@ pub fn catalogue(
             ],
         ),
         // The chambers' mass balances take a leak from the library of each source (the return,
-        // the supply) and law (an orifice, a laminar path); the pairs combine two of them.
+        // the supply, the other chamber) and law (an orifice, a laminar path; between the
+        // chambers the orifice is the piston's leakage); the pairs combine two of them.
         c(
             "laminar chamber leaks to the return",
             "chambers",
@@ -599,6 +600,24 @@ pub fn catalogue(
                 term_off("chamber_supply_leak_1", "m2", 5e-9, 1e-6),
                 term_off("chamber_supply_leak_2", "m2", 5e-9, 1e-6),
             ],
+        ),
+        c(
+            "laminar chamber leaks from the supply",
+            "chambers",
+            "extra_flow",
+            None,
+            vec![
+                term_off("chamber_laminar_supply_leak_1", "kg/(s.Pa)", 1e-11, 1e-6),
+                term_off("chamber_laminar_supply_leak_2", "kg/(s.Pa)", 1e-11, 1e-6),
+            ],
+        ),
+        // Beside the leakage past the piston (2.23), which keeps its orifice law (its own candidate).
+        c(
+            "laminar leak between the chambers",
+            "chambers",
+            "extra_flow",
+            None,
+            vec![term_off("chamber_laminar_cross_leak", "kg/(s.Pa)", 1e-11, 1e-6)],
         ),
         c(
             "Coulomb friction",
