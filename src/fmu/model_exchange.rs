@@ -128,6 +128,9 @@ const REFUSED: &[Refused] = &[
             vr::EXTRA_FORCE_ACCELERATION,
             vr::EXTRA_FORCE_VELOCITY_SQUARED,
             vr::EXTRA_FORCE_SIGN_PRESSURE,
+            vr::EXTRA_FORCE_PRODUCT_1_COEFFICIENT,
+            vr::EXTRA_FORCE_PRODUCT_2_FIRST + 3,
+            vr::EXTRA_FORCE_PRODUCT_3_FIRST + 3,
         ],
     },
     Refused {

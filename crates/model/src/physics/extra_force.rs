@@ -15,6 +15,28 @@
 //! (`position_force_rate`) and Coulomb friction (the named `piston_friction`) are the
 //! library's other members; they keep their parameters.
 //!
+//! **Products of the mechanics' signals.** Beside the hand-picked members, three slots
+//! (`extra_force_product_k_*`, k = 1..3, off with a coefficient of 0) each add
+//! c_k g₁ g₂ to the force the sensor reads where the pressures set it, with
+//! g₁ = (s₁ − o_k) / r₁ and g₂ = s₂ / r₂ two of the signals below ([`ProductSignal`]), o_k the
+//! slot's origin (subtracted from the first signal, in its SI unit: it writes x_s − x₀) and
+//! r the signal's reference unit, so that the coefficient c_k is a force (N): c > 0 adds to
+//! the force the sensor reads (the same sign as the library's coefficients above).
+//!
+//! | code | signal s | reference unit r |
+//! |---|---|---|
+//! | 0 | the constant 1 (no factor; the origin is ignored) | 1 |
+//! | 1 | x_s, the stopper position | 10 mm |
+//! | 2 | v, the stopper velocity | 0.1 m/s |
+//! | 3 | tanh(v / `extra_force_sign_velocity`), its smooth sign | 1 |
+//! | 4 | a, the stopper acceleration | 1 m/s² |
+//! | 5 | \|v\| | 0.1 m/s |
+//! | 6 | P1 − P_r | 1 bar (1e5 Pa) |
+//! | 7 | P2 − P_r | 1 bar (1e5 Pa) |
+//!
+//! The velocity and the acceleration are the library's (below); the diagnosis forms its
+//! regressors with [`ProductSlot::regressor`] from the same signals.
+//!
 //! **The stopper acceleration.** The stopper position is an input that moves linearly
 //! between samples (or communication steps), so its second derivative is a train of
 //! impulses. The acceleration the model uses is the rate of the stopper's piecewise-constant
@@ -105,6 +127,216 @@ pub fn stopper_accelerations(time: &[f64], x_s: &[f64]) -> Vec<f64> {
 pub fn signals(stopper_velocity: f64, sign_velocity: f64, p1: f64, p2: f64, p_r: f64) -> [f64; 3] {
     let v = stopper_velocity;
     [v * v.abs(), (v / sign_velocity).tanh() * (p1 + p2 - 2.0 * p_r), p1 - p2]
+}
+
+/// The signals of the product slots, by code (see the module's table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProductSignal {
+    One,
+    Position,
+    Velocity,
+    Sign,
+    Acceleration,
+    Speed,
+    Pressure1,
+    Pressure2,
+}
+
+/// The number of extra force product slots.
+pub const PRODUCT_SLOTS: usize = 3;
+
+/// The largest signal code of a product slot.
+pub const LAST_PRODUCT_CODE: u32 = 7;
+
+impl ProductSignal {
+    pub const ALL: [ProductSignal; 8] = [
+        ProductSignal::One,
+        ProductSignal::Position,
+        ProductSignal::Velocity,
+        ProductSignal::Sign,
+        ProductSignal::Acceleration,
+        ProductSignal::Speed,
+        ProductSignal::Pressure1,
+        ProductSignal::Pressure2,
+    ];
+
+    pub fn code(self) -> u32 {
+        self as u32
+    }
+
+    /// The signal of a code, if it is a whole number from 0 to [`LAST_PRODUCT_CODE`].
+    pub fn from_code(code: f64) -> Option<Self> {
+        if code.fract() != 0.0 || !(0.0..=LAST_PRODUCT_CODE as f64).contains(&code) {
+            return None;
+        }
+        Some(Self::ALL[code as usize])
+    }
+
+    /// A short name, as the readings write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProductSignal::One => "1",
+            ProductSignal::Position => "x_s",
+            ProductSignal::Velocity => "v",
+            ProductSignal::Sign => "sign(v)",
+            ProductSignal::Acceleration => "a",
+            ProductSignal::Speed => "|v|",
+            ProductSignal::Pressure1 => "(P1 − P_r)",
+            ProductSignal::Pressure2 => "(P2 − P_r)",
+        }
+    }
+
+    /// The signal's SI unit (of the origin, for the first factor).
+    pub fn unit(self) -> &'static str {
+        match self {
+            ProductSignal::One | ProductSignal::Sign => "1",
+            ProductSignal::Position => "m",
+            ProductSignal::Velocity | ProductSignal::Speed => "m/s",
+            ProductSignal::Acceleration => "m/s²",
+            ProductSignal::Pressure1 | ProductSignal::Pressure2 => "Pa",
+        }
+    }
+
+    /// The reference unit r in SI units: the factor is the signal over it.
+    pub fn reference(self) -> f64 {
+        match self {
+            ProductSignal::One | ProductSignal::Sign | ProductSignal::Acceleration => 1.0,
+            ProductSignal::Position => 0.01,
+            ProductSignal::Velocity | ProductSignal::Speed => 0.1,
+            ProductSignal::Pressure1 | ProductSignal::Pressure2 => 1e5,
+        }
+    }
+
+    /// The reference unit in words.
+    pub fn reference_text(self) -> &'static str {
+        match self {
+            ProductSignal::One | ProductSignal::Sign => "1",
+            ProductSignal::Position => "10 mm",
+            ProductSignal::Velocity | ProductSignal::Speed => "0.1 m/s",
+            ProductSignal::Acceleration => "1 m/s²",
+            ProductSignal::Pressure1 | ProductSignal::Pressure2 => "1 bar",
+        }
+    }
+
+    /// The signal's value in its SI unit.
+    pub fn value(self, m: &MechanicsSignals) -> f64 {
+        match self {
+            ProductSignal::One => 1.0,
+            ProductSignal::Position => m.x_s,
+            ProductSignal::Velocity => m.velocity,
+            ProductSignal::Sign => (m.velocity / m.sign_velocity).tanh(),
+            ProductSignal::Acceleration => m.acceleration,
+            ProductSignal::Speed => m.velocity.abs(),
+            ProductSignal::Pressure1 => m.p1 - m.p_r,
+            ProductSignal::Pressure2 => m.p2 - m.p_r,
+        }
+    }
+}
+
+/// The mechanics' signals at a sample, from which the product slots' factors are formed:
+/// the stopper position, its velocity at the sample and acceleration as the library forms
+/// them, the smooth sign's velocity, the chamber and return pressures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MechanicsSignals {
+    pub x_s: f64,
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub sign_velocity: f64,
+    pub p1: f64,
+    pub p2: f64,
+    pub p_r: f64,
+}
+
+/// One product slot's settings: the two signal codes, the first's origin and the
+/// coefficient (N; 0 = off).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ProductSlot {
+    pub first: f64,
+    pub second: f64,
+    pub origin: f64,
+    pub coefficient: f64,
+}
+
+impl ProductSlot {
+    pub fn is_on(&self) -> bool {
+        self.coefficient != 0.0
+    }
+
+    /// g₁ g₂: the first signal less the origin over its reference unit, times the second
+    /// over its own (the constant 1 for code 0, whose origin is ignored). Codes out of range
+    /// read as 0 ([`check_products`] refuses them before a model is built).
+    pub fn regressor(&self, m: &MechanicsSignals) -> f64 {
+        let (first, second) = match (
+            ProductSignal::from_code(self.first),
+            ProductSignal::from_code(self.second),
+        ) {
+            (Some(first), Some(second)) => (first, second),
+            _ => return 0.0,
+        };
+        let g1 = match first {
+            ProductSignal::One => 1.0,
+            s => (s.value(m) - self.origin) / s.reference(),
+        };
+        g1 * (second.value(m) / second.reference())
+    }
+}
+
+/// Σ c_k g₁ g₂ over the slots that are on: the force (N) the products add to the force the
+/// sensor reads where the pressures set it.
+pub fn product_force(slots: &[ProductSlot; PRODUCT_SLOTS], m: &MechanicsSignals) -> f64 {
+    slots
+        .iter()
+        .filter(|slot| slot.is_on())
+        .map(|slot| slot.coefficient * slot.regressor(m))
+        .sum()
+}
+
+/// Whether a product slot is on.
+pub fn products_on(slots: &[ProductSlot; PRODUCT_SLOTS]) -> bool {
+    slots.iter().any(ProductSlot::is_on)
+}
+
+/// The slot (0-based) and field of a product slot's value reference.
+pub fn product_field_mut(slots: &mut [ProductSlot; PRODUCT_SLOTS], value_reference: u32) -> Option<&mut f64> {
+    use crate::variables::vr;
+    if !(vr::EXTRA_FORCE_PRODUCT_1_FIRST..=vr::EXTRA_FORCE_PRODUCT_LAST).contains(&value_reference) {
+        return None;
+    }
+    let offset = value_reference - vr::EXTRA_FORCE_PRODUCT_1_FIRST;
+    let slot = &mut slots[(offset / vr::EXTRA_FORCE_PRODUCT_STRIDE) as usize];
+    match offset % vr::EXTRA_FORCE_PRODUCT_STRIDE {
+        0 => Some(&mut slot.first),
+        1 => Some(&mut slot.second),
+        2 => Some(&mut slot.origin),
+        3 => Some(&mut slot.coefficient),
+        _ => None,
+    }
+}
+
+/// The slots' signal codes whole numbers from 0 to [`LAST_PRODUCT_CODE`] (run with
+/// `Parameters::validate`; a setter takes any value within the row's limits, as the
+/// modulation slots' codes).
+pub fn check_products(slots: &[ProductSlot; PRODUCT_SLOTS]) -> Result<(), String> {
+    for (k, slot) in slots.iter().enumerate() {
+        for (field, code) in [("first", slot.first), ("second", slot.second)] {
+            if ProductSignal::from_code(code).is_none() {
+                return Err(format!(
+                    "extra_force_product_{}_{field} = {} is invalid: must be a whole number from 0 to {LAST_PRODUCT_CODE} ({})",
+                    k + 1,
+                    crate::variables::number(code),
+                    ProductSignal::ALL
+                        .iter()
+                        .map(|&s| match s {
+                            ProductSignal::One => "0 none (the constant 1)".to_string(),
+                            s => format!("{} {} ({}, per {})", s.code(), s.name(), s.unit(), s.reference_text()),
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

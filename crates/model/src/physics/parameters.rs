@@ -2,6 +2,7 @@
 //! FMU's variable table, so the two cannot disagree).
 
 use super::chambers::CylinderGeometry;
+use super::extra_force::{ProductSlot, PRODUCT_SLOTS};
 use super::modulation::{Slot, SLOTS};
 use super::orifice_flow::FlowConstants;
 use super::static_curve::StaticCurve;
@@ -145,6 +146,9 @@ pub struct Parameters {
     /// The modulation slots: a constant that varies with a signal of the chain (off with
     /// no constant named; see [`super::modulation`]).
     pub modulation: [Slot; SLOTS],
+    /// The extra force's product slots (off with a coefficient of 0; see
+    /// [`super::extra_force`]).
+    pub extra_force_products: [ProductSlot; PRODUCT_SLOTS],
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -282,6 +286,7 @@ impl Default for Parameters {
             p2_sensor_curve: StaticCurve::default(),
             discharge_curve: StaticCurve::default(),
             modulation: [Slot::default(); SLOTS],
+            extra_force_products: [ProductSlot::default(); PRODUCT_SLOTS],
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -526,6 +531,18 @@ impl Parameters {
         vr::MODULATION_2_Y + 3,
         vr::MODULATION_2_Y + 4,
         vr::MODULATION_2_Y + 5,
+        vr::EXTRA_FORCE_PRODUCT_1_FIRST,
+        vr::EXTRA_FORCE_PRODUCT_1_FIRST + 1,
+        vr::EXTRA_FORCE_PRODUCT_1_FIRST + 2,
+        vr::EXTRA_FORCE_PRODUCT_1_FIRST + 3,
+        vr::EXTRA_FORCE_PRODUCT_2_FIRST,
+        vr::EXTRA_FORCE_PRODUCT_2_FIRST + 1,
+        vr::EXTRA_FORCE_PRODUCT_2_FIRST + 2,
+        vr::EXTRA_FORCE_PRODUCT_2_FIRST + 3,
+        vr::EXTRA_FORCE_PRODUCT_3_FIRST,
+        vr::EXTRA_FORCE_PRODUCT_3_FIRST + 1,
+        vr::EXTRA_FORCE_PRODUCT_3_FIRST + 2,
+        vr::EXTRA_FORCE_PRODUCT_3_FIRST + 3,
     ];
 
     pub(crate) fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
@@ -684,6 +701,9 @@ impl Parameters {
             r @ vr::MODULATION_1_PARAMETER..=vr::MODULATION_LAST => {
                 return super::modulation::field_mut(&mut self.modulation, r)
             }
+            r @ vr::EXTRA_FORCE_PRODUCT_1_FIRST..=vr::EXTRA_FORCE_PRODUCT_LAST => {
+                return super::extra_force::product_field_mut(&mut self.extra_force_products, r)
+            }
             _ => return None,
         })
     }
@@ -764,6 +784,7 @@ impl Parameters {
                 self.l_cyl, self.l_p
             ));
         }
+        super::extra_force::check_products(&self.extra_force_products)?;
         // Last: it validates the model with each slot's constant at each of its knots.
         super::modulation::validate(self)
     }

@@ -518,3 +518,65 @@ fn a_lagging_mounts_state_follows_the_pressure_difference_through_its_lag_and_re
         .stopper_mount_state()
         .is_none());
 }
+
+#[test]
+fn the_extra_force_products_add_their_formula_to_the_measured_force_and_bad_codes_are_refused() {
+    use crate::physics::extra_force::{self, ProductSlot};
+    // Slot 1: 0.7 N × (x_s − 54 mm)/10 mm × a/(1 m/s²); slot 3: −0.3 N × (P2 − P_r)/1 bar ×
+    // tanh(v / 1 mm/s); slot 2 off.
+    let slots = [
+        ProductSlot {
+            first: 1.0,
+            second: 4.0,
+            origin: 0.054,
+            coefficient: 0.7,
+        },
+        ProductSlot::default(),
+        ProductSlot {
+            first: 7.0,
+            second: 3.0,
+            origin: 0.0,
+            coefficient: -0.3,
+        },
+    ];
+    let on = with(|p| p.extra_force_products = slots);
+    assert!(on.reads_stopper_motion);
+    for rate in [1000.0, 250.0] {
+        let (plain, time, x) = shaken(&thesis_model(), rate, (0.8 * rate) as usize);
+        let (extra, _, _) = shaken(&on, rate, time.len());
+        let acceleration = extra_force::stopper_accelerations(&time, &x);
+        let velocity = extra_force::stopper_velocities(&time, &x);
+        let p_r = on.params.p_r;
+        let mut largest = 0.0f64;
+        for k in 1..time.len() {
+            let (a, b) = (&plain[k], &extra[k]);
+            assert_eq!((a.p1, a.p2), (b.p1, b.p2));
+            let expected =
+                0.7 * (x[k] - 0.054) / 0.01 * acceleration[k] - 0.3 * (a.p2 - p_r) / 1e5 * (velocity[k] / 1e-3).tanh();
+            assert!(
+                (b.f_meas - a.f_meas - expected).abs() < 1e-9 * (1.0 + a.f_meas.abs()),
+                "{rate} Hz, sample {k}: {} against {expected}",
+                b.f_meas - a.f_meas
+            );
+            largest = largest.max(expected.abs());
+        }
+        assert!(largest > 0.5, "the products are felt: {largest} N");
+    }
+    // A code that is no signal is refused when the model is built, naming the variable, the
+    // value and the limit; beyond the row's limits the setter refuses it.
+    let mut p = Parameters::default();
+    p.set(crate::variables::vr::EXTRA_FORCE_PRODUCT_2_FIRST + 1, 2.5)
+        .unwrap();
+    let e = Actuator::new(p.clone()).unwrap_err();
+    assert!(
+        e.starts_with("extra_force_product_2_second = 2.5 is invalid: must be a whole number from 0 to 7"),
+        "{e}"
+    );
+    let e = p
+        .set(crate::variables::vr::EXTRA_FORCE_PRODUCT_3_FIRST, 8.0)
+        .unwrap_err();
+    assert!(
+        e.contains("extra_force_product_3_first") && e.contains('8') && e.contains('7'),
+        "{e}"
+    );
+}

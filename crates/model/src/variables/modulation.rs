@@ -129,7 +129,7 @@ pub(super) const SLOT_1: [Row; 16] = slot_rows!(1, vr::MODULATION_1_PARAMETER);
 pub(super) const SLOT_2: [Row; 16] = slot_rows!(2, vr::MODULATION_2_PARAMETER);
 
 /// `parts` one after the other, as one array of `N` rows (N their total length).
-pub(super) const fn concatenated<const N: usize>(parts: [&[Row]; 3]) -> [Row; N] {
+pub(super) const fn concatenated<const N: usize>(parts: [&[Row]; 4]) -> [Row; N] {
     let mut out = [parts[0][0]; N];
     let mut k = 0;
     let mut part = 0;
