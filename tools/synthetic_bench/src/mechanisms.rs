@@ -129,6 +129,9 @@
 //! * `laminar_cross_leak` (`chambers`/`extra_flow`, g): g (P1 − P2) flows from chamber 1 into
 //!   chamber 2 beside the leakage past the piston (a scored bore), at the upstream chamber's
 //!   temperature.
+//! * `position_sign_force` (`mechanics`/`extra_force`, k, with `position_sign_origin` x₀):
+//!   the force gains k (x_s − x₀) tanh(v / 1 mm/s) with the stopper's own velocity.
+//!   `chamber_1_pressure_force` (`mechanics`/`extra_force`, μ): it gains μ (P1 − P_r).
 //! * `force_sensor_filter_frequency` (`force_sensor`/`dynamics`, f_n, with
 //!   `force_sensor_filter_damping` ζ): the force reading passes, after any lag, through
 //!   y'' + 2ζω y' + ω² y = ω² u, ω = 2π f_n (an amplifier's anti-aliasing filter; ζ = 1/√2
@@ -271,6 +274,15 @@ pub struct UndeclaredEffects {
     /// `chambers`/`extra_flow`: laminar conductance (kg/(s·Pa)) between the chambers, the flow
     /// (P1 − P2) times this from chamber 1 into chamber 2 (a scored bore); 0 = none.
     pub laminar_cross_leak: f64,
+    /// `mechanics`/`extra_force`: a force that adds to the pressure force, k (x_s − x₀)
+    /// tanh(v / 1 mm/s), v the stopper's own velocity: a friction that grows (and turns) along
+    /// the bore; k in N/m; 0 = none.
+    pub position_sign_force: f64,
+    /// Its origin x₀ (m).
+    pub position_sign_origin: f64,
+    /// `mechanics`/`extra_force`: a force that adds to the pressure force, μ (P1 − P_r), μ in
+    /// m² (chamber 1's pressure acting on an annulus the thesis leaves out); 0 = none.
+    pub chamber_1_pressure_force: f64,
     /// `force_sensor`/`dynamics`: natural frequency (Hz) of a second-order low-pass filter
     /// (the bridge amplifier's anti-aliasing filter) after any force sensor lag; 0 = none.
     pub force_sensor_filter_frequency: f64,

@@ -423,6 +423,12 @@ impl Model {
         if u.moving_mass != 0.0 {
             fp -= u.moving_mass * xs_acc;
         }
+        if u.position_sign_force != 0.0 {
+            fp += u.position_sign_force * (xs - u.position_sign_origin) * (xs_dot / 1e-3).tanh();
+        }
+        if u.chamber_1_pressure_force != 0.0 {
+            fp += u.chamber_1_pressure_force * (y[S_P1] - self.p.p_return);
+        }
         fp.max(self.spring_force(xs))
     }
 
