@@ -22,6 +22,7 @@ use crate::recording::Recording;
 use crate::replay::{replay_fast, Replay};
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::current_driver;
+use jetpipe_model::physics::extra_force::ProductSignal;
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::sensors::{self, Channel, SensorLaw};
 use jetpipe_model::variables::VARIABLES;
@@ -63,6 +64,14 @@ pub enum Regressor {
     /// that grows with the pressure. The speed v_e (`extra_force_sign_velocity`) is the
     /// candidate's [`Mechanism::Shape`] term (0: the base model's).
     SignPressure(f64),
+    /// A product of two of the mechanics' signals there, the first less `origin`, each over
+    /// its reference unit, as the model's product slots form it
+    /// (`jetpipe_model::physics::extra_force::ProductSlot::regressor`; [`crate::products`]).
+    Product {
+        first: ProductSignal,
+        second: ProductSignal,
+        origin: f64,
+    },
     /// (t − t_mid) / (t_end − t_start): drift.
     Ramp,
     Sine(f64),

@@ -38,6 +38,8 @@ pub fn model_terms(
     let mut acceleration = 0.0;
     let mut quadratic = 0.0;
     let mut sign_pressure = 0.0;
+    // The product slots' coefficients (a slot's parameter, the fitted force).
+    let mut products: Vec<(&'static str, f64)> = vec![];
     // Coefficients of the pressure channels' regressors: (one, own, ramp) per transducer.
     let mut transducer = [[0.0; 3]; 2];
     // Modulations of a constant: (parameter, ramp coefficient, sine, cosine, frequency).
@@ -115,6 +117,7 @@ pub fn model_terms(
                 Regressor::Acceleration => acceleration += value,
                 Regressor::VelocitySquared => quadratic += value,
                 Regressor::SignPressure(_) => sign_pressure += value,
+                Regressor::Product { .. } => products.push((term.name, value)),
                 Regressor::Segment { .. } => return None,
             },
             _ => return None,
@@ -197,6 +200,11 @@ pub fn model_terms(
             "extra_force_sign_pressure",
             p.extra_force_sign_pressure + sign_pressure / g,
         ));
+    }
+    for (name, value) in products {
+        if value != 0.0 {
+            set.push((name, parameter_value(p, name) + value / g));
+        }
     }
     if position != 0.0 {
         let (k0, x0) = (p.position_force_rate, p.position_force_reference);
@@ -320,6 +328,10 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
         .filter_map(|&(name, value)| physical_reading(name, value - parameter_value(before, name)))
         .collect();
     let mut sentence = format!("At the {location} ({family}), a {label}: {}.", parts.join(", "));
+    if let Some(products) = crate::products::reading(set, before) {
+        sentence.push(' ');
+        sentence.push_str(&products);
+    }
     for p in physical {
         sentence.push(' ');
         sentence.push_str(&p);

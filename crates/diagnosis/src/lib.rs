@@ -36,6 +36,7 @@ pub mod modulation;
 mod named;
 pub mod noise;
 mod pairs;
+pub mod products;
 pub mod recording;
 pub mod replay;
 mod report;

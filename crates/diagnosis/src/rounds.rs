@@ -309,6 +309,7 @@ fn replay_round(
     let knots = curve_knots(cx, problem, &current);
     let candidates: Vec<Candidate> = catalogue(&f.params, cx.pressure_noise.is_some(), periodic, &knots)
         .into_iter()
+        .chain(crate::products::candidates(&f.params, problem.mean_position))
         .filter(|c| !f.effects.iter().any(|e| Some(e.name) == c.named))
         .filter(|c| !pressures_agree || matches!(c.location, "mechanics" | "force_sensor"))
         .collect();

@@ -179,7 +179,26 @@ impl<'a> Problem<'a> {
                 let ve = if ve > 0.0 { ve } else { p.extra_force_sign_velocity };
                 jetpipe_model::physics::extra_force::signals(v, ve, r.p1[k], r.p2[k], p.p_r)[1]
             }
+            Regressor::Product { first, second, origin } if set_by_pressures => {
+                use jetpipe_model::physics::extra_force::{MechanicsSignals, ProductSlot};
+                let slot = ProductSlot {
+                    first: f64::from(first.code()),
+                    second: f64::from(second.code()),
+                    origin,
+                    coefficient: 1.0,
+                };
+                slot.regressor(&MechanicsSignals {
+                    x_s: self.recording.x_s[k],
+                    velocity: v,
+                    acceleration: self.acceleration[k],
+                    sign_velocity: self.base.extra_force_sign_velocity,
+                    p1: r.p1[k],
+                    p2: r.p2[k],
+                    p_r: self.base.p_r,
+                })
+            }
             Regressor::Friction
+            | Regressor::Product { .. }
             | Regressor::SmoothFriction(_)
             | Regressor::Stribeck(..)
             | Regressor::Viscous
@@ -291,6 +310,15 @@ impl Problem<'_> {
             }
         }
         out
+    }
+
+    /// A regressor's column over the recording, with the replay `r` (for the tests).
+    #[cfg(test)]
+    pub(crate) fn column(&self, regressor: Regressor, r: &Replay) -> Vec<f64> {
+        let floor = self.floor(r);
+        (0..self.recording.len())
+            .map(|k| self.regressor(regressor, r, &r.force, &floor, k))
+            .collect()
     }
 
     /// Samples where the spring floor, not the pressures, sets the modelled force.
