@@ -585,9 +585,10 @@ impl CoSimModel for ActuatorFmu {
 /// simulation's snapshot as one counted array (`SimulationSnapshot::to_values`). Version 3:
 /// the snapshot replaced the simulation's fields written one by one; version 4: the
 /// restrictions' parameters and the pressures of the gas volumes behind them; version 5: the
-/// interface and the Model Exchange state; version 6: the modulation slots' parameters.
+/// interface and the Model Exchange state; version 6: the modulation slots' parameters;
+/// version 7: the laminar chamber leaks and the extra force's product slots.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 6, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 7, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped
