@@ -16,7 +16,7 @@
 //! checked through the model like every other candidate.
 
 use crate::blocks::Block;
-use crate::corrections::{parameter_value, Candidate, Fit, Mechanism, Problem, Sensitivity, Term};
+use crate::corrections::{interned, parameter_value, Candidate, Fit, Mechanism, Problem, Sensitivity, Term};
 use crate::replay::Replay;
 use crate::signals::{stopper_velocity, CHANNELS, FORCE, P1, P2};
 use jetpipe_model::physics::modulation::{ModulationSignal, MAX_KNOTS, MODULATABLE, SIGN_VELOCITY};
@@ -627,20 +627,6 @@ fn screen_periodic(
     (scored < constant_ss + penalty).then(|| (vec![-1.0, 1.0, -1.0, 1.0], y, scored))
 }
 
-fn leaked(text: String) -> &'static str {
-    use std::collections::HashSet;
-    use std::sync::Mutex;
-    static NAMES: Mutex<Option<HashSet<&'static str>>> = Mutex::new(None);
-    let mut names = NAMES.lock().unwrap_or_else(|e| e.into_inner());
-    let set = names.get_or_insert_with(HashSet::new);
-    if let Some(&name) = set.get(text.as_str()) {
-        return name;
-    }
-    let name: &'static str = Box::leak(text.into_boxed_str());
-    set.insert(name);
-    name
-}
-
 /// Whether a candidate is a modulation (it fills a modulation slot).
 pub fn is_modulation(c: &Candidate) -> bool {
     c.settings.iter().any(|(name, _)| name.starts_with("modulation_"))
@@ -668,7 +654,7 @@ pub fn is_flat(values: &[f64]) -> bool {
 
 /// The FMU parameter of slot `slot`'s field `field` (`"y_3"`, `"parameter"`...).
 pub fn slot_parameter(slot: usize, field: &str) -> &'static str {
-    leaked(format!("modulation_{slot}_{field}"))
+    interned(format!("modulation_{slot}_{field}"))
 }
 
 /// The modulation slots that `params` leaves off (a periodic modulation takes two).
@@ -732,7 +718,7 @@ pub fn candidate(s: &Screened, params: &Parameters, catalogue: &[Candidate]) -> 
     }
     let what = s.follows.to_string();
     Some(Candidate {
-        label: leaked(format!("{} varying with {what}", s.constant)),
+        label: interned(format!("{} varying with {what}", s.constant)),
         location,
         family,
         named: None,

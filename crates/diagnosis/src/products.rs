@@ -14,7 +14,7 @@
 //! and the candidate has a second slot with the other factor alone, so that
 //! c₁ (x_s − x̄) g + c₂ g = c₁ (x_s − x₀) g stays linear in its coefficients.
 
-use crate::corrections::{parameter_value, Candidate, Mechanism, Regressor, Term};
+use crate::corrections::{interned, parameter_value, Candidate, Mechanism, Regressor, Term};
 use crate::signals::FORCE;
 use jetpipe_model::physics::extra_force::{ProductSignal, PRODUCT_SLOTS};
 use jetpipe_model::physics::parameters::Parameters;
@@ -116,21 +116,7 @@ fn label(first: ProductSignal, second: ProductSignal) -> &'static str {
     } else {
         format!("extra force ∝ {}·{}", name(first), name(second))
     };
-    leaked(text)
-}
-
-fn leaked(text: String) -> &'static str {
-    use std::collections::HashSet;
-    use std::sync::Mutex;
-    static NAMES: Mutex<Option<HashSet<&'static str>>> = Mutex::new(None);
-    let mut names = NAMES.lock().unwrap_or_else(|e| e.into_inner());
-    let set = names.get_or_insert_with(HashSet::new);
-    if let Some(&name) = set.get(text.as_str()) {
-        return name;
-    }
-    let name: &'static str = Box::leak(text.into_boxed_str());
-    set.insert(name);
-    name
+    interned(text)
 }
 
 /// One slot's coefficient as a linear term on the force channel.
