@@ -43,6 +43,7 @@ mod report;
 mod rounds;
 pub mod signals;
 pub mod signature;
+mod split;
 mod withdraw;
 
 use serde_json::{json, Value};
@@ -297,19 +298,6 @@ impl Localization {
     }
 }
 
-/// The pressure channels' split of the chain.
-#[derive(Clone, Debug)]
-pub struct PressureSplit {
-    /// RMS of the measured force minus the force the measured pressures give, N, and in
-    /// units of its own noise.
-    pub force_vs_pressures_rms: f64,
-    pub force_vs_pressures_ratio: f64,
-    /// RMS of the measured minus the modelled pressures, Pa, and in units of their noise.
-    pub pressure_rms: [f64; 2],
-    pub pressure_ratio: [f64; 2],
-    pub sentence: String,
-}
-
 /// A named effect that was added.
 #[derive(Clone, Debug)]
 pub struct AddedEffect {
@@ -394,6 +382,7 @@ pub struct Diagnosis {
     pub fast_replay: agreement::FastReplayCheck,
 }
 
+pub use split::PressureSplit;
 pub use withdraw::Withdrawn;
 
 impl Diagnosis {
@@ -402,13 +391,14 @@ impl Diagnosis {
         self.after.heldout_rms <= EXPLAINED_WITHIN_NOISE * self.noise_floor
     }
     /// Whether every measured channel is within its noise: the force on the held-out blocks,
-    /// and each pressure, when the recording has them, after the start.
+    /// and each pressure, when the recording has them, after the start and over the whole
+    /// recording.
     pub fn explained(&self) -> bool {
         self.force_explained()
             && self
                 .pressure_split
                 .as_ref()
-                .map_or(true, |s| s.pressure_ratio.iter().all(|r| *r <= EXPLAINED_WITHIN_NOISE))
+                .map_or(true, PressureSplit::pressures_within_noise)
     }
     pub fn verdict(&self) -> &'static str {
         if self.explained() {
@@ -417,71 +407,6 @@ impl Diagnosis {
             "unexplained_remainder"
         }
     }
-}
-
-/// The pressure channels' split: the force against A_p (p1 − p2), the pressures against
-/// the model's.
-fn pressure_split(
-    model: &Actuator,
-    recording: &Recording,
-    replay: &Replay,
-    noise: f64,
-    pressure_noise: [f64; 2],
-    blocks: &[Block],
-) -> Option<PressureSplit> {
-    let from_pressures = force_from_pressures(model, recording)?;
-    let (p1, p2) = (recording.p1.as_ref()?, recording.p2.as_ref()?);
-    // Over the samples after the start, where the model's starting state has faded.
-    let rms = |x: &[f64]| {
-        let kept: Vec<f64> = x
-            .iter()
-            .zip(blocks)
-            .filter(|(_, &b)| b != Block::Settling)
-            .map(|(v, _)| *v)
-            .collect();
-        rms(&kept)
-    };
-    let mechanical = rms(&difference(&recording.force, &from_pressures));
-    let area = model.piston_area;
-    let mechanical_noise =
-        (noise * noise + area * area * (pressure_noise[0].powi(2) + pressure_noise[1].powi(2))).sqrt();
-    let pressure_rms = [rms(&difference(p1, &replay.p1)), rms(&difference(p2, &replay.p2))];
-    let pressure_ratio = [
-        pressure_rms[0] / pressure_noise[0].max(1e-9),
-        pressure_rms[1] / pressure_noise[1].max(1e-9),
-    ];
-    let ratio = mechanical / mechanical_noise.max(1e-12);
-    let pressures_off = pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE);
-    let force_off = ratio > EXPLAINED_WITHIN_NOISE;
-    // Where both agree within their noise but the force departs from the model, the pressures
-    // are too noisy to place the departure: one of them would move by half the force's
-    // departure over A_p, which is within their noise.
-    let force_from_model = rms(&difference(&recording.force, &replay.force)) / noise.max(1e-12);
-    let reading = match (force_off, pressures_off) {
-        (false, false) if force_from_model > EXPLAINED_WITHIN_NOISE => {
-            "the force departs from the model, by less than the pressures' noise can place on either side of the piston"
-        }
-        (false, false) => "force, pressures and model agree",
-        (false, true) => {
-            "the force agrees with the pressures but the pressures depart from the model's: the departure lies upstream of the piston (command to chambers)"
-        }
-        (true, false) => {
-            "the pressures agree with the model but the force does not agree with them: the departure lies in the mechanics or the force sensor"
-        }
-        (true, true) => {
-            "neither the force agrees with the pressures nor the pressures with the model: a pressure sensor error, or departures on both sides of the piston"
-        }
-    };
-    Some(PressureSplit {
-        force_vs_pressures_rms: mechanical,
-        force_vs_pressures_ratio: ratio,
-        pressure_rms,
-        pressure_ratio,
-        sentence: format!(
-            "The measured force differs from A_p (p1 − p2) of the measured pressures by {mechanical:.4} N RMS ({ratio:.1}× its noise) and the pressures differ from the model's by {:.0} and {:.0} Pa RMS ({:.1}× and {:.1}× their noise): {reading}.",
-            pressure_rms[0], pressure_rms[1], pressure_ratio[0], pressure_ratio[1]
-        ),
-    })
 }
 
 /// The force sensor's reading if the measured pressures drove the model's mechanics
@@ -894,9 +819,12 @@ pub(crate) fn refit_jointly(
     };
     *replays += fit.replays + names.len();
     let mut trial = params.clone();
-    let valid = names
+    // The command the driver sees does not fall as the logged one rises, after the refit as
+    // when the curve was first fitted.
+    let mut refitted: Vec<(&'static str, f64)> = names.iter().copied().zip(fit.values.iter().copied()).collect();
+    curves::monotone_command(&mut refitted);
+    let valid = refitted
         .iter()
-        .zip(&fit.values)
         .all(|(name, value)| set_parameter(&mut trial, name, *value).is_ok())
         && trial.validate().is_ok();
     if !valid {
@@ -996,7 +924,7 @@ fn conclude(
     let after = after;
     let split = cx
         .pressure_noise
-        .and_then(|pn| pressure_split(&final_model, full, &after, noise, pn, blocks));
+        .and_then(|pn| split::pressure_split(&final_model, full, &after, noise, pn, blocks));
     // What the remainder follows, on the fits' rows.
     let after_at_rows = thinned.map(|rows| after.at_rows(rows));
     let after_rows = after_at_rows.as_ref().unwrap_or(&after);
@@ -1071,7 +999,7 @@ fn what_stays_unexplained(
     let explained = after_errors.heldout_rms <= EXPLAINED_WITHIN_NOISE * noise;
     // Every measured channel counts: pressures that depart while the force does not (a
     // pressure transducer, say) leave a remainder too, with its place and signature.
-    let pressures_off = split.map_or(false, |s| s.pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE));
+    let pressures_off = split.map_or(false, |s| !s.pressures_within_noise());
     if explained && !pressures_off {
         return None;
     }
@@ -1100,23 +1028,21 @@ fn what_stays_unexplained(
     let (sentence, signature) = if explained {
         let s = split.expect("pressures_off needs the split");
         let recording = cx.recording;
-        let worse = if s.pressure_ratio[0] >= s.pressure_ratio[1] {
-            0
-        } else {
-            1
-        };
+        let worse = s.worse_chamber();
         let measured = if worse == 0 { &recording.p1 } else { &recording.p2 };
         let modelled = if worse == 0 { &after.p1 } else { &after.p2 };
         let residual = difference(measured.as_ref().expect("pressures"), modelled);
         let signature = Signature::of(&recording.time, &residual, chain, "Pa");
         (
             format!(
-                "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's by {:.0} and {:.0} Pa RMS ({:.1}× and {:.1}× their noise); {place}. Chamber {}: {}",
+                "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's by {:.0} and {:.0} Pa RMS after the start ({:.1}× and {:.1}× their noise; {:.1}× and {:.1}× over the whole recording); {place}. Chamber {}: {}",
                 after_errors.heldout_rms,
                 s.pressure_rms[0],
                 s.pressure_rms[1],
                 s.pressure_ratio[0],
                 s.pressure_ratio[1],
+                s.whole_pressure_ratio[0],
+                s.whole_pressure_ratio[1],
                 worse + 1,
                 signature.sentence
             ),

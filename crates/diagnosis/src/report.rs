@@ -233,6 +233,7 @@ impl Diagnosis {
                     "force_vs_pressures_ratio_to_noise": s.force_vs_pressures_ratio,
                     "pressures_vs_model_rms_Pa": s.pressure_rms,
                     "pressures_vs_model_ratio_to_noise": s.pressure_ratio,
+                    "pressures_vs_model_whole_ratio_to_noise": s.whole_pressure_ratio,
                     "sentence": s.sentence,
                 }),
                 None => json!({
