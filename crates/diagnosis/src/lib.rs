@@ -1003,13 +1003,39 @@ fn what_stays_unexplained(
     if explained && !pressures_off {
         return None;
     }
-    let (location, family, alternatives) = match localization {
+    let (mut location, mut family, mut alternatives) = match localization {
         Some(l) => (l.location, l.family, l.alternatives()),
         None => ("unknown", "unknown", vec![]),
     };
+    let share_at = |place: &str| {
+        localization
+            .as_ref()
+            .and_then(|l| l.by_location.iter().find(|(p, _, _)| *p == place))
+            .map_or(0.0, |(_, e, _)| *e)
+    };
+    // Pressures at their noise and a force that does not agree with them place the departure
+    // after the pressures, in the mechanics or the force sensor, though no candidate there
+    // explains a good part of it: both are named, the better candidates' place first.
+    let after_the_pressures =
+        location == "unknown" && split.map_or(false, PressureSplit::departure_after_the_pressures);
+    if after_the_pressures {
+        let (first, second) = if share_at("force_sensor") > share_at("mechanics") {
+            ("force_sensor", "mechanics")
+        } else {
+            ("mechanics", "force_sensor")
+        };
+        (location, family, alternatives) = (first, "unknown", vec![second]);
+    }
     let ratio = after_errors.heldout_rms / noise.max(1e-12);
     let place = if location == "unknown" {
         "no candidate place in the chain explains a good part of it".to_string()
+    } else if after_the_pressures {
+        format!(
+            "the pressures agree with the model's and the force does not agree with them, so the model departs in the {location} or the {} (the pressure channels tell these two apart from the rest of the chain but not from each other), where no candidate explains a good part of it (the best there: {:.0} % and {:.0} % of the held-out misfit)",
+            alternatives[0],
+            100.0 * share_at(location),
+            100.0 * share_at(alternatives[0])
+        )
     } else {
         let share = localization
             .as_ref()

@@ -36,6 +36,12 @@ impl PressureSplit {
             .all(|r| *r <= EXPLAINED_WITHIN_NOISE)
     }
 
+    /// Whether the pressures are within their noise while the force departs from the force
+    /// they give: the departure lies after the pressures, in the mechanics or the force sensor.
+    pub fn departure_after_the_pressures(&self) -> bool {
+        self.pressures_within_noise() && self.force_vs_pressures_ratio > EXPLAINED_WITHIN_NOISE
+    }
+
     /// The chamber (0 or 1) whose pressure departs most, over either span.
     pub(crate) fn worse_chamber(&self) -> usize {
         let worst = |k: usize| self.pressure_ratio[k].max(self.whole_pressure_ratio[k]);
@@ -219,5 +225,29 @@ mod tests {
             "{}",
             split.sentence
         );
+        assert!(!split.departure_after_the_pressures(), "the force is A_p (p1 − p2)");
+    }
+
+    #[test]
+    fn a_force_apart_from_pressures_at_their_noise_places_the_departure_after_them() {
+        let model = Actuator::new(Parameters::default()).unwrap();
+        let (mut recording, replay) = recording_and_replay(&model, 300.0, 0, 0.0);
+        // The force's own noise (0.05 N) and A_p times the pressures' leave a square wave of
+        // 1 N that the pressures do not give at 1 N over their combined noise.
+        for (k, f) in recording.force.iter_mut().enumerate() {
+            *f += if k % 100 < 50 { 1.0 } else { -1.0 };
+        }
+        let blocks = vec![Block::Training; 1000];
+        let split = pressure_split(&model, &recording, &replay, 0.05, [300.0, 300.0], &blocks).unwrap();
+        let combined = (0.05f64.powi(2) + 2.0 * (model.piston_area * 300.0).powi(2)).sqrt();
+        assert!(
+            (split.force_vs_pressures_ratio - 1.0 / combined).abs() < 0.05 * split.force_vs_pressures_ratio,
+            "{} against {}",
+            split.force_vs_pressures_ratio,
+            1.0 / combined
+        );
+        assert!(split.force_vs_pressures_ratio > 1.5);
+        assert!(split.pressures_within_noise());
+        assert!(split.departure_after_the_pressures());
     }
 }
