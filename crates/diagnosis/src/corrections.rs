@@ -278,6 +278,23 @@ pub fn set_parameter(p: &mut Parameters, name: &str, value: f64) -> Result<(), S
     p.set(value_reference(name), value)
 }
 
+/// A name built at run time (a generated candidate's parameter or label) as the `&'static str`
+/// the candidates carry: each distinct text is leaked once and shared afterwards, so the
+/// memory held is bounded by the number of distinct generated names.
+pub(crate) fn interned(text: String) -> &'static str {
+    use std::collections::HashSet;
+    use std::sync::Mutex;
+    static NAMES: Mutex<Option<HashSet<&'static str>>> = Mutex::new(None);
+    let mut names = NAMES.lock().unwrap_or_else(|e| e.into_inner());
+    let set = names.get_or_insert_with(HashSet::new);
+    if let Some(&name) = set.get(text.as_str()) {
+        return name;
+    }
+    let name: &'static str = Box::leak(text.into_boxed_str());
+    set.insert(name);
+    name
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -326,21 +343,4 @@ mod tests {
             }
         }
     }
-}
-
-/// A name built at run time (a generated candidate's parameter or label) as the `&'static str`
-/// the candidates carry: each distinct text is leaked once and shared afterwards, so the
-/// memory held is bounded by the number of distinct generated names.
-pub(crate) fn interned(text: String) -> &'static str {
-    use std::collections::HashSet;
-    use std::sync::Mutex;
-    static NAMES: Mutex<Option<HashSet<&'static str>>> = Mutex::new(None);
-    let mut names = NAMES.lock().unwrap_or_else(|e| e.into_inner());
-    let set = names.get_or_insert_with(HashSet::new);
-    if let Some(&name) = set.get(text.as_str()) {
-        return name;
-    }
-    let name: &'static str = Box::leak(text.into_boxed_str());
-    set.insert(name);
-    name
 }
