@@ -38,7 +38,11 @@ def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values
     fmu = make_slave(unzipdir, model_description)
     t, v, x = recording["time_s"], recording["v_da_V"], stopper_positions(recording["x_s_m"])
     try:
-        initialize(fmu, vrs, inputs=(v[0], x[0]), parameters=start_values)
+        # The report's start values are Reals but for start_at_equilibrium, a Boolean (false
+        # where the replays started the chambers at the pressures first read).
+        reals = {n: value for n, value in start_values.items() if not isinstance(value, bool)}
+        booleans = {n: value for n, value in start_values.items() if isinstance(value, bool)}
+        initialize(fmu, vrs, inputs=(v[0], x[0]), parameters=reals, booleans=booleans)
         read = np.empty((len(outputs), len(t)))
         vr_v, vr_x, vr_out = [vrs["v_DA"]], [vrs["x_s"]], [vrs[name] for name in outputs]
         for k in range(len(t)):

@@ -231,10 +231,14 @@ impl ActuatorFmu {
         let mut simulation = if self.start_at_equilibrium {
             Simulation::at_equilibrium(model, self.v_da, self.x_s, self.start_time, self.tolerance)?
         } else {
-            let mut state = jetpipe_model::simulation::equilibrium_of_electromechanics(&model, self.v_da);
-            state[index::P1] = self.p1_start;
-            state[index::P2] = self.p2_start;
-            Simulation::from_state(model, state, self.v_da, self.x_s, self.start_time, self.tolerance)
+            Simulation::at_pressures(
+                model,
+                self.v_da,
+                self.x_s,
+                self.start_time,
+                self.tolerance,
+                [self.p1_start, self.p2_start],
+            )?
         };
         simulation.set_command_rate(self.v_da_rate)?;
         simulation.set_stopper_rate(self.x_s_rate)?;

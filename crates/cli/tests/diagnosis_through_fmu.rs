@@ -14,6 +14,7 @@ use jetpipe::variables::vr;
 use jetpipe_diagnosis::diagnose;
 use jetpipe_diagnosis::recording::Recording;
 use jetpipe_model::physics::parameters::Parameters;
+use jetpipe_model::variable::VarType;
 use jetpipe_model::variables::VARIABLES;
 use synthetic_bench::{
     generate_protocol_with, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
@@ -45,12 +46,15 @@ fn replayed_force(recording: &Recording, start_values: &[(u32, f64)]) -> Vec<f64
         assert_eq!(fmi2SetupExperiment(c, fmi2False, 0.0, t[0], fmi2False, 0.0), fmi2OK);
         assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
         for &(r, value) in start_values {
-            assert_eq!(
-                fmi2SetReal(c, &r, 1, &value),
-                fmi2OK,
-                "vr {r} = {value}: {:?}",
-                sink.since(0)
-            );
+            let boolean = VARIABLES
+                .iter()
+                .any(|v| v.value_reference == r && v.var_type == VarType::Boolean);
+            let status = if boolean {
+                fmi2SetBoolean(c, &r, 1, &((value != 0.0) as fmi2Boolean))
+            } else {
+                fmi2SetReal(c, &r, 1, &value)
+            };
+            assert_eq!(status, fmi2OK, "vr {r} = {value}: {:?}", sink.since(0));
         }
         set_inputs(c, v[0], x[0]);
         assert_eq!(fmi2ExitInitializationMode(c), fmi2OK, "{:?}", sink.since(0));
@@ -114,7 +118,8 @@ fn the_fmu_with_the_start_values_of_a_drifting_gas_temperature_reproduces_the_re
                 .iter()
                 .find(|v| v.name == name)
                 .unwrap_or_else(|| panic!("{name} is not an FMU variable"));
-            (variable.value_reference, value.as_f64().unwrap())
+            let value = value.as_f64().or_else(|| value.as_bool().map(f64::from)).unwrap();
+            (variable.value_reference, value)
         })
         .collect();
     assert!(

@@ -14,7 +14,7 @@
 //! neither fitted nor scored.
 
 use crate::recording::Recording;
-use crate::replay::replay_fast_from;
+use crate::replay::{replay_fast_from, Start};
 use crate::BLOCK_SECONDS;
 use jetpipe_model::physics::actuator::Actuator;
 
@@ -66,7 +66,9 @@ pub const LONGEST_SETTLING: f64 = 10.0;
 /// `recording`, to within [`SETTLED_WITHIN_NOISE`] of each channel's floor in `noise`
 /// (force, p1, p2; 0 for a channel not weighed), the start taken to lie among the
 /// equilibria of the first block's commands. At most a quarter of the recording or
-/// [`LONGEST_SETTLING`] in.
+/// [`LONGEST_SETTLING`] in. The replays start at those equilibria even where the recording's
+/// pressures give the chambers' start: what the transducers do not read (the jet pipe's
+/// hysteresis memory, say) stays unknown for as long as such a start shows.
 pub fn settling_time(model: &Actuator, recording: &Recording, noise: [f64; 3]) -> Result<f64, String> {
     let time = &recording.time;
     let t0 = time[0];
@@ -77,13 +79,13 @@ pub fn settling_time(model: &Actuator, recording: &Recording, noise: [f64; 3]) -
     let (lowest, highest) = recording.v_da[..first_block.max(1)]
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-    let first = replay_fast_from(model, recording, end, recording.v_da[0])?;
+    let first = replay_fast_from(model, recording, end, Start::AtEquilibrium(recording.v_da[0]))?;
     let mut last_apart: Option<usize> = None;
     for held in [lowest, highest] {
         if held == recording.v_da[0] {
             continue;
         }
-        let other = replay_fast_from(model, recording, end, held)?;
+        let other = replay_fast_from(model, recording, end, Start::AtEquilibrium(held))?;
         let channels = [
             (&first.force, &other.force),
             (&first.p1, &other.p1),

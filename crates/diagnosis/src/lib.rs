@@ -380,6 +380,9 @@ pub struct Diagnosis {
     pub withdrawn: Option<Withdrawn>,
     /// The fits' fixed-step replay against the error-controlled one, and the step they used.
     pub fast_replay: agreement::FastReplayCheck,
+    /// The chamber pressures the final model's replay started from, where the recording has
+    /// pressure channels ([`replay::start_pressures`]); at the equilibrium otherwise.
+    pub start_pressures: Option<[f64; 2]>,
 }
 
 pub use split::PressureSplit;
@@ -981,6 +984,7 @@ fn conclude(
         replays,
         withdrawn,
         fast_replay,
+        start_pressures: replay::start_pressures(&final_model, full),
     })
 }
 

@@ -1,10 +1,79 @@
 //! Replaying a recording's inputs through the model: the command held between samples,
 //! the stopper moving linearly between samples (docs/model.md, "CSV formats"). A recording
 //! thinned for the fits is replayed at its full rate, its outputs kept at its rows.
+//!
+//! The model starts at rest at the first command (the bench holds it before t = 0). With
+//! pressure channels its chamber pressures start where the transducers read them
+//! ([`start_pressures`]): a bench that had not settled, or a closed loop that began from
+//! another command, starts where it was, not at an equilibrium it had not reached.
 
 use crate::recording::Recording;
 use jetpipe_model::physics::actuator::{Actuator, Outputs};
+use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 use jetpipe_model::simulation::{FixedStep, Simulation, StepFailure};
+
+/// The readings averaged for the chamber pressures at the start ([`start_pressures`]): their
+/// noise falls by half, and at 250 Hz they span 12 ms, within which a held command moves
+/// the chambers little.
+pub const START_READINGS: usize = 4;
+
+/// The chamber pressures (Pa) at the recording's first sample as `model`'s transducers read
+/// them: the mean of the first [`START_READINGS`] readings of each, taken back through the
+/// transducer's law. `None` without pressure channels, or where a law has no inverse or the
+/// pressures would not be positive.
+pub fn start_pressures(model: &Actuator, recording: &Recording) -> Option<[f64; 2]> {
+    let k = START_READINGS.min(recording.len());
+    if k == 0 {
+        return None;
+    }
+    let time = &recording.time[..k];
+    let back = |channel: Channel, readings: &Option<Vec<f64>>| -> Option<f64> {
+        let readings = &readings.as_ref()?[..k];
+        let law = SensorLaw::of(&model.params, channel);
+        let pressures = if law.is_identity() {
+            readings.to_vec()
+        } else {
+            law.unread(time, readings)?
+        };
+        let mean = pressures.iter().sum::<f64>() / k as f64;
+        (mean.is_finite() && mean > 0.0).then_some(mean)
+    };
+    Some([
+        back(Channel::Pressure1, &recording.p1)?,
+        back(Channel::Pressure2, &recording.p2)?,
+    ])
+}
+
+/// Where a replay starts: at rest at the command held before the recording, with the
+/// chamber pressures where the transducers read them when the recording has them
+/// (`AsRead`), or at that command's equilibrium (`AtEquilibrium`: what
+/// [`crate::blocks::settling_time`] compares, since states the transducers do not read, a
+/// hysteresis loop's memory say, stay unknown for as long as a start at another equilibrium
+/// shows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Start {
+    AsRead(f64),
+    AtEquilibrium(f64),
+}
+
+/// The simulation a replay starts from ([`Start`]).
+fn starting_simulation(
+    model: &Actuator,
+    recording: &Recording,
+    start: Start,
+    x_s: f64,
+    time: f64,
+    tolerance: f64,
+) -> Result<Simulation, String> {
+    let (held, pressures) = match start {
+        Start::AsRead(held) => (held, start_pressures(model, recording)),
+        Start::AtEquilibrium(held) => (held, None),
+    };
+    match pressures {
+        Some(pressures) => Simulation::at_pressures(model.clone(), held, x_s, time, tolerance, pressures),
+        None => Simulation::at_equilibrium(model.clone(), held, x_s, time, tolerance),
+    }
+}
 
 /// The model's outputs at every sample of a recording.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -111,29 +180,29 @@ impl<'a> Drive<'a> {
     }
 }
 
-/// Simulate `recording` from the equilibrium of its first sample (the bench holds the
-/// first command before t = 0). Samples in `0..end` only.
+/// Simulate `recording` from rest at its first sample (the bench holds the first command
+/// before t = 0; [`starting_simulation`]). Samples in `0..end` only.
 pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usize) -> Result<Replay, String> {
     match recording.v_da.first() {
-        Some(&first) => replay_from(model, recording, tolerance, end, first),
+        Some(&first) => replay_from(model, recording, tolerance, end, Start::AsRead(first)),
         None => Ok(Replay::default()),
     }
 }
 
-/// [`replay`] from the equilibrium of `held`, the command held before the recording.
+/// [`replay`] from `start`.
 fn replay_from(
     model: &Actuator,
     recording: &Recording,
     tolerance: f64,
     end: usize,
-    held: f64,
+    start: Start,
 ) -> Result<Replay, String> {
     if end.min(recording.len()) == 0 {
         return Ok(Replay::default());
     }
     let drive = Drive::of(recording, end);
     let (time, v_da, x_s) = (drive.time, drive.v_da, drive.x_s);
-    let mut sim = Simulation::at_equilibrium(model.clone(), held, x_s[0], time[0], tolerance)?;
+    let mut sim = starting_simulation(model, recording, start, x_s[0], time[0], tolerance)?;
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();
     for k in 0..=drive.last {
@@ -168,21 +237,29 @@ pub const MAX_FAST_STEP: f64 = 1.05e-3;
 /// has no modal form.
 pub fn replay_fast(model: &Actuator, recording: &Recording, end: usize) -> Result<Replay, String> {
     match recording.v_da.first() {
-        Some(&first) => replay_fast_from(model, recording, end, first),
+        Some(&first) => replay_fast_from(model, recording, end, Start::AsRead(first)),
         None => Ok(Replay::default()),
     }
 }
 
-/// [`replay_fast`] from the equilibrium of `held`, the command held before the recording.
-pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, held: f64) -> Result<Replay, String> {
+/// [`replay_fast`] from `start`.
+pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, start: Start) -> Result<Replay, String> {
     if end.min(recording.len()) == 0 {
         return Ok(Replay::default());
     }
     let drive = Drive::of(recording, end);
     let (t, v_da, x_s) = (drive.time, drive.v_da, drive.x_s);
-    let mut sim = match FixedStep::at_equilibrium(model.clone(), held, x_s[0], t[0])? {
+    let simulation = starting_simulation(
+        model,
+        recording,
+        start,
+        x_s[0],
+        t[0],
+        jetpipe_model::simulation::DEFAULT_RELATIVE_TOLERANCE,
+    )?;
+    let mut sim = match FixedStep::new(simulation) {
         Some(sim) => sim,
-        None => return replay_from(model, recording, 1e-5, end, held),
+        None => return replay_from(model, recording, 1e-5, end, start),
     };
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();

@@ -125,6 +125,13 @@ impl Diagnosis {
                 }
             }
         }
+        // The replays started the chambers where the transducers read them: the FMU starts
+        // there too.
+        if let Some([p1, p2]) = self.start_pressures {
+            start_values.insert("start_at_equilibrium".into(), json!(false));
+            start_values.insert("P1_start".into(), json!(p1));
+            start_values.insert("P2_start".into(), json!(p2));
+        }
         let mut report = json!({
             "recording": recording_name,
             "samples": self.samples,

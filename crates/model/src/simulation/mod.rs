@@ -244,6 +244,43 @@ impl Simulation {
         Ok(simulation)
     }
 
+    /// A simulation at the equilibrium of the given inputs except for the chamber pressures,
+    /// which are `pressures` (Pa): a bench that had not settled when its recording began, as
+    /// its transducers read it. The current and the jet pipe, whose time constants are
+    /// milliseconds, start at their equilibrium, and so do the volumes behind restrictions,
+    /// which follow the chambers within their own short time constants. Where the inputs have
+    /// no equilibrium, the current and the jet pipe start at their static values alone.
+    pub fn at_pressures(
+        model: Actuator,
+        v_da: f64,
+        x_s: f64,
+        time: f64,
+        relative_tolerance: f64,
+        pressures: [f64; 2],
+    ) -> Result<Self, String> {
+        for (name, p) in [("P1_start", pressures[0]), ("P2_start", pressures[1])] {
+            if !(p.is_finite() && p > 0.0) {
+                return Err(format!("{name} = {p} Pa is invalid: must be above 0 Pa"));
+            }
+        }
+        let (state, nodes) = match Self::at_equilibrium(model.clone(), v_da, x_s, time, relative_tolerance) {
+            Ok(settled) => (settled.state, Some(settled.nodes)),
+            Err(_) => {
+                check_finite("v_DA", v_da, "V")?;
+                model.params.check_stopper(x_s)?;
+                (equilibrium_of_electromechanics(&model, v_da), None)
+            }
+        };
+        let mut state = state;
+        state[index::P1] = pressures[0];
+        state[index::P2] = pressures[1];
+        let mut simulation = Self::from_state(model, state, v_da, x_s, time, relative_tolerance);
+        if let Some(nodes) = nodes.filter(|_| simulation.model.has_volume_states()) {
+            simulation.nodes = nodes;
+        }
+        Ok(simulation)
+    }
+
     /// A simulation from a given state.
     pub fn from_state(model: Actuator, state: State, v_da: f64, x_s: f64, time: f64, relative_tolerance: f64) -> Self {
         let propagator = ElectromechanicalPropagator::new(&model.params);
@@ -490,6 +527,42 @@ mod tests {
         let mut p = Parameters::default();
         change(&mut p);
         Actuator::new(p).unwrap()
+    }
+
+    #[test]
+    fn a_start_at_given_pressures_keeps_them_and_the_electromechanics_equilibrium_and_then_settles() {
+        let model = thesis_model();
+        let settled = Simulation::at_equilibrium(model.clone(), 2.5, 0.054, 0.0, 1e-8).unwrap();
+        let same = Simulation::at_pressures(
+            model.clone(),
+            2.5,
+            0.054,
+            0.0,
+            1e-8,
+            [settled.state[index::P1], settled.state[index::P2]],
+        )
+        .unwrap();
+        assert_eq!(same.state, settled.state);
+        let mut apart = Simulation::at_pressures(model.clone(), 2.5, 0.054, 0.0, 1e-8, [4.0e5, 2.0e5]).unwrap();
+        assert_eq!((apart.state[index::P1], apart.state[index::P2]), (4.0e5, 2.0e5));
+        assert_eq!(apart.state[index::CURRENT], settled.state[index::CURRENT]);
+        assert_eq!(apart.state[index::JET_POSITION], settled.state[index::JET_POSITION]);
+        // Held at the same inputs, the chambers go to the equilibrium's pressures.
+        for _ in 0..40 {
+            apart.step(0.25).unwrap();
+        }
+        for k in [index::P1, index::P2] {
+            assert!(
+                (apart.state[k] - settled.state[k]).abs() < 1.0,
+                "{} against {}",
+                apart.state[k],
+                settled.state[k]
+            );
+        }
+        let error = Simulation::at_pressures(model, 2.5, 0.054, 0.0, 1e-8, [0.0, 2.0e5])
+            .err()
+            .unwrap();
+        assert!(error.contains("P1_start = 0 Pa"), "{error}");
     }
 
     #[test]
