@@ -329,6 +329,40 @@ mod tests {
     }
 
     #[test]
+    fn with_pressure_channels_the_replay_starts_the_chambers_at_the_first_readings_through_the_transducers() {
+        let mut recording = protocol_of(200);
+        // The first four readings average 4.1e5 and 2.05e5 Pa; later ones do not count.
+        let p1: Vec<f64> = (0..200)
+            .map(|k| [4.0e5, 4.2e5, 4.1e5, 4.1e5][k.min(3)] + if k >= 4 { 5e4 } else { 0.0 })
+            .collect();
+        let p2: Vec<f64> = (0..200).map(|k| if k < 4 { 2.05e5 } else { 3e5 }).collect();
+        recording.p1 = Some(p1);
+        recording.p2 = Some(p2);
+        let mut params = Parameters::default();
+        params.p1_sensor_offset = 1.0e4;
+        let model = Actuator::new(params).unwrap();
+        let start = start_pressures(&model, &recording).expect("pressure channels");
+        assert!((start[0] - 4.0e5).abs() < 1e-6, "{start:?}");
+        assert!((start[1] - 2.05e5).abs() < 1e-6, "{start:?}");
+        let replayed = replay(&model, &recording, 1e-6, 1).unwrap();
+        assert!(
+            (replayed.p1[0] - 4.1e5).abs() < 1e-6,
+            "read through the offset: {}",
+            replayed.p1[0]
+        );
+        assert!((replayed.p2[0] - 2.05e5).abs() < 1e-6, "{}", replayed.p2[0]);
+        // Without pressure channels, the equilibrium.
+        recording.p1 = None;
+        assert_eq!(start_pressures(&model, &recording), None);
+        let settled =
+            Simulation::at_equilibrium(model.clone(), recording.v_da[0], recording.x_s[0], 0.0, 1e-6).unwrap();
+        assert_eq!(
+            replay(&model, &recording, 1e-6, 1).unwrap().p2[0],
+            settled.outputs().p2_meas
+        );
+    }
+
+    #[test]
     fn a_thinned_recording_is_replayed_at_its_full_rate_and_gives_the_outputs_at_its_rows() {
         // 24 s: six stretches of 4 s, of which every second is kept for at most 12,000 rows.
         let recording = protocol_of(24_000);
