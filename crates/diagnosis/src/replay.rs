@@ -338,9 +338,11 @@ mod tests {
         let p2: Vec<f64> = (0..200).map(|k| if k < 4 { 2.05e5 } else { 3e5 }).collect();
         recording.p1 = Some(p1);
         recording.p2 = Some(p2);
-        let mut params = Parameters::default();
-        params.p1_sensor_offset = 1.0e4;
-        let model = Actuator::new(params).unwrap();
+        let model = Actuator::new(Parameters {
+            p1_sensor_offset: 1.0e4,
+            ..Parameters::default()
+        })
+        .unwrap();
         let start = start_pressures(&model, &recording).expect("pressure channels");
         assert!((start[0] - 4.0e5).abs() < 1e-6, "{start:?}");
         assert!((start[1] - 2.05e5).abs() < 1e-6, "{start:?}");
