@@ -909,7 +909,7 @@ fn conclude(
     let blocks = &full_blocks;
     let before_errors = errors(&before, full, blocks);
     let mut after_errors = errors(&after, full, blocks);
-    let withdrawn = withdraw::withdraw_if_worse(&mut found, &before_model.params, &before_errors, &after_errors);
+    let withdrawn = withdraw::withdraw_if_worse(&mut found, &before_model.params, &before_errors, &after_errors, noise);
     if let Some(w) = &withdrawn {
         progress(&format!(
             "the accurate replay finds the model with {} worse than the starting model (held-out {:.4} against {:.4} N, whole {:.4} against {:.4} N): they are withdrawn",
