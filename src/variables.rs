@@ -147,6 +147,15 @@ pub const UNITS: &[UnitDefinition] = &[
         k: 0,
     },
     UnitDefinition {
+        // A mass flow: the extra flow slots' coefficients.
+        name: "kg/s",
+        kg: 1,
+        m: 0,
+        s: -1,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
         name: "m/N",
         kg: -1,
         m: 0,

@@ -4,6 +4,7 @@
 
 pub use crate::variable::{Causality, VarType, Variability, Variable};
 
+mod extra_flow;
 mod extra_force;
 mod modulation;
 
@@ -180,8 +181,8 @@ pub mod vr {
 
     // Modulation slots (crate::physics::modulation), off with no constant named.
     pub use super::modulation::vr::*;
-    // The extra force's product slots (crate::physics::extra_force), off with a coefficient of 0.
-    pub use super::extra_force::vr::*;
+    // The extra force's product slots and the extra flow slots, off with a coefficient of 0.
+    pub use super::{extra_flow::vr::*, extra_force::vr::*};
 }
 
 /// The D/A converter's range: a command outside it is refused.
@@ -385,18 +386,12 @@ const CURVE_DISCHARGE: &str = "a discharge coefficient lies between 0 (closed) a
 
 /// Every variable of the FMU, one row each: name, value reference, unit, start, limits,
 /// description and thesis reference. Defaults: Table 3.1 of the thesis and docs/model.md.
-/// The modulation slots' rows come next to last (`variables/modulation.rs`), the extra
-/// force's product slots last (`variables/extra_force.rs`).
+/// Then the modulation slots' rows (`variables/modulation.rs`), the extra force's product
+/// slots (`variables/extra_force.rs`) and the extra flow slots (`variables/extra_flow.rs`).
 pub const TABLE: &[Row] = &TABLE_ARRAY;
-const TABLE_LENGTH: usize =
-    ROWS_BEFORE_THE_SLOTS.len() + modulation::SLOT_1.len() + modulation::SLOT_2.len() + extra_force::SLOTS.len();
+const TABLE_LENGTH: usize = ROWS_BEFORE_THE_SLOTS.len() + modulation::length(&modulation::SLOT_ROWS);
 #[allow(clippy::large_const_arrays)]
-const TABLE_ARRAY: [Row; TABLE_LENGTH] = modulation::concatenated([
-    ROWS_BEFORE_THE_SLOTS,
-    &modulation::SLOT_1,
-    &modulation::SLOT_2,
-    &extra_force::SLOTS,
-]);
+const TABLE_ARRAY: [Row; TABLE_LENGTH] = modulation::concatenated(ROWS_BEFORE_THE_SLOTS, &modulation::SLOT_ROWS);
 
 const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     input("v_DA", vr::V_DA, "V", 0.0, "D/A command voltage to the current driver").cite("(2.3)"),

@@ -53,7 +53,8 @@ pub struct MassFlows {
     /// What each chamber loses through leaks of its own: to the return pressure (the
     /// `chamber_vent_*` orifices, the `chamber_laminar_vent_*` paths) less what it gains from
     /// the supply (the `chamber_supply_leak_*` orifices, the `chamber_laminar_supply_leak_*`
-    /// paths); zero in the thesis model.
+    /// paths) less the extra flow slots' flows into it ([`super::extra_flow`]); zero in the
+    /// thesis model.
     pub vent_1: f64,
     pub vent_2: f64,
 }
@@ -224,7 +225,8 @@ impl Actuator {
             params.chamber_laminar_cross_leak,
         ]
         .iter()
-        .any(|&leak| leak != 0.0);
+        .any(|&leak| leak != 0.0)
+            || super::extra_flow::flows_on(&params.extra_flows);
         let rate_terms =
             if restrictions.any() || discharge_curve.is_some() || chamber_leaks || params.stopper_compliance != 0.0 {
                 RateTerms::Extended
@@ -357,7 +359,8 @@ impl Actuator {
     /// The flows each chamber loses through leaks other than the valve's and the piston's:
     /// the `chamber_vent_*` orifices to the return pressure, the `chamber_laminar_vent_*`
     /// paths to it, less what the `chamber_supply_leak_*` orifices and the
-    /// `chamber_laminar_supply_leak_*` paths bring in from the supply.
+    /// `chamber_laminar_supply_leak_*` paths bring in from the supply and the extra flow
+    /// slots bring in ([`super::extra_flow`]).
     fn chamber_vents(&self, p1: f64, p2: f64) -> (f64, f64) {
         if !self.chamber_leaks {
             return (0.0, 0.0);
@@ -367,11 +370,20 @@ impl Actuator {
         let lost = |vent: f64, laminar: f64, supplied: f64, chamber: f64| {
             mass_flow(k, vent, chamber, p.p_r) + laminar * (chamber - p.p_r) - mass_flow(k, supplied, p.p_s, chamber)
         };
+        let pressures = super::extra_flow::ChamberPressures {
+            p1,
+            p2,
+            p_s: p.p_s,
+            p_r: p.p_r,
+        };
+        let [extra_1, extra_2] = super::extra_flow::inflows(&p.extra_flows, &pressures);
         (
             lost(p.chamber_vent_1, p.chamber_laminar_vent_1, p.chamber_supply_leak_1, p1)
-                - p.chamber_laminar_supply_leak_1 * (p.p_s - p1),
+                - p.chamber_laminar_supply_leak_1 * (p.p_s - p1)
+                - extra_1,
             lost(p.chamber_vent_2, p.chamber_laminar_vent_2, p.chamber_supply_leak_2, p2)
-                - p.chamber_laminar_supply_leak_2 * (p.p_s - p2),
+                - p.chamber_laminar_supply_leak_2 * (p.p_s - p2)
+                - extra_2,
         )
     }
 

@@ -15,6 +15,7 @@
 //! | piston force and spring | [`piston`] | (2.36)–(2.38) |
 //! | effects the thesis model lacks (off by default) | [`effects`] | docs/model.md |
 //! | an extra force in the piston's balance, from a library of local signals (off by default) | [`extra_force`] | (2.36) |
+//! | an extra mass flow into one chamber alone, from a library of pressure signals (off by default) | [`extra_flow`] | (2.24)–(2.25) |
 //! | restrictions and gas volumes between the valve and the air (off by default) | [`restrictions`] | (2.18), (2.29) |
 //! | the command as the current driver sees it (off by default) | [`command_stage`] | (2.1) |
 //! | what the force and pressure transducers read | [`sensors`] | docs/model.md |
@@ -28,6 +29,7 @@ pub mod chambers;
 pub mod command_stage;
 pub mod current_driver;
 pub mod effects;
+pub mod extra_flow;
 pub mod extra_force;
 pub mod jet_pipe;
 pub mod modulation;

@@ -2,6 +2,7 @@
 //! FMU's variable table, so the two cannot disagree).
 
 use super::chambers::CylinderGeometry;
+use super::extra_flow::{FlowSlot, FLOW_SLOTS};
 use super::extra_force::{ProductSlot, PRODUCT_SLOTS};
 use super::modulation::{Slot, SLOTS};
 use super::orifice_flow::FlowConstants;
@@ -149,6 +150,9 @@ pub struct Parameters {
     /// The extra force's product slots (off with a coefficient of 0; see
     /// [`super::extra_force`]).
     pub extra_force_products: [ProductSlot; PRODUCT_SLOTS],
+    /// The extra flow slots: a flow into one chamber alone (off with a coefficient of 0; see
+    /// [`super::extra_flow`]).
+    pub extra_flows: [FlowSlot; FLOW_SLOTS],
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -287,6 +291,7 @@ impl Default for Parameters {
             discharge_curve: StaticCurve::default(),
             modulation: [Slot::default(); SLOTS],
             extra_force_products: [ProductSlot::default(); PRODUCT_SLOTS],
+            extra_flows: [FlowSlot::default(); FLOW_SLOTS],
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -543,6 +548,15 @@ impl Parameters {
         vr::EXTRA_FORCE_PRODUCT_3_FIRST + 1,
         vr::EXTRA_FORCE_PRODUCT_3_FIRST + 2,
         vr::EXTRA_FORCE_PRODUCT_3_FIRST + 3,
+        vr::EXTRA_FLOW_1_CHAMBER,
+        vr::EXTRA_FLOW_1_CHAMBER + 1,
+        vr::EXTRA_FLOW_1_CHAMBER + 2,
+        vr::EXTRA_FLOW_2_CHAMBER,
+        vr::EXTRA_FLOW_2_CHAMBER + 1,
+        vr::EXTRA_FLOW_2_CHAMBER + 2,
+        vr::EXTRA_FLOW_3_CHAMBER,
+        vr::EXTRA_FLOW_3_CHAMBER + 1,
+        vr::EXTRA_FLOW_3_CHAMBER + 2,
     ];
 
     pub(crate) fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
@@ -704,6 +718,9 @@ impl Parameters {
             r @ vr::EXTRA_FORCE_PRODUCT_1_FIRST..=vr::EXTRA_FORCE_PRODUCT_LAST => {
                 return super::extra_force::product_field_mut(&mut self.extra_force_products, r)
             }
+            r @ vr::EXTRA_FLOW_1_CHAMBER..=vr::EXTRA_FLOW_LAST => {
+                return super::extra_flow::flow_field_mut(&mut self.extra_flows, r)
+            }
             _ => return None,
         })
     }
@@ -785,6 +802,7 @@ impl Parameters {
             ));
         }
         super::extra_force::check_products(&self.extra_force_products)?;
+        super::extra_flow::check_flows(&self.extra_flows)?;
         // Last: it validates the model with each slot's constant at each of its knots.
         super::modulation::validate(self)
     }

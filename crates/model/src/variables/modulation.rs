@@ -128,10 +128,29 @@ macro_rules! slot_rows {
 pub(super) const SLOT_1: [Row; 16] = slot_rows!(1, vr::MODULATION_1_PARAMETER);
 pub(super) const SLOT_2: [Row; 16] = slot_rows!(2, vr::MODULATION_2_PARAMETER);
 
-/// `parts` one after the other, as one array of `N` rows (N their total length).
-pub(super) const fn concatenated<const N: usize>(parts: [&[Row]; 4]) -> [Row; N] {
-    let mut out = [parts[0][0]; N];
+/// The slots' rows after the table's others: the modulation slots', the extra force's product
+/// slots' (`variables/extra_force.rs`), the extra flow slots' (`variables/extra_flow.rs`).
+pub(super) const SLOT_ROWS: [&[Row]; 4] = [&SLOT_1, &SLOT_2, &super::extra_force::SLOTS, &super::extra_flow::SLOTS];
+
+/// The number of rows in `parts`.
+pub(super) const fn length(parts: &[&[Row]]) -> usize {
+    let mut total = 0;
+    let mut part = 0;
+    while part < parts.len() {
+        total += parts[part].len();
+        part += 1;
+    }
+    total
+}
+
+/// `first`, then `parts` one after the other, as one array of `N` rows (N their total length).
+pub(super) const fn concatenated<const N: usize>(first: &[Row], parts: &[&[Row]]) -> [Row; N] {
+    let mut out = [first[0]; N];
     let mut k = 0;
+    while k < first.len() {
+        out[k] = first[k];
+        k += 1;
+    }
     let mut part = 0;
     while part < parts.len() {
         let mut i = 0;

@@ -1,6 +1,6 @@
 //! The actuator's tests: the Jacobian, the mass flows and the rates' fast paths against the
 //! general ones, the chambers' leaks, the discharge curve, the outputs, the extra force's
-//! product slots.
+//! product slots, the extra flow slots.
 
 use super::*;
 
@@ -90,8 +90,9 @@ fn the_thesis_rates_are_the_general_paths_to_the_last_bit() {
 #[test]
 fn a_vent_a_restriction_or_a_compliant_stopper_takes_the_general_rates() {
     type Setter = fn(&mut Parameters);
-    let terms: [(&str, Setter); 9] = [
+    let terms: [(&str, Setter); 10] = [
         ("chamber_vent_2", |p| p.chamber_vent_2 = 2e-9),
+        ("extra_flow_1_coefficient", |p| p.extra_flows[0].coefficient = 1e-6),
         ("chamber_supply_leak_1", |p| p.chamber_supply_leak_1 = 2e-9),
         ("chamber_laminar_vent_2", |p| p.chamber_laminar_vent_2 = 1e-11),
         ("chamber_laminar_supply_leak_1", |p| {
@@ -262,5 +263,56 @@ fn the_thesis_outputs_are_the_general_paths_to_the_last_bit() {
         },
     ] {
         assert!(!Actuator::new(params).unwrap().thesis_outputs);
+    }
+}
+
+#[test]
+fn an_extra_flow_of_p1_less_p2_into_chamber_2_changes_chamber_2s_inflow_alone() {
+    use super::super::extra_flow::FlowSlot;
+    let c = 3.1e-6; // kg/s per bar of P1 − P2
+    let mut params = Parameters::default();
+    params.extra_flows[1] = FlowSlot {
+        chamber: 2.0,
+        signal: 1.0,
+        coefficient: c,
+    };
+    let model = Actuator::new(params).unwrap();
+    let thesis = Actuator::new(Parameters::default()).unwrap();
+    for (x_jp, p1, p2) in [(0.02e-3, 380e3, 210e3), (-0.05e-3, 150e3, 460e3), (0.0, 300e3, 300e3)] {
+        let with = model.mass_flows(x_jp, p1, p2);
+        let without = thesis.mass_flows(x_jp, p1, p2);
+        let added = c * (p1 - p2) / 1e5;
+        let change_2 = with.net_2() - without.net_2();
+        assert!(
+            (change_2 - added).abs() <= 1e-12 * without.net_2().abs().max(added.abs()),
+            "chamber 2 gains {change_2} kg/s against {added} at P1 {p1}, P2 {p2}"
+        );
+        assert_eq!(with.net_1(), without.net_1(), "chamber 1 at P1 {p1}, P2 {p2}");
+        assert_eq!(with.leakage, without.leakage);
+    }
+    // Mass is not conserved between the chambers: their net flows' sum changes by the flow.
+    let (p1, p2) = (400e3, 200e3);
+    let sum = |f: MassFlows| f.net_1() + f.net_2();
+    let gained = sum(model.mass_flows(0.0, p1, p2)) - sum(thesis.mass_flows(0.0, p1, p2));
+    assert!((gained - 2.0 * c).abs() < 1e-12 * 2.0 * c + 1e-18, "{gained}");
+}
+
+#[test]
+fn the_extra_flow_slots_are_off_by_default_and_leave_the_thesis_model_unchanged() {
+    let params = Parameters::default();
+    assert!(params.extra_flows.iter().all(|slot| slot.coefficient == 0.0));
+    let model = Actuator::new(params.clone()).unwrap();
+    assert_eq!(model.rate_terms(), RateTerms::Thesis);
+    // A slot with a chamber and a signal but no coefficient is still off.
+    let mut set_up = params;
+    set_up.extra_flows[0].chamber = 2.0;
+    set_up.extra_flows[0].signal = 4.0;
+    let idle = Actuator::new(set_up).unwrap();
+    assert_eq!(idle.rate_terms(), RateTerms::Thesis);
+    for (x_jp, p1, p2, x_s, x_s_rate) in rate_samples() {
+        assert_eq!(
+            idle.pressure_rates(x_jp, p1, p2, x_s, x_s_rate),
+            model.pressure_rates(x_jp, p1, p2, x_s, x_s_rate)
+        );
     }
 }
