@@ -129,6 +129,10 @@
 //! * `laminar_cross_leak` (`chambers`/`extra_flow`, g): g (P1 − P2) flows from chamber 1 into
 //!   chamber 2 beside the leakage past the piston (a scored bore), at the upstream chamber's
 //!   temperature.
+//! * `difference_inflow_2` (`chambers`/`extra_flow`, g): chamber 2 alone gains g (P1 − P2),
+//!   which no other place loses (mass is not conserved: a flow from outside the model's two
+//!   chambers that follows their difference); inflow at T, outflow (P1 < P2) at chamber 2's
+//!   temperature.
 //! * `position_sign_force` (`mechanics`/`extra_force`, k, with `position_sign_origin` x₀):
 //!   the force gains k (x_s − x₀) tanh(v / 1 mm/s) with the stopper's own velocity.
 //!   `chamber_1_pressure_force` (`mechanics`/`extra_force`, μ): it gains μ (P1 − P_r).
@@ -274,6 +278,9 @@ pub struct UndeclaredEffects {
     /// `chambers`/`extra_flow`: laminar conductance (kg/(s·Pa)) between the chambers, the flow
     /// (P1 − P2) times this from chamber 1 into chamber 2 (a scored bore); 0 = none.
     pub laminar_cross_leak: f64,
+    /// `chambers`/`extra_flow`: chamber 2 alone gains this (kg/(s·Pa)) times (P1 − P2), taken
+    /// from no other place (negative with P1 < P2, or with a negative g); 0 = none.
+    pub difference_inflow_2: f64,
     /// `mechanics`/`extra_force`: a force that adds to the pressure force, k (x_s − x₀)
     /// tanh(v / 1 mm/s), v the stopper's own velocity: a friction that grows (and turns) along
     /// the bore; k in N/m; 0 = none.

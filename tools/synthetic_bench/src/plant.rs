@@ -640,7 +640,8 @@ impl Model {
         let u = &self.e.undeclared;
         // undeclared chamber leaks beyond the orifice to atmosphere: an orifice from the
         // supply into chamber 2, a laminar path from chamber 1 to atmosphere, one from the
-        // supply into chamber 2, one from chamber 1 into chamber 2
+        // supply into chamber 2, one from chamber 1 into chamber 2; and a flow into chamber 2
+        // alone in proportion to P1 − P2, which chamber 1 does not lose
         let m_sl2 = if u.supply_leak_2 > 0.0 {
             self.orifice(u.supply_leak_2, ps, t0, p2, t2)
         } else {
@@ -650,7 +651,8 @@ impl Model {
         let m_lsl2 = u.laminar_supply_leak_2 * (ps - p2);
         let m_lx = u.laminar_cross_leak * (p1 - p2);
         m1 -= m_lam1 + m_lx;
-        let m2 = m_s2 - m_r2 + m_l - m_d2 + m_sl2 + m_lsl2 + m_lx;
+        let m_di2 = u.difference_inflow_2 * (p1 - p2);
+        let m2 = m_s2 - m_r2 + m_l - m_d2 + m_sl2 + m_lsl2 + m_lx + m_di2;
         if !self.heat {
             dy[S_P1] = p.gamma / v1 * (rt * m1 - p1 * dv1);
             dy[S_P2] = p.gamma / v2 * (rt * m2 - p2 * dv2);
@@ -669,7 +671,7 @@ impl Model {
             }
             h1 += up(-m_lam1, t0, t1) + up(-m_lx, t2, t1);
             let h2 = up(m_s2, t0, t2) + up(-m_r2, t0, t2) + up(m_l, t1, t2) + up(-m_d2, t0, t2) + up(m_sl2, t0, t2);
-            let h2 = h2 + up(m_lsl2, t0, t2) + up(m_lx, t1, t2);
+            let h2 = h2 + up(m_lsl2, t0, t2) + up(m_lx, t1, t2) + up(m_di2, t0, t2);
             let chamber = |pc: f64, tc: f64, v: f64, dv: f64, m: f64, h: f64| {
                 let dp = p.gamma / v * (p.r_gas * h - pc * dv) + pc * (t0 - tc) / tc * self.inv_tau_th;
                 let dt = tc * (dp / pc + dv / v) - p.r_gas * tc * tc * m / (pc * v);

@@ -456,6 +456,46 @@ fn a_laminar_leak_from_the_supply_raises_chamber_2_and_one_between_the_chambers_
 }
 
 #[test]
+fn a_flow_into_chamber_2_alone_raises_both_chambers_where_a_leak_between_them_of_the_same_size_lowers_chamber_1() {
+    let spec = ProtocolSpec {
+        duration: 20.0,
+        sample_rate: 500.0,
+        ..ProtocolSpec::default()
+    };
+    let with = |undeclared: synthetic_bench::UndeclaredEffects| {
+        late_mean_pressures(&generate_protocol(&spec, &with_undeclared(undeclared)).unwrap())
+    };
+    let clean = late_mean_pressures(&generate_protocol(&spec, &BenchEffects::default()).unwrap());
+    let alone = with(synthetic_bench::UndeclaredEffects {
+        difference_inflow_2: 2e-11,
+        ..Default::default()
+    });
+    let crossed = with(synthetic_bench::UndeclaredEffects {
+        laminar_cross_leak: 2e-11,
+        ..Default::default()
+    });
+    // P1's mean stays above P2's over the protocol's second half: both move mass into chamber 2.
+    assert!(clean.0 > clean.1 + 5e4, "P1 {} P2 {}", clean.0, clean.1);
+    let moved = |p: (f64, f64)| (p.0 - clean.0, p.1 - clean.1);
+    let (alone_1, alone_2) = moved(alone);
+    let (crossed_1, crossed_2) = moved(crossed);
+    assert!(
+        alone_2 > 1e3 && crossed_2 > 1e3,
+        "P2 moved {alone_2} Pa alone, {crossed_2} Pa between"
+    );
+    // The flow between the chambers comes out of chamber 1; the flow into chamber 2 alone is
+    // mass gained, which reaches chamber 1 past the piston.
+    assert!(
+        crossed_1 < -500.0,
+        "P1 moved {crossed_1} Pa with the leak between the chambers"
+    );
+    assert!(
+        alone_1 > 500.0,
+        "P1 moved {alone_1} Pa with the flow into chamber 2 alone"
+    );
+}
+
+#[test]
 fn a_discharge_coefficient_rising_as_the_flow_chokes_changes_the_pressures_and_zero_changes_nothing() {
     let spec = ProtocolSpec {
         duration: 20.0,

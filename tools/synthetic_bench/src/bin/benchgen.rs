@@ -194,6 +194,10 @@ struct Cli {
     /// A laminar leak from chamber 1 into chamber 2: its conductance, kg/(s·Pa) (e.g. 4e-12).
     #[arg(long)]
     laminar_cross_leak: Option<f64>,
+    /// A flow into chamber 2 alone in proportion to P1 − P2 (chamber 1 does not lose it): its
+    /// coefficient, kg/(s·Pa), of either sign (e.g. 5e-12).
+    #[arg(long, allow_hyphen_values = true)]
+    difference_inflow_2: Option<f64>,
     /// The force reading passes through a second-order low-pass filter of this natural
     /// frequency, Hz (e.g. 40).
     #[arg(long)]
@@ -291,6 +295,7 @@ fn main() -> ExitCode {
     set(&mut und.laminar_leak_1, cli.laminar_leak_1);
     set(&mut und.laminar_supply_leak_2, cli.laminar_supply_leak_2);
     set(&mut und.laminar_cross_leak, cli.laminar_cross_leak);
+    set(&mut und.difference_inflow_2, cli.difference_inflow_2);
     set(&mut und.force_sensor_filter_frequency, cli.force_sensor_filter);
     set(&mut und.force_sensor_filter_damping, cli.force_sensor_filter_damping);
     set(&mut und.pressure_sensor_filter_1, cli.pressure_sensor_filter_1);
@@ -347,6 +352,7 @@ fn main() -> ExitCode {
             und.pressure_sensor_quadratic_2,
             und.stopper_position_offset,
             und.gas_temperature_drift,
+            und.difference_inflow_2,
         ]
         .iter()
         .all(|x| x.is_finite());
