@@ -55,6 +55,7 @@ mechanisms=(
     "laminar_leak_1|chambers|extra_flow|--laminar-leak-1 3e-11"
     "laminar_supply_leak_2|chambers|extra_flow|--laminar-supply-leak-2 4e-12"
     "laminar_cross_leak|chambers|extra_flow|--laminar-cross-leak 4e-12"
+    "difference_inflow_2|chambers|extra_flow|--difference-inflow-2 5e-12"
     "force_filter_40hz|force_sensor|dynamics|--force-sensor-filter 40 --force-sensor-filter-damping 0.5"
     "p1_filter_30hz|pressure_sensors|dynamics|--pressure-sensor-filter-1 30 --pressure-sensor-filter-damping-1 1"
     "spring_rate_150|mechanics|parameter_offset|--plant k_spring=150"

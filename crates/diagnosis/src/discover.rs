@@ -332,6 +332,10 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
         sentence.push(' ');
         sentence.push_str(&products);
     }
+    if let Some(flows) = crate::extra_flows::reading(set, before) {
+        sentence.push(' ');
+        sentence.push_str(&flows);
+    }
     for p in physical {
         sentence.push(' ');
         sentence.push_str(&p);

@@ -30,6 +30,7 @@ pub mod curves;
 pub mod discharge;
 mod discover;
 mod eliminate;
+pub mod extra_flows;
 pub mod lines;
 mod localize;
 pub mod modulation;

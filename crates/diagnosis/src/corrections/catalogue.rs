@@ -983,5 +983,7 @@ pub fn catalogue(
     }
     list.extend(crate::curves::candidates(base, knots, has_pressures));
     list.extend(crate::discharge::candidate(base));
+    // A flow into one chamber alone, generated from the extra flow slots' signals.
+    list.extend(crate::extra_flows::candidates(base));
     list
 }

@@ -5,6 +5,7 @@
 //! * `undeclared`: the synthetic bench's undeclared mechanisms;
 //! * `protocols`: the general discovery pieces on recordings under other protocols;
 //! * `balance`: an extra force in the piston's balance picked from a library of local signals;
+//! * `flows`: an extra mass flow into one chamber alone, from the generated class;
 //! * `curves`: the static-curve class at the command and the transducers;
 //! * `search`: compounds and mechanisms that a search locking in on its first choice missed;
 //! * `constants`: a thesis constant of the plant other than the model's, re-identified;
@@ -23,6 +24,7 @@
 mod balance;
 mod constants;
 mod curves;
+mod flows;
 mod modulations;
 mod protocols;
 mod search;

@@ -150,10 +150,12 @@ impl FlowSlot {
 
     /// The chamber's index (0 or 1), if the code is 1 or 2.
     fn chamber_index(&self) -> Option<usize> {
-        match self.chamber {
-            c if c == 1.0 => Some(0),
-            c if c == 2.0 => Some(1),
-            _ => None,
+        if self.chamber == 1.0 {
+            Some(0)
+        } else if self.chamber == 2.0 {
+            Some(1)
+        } else {
+            None
         }
     }
 
