@@ -30,9 +30,20 @@
 //!
 //! The square roots have an infinite slope at a zero difference, as the orifice law (2.18)
 //! and the piston's leakage (2.23) have.
+//!
+//! **A chamber cannot give mass it has not got.** Where a slot takes mass out of a chamber
+//! (c g < 0), the outflow fades in proportion to the chamber's pressure below
+//! [`FADE_PRESSURE`] (0.1 bar absolute) and vanishes at 0: c g exactly wherever the chamber
+//! holds 0.1 bar or more, which the return pressure (1 bar) keeps it above in any working
+//! state. Without it an outflow that the valve cannot make up (a constant one, or one in
+//! proportion to P1 − P2 with the wrong sign, which a fit may try) drove the pressure
+//! through zero, where the integrators crawled at steps of 1e-12 s.
 
 /// Reference unit of the signals: 1 bar.
 pub const REFERENCE: f64 = 1e5;
+
+/// Below this absolute pressure (Pa) of its chamber a slot's outflow fades to 0 at 0 Pa.
+pub const FADE_PRESSURE: f64 = 1e4;
 
 /// The number of extra flow slots.
 pub const FLOW_SLOTS: usize = 3;
@@ -169,12 +180,19 @@ impl FlowSlot {
     }
 }
 
-/// The mass flows (kg/s) the slots that are on bring into chambers 1 and 2: Σ c_k g_k.
+/// The mass flows (kg/s) the slots that are on bring into chambers 1 and 2: Σ c_k g_k, an
+/// outflow faded below [`FADE_PRESSURE`] (see the module's comment).
 pub fn inflows(slots: &[FlowSlot; FLOW_SLOTS], p: &ChamberPressures) -> [f64; 2] {
     let mut out = [0.0; 2];
     for slot in slots.iter().filter(|s| s.is_on()) {
         if let Some(i) = slot.chamber_index() {
-            out[i] += slot.coefficient * slot.regressor(p);
+            let flow = slot.coefficient * slot.regressor(p);
+            let own = if i == 0 { p.p1 } else { p.p2 };
+            out[i] += if flow < 0.0 && own < FADE_PRESSURE {
+                flow * (own / FADE_PRESSURE).max(0.0)
+            } else {
+                flow
+            };
         }
     }
     out
@@ -273,6 +291,39 @@ mod tests {
         let [in_1, in_2] = inflows(&slots, &p);
         assert_eq!(in_1, 0.0);
         assert!((in_2 - (3e-6 * -2.0 + 1e-7)).abs() < 1e-18, "{in_2}");
+    }
+
+    #[test]
+    fn an_outflow_fades_below_a_tenth_of_a_bar_and_an_inflow_does_not() {
+        let out_of_2 = [
+            FlowSlot {
+                chamber: 2.0,
+                signal: 0.0,
+                coefficient: -2e-6,
+            },
+            FlowSlot {
+                chamber: 1.0,
+                signal: 0.0,
+                coefficient: 3e-6,
+            },
+            FlowSlot::default(),
+        ];
+        let at = |p1: f64, p2: f64| {
+            inflows(
+                &out_of_2,
+                &ChamberPressures {
+                    p1,
+                    p2,
+                    p_s: 7e5,
+                    p_r: 1e5,
+                },
+            )
+        };
+        assert_eq!(at(2e3, 1e4), [3e-6, -2e-6]);
+        let [in_1, in_2] = at(2e3, 2.5e3);
+        assert_eq!(in_1, 3e-6);
+        assert!((in_2 + 0.5e-6).abs() < 1e-18, "{in_2}");
+        assert_eq!(at(2e3, -1.0)[1], 0.0);
     }
 
     #[test]

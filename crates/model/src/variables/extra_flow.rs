@@ -22,7 +22,7 @@ pub mod vr {
 const CHAMBER: &str =
     "extra flow slot: the chamber (1 or 2) whose mass balance gains the slot's flow; no other place loses it";
 const SIGNAL: &str = "extra flow slot: the code of its signal g, with P_i the slot's chamber's pressure: 0 the constant 1, 1 (P1 - P2) / 1 bar, 2 (P_s - P_i) / 1 bar, 3 (P_i - P_r) / 1 bar, 4 sqrt(|P1 - P2| / 1 bar) sign(P1 - P2), 5 sqrt(|P_s - P_i| / 1 bar) sign(P_s - P_i), 6 sqrt(|P_i - P_r| / 1 bar) sign(P_i - P_r) (1 bar = 1e5 Pa)";
-const COEFFICIENT: &str = "extra flow slot: the chamber gains this times g as mass flow, at the chamber's gas temperature (negative: it loses it; 0 = off)";
+const COEFFICIENT: &str = "extra flow slot: the chamber gains this times g as mass flow, at the chamber's gas temperature (negative: it loses it, fading below 0.1 bar absolute in the chamber; 0 = off)";
 const CHAMBERS: &str = "the actuator has chambers 1 and 2";
 const CODES: &str = "the signal codes run from 0 to 6";
 const FLOW: &str = "0.1 kg/s per bar: as the laminar leaks' 1e-6 kg/(s.Pa), about a hundred times what the valve's open port passes from the supply";
