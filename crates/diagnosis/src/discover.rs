@@ -327,7 +327,12 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
         .iter()
         .filter_map(|&(name, value)| physical_reading(name, value - parameter_value(before, name)))
         .collect();
-    let mut sentence = format!("At the {location} ({family}), a {label}: {}.", parts.join(", "));
+    let article = if label.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    };
+    let mut sentence = format!("At the {location} ({family}), {article} {label}: {}.", parts.join(", "));
     if let Some(products) = crate::products::reading(set, before) {
         sentence.push(' ');
         sentence.push_str(&products);

@@ -8,7 +8,7 @@
 //! chamber i is `chamber_laminar_supply_leak_i` and c (P_i − P_r) out of it is
 //! `chamber_laminar_vent_i`. Ten candidates: five signals into each of two chambers.
 
-use crate::corrections::{parameter_value, Candidate, Mechanism, Term};
+use crate::corrections::{interned, parameter_value, Candidate, Mechanism, Term};
 use jetpipe_model::physics::extra_flow::{FlowSignal, FLOW_SLOTS};
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -56,23 +56,9 @@ pub fn members() -> Vec<(FlowSignal, usize)> {
         .collect()
 }
 
-fn leaked(text: String) -> &'static str {
-    use std::collections::HashSet;
-    use std::sync::Mutex;
-    static NAMES: Mutex<Option<HashSet<&'static str>>> = Mutex::new(None);
-    let mut names = NAMES.lock().unwrap_or_else(|e| e.into_inner());
-    let set = names.get_or_insert_with(HashSet::new);
-    if let Some(&name) = set.get(text.as_str()) {
-        return name;
-    }
-    let name: &'static str = Box::leak(text.into_boxed_str());
-    set.insert(name);
-    name
-}
-
 /// The label of a member: "extra flow into chamber 2 ∝ (P1 − P2)".
 fn label(signal: FlowSignal, chamber: usize) -> &'static str {
-    leaked(match signal {
+    interned(match signal {
         FlowSignal::One => format!("constant extra flow into chamber {chamber}"),
         s => format!("extra flow into chamber {chamber} ∝ {}", s.name(chamber)),
     })
