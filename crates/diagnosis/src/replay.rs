@@ -181,7 +181,7 @@ impl<'a> Drive<'a> {
 }
 
 /// Simulate `recording` from rest at its first sample (the bench holds the first command
-/// before t = 0; [`starting_simulation`]). Samples in `0..end` only.
+/// before t = 0; [`Start::AsRead`]). Samples in `0..end` only.
 pub fn replay(model: &Actuator, recording: &Recording, tolerance: f64, end: usize) -> Result<Replay, String> {
     match recording.v_da.first() {
         Some(&first) => replay_from(model, recording, tolerance, end, Start::AsRead(first)),
