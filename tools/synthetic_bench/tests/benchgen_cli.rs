@@ -39,6 +39,40 @@ fn benchgen_writes_the_recording_of_the_library() {
 }
 
 #[test]
+fn benchgen_writes_the_recording_of_the_library_with_the_two_extra_piston_forces() {
+    let dir = std::env::temp_dir().join(format!("benchgen-forces-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (cli, library, without) = (dir.join("cli.csv"), dir.join("library.csv"), dir.join("without.csv"));
+    let output = Command::new(env!("CARGO_BIN_EXE_benchgen"))
+        .args(["--out", cli.to_str().unwrap(), "--seed", "3", "--duration", "3"])
+        .args(["--position-sign-force", "-75", "--position-sign-origin", "0.054"])
+        .args(["--chamber-1-pressure-force", "1e-6"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let mut effects = BenchEffects::default();
+    effects.undeclared.position_sign_force = -75.0;
+    effects.undeclared.position_sign_origin = 0.054;
+    effects.undeclared.chamber_1_pressure_force = 1e-6;
+    write_csv(&generate(&effects, 3, 3.0), &library).unwrap();
+    write_csv(&generate(&BenchEffects::default(), 3, 3.0), &without).unwrap();
+    let read = |path: &std::path::Path| std::fs::read(path).unwrap();
+    assert!(
+        read(&cli) == read(&library),
+        "the command line gives the library's recording"
+    );
+    // Once the pressures lift the force above the spring's floor (the first second holds it
+    // there), 1e-6 m² on chamber 1's pressure above the return moves it by tenths of a newton.
+    assert!(read(&cli) != read(&without), "the forces change the recording");
+    let refused = Command::new(env!("CARGO_BIN_EXE_benchgen"))
+        .args(["--out", "unused.csv", "--chamber-1-pressure-force", "nan"])
+        .output()
+        .unwrap();
+    assert_eq!(refused.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn benchgen_refuses_an_unknown_mechanism() {
     let output = Command::new(env!("CARGO_BIN_EXE_benchgen"))
         .args(["--out", "unused.csv", "--undeclared", "no_such_mechanism"])

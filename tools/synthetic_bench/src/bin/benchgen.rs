@@ -198,6 +198,17 @@ struct Cli {
     /// coefficient, kg/(s·Pa), of either sign (e.g. 5e-12).
     #[arg(long, allow_hyphen_values = true)]
     difference_inflow_2: Option<f64>,
+    /// A force on the piston k (x_s − x0) tanh(v / 1 mm/s), v the stopper's velocity (a
+    /// friction that grows and turns along the bore): k, N/m, of either sign (e.g. 75).
+    #[arg(long, allow_hyphen_values = true)]
+    position_sign_force: Option<f64>,
+    /// With --position-sign-force: its origin x0, m (e.g. 0.054).
+    #[arg(long, allow_hyphen_values = true)]
+    position_sign_origin: Option<f64>,
+    /// A force on the piston μ (P1 − P_r) (chamber 1's pressure on an annulus the thesis leaves
+    /// out): μ, m², of either sign (e.g. 1e-6).
+    #[arg(long, allow_hyphen_values = true)]
+    chamber_1_pressure_force: Option<f64>,
     /// The force reading passes through a second-order low-pass filter of this natural
     /// frequency, Hz (e.g. 40).
     #[arg(long)]
@@ -296,6 +307,9 @@ fn main() -> ExitCode {
     set(&mut und.laminar_supply_leak_2, cli.laminar_supply_leak_2);
     set(&mut und.laminar_cross_leak, cli.laminar_cross_leak);
     set(&mut und.difference_inflow_2, cli.difference_inflow_2);
+    set(&mut und.position_sign_force, cli.position_sign_force);
+    set(&mut und.position_sign_origin, cli.position_sign_origin);
+    set(&mut und.chamber_1_pressure_force, cli.chamber_1_pressure_force);
     set(&mut und.force_sensor_filter_frequency, cli.force_sensor_filter);
     set(&mut und.force_sensor_filter_damping, cli.force_sensor_filter_damping);
     set(&mut und.pressure_sensor_filter_1, cli.pressure_sensor_filter_1);
@@ -353,6 +367,9 @@ fn main() -> ExitCode {
             und.stopper_position_offset,
             und.gas_temperature_drift,
             und.difference_inflow_2,
+            und.position_sign_force,
+            und.position_sign_origin,
+            und.chamber_1_pressure_force,
         ]
         .iter()
         .all(|x| x.is_finite());
