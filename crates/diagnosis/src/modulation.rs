@@ -90,6 +90,7 @@ pub fn place_of(constant: &'static str, catalogue: &[Candidate]) -> &'static str
         "P_r" => "return",
         "T" | "dead_volume_1" | "dead_volume_2" | "C_dm_A_lpp" | "C_db_A_lpp" => "chambers",
         "D_cyl" | "k_spring" | "friction_coulomb" | "viscous_friction" => "mechanics",
+        n if n.starts_with("extra_force") => "mechanics",
         _ => "valve",
     }
 }
@@ -130,6 +131,8 @@ pub fn sensitivity_step(constant: &'static str, base: &Parameters, catalogue: &[
         "p1_sensor_offset" | "p2_sensor_offset" => 100.0,
         "i_offset" => 1e-3,
         "x_jp_offset" => 2e-6,
+        // About 0.5 % of the thesis piston's area (1.98e-4 m²).
+        "extra_force_pressure_difference" => 1e-6,
         _ => 1e-3,
     }
 }

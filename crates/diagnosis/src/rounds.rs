@@ -290,7 +290,9 @@ fn replay_round(
             let n = force_residual.len();
             let sample_rate = recording.sample_rate();
             let inputs = [&recording.v_da[..n], &recording.x_s[..n]];
-            lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n]).map(|l| l.hz)
+            // Placed again at the samples' own times: the fits' stretches have gaps.
+            lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n])
+                .map(|l| signature::polished_line(&recording.time, &force_residual, l.hz, sample_rate / n as f64))
         });
     // Pressures within their noise: nothing upstream of the piston departs by more
     // than they can show, and only the mechanics and the force sensor are fitted. They can

@@ -236,7 +236,8 @@ impl Actuator {
         let extra_library = params.extra_force_acceleration != 0.0
             || params.extra_force_velocity_squared != 0.0
             || params.extra_force_sign_pressure != 0.0
-            || params.extra_force_pressure_difference != 0.0;
+            || params.extra_force_pressure_difference != 0.0
+            || super::modulation::modulates_extra_force(&params);
         let extra_products = extra_force::products_on(&params.extra_force_products);
         // The velocity the forces read is taken at the sample from the last two intervals'
         // motions ([`super::extra_force`]), as the acceleration is.

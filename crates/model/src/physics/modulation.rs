@@ -58,6 +58,7 @@ pub const MODULATABLE: &[u32] = &[
     vr::P1_SENSOR_GAIN,
     vr::P2_SENSOR_OFFSET,
     vr::P2_SENSOR_GAIN,
+    vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
 ];
 
 const VOLUME_JUMP: &str = "a chamber volume that changed from one step to the next would keep its pressure, creating or destroying air, where a moved stopper conserves it (P V^gamma); the model has no such jump for a constant";
@@ -92,7 +93,8 @@ const DISCHARGE: &[u32] = &[
     vr::RETURN_AREA_SCALE_2,
 ];
 
-/// The constants that switch on the outputs' general law (friction and the transducers').
+/// The constants that switch on the outputs' general law (friction, the transducers' and the
+/// piston's effective-area error).
 const OUTPUT_LAW: &[u32] = &[
     vr::FRICTION_COULOMB,
     vr::VISCOUS_FRICTION,
@@ -102,6 +104,7 @@ const OUTPUT_LAW: &[u32] = &[
     vr::P1_SENSOR_GAIN,
     vr::P2_SENSOR_OFFSET,
     vr::P2_SENSOR_GAIN,
+    vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
 ];
 
 /// The constants the outputs at a communication point read, beyond the states: those of
@@ -117,6 +120,7 @@ const OUTPUTS: &[u32] = &[
     vr::P2_SENSOR_GAIN,
     vr::K_SPRING,
     vr::P_R,
+    vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
 ];
 
 /// The stopper velocity at which the sign signal, tanh(v / this), is 0.76.
@@ -374,6 +378,12 @@ pub fn modulates_output_law(p: &Parameters) -> bool {
 /// Whether a slot modulates a friction: the stopper's motion is then formed at each sample.
 pub fn modulates_friction(p: &Parameters) -> bool {
     modulates_any_of(p, &[vr::FRICTION_COULOMB, vr::VISCOUS_FRICTION])
+}
+
+/// Whether a slot modulates a coefficient of the extra force's library (the library's terms
+/// are then formed even where the coefficient's nominal value is 0).
+pub fn modulates_extra_force(p: &Parameters) -> bool {
+    modulates_any_of(p, &[vr::EXTRA_FORCE_PRESSURE_DIFFERENCE])
 }
 
 /// Whether a slot modulates a constant the outputs read.

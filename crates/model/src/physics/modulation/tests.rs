@@ -484,3 +484,40 @@ fn model_exchange_and_the_linearisation_are_told_which_slot_they_refuse() {
     );
     assert!(crate::linearize(&Actuator::new(Parameters::default()).unwrap(), 2.0, 0.054).is_ok());
 }
+
+#[test]
+fn an_effective_area_error_modulated_by_the_pressure_difference_adds_its_force_and_leaves_the_pressures() {
+    let slot = Slot::through(
+        vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
+        ModulationSignal::PressureDifference,
+        &[-3e5, 3e5],
+        &[-1e-5, 1e-5],
+    );
+    let with = run(&with_slot(slot));
+    let without = run(&Parameters::default());
+    let p = Parameters::default();
+    let (mut largest, mut checked) = (0.0_f64, 0);
+    for (a, b) in with.iter().zip(&without) {
+        assert_eq!((a[2], a[3]), (b[2], b[3]), "the pressures are the thesis model's");
+        // Where the spring's floor holds the force (§2.7) the area error does not show.
+        let x_s = 0.054 + 0.005 * (2.0 * std::f64::consts::PI * 5.0 * a[0]).sin();
+        let floor = crate::physics::piston::spring_force(p.k_spring, p.l_spring0, p.l_s, p.l_p, x_s);
+        if a[1].min(b[1]) < floor + 0.1 {
+            continue;
+        }
+        let difference = a[2] - a[3];
+        let area_error = 1e-5 * (difference / 3e5).clamp(-1.0, 1.0);
+        let added = a[1] - b[1];
+        assert!(
+            (added - area_error * difference).abs() < 1e-9 * b[1].abs().max(1.0),
+            "{added} N against {} N at {:?} and {:?}",
+            area_error * difference,
+            a,
+            b
+        );
+        largest = largest.max(added.abs());
+        checked += 1;
+    }
+    assert!(checked > 150, "{checked} of 300 samples above the spring's floor");
+    assert!(largest > 0.1, "the slot moved the force by {largest} N");
+}
