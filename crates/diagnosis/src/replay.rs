@@ -19,8 +19,12 @@ pub const START_READINGS: usize = 4;
 
 /// The chamber pressures (Pa) at the recording's first sample as `model`'s transducers read
 /// them: the mean of the first [`START_READINGS`] readings of each, taken back through the
-/// transducer's law. `None` without pressure channels, or where a law has no inverse or the
-/// pressures would not be positive.
+/// transducer's static law. A lag or a delay of the reading is left out: the replay starts
+/// from rest, where a transducer's memory holds what it reads, and the law's inverse would
+/// differentiate the readings, which over four samples is their noise times the lag over
+/// the sampling interval (an 11 ms lag read at 2 kHz started the chambers kPa away and made
+/// the model with the lag worse over its first tenth of a second). `None` without pressure
+/// channels, or where a law has no inverse or the pressures would not be positive.
 pub fn start_pressures(model: &Actuator, recording: &Recording) -> Option<[f64; 2]> {
     let k = START_READINGS.min(recording.len());
     if k == 0 {
@@ -29,7 +33,11 @@ pub fn start_pressures(model: &Actuator, recording: &Recording) -> Option<[f64; 
     let time = &recording.time[..k];
     let back = |channel: Channel, readings: &Option<Vec<f64>>| -> Option<f64> {
         let readings = &readings.as_ref()?[..k];
-        let law = SensorLaw::of(&model.params, channel);
+        let law = SensorLaw {
+            lag: 0.0,
+            delay: 0.0,
+            ..SensorLaw::of(&model.params, channel)
+        };
         let pressures = if law.is_identity() {
             readings.to_vec()
         } else {
@@ -362,6 +370,31 @@ mod tests {
             replay(&model, &recording, 1e-6, 1).unwrap().p2[0],
             settled.outputs().p2_meas
         );
+    }
+
+    #[test]
+    fn a_lagging_transducer_is_taken_back_through_its_static_law_as_a_transducer_at_rest() {
+        // Readings at 1 kHz with ±400 Pa of noise (alternating, the worst case for a
+        // difference) through an 11 ms lag and an offset: the law's inverse would add
+        // 11 × 800 Pa / 2 of their noise to the start.
+        let mut recording = protocol_of(200);
+        let noisy = |level: f64| -> Vec<f64> {
+            (0..200)
+                .map(|k| level + if k % 2 == 0 { 400.0 } else { -400.0 })
+                .collect()
+        };
+        recording.p1 = Some(noisy(4.0e5));
+        recording.p2 = Some(noisy(2.0e5));
+        let model = Actuator::new(Parameters {
+            p1_sensor_lag: 11e-3,
+            p1_sensor_delay: 3e-3,
+            p1_sensor_offset: 5e3,
+            ..Parameters::default()
+        })
+        .unwrap();
+        let start = start_pressures(&model, &recording).expect("pressure channels");
+        assert!((start[0] - (4.0e5 - 5e3)).abs() < 1e-6, "{start:?}");
+        assert!((start[1] - 2.0e5).abs() < 1e-6, "{start:?}");
     }
 
     #[test]
