@@ -13,10 +13,13 @@
 //!
 //! The slew limit, the lag and the filter act on the command as it is held between communication
 //! points (a sampled D/A stage): the FMU stepped at a recording's sample times and the
-//! replay of that recording see the same command. The lag's output is held over a step; the
-//! filter's moves linearly from its value at the step's start to its value at the step's end
-//! ([`CommandStage::rate_over`]), or, where the filter is fast beside the step, through its
-//! exact values at up to [`MAX_FILTER_PIECES`] nodes within it ([`CommandStage::pieces_over`]).
+//! replay of that recording see the same command. The output of the last of them, the filter's
+//! or else the lag's, moves linearly from its value at the step's start to its exact value at
+//! the step's end ([`CommandStage::rate_over`]), or, where it is fast beside the step, through
+//! its exact values at up to [`MAX_FILTER_PIECES`] nodes within it
+//! ([`CommandStage::pieces_over`]). Held over the step instead, a 5.8 ms lag sampled at
+//! 500 Hz reached the driver about a step late, and a fit took 3.2 ms for it. With both on,
+//! the filter's input is the lag's output held over each step.
 
 use super::current_driver;
 use super::parameters::Parameters;
@@ -130,8 +133,12 @@ impl CommandStage {
     /// The rate (V/s) at which the command the driver sees moves over the next `step` seconds:
     /// with the second-order filter on, from its output now to its output at the step's end,
     /// its input held (the filter's exact response at both ends, linear between, rather than
-    /// held, which would lag it by half a step); 0 otherwise, the command held.
+    /// held, which would lag it by half a step); with the lag alone, the same of the lag;
+    /// 0 otherwise, the command held.
     pub fn rate_over(&self, p: &Parameters, step: f64) -> f64 {
+        if p.command_filter_frequency <= 0.0 && p.command_lag > 0.0 && step > 0.0 {
+            return (self.lagged_after(p, step) - self.lagged) / step;
+        }
         if p.command_filter_frequency > 0.0 && step > 0.0 {
             let input = self.unfiltered(p);
             let (end, _) = second_order_step(
@@ -155,8 +162,11 @@ impl CommandStage {
     /// one ramp over the whole step does ([`Self::rate_over`]). A 460 Hz filter ramped over
     /// the 4 ms of a 250 Hz sample reached its input 2 ms late, where it takes 0.5 ms.
     pub fn pieces_over(&self, p: &Parameters, step: f64) -> Option<smallvec::SmallVec<[(f64, f64, f64); 2]>> {
-        if p.command_filter_frequency <= 0.0 || step.is_nan() || step <= 0.0 {
+        if step.is_nan() || step <= 0.0 {
             return None;
+        }
+        if p.command_filter_frequency <= 0.0 {
+            return self.lag_pieces_over(p, step);
         }
         let pieces = (4.0 * p.command_filter_frequency * step)
             .ceil()
@@ -179,6 +189,40 @@ impl CommandStage {
                 input,
                 input,
             );
+            let duration = until - elapsed;
+            out.push((duration, value, (end - value) / duration));
+            value = end;
+            elapsed = until;
+        }
+        Some(out)
+    }
+
+    /// The lag's output `after` seconds past the last communication point, its input held:
+    /// the exact solution of the first-order lag.
+    fn lagged_after(&self, p: &Parameters, after: f64) -> f64 {
+        self.lagged + (1.0 - (-after / p.command_lag).exp()) * (self.held - self.lagged)
+    }
+
+    /// With the lag on (and no filter after it) and fast beside `step` (the step longer than
+    /// a quarter of the lag), the command the driver sees over the step as linear pieces
+    /// between the lag's exact values, each at most a quarter of the lag long and at most
+    /// [`MAX_FILTER_PIECES`] of them; `None` when one ramp does ([`Self::rate_over`]). The
+    /// chord of an exponential over a quarter of its time constant departs from it by less
+    /// than 1/128 of the way it moves.
+    fn lag_pieces_over(&self, p: &Parameters, step: f64) -> Option<smallvec::SmallVec<[(f64, f64, f64); 2]>> {
+        if p.command_lag <= 0.0 {
+            return None;
+        }
+        let pieces = (4.0 * step / p.command_lag).ceil().min(MAX_FILTER_PIECES as f64);
+        if pieces < 2.0 {
+            return None;
+        }
+        let pieces = pieces as usize;
+        let mut out = smallvec::SmallVec::new();
+        let (mut value, mut elapsed) = (self.lagged, 0.0);
+        for k in 1..=pieces {
+            let until = step * k as f64 / pieces as f64;
+            let end = self.lagged_after(p, until);
             let duration = until - elapsed;
             out.push((duration, value, (end - value) / duration));
             value = end;
@@ -377,5 +421,49 @@ mod tests {
         let v = static_map(&p, 10.0);
         assert!((current_driver::static_current(p.k_cd, p.i_offset, v) - 0.2).abs() < 1e-12);
         assert_eq!(static_map(&p, 1.0), 1.0);
+    }
+
+    /// A 5.8 ms lag over the 2 ms and 4 ms steps of 500 Hz and 250 Hz recordings: the driver
+    /// sees the lag's continuous response to the step applied at the step's start, not its
+    /// value at the start held.
+    #[test]
+    fn a_lag_moves_within_the_step_along_its_exponential() {
+        let lag = 5.8e-3;
+        let p = Parameters {
+            command_lag: lag,
+            ..Parameters::default()
+        };
+        for step in [2e-3, 4e-3, 1e-4] {
+            let mut stage = CommandStage::at_rest(&p, 0.0, 0.0);
+            stage.next(&p, 0.0, 3.0);
+            let exact = |s: f64| 3.0 * (1.0 - (-s / lag).exp());
+            let seen: Vec<(f64, f64, f64)> = match stage.pieces_over(&p, step) {
+                Some(pieces) => pieces.to_vec(),
+                None => vec![(step, stage.current(&p), stage.rate_over(&p, step))],
+            };
+            let mut start = 0.0;
+            for (duration, value, rate) in seen {
+                assert!(
+                    duration <= 0.25 * lag + 1e-15 || step < 0.25 * lag,
+                    "{step}: {duration}"
+                );
+                assert!((value - exact(start)).abs() < 1e-12, "{step}, at {start}: {value}");
+                for j in 1..=4 {
+                    let s = duration * j as f64 / 4.0;
+                    let chord = value + rate * s;
+                    // Chord and exponential part by at most (duration/lag)²/8 of the move.
+                    let bound = 3.0 * (duration / lag).powi(2) / 8.0 + 1e-12;
+                    assert!(
+                        (chord - exact(start + s)).abs() <= bound,
+                        "{step}, at {}: {chord}",
+                        start + s
+                    );
+                }
+                start += duration;
+            }
+            assert!((start - step).abs() < 1e-15);
+            // The next communication point holds the lag's exact value.
+            assert!((stage.next(&p, step, 3.0) - exact(step)).abs() < 1e-12);
+        }
     }
 }
