@@ -580,3 +580,34 @@ fn the_extra_force_products_add_their_formula_to_the_measured_force_and_bad_code
         "{e}"
     );
 }
+
+#[test]
+fn a_transducer_faster_than_the_communication_step_reads_the_same_at_coarse_and_fine_steps() {
+    // A 1 ms force-sensor lag stepped at 8 ms and at 0.1 ms after a command step: at the
+    // coarse points the readings agree with the fine run's, where a memory recorded only at
+    // the 8 ms points would read the force's rise as a chord between them.
+    let model = with(|p| p.force_sensor_lag = 1e-3);
+    let run = |step: f64, points: usize| -> Vec<f64> {
+        let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
+        sim.set_command(6.0).unwrap();
+        let mut out = vec![];
+        for k in 1..=points {
+            sim.step(step).unwrap();
+            if k % ((8e-3 / step).round() as usize) == 0 {
+                out.push(sim.outputs().f_meas);
+            }
+        }
+        out
+    };
+    let coarse = run(8e-3, 10);
+    let fine = run(1e-4, 800);
+    let rise = fine.last().unwrap() - fine[0];
+    assert!(rise > 5.0, "the force rose by {rise} N");
+    for (k, (c, f)) in coarse.iter().zip(&fine).enumerate() {
+        assert!(
+            (c - f).abs() < 2e-3 * rise,
+            "at {} ms: {c} N against {f} N",
+            8 * (k + 1)
+        );
+    }
+}
