@@ -21,10 +21,13 @@ ROOT = Path(__file__).resolve().parent.parent
 BIN = ROOT / "target" / "release"
 
 
-def stopper_positions(x):
-    """The report's `stopper_positions`: x_s smoothed over samples k-3..k+3 with the weights
-    (-2, 3, 6, 7, 6, 3, -2)/21, the recorded positions at the first and last three samples."""
+def stopper_positions(x, smoothed):
+    """The report's `stopper_positions`: where `stopper_positions_smoothed` (1 kHz and faster),
+    x_s smoothed over samples k-3..k+3 with the weights (-2, 3, 6, 7, 6, 3, -2)/21, the
+    recorded positions at the first and last three samples; else x_s as recorded."""
     x = np.asarray(x, dtype=float)
+    if not smoothed:
+        return x.copy()
     weights = np.array([-2.0, 3.0, 6.0, 7.0, 6.0, 3.0, -2.0]) / 21.0
     out = x.copy()
     for k in range(3, len(x) - 3):
@@ -32,11 +35,12 @@ def stopper_positions(x):
     return out
 
 
-def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, outputs=("F_meas",)):
+def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, smoothed, outputs=("F_meas",)):
     """The FMU's `outputs` at every sample of the recording (one array, or a tuple of them),
-    the stopper driven with the positions the diagnosis replays."""
+    the stopper driven with the positions the diagnosis replays (`smoothed`: the report's
+    `stopper_positions_smoothed`)."""
     fmu = make_slave(unzipdir, model_description)
-    t, v, x = recording["time_s"], recording["v_da_V"], stopper_positions(recording["x_s_m"])
+    t, v, x = recording["time_s"], recording["v_da_V"], stopper_positions(recording["x_s_m"], smoothed)
     try:
         # The report's start values are Reals but for start_at_equilibrium, a Boolean (false
         # where the replays started the chambers at the pressures first read).
@@ -78,7 +82,7 @@ def generated_and_diagnosed(tmp_path, name, *benchgen_args):
 def force_errors_through_fmu(unzipdir, model_description, vrs, recording, report, name):
     """The force's RMS error with the report's start values through the FMU, the one the
     report gives after, and the one before."""
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"])
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported, before = report["after"]["force_rms_N"], report["before"]["force_rms_N"]
     print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; before {before:.4f} N")
@@ -89,7 +93,7 @@ def force_errors_through_fmu(unzipdir, model_description, vrs, recording, report
 def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description, vrs, tmp_path):
     recording, report = generated_and_diagnosed(tmp_path, "friction", "--seed", "31", "--friction-coulomb", "2.5")
     assert [e["name"] for e in report["effects"]][:1] == ["piston_friction"], report["effects"]
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"])
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
@@ -129,7 +133,7 @@ def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
     start_values = report["fmu_start_values"]
     assert start_values.get("hysteresis_exponent", 0) > 0, start_values
     assert start_values.get("hysteresis_start", 0) < -0.5, start_values
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values)
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"])
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
@@ -149,7 +153,7 @@ def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors
     assert report["effects"] == [], report["effects"]
     assert parameter in report["discovered"][0]["parameters"], report["discovered"]
     assert report["discovered"][0]["location"] == "pressure_sensors", report["discovered"]
-    p1, p2 = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"],
+    p1, p2 = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"],
                                 outputs=("P1_meas", "P2_meas"))
     through_fmu = [float(np.sqrt(np.mean((recording[c] - p) ** 2))) for c, p in (("p1_Pa", p1), ("p2_Pa", p2))]
     reported = report["after"]["pressure_rms_Pa"]
@@ -174,7 +178,7 @@ def test_fmu_start_values_of_an_extra_force_on_the_piston_reproduce_the_after_er
                                                 "--seed", "5", "--force-noise", "0.03", *args)
     assert report["discovered"][0]["location"] == "mechanics", report["discovered"]
     assert parameter in report["fmu_start_values"], report["fmu_start_values"]
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"])
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"])
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; "
@@ -198,7 +202,7 @@ def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
     start_values = report["fmu_start_values"]
     assert start_values.get(f"{prefix}_knots", 0) >= 3, start_values
     assert report["discovered"][0]["family"] == "limit", report["discovered"]
-    read = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, outputs=outputs)
+    read = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"], outputs=outputs)
     if outputs == ("F_meas",):
         rms = float(np.sqrt(np.mean((recording["force_N"] - read) ** 2)))
         reported = report["after"]["force_rms_N"]

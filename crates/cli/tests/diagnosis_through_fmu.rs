@@ -20,9 +20,13 @@ use synthetic_bench::{
     generate_protocol_with, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
 };
 
-/// The report's `stopper_positions`: x_s smoothed over samples k-3..k+3 with the weights
-/// (-2, 3, 6, 7, 6, 3, -2)/21, the recorded positions at the first and last three samples.
-fn stopper_positions(x: &[f64]) -> Vec<f64> {
+/// The report's `stopper_positions`: where `stopper_positions_smoothed`, x_s smoothed over
+/// samples k-3..k+3 with the weights (-2, 3, 6, 7, 6, 3, -2)/21, the recorded positions at
+/// the first and last three samples; else x_s as recorded.
+fn stopper_positions(x: &[f64], smoothed: bool) -> Vec<f64> {
+    if !smoothed {
+        return x.to_vec();
+    }
     let n = x.len();
     let weights = [-2.0, 3.0, 6.0, 7.0, 6.0, 3.0, -2.0];
     (0..n)
@@ -35,10 +39,11 @@ fn stopper_positions(x: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// F_meas at every sample of `recording` from the FMU with `start_values` set.
-fn replayed_force(recording: &Recording, start_values: &[(u32, f64)]) -> Vec<f64> {
+/// F_meas at every sample of `recording` from the FMU with `start_values` set, the stopper
+/// driven with the positions the diagnosis replayed.
+fn replayed_force(recording: &Recording, start_values: &[(u32, f64)], smoothed: bool) -> Vec<f64> {
     let (t, v) = (&recording.time, &recording.v_da);
-    let x = stopper_positions(&recording.x_s);
+    let x = stopper_positions(&recording.x_s, smoothed);
     let sink = Sink::default();
     let mut force = Vec::with_capacity(t.len());
     unsafe {
@@ -127,7 +132,8 @@ fn the_fmu_with_the_start_values_of_a_drifting_gas_temperature_reproduces_the_re
         "no T_drift among {:?}",
         report["fmu_start_values"]
     );
-    let force = replayed_force(&recording, &start_values);
+    let smoothed = report["stopper_positions_smoothed"].as_bool().unwrap();
+    let force = replayed_force(&recording, &start_values, smoothed);
     let n = force.len() as f64;
     let rms = (force
         .iter()

@@ -384,6 +384,9 @@ pub struct Diagnosis {
     /// The chamber pressures the final model's replay started from, where the recording has
     /// pressure channels ([`replay::start_pressures`]); at the equilibrium otherwise.
     pub start_pressures: Option<[f64; 2]>,
+    /// Whether the replays drove the stopper with the smoothed positions
+    /// ([`recording::Recording::with_stopper_smoothed`]) or the recorded ones.
+    pub stopper_smoothed: bool,
 }
 
 pub use split::PressureSplit;
@@ -848,6 +851,23 @@ pub(crate) fn refit_jointly(
     Ok(Some((before_joint, after_joint)))
 }
 
+/// A discovered term whose constants all stand at the model's defaults (a compliance
+/// refitted to its bound of 0) is not in the model: what the round that added it gained came
+/// from the constants refitted beside it. It is not reported.
+fn drop_terms_at_defaults(found: &mut rounds::Findings, progress: &mut dyn FnMut(&str)) {
+    let params = &found.params;
+    found.discovered.retain(|d| {
+        let off = !d.parameters.is_empty()
+            && d.parameters
+                .iter()
+                .all(|(name, _)| parameter_value(params, name) == parameter_value(&Parameters::default(), name));
+        if off {
+            progress(&format!("  {} stands at its defaults: not reported", d.candidate));
+        }
+        !off
+    });
+}
+
 /// After the joint refit: a named effect the refit turned off (its amplitude at zero:
 /// another term took over what it explained) is no longer there, and the others report
 /// their refitted values.
@@ -896,6 +916,7 @@ fn conclude(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
     let (full, noise) = (cx.full, cx.noise);
+    drop_terms_at_defaults(&mut found, progress);
     // The reported figures come from the accurate, error-controlled replay of every sample.
     progress("final replays with the error-controlled integrator");
     let (before_model, before, fast_replay) = start;
@@ -986,6 +1007,7 @@ fn conclude(
         withdrawn,
         fast_replay,
         start_pressures: replay::start_pressures(&final_model, full),
+        stopper_smoothed: recording::stopper_smoothing_applies(&full.time),
     })
 }
 

@@ -191,7 +191,12 @@ impl Diagnosis {
             })).collect::<Vec<_>>(),
             "residual_tests": self.residual_tests,
             "fmu_start_values": start_values,
-            "stopper_positions": "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21 (the recorded positions at the first and last three samples), as the FMU must be to reproduce these errors",
+            "stopper_positions": if self.stopper_smoothed {
+                "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21 (the recorded positions at the first and last three samples), as the FMU must be to reproduce these errors"
+            } else {
+                "the model was driven with x_s_m as recorded (sampled every 1.5 ms or slower, where the smoothing applied at faster rates would round the motion's corners), as the FMU must be to reproduce these errors"
+            },
+            "stopper_positions_smoothed": self.stopper_smoothed,
             "joint_refit": self.joint_refit.map(|(a, b)| json!({"heldout_before_rms_N": a, "heldout_after_rms_N": b})),
             "withdrawn": self.withdrawn.as_ref().map(|w| json!({
                 "names": w.names,

@@ -9,6 +9,7 @@ use crate::replay::Replay;
 use crate::signals::{chamber_pressures, difference, rms};
 use crate::EXPLAINED_WITHIN_NOISE;
 use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 
 /// The pressure channels' split of the chain.
 #[derive(Clone, Debug)]
@@ -93,9 +94,23 @@ pub(crate) fn pressure_split(
             .collect();
         rms(&kept)
     };
-    let mechanical = after_start(&difference(&recording.force, &from_pressures));
+    // The force the sensor's law read, taken back through it (an offset and a gain the model
+    // has are not a departure of the force from the pressures), with the noise it then carries.
+    let force_law = SensorLaw::of(&model.params, Channel::Force);
+    let (force, force_noise) = match (!force_law.is_identity())
+        .then(|| force_law.unread(&recording.time, &recording.force))
+        .flatten()
+    {
+        Some(force) => {
+            let floor = noise_floor(&force).max(noise / force_law.gain.abs().max(1e-12));
+            (force, floor)
+        }
+        None => (recording.force.clone(), noise),
+    };
+    let mechanical = after_start(&difference(&force, &from_pressures));
     let area = model.piston_area;
-    let mechanical_noise = (noise * noise + area * area * (chamber_noise[0].powi(2) + chamber_noise[1].powi(2))).sqrt();
+    let mechanical_noise =
+        (force_noise * force_noise + area * area * (chamber_noise[0].powi(2) + chamber_noise[1].powi(2))).sqrt();
     let pressure_rms = [
         after_start(&difference(p1, &replay.p1)),
         after_start(&difference(p2, &replay.p2)),
@@ -307,5 +322,36 @@ mod tests {
             split.force_vs_pressures_ratio
         );
         assert!(!split.departure_after_the_pressures());
+    }
+
+    #[test]
+    fn a_force_read_through_the_models_sensor_offset_and_gain_agrees_with_the_pressures() {
+        let model = Actuator::new(Parameters {
+            force_sensor_offset: 0.5,
+            force_sensor_gain: 1.03,
+            ..Parameters::default()
+        })
+        .unwrap();
+        let (mut recording, replay) = recording_and_replay(&model, 300.0, 0, 0.0);
+        for f in recording.force.iter_mut() {
+            *f = 0.5 + 1.03 * *f;
+        }
+        let blocks = vec![Block::Training; 1000];
+        let split = pressure_split(&model, &recording, &replay, 0.05, [300.0, 300.0], &blocks).unwrap();
+        // The pressures' alternating noise, opposite in the two, is all that is left.
+        assert!(
+            split.force_vs_pressures_ratio <= crate::EXPLAINED_WITHIN_NOISE,
+            "{}",
+            split.force_vs_pressures_ratio
+        );
+        assert!(!split.departure_after_the_pressures());
+        // The same readings against a model without the sensor's law depart.
+        let plain = Actuator::new(Parameters::default()).unwrap();
+        let split = pressure_split(&plain, &recording, &replay, 0.05, [300.0, 300.0], &blocks).unwrap();
+        assert!(
+            split.force_vs_pressures_ratio > 1.5,
+            "{}",
+            split.force_vs_pressures_ratio
+        );
     }
 }
