@@ -756,7 +756,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(0.1)
         .cite("(2.32)")
         .because("0.1 s: a mount that slow is no stiffness any more but a second actuator"),
-    parameter("command_lag", vr::COMMAND_LAG, "s", 0.0, "command dynamics: the current driver sees v_DA through a first-order lag of this time constant, updated at each communication point with the command held over the step (0 = off)")
+    parameter("command_lag", vr::COMMAND_LAG, "s", 0.0, "command dynamics: the current driver sees v_DA through a first-order lag of this time constant, its input the command held over each communication step, its output moving along its exact response within the step (linearly between exact values at most a quarter of the lag apart) (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("(2.1)")
         .because("1 s: a lag that long is no D/A stage any more"),
@@ -800,7 +800,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1000.0).at_most(1000.0)
         .cite("")
         .because("1000 N/s: nine times the largest force every second"),
-    parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between communication points (0 = off)")
+    parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: a sensor that slow reads no dynamics at all"),
@@ -824,7 +824,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1000.0).at_most(1000.0)
         .cite("")
         .because("1000 N: nine times the largest force"),
-    parameter("force_sensor_filter_frequency", vr::FORCE_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "force sensor dynamics: F_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between communication points (0 = off)")
+    parameter("force_sensor_filter_frequency", vr::FORCE_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "force sensor dynamics: F_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("")
         .because(FILTER_FREQUENCY),
@@ -904,7 +904,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1e5).at_most(1e5)
         .cite("")
         .because("1e5 Pa/s: the supply's gauge pressure in under six seconds"),
-    parameter("p1_sensor_lag", vr::P1_SENSOR_LAG, "s", 0.0, "pressure transducer 1: P1_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between communication points (0 = off)")
+    parameter("p1_sensor_lag", vr::P1_SENSOR_LAG, "s", 0.0, "pressure transducer 1: P1_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: a transducer that slow reads no dynamics at all"),
@@ -912,7 +912,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: as the command delay"),
-    parameter("p1_sensor_filter_frequency", vr::P1_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 1: P1_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between communication points (0 = off)")
+    parameter("p1_sensor_filter_frequency", vr::P1_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 1: P1_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("")
         .because(FILTER_FREQUENCY),
@@ -932,7 +932,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1e5).at_most(1e5)
         .cite("")
         .because("1e5 Pa/s: the supply's gauge pressure in under six seconds"),
-    parameter("p2_sensor_lag", vr::P2_SENSOR_LAG, "s", 0.0, "pressure transducer 2: P2_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between communication points (0 = off)")
+    parameter("p2_sensor_lag", vr::P2_SENSOR_LAG, "s", 0.0, "pressure transducer 2: P2_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: a transducer that slow reads no dynamics at all"),
@@ -940,7 +940,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: as the command delay"),
-    parameter("p2_sensor_filter_frequency", vr::P2_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 2: P2_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between communication points (0 = off)")
+    parameter("p2_sensor_filter_frequency", vr::P2_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 2: P2_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("")
         .because(FILTER_FREQUENCY),
