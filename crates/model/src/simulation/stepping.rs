@@ -241,9 +241,12 @@ impl Simulation {
     ) -> Result<(), StepFailure> {
         let part = step / parts as f64;
         let slack = 1e-9 * step;
-        let velocity = self.stopper_velocity;
+        // The forces the transducers read within the step take the step's own velocity; the
+        // last interval's is back for the step's end, failed or not.
+        let velocity = std::mem::replace(&mut self.stopper_velocity, self.x_s_rate);
         let (mut elapsed, mut next_record) = (0.0, part);
-        for &(duration, v, v_rate) in segments {
+        let mut result = Ok(());
+        'segments: for &(duration, v, v_rate) in segments {
             let mut done = 0.0;
             while duration - done > slack {
                 let piece = if duration - done <= next_record - elapsed + slack {
@@ -251,11 +254,13 @@ impl Simulation {
                 } else {
                     next_record - elapsed
                 };
-                self.advance_or_drop_the_rates(piece, v + v_rate * done, v_rate)?;
+                result = self.advance_or_drop_the_rates(piece, v + v_rate * done, v_rate);
+                if result.is_err() {
+                    break 'segments;
+                }
                 done += piece;
                 elapsed += piece;
                 if elapsed >= next_record - slack && next_record < step - slack {
-                    self.stopper_velocity = self.x_s_rate;
                     let mut y = self.outputs_at_sample();
                     self.record_transducers(&mut y);
                     next_record += part;
@@ -263,7 +268,7 @@ impl Simulation {
             }
         }
         self.stopper_velocity = velocity;
-        Ok(())
+        result
     }
 
     /// Record the transducers' static readings in `y` (at the simulation's time) in the
