@@ -35,12 +35,27 @@ def stopper_positions(x, smoothed):
     return out
 
 
-def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, smoothed, outputs=("F_meas",)):
+def stopper_accelerations(t, x, half_width):
+    """The report's `stopper_acceleration_input` recipe: (x(t+T) - 2 x(t) + x(t-T)) / T^2, x
+    linear between samples, T shrunk to the time left near the ends, 0 at the first and last."""
+    t, x = np.asarray(t, dtype=float), np.asarray(x, dtype=float)
+    half = np.minimum(half_width, np.minimum(t - t[0], t[-1] - t))
+    a = np.zeros_like(x)
+    inner = half > 0
+    h = half[inner]
+    a[inner] = (np.interp(t[inner] + h, t, x) - 2.0 * x[inner] + np.interp(t[inner] - h, t, x)) / (h * h)
+    return a
+
+
+def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, smoothed, outputs=("F_meas",),
+                       acceleration=None):
     """The FMU's `outputs` at every sample of the recording (one array, or a tuple of them),
     the stopper driven with the positions the diagnosis replays (`smoothed`: the report's
-    `stopper_positions_smoothed`)."""
+    `stopper_positions_smoothed`) and, where the report's `stopper_acceleration_input`
+    (`acceleration`) says so, its acceleration fed to the input a_s."""
     fmu = make_slave(unzipdir, model_description)
     t, v, x = recording["time_s"], recording["v_da_V"], stopper_positions(recording["x_s_m"], smoothed)
+    a = None if acceleration is None else stopper_accelerations(t, x, acceleration["half_width_s"])
     try:
         # The report's start values are Reals but for start_at_equilibrium, a Boolean (false
         # where the replays started the chambers at the pressures first read).
@@ -48,7 +63,9 @@ def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values
         booleans = {n: value for n, value in start_values.items() if isinstance(value, bool)}
         initialize(fmu, vrs, inputs=(v[0], x[0]), parameters=reals, booleans=booleans)
         read = np.empty((len(outputs), len(t)))
-        vr_v, vr_x, vr_out = [vrs["v_DA"]], [vrs["x_s"]], [vrs[name] for name in outputs]
+        vr_v, vr_x, vr_a, vr_out = [vrs["v_DA"]], [vrs["x_s"]], [vrs["a_s"]], [vrs[name] for name in outputs]
+        if a is not None:
+            fmu.setReal(vr_a, [a[0]])
         for k in range(len(t)):
             read[:, k] = fmu.getReal(vr_out)
             if k + 1 == len(t):
@@ -56,6 +73,8 @@ def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values
             dt = t[k + 1] - t[k]
             fmu.setReal(vr_v, [v[k]])
             fmu.setRealInputDerivatives(vr_x, [1], [(x[k + 1] - x[k]) / dt])
+            if a is not None:
+                fmu.setRealInputDerivatives(vr_a, [1], [(a[k + 1] - a[k]) / dt])
             fmu.doStep(currentCommunicationPoint=t[k], communicationStepSize=dt)
         return read[0] if len(outputs) == 1 else tuple(read)
     finally:
@@ -82,7 +101,7 @@ def generated_and_diagnosed(tmp_path, name, *benchgen_args):
 def force_errors_through_fmu(unzipdir, model_description, vrs, recording, report, name):
     """The force's RMS error with the report's start values through the FMU, the one the
     report gives after, and the one before."""
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"])
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported, before = report["after"]["force_rms_N"], report["before"]["force_rms_N"]
     print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; before {before:.4f} N")
@@ -93,7 +112,7 @@ def force_errors_through_fmu(unzipdir, model_description, vrs, recording, report
 def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description, vrs, tmp_path):
     recording, report = generated_and_diagnosed(tmp_path, "friction", "--seed", "31", "--friction-coulomb", "2.5")
     assert [e["name"] for e in report["effects"]][:1] == ["piston_friction"], report["effects"]
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"])
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
@@ -133,7 +152,7 @@ def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
     start_values = report["fmu_start_values"]
     assert start_values.get("hysteresis_exponent", 0) > 0, start_values
     assert start_values.get("hysteresis_start", 0) < -0.5, start_values
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"])
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
@@ -154,7 +173,7 @@ def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors
     assert parameter in report["discovered"][0]["parameters"], report["discovered"]
     assert report["discovered"][0]["location"] == "pressure_sensors", report["discovered"]
     p1, p2 = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"],
-                                outputs=("P1_meas", "P2_meas"))
+                                outputs=("P1_meas", "P2_meas"), acceleration=report.get("stopper_acceleration_input"))
     through_fmu = [float(np.sqrt(np.mean((recording[c] - p) ** 2))) for c, p in (("p1_Pa", p1), ("p2_Pa", p2))]
     reported = report["after"]["pressure_rms_Pa"]
     before = report["before"]["pressure_rms_Pa"]
@@ -178,7 +197,10 @@ def test_fmu_start_values_of_an_extra_force_on_the_piston_reproduce_the_after_er
                                                 "--seed", "5", "--force-noise", "0.03", *args)
     assert report["discovered"][0]["location"] == "mechanics", report["discovered"]
     assert parameter in report["fmu_start_values"], report["fmu_start_values"]
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"])
+    # A force on the stopper's motion reads the acceleration the report says how to form.
+    assert report["fmu_start_values"]["stopper_acceleration_input_share"] == 1.0
+    assert report["stopper_acceleration_input"]["half_width_s"] > 0
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; "
@@ -202,7 +224,7 @@ def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
     start_values = report["fmu_start_values"]
     assert start_values.get(f"{prefix}_knots", 0) >= 3, start_values
     assert report["discovered"][0]["family"] == "limit", report["discovered"]
-    read = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"], outputs=outputs)
+    read = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"], outputs=outputs, acceleration=report.get("stopper_acceleration_input"))
     if outputs == ("F_meas",):
         rms = float(np.sqrt(np.mean((recording["force_N"] - read) ** 2)))
         reported = report["after"]["force_rms_N"]

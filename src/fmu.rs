@@ -45,6 +45,14 @@ pub fn extent(value_reference: u32) -> Extent {
                 nominal: scale(start(vr::X_S)),
             }
         }
+        vr::A_S => {
+            let v = &jetpipe_model::variables::row(vr::A_S).expect("a_s has a row").variable;
+            Extent {
+                min: v.min,
+                max: v.max,
+                nominal: Some(1.0),
+            }
+        }
         vr::P1 | vr::P2 => Extent {
             min: Some(0.0),
             max: None,
@@ -96,12 +104,12 @@ const DEPENDS: DependencyKind = DependencyKind::Dependent;
 pub const DEPENDENCIES: &[OutputDependencies] = &[
     OutputDependencies {
         output: vr::F_ACT,
-        step: &[(vr::X_S, DEPENDS)],
+        step: &[(vr::X_S, DEPENDS), (vr::A_S, DEPENDS)],
         initial: None,
     },
     OutputDependencies {
         output: vr::F_MEAS,
-        step: &[(vr::X_S, DEPENDS)],
+        step: &[(vr::X_S, DEPENDS), (vr::A_S, DEPENDS)],
         initial: None,
     },
     OutputDependencies {
@@ -204,6 +212,9 @@ pub struct ActuatorFmu {
     x_s: f64,
     v_da_rate: f64,
     x_s_rate: f64,
+    /// The stopper acceleration input and its rate, until initialisation ends.
+    a_s: f64,
+    a_s_rate: f64,
     start_at_equilibrium: bool,
     p1_start: f64,
     p2_start: f64,
@@ -242,6 +253,8 @@ impl ActuatorFmu {
         };
         simulation.set_command_rate(self.v_da_rate)?;
         simulation.set_stopper_rate(self.x_s_rate)?;
+        simulation.set_stopper_acceleration(self.a_s)?;
+        simulation.set_stopper_acceleration_rate(self.a_s_rate)?;
         Ok(simulation)
     }
 
@@ -278,6 +291,10 @@ impl ActuatorFmu {
         match value_reference {
             vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, Simulation::v_da)),
             vr::X_S => Ok(self.simulation.as_ref().map_or(self.x_s, Simulation::x_s)),
+            vr::A_S => Ok(self
+                .simulation
+                .as_ref()
+                .map_or(self.a_s, Simulation::stopper_acceleration_input)),
             vr::F_ACT | vr::F_MEAS | vr::P1 | vr::P2 | vr::P1_MEAS | vr::P2_MEAS | vr::I | vr::X_JP => {
                 let computed;
                 let simulation = match &self.simulation {
@@ -328,6 +345,8 @@ impl CoSimModel for ActuatorFmu {
             x_s: start(vr::X_S),
             v_da_rate: 0.0,
             x_s_rate: 0.0,
+            a_s: start(vr::A_S),
+            a_s_rate: 0.0,
             start_at_equilibrium: start(vr::START_AT_EQUILIBRIUM) != 0.0,
             p1_start: start(vr::P1_START),
             p2_start: start(vr::P2_START),
@@ -396,6 +415,14 @@ impl CoSimModel for ActuatorFmu {
                     Ok(())
                 }
                 None => Err(format!("x_s = {value} m is invalid: must be finite")),
+            },
+            vr::A_S => match &mut self.simulation {
+                Some(s) => s.set_stopper_acceleration(value),
+                None => {
+                    jetpipe_model::variables::check(value_reference, value)?;
+                    self.a_s = value;
+                    Ok(())
+                }
             },
             vr::P1_START | vr::P2_START => {
                 jetpipe_model::variables::check(value_reference, value)?;
@@ -482,7 +509,8 @@ impl CoSimModel for ActuatorFmu {
         match (value_reference, &mut self.simulation) {
             (vr::V_DA, Some(s)) => s.set_command_rate(value),
             (vr::X_S, Some(s)) => s.set_stopper_rate(value),
-            (vr::V_DA | vr::X_S, None) if !value.is_finite() => Err(format!(
+            (vr::A_S, Some(s)) => s.set_stopper_acceleration_rate(value),
+            (vr::V_DA | vr::X_S | vr::A_S, None) if !value.is_finite() => Err(format!(
                 "der({}) = {value} is invalid: must be finite",
                 variable_name(value_reference)
             )),
@@ -492,6 +520,10 @@ impl CoSimModel for ActuatorFmu {
             }
             (vr::X_S, None) => {
                 self.x_s_rate = value;
+                Ok(())
+            }
+            (vr::A_S, None) => {
+                self.a_s_rate = value;
                 Ok(())
             }
             _ => Err(format!("value reference {value_reference} is not an input")),
@@ -537,6 +569,8 @@ impl CoSimModel for ActuatorFmu {
             self.x_s,
             self.v_da_rate,
             self.x_s_rate,
+            self.a_s,
+            self.a_s_rate,
             self.p1_start,
             self.p2_start,
             self.tolerance,
@@ -566,6 +600,8 @@ impl CoSimModel for ActuatorFmu {
         restored.x_s = r.f64()?;
         restored.v_da_rate = r.f64()?;
         restored.x_s_rate = r.f64()?;
+        restored.a_s = r.f64()?;
+        restored.a_s_rate = r.f64()?;
         restored.p1_start = r.f64()?;
         restored.p2_start = r.f64()?;
         restored.tolerance = r.f64()?;
@@ -591,9 +627,9 @@ impl CoSimModel for ActuatorFmu {
 /// restrictions' parameters and the pressures of the gas volumes behind them; version 5: the
 /// interface and the Model Exchange state; version 6: the modulation slots' parameters;
 /// version 7: the laminar chamber leaks and the extra force's product slots; version 8: the
-/// extra flow slots.
+/// extra flow slots; version 9: the stopper acceleration input.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 8, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 9, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped
@@ -680,15 +716,24 @@ mod tests {
 
     #[test]
     fn declared_dependencies_are_what_perturbations_show() {
-        let report = fmi2::structure_check::check_dependencies::<ActuatorFmu>(1e-3);
+        // With a moving mass that reads the stopper acceleration input, which the forces then
+        // follow at once; at the start values it is not read.
+        let settings = [
+            (vr::EXTRA_FORCE_ACCELERATION, -0.2),
+            (vr::STOPPER_ACCELERATION_INPUT_SHARE, 1.0),
+        ];
+        let report = fmi2::structure_check::check_dependencies_with::<ActuatorFmu>(1e-3, &settings);
         assert!(report.problems.is_empty(), "{:#?}", report.problems);
-        // Only the stopper acts within a step, on the pressures and the forces.
+        // Only the stopper acts within a step, on the pressures and the forces, and its
+        // acceleration on the forces.
         let mut pairs = report.step_pairs.clone();
         pairs.sort();
         assert_eq!(
             pairs,
             vec![
+                ("F_act", "a_s"),
                 ("F_act", "x_s"),
+                ("F_meas", "a_s"),
                 ("F_meas", "x_s"),
                 ("P1", "x_s"),
                 ("P1_meas", "x_s"),

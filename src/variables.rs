@@ -534,7 +534,7 @@ mod tests {
             .collect();
         assert_eq!(
             outputs,
-            vec![3, 4, 5, 6, 7, 8, 9, 10],
+            vec![4, 5, 6, 7, 8, 9, 10, 11],
             "F_act, P1, P2, i, F_meas, P1_meas, P2_meas, x_jp"
         );
         for i in outputs {
@@ -544,13 +544,18 @@ mod tests {
             );
         }
         // Within a step only x_s (index 2) acts, on the forces and the pressures as they are
-        // and as read; i and x_jp on nothing.
-        for i in [3, 4, 5, 7, 8, 9] {
+        // and as read, and a_s (index 3) on the forces; i and x_jp on nothing.
+        for i in [4, 8] {
+            assert!(xml.contains(&format!(
+                r#"<Unknown index="{i}" dependencies="2 3" dependenciesKind="dependent dependent"/>"#
+            )));
+        }
+        for i in [5, 6, 9, 10] {
             assert!(xml.contains(&format!(
                 r#"<Unknown index="{i}" dependencies="2" dependenciesKind="dependent"/>"#
             )));
         }
-        for i in [6, 10] {
+        for i in [7, 11] {
             assert!(xml.contains(&format!(
                 r#"<Unknown index="{i}" dependencies="" dependenciesKind=""/>"#
             )));

@@ -154,6 +154,7 @@ mod tests {
             p2: None,
             full_rate: None,
             fast_replay_step: MAX_FAST_STEP,
+            acceleration_window: 0.0,
         };
         let accurate = replay(model, &recording, 1e-7, n).unwrap();
         // Gaussian noise by the sum of twelve uniforms.

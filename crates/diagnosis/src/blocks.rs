@@ -129,6 +129,7 @@ mod tests {
             v_da,
             full_rate: None,
             fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
         }
     }
 

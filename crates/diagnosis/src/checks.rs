@@ -199,6 +199,7 @@ mod tests {
             time,
             full_rate: None,
             fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
         }
     }
 

@@ -19,6 +19,7 @@
 //! The recordings themselves are [`recording`]; [`replay`](mod@replay) runs their inputs
 //! through the model (crate `jetpipe-model`).
 
+pub mod acceleration;
 pub mod agreement;
 mod alternatives;
 mod beside;
@@ -387,6 +388,9 @@ pub struct Diagnosis {
     /// Whether the replays drove the stopper with the smoothed positions
     /// ([`recording::Recording::with_stopper_smoothed`]) or the recorded ones.
     pub stopper_smoothed: bool,
+    /// The half-width (s) of the stopper acceleration the final model reads as its input a_s
+    /// ([`acceleration`]); 0 where it reads none (no force on the stopper's motion).
+    pub acceleration_window: f64,
 }
 
 pub use split::PressureSplit;
@@ -699,6 +703,8 @@ pub fn diagnose_with(
         progress(&sentence);
         input_checks.push(sentence);
     }
+    smoothed.acceleration_window =
+        acceleration::choose_window(&smoothed, &signals::difference(&smoothed.force, &before_accurate.force));
     let fitted = smoothed.rows_for_fits(recording::MAX_FIT_ROWS);
     let cx = Context::measure(&smoothed, &fitted, &before_model, options, &mut input_checks, progress)?;
     let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
@@ -709,11 +715,14 @@ pub fn diagnose_with(
         base,
     )?);
     // 2. The static identification, when asked for.
-    let (params, calibrated) = if options.calibrate {
+    let (mut params, calibrated) = if options.calibrate {
         calibrate_static(&cx, base, progress)
     } else {
         (base.clone(), vec![])
     };
+    // The forces on the stopper's motion read the acceleration smoothed from the recording
+    // (a model without such a force reads none: the share goes back to 0 at the end).
+    params.stopper_acceleration_input_share = 1.0;
     let mut cx = cx.with_piston_area(before_model.piston_area);
     // 3–5. Replay, localize, add what earns its place; then refit the additions together.
     let mut replays = 1;
@@ -917,6 +926,9 @@ fn conclude(
 ) -> Result<Diagnosis, String> {
     let (full, noise) = (cx.full, cx.noise);
     drop_terms_at_defaults(&mut found, progress);
+    if !Actuator::new(found.params.clone())?.reads_stopper_motion {
+        found.params.stopper_acceleration_input_share = base_share(&start.0);
+    }
     // The reported figures come from the accurate, error-controlled replay of every sample.
     progress("final replays with the error-controlled integrator");
     let (before_model, before, fast_replay) = start;
@@ -1008,7 +1020,17 @@ fn conclude(
         fast_replay,
         start_pressures: replay::start_pressures(&final_model, full),
         stopper_smoothed: recording::stopper_smoothing_applies(&full.time),
+        acceleration_window: if final_model.params.stopper_acceleration_input_share > 0.0 {
+            full.acceleration_window
+        } else {
+            0.0
+        },
     })
+}
+
+/// The share of the stopper acceleration input in the model the diagnosis started from.
+fn base_share(before: &Actuator) -> f64 {
+    before.params.stopper_acceleration_input_share
 }
 
 /// Explained when the held-out force error is within its noise; otherwise, or when the

@@ -978,6 +978,7 @@ mod tests {
             p2: None,
             full_rate: None,
             fast_replay_step: 1e-3,
+            acceleration_window: 0.0,
         };
         let blocks: Vec<Block> = (0..n)
             .map(|k| {

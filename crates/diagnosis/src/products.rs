@@ -324,6 +324,7 @@ mod tests {
             time,
             full_rate: None,
             fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
         };
         let base = Parameters::default();
         let blocks = crate::blocks::blocks(&recording.time, 0.1);

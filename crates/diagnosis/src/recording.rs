@@ -21,6 +21,9 @@ pub struct Recording {
     /// [`crate::replay::MAX_FAST_STEP`], or shorter where that replay departs from the
     /// error-controlled one ([`crate::agreement::fast_step_that_agrees`]).
     pub fast_replay_step: f64,
+    /// The half-width T (s) of the stopper acceleration the replays give the model as its input
+    /// a_s ([`crate::acceleration`]); 0 where the model forms it from the positions.
+    pub acceleration_window: f64,
 }
 
 /// The inputs of a recording at every sample, and the samples a thinned view keeps.
@@ -165,6 +168,7 @@ impl Recording {
                 rows,
             })),
             fast_replay_step: self.fast_replay_step,
+            acceleration_window: self.acceleration_window,
         }
     }
 
@@ -320,6 +324,7 @@ impl Recording {
             p2: has_pressures.then_some(p2),
             full_rate: None,
             fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
         })
     }
 }
@@ -355,6 +360,7 @@ mod tests {
                 p2: None,
                 full_rate: None,
                 fast_replay_step: crate::replay::MAX_FAST_STEP,
+                acceleration_window: 0.0,
             }
         };
         for rate in [250.0, 500.0] {

@@ -166,6 +166,14 @@ impl<'a> Drive<'a> {
         }
     }
 
+    /// The stopper acceleration input at every sample of the drive, where the model takes
+    /// it ([`crate::acceleration`]): formed over the whole recording, so that a replay of its
+    /// first rows reads the same values as one of all.
+    fn accelerations(&self, model: &Actuator, recording: &Recording) -> Option<Vec<f64>> {
+        (model.params.stopper_acceleration_input_share > 0.0 && recording.acceleration_window > 0.0)
+            .then(|| crate::acceleration::smoothed_accelerations(self.time, self.x_s, recording.acceleration_window))
+    }
+
     fn rows(&self) -> usize {
         self.rows.map_or(self.last + 1, |r| r.len())
     }
@@ -211,6 +219,10 @@ fn replay_from(
     let drive = Drive::of(recording, end);
     let (time, v_da, x_s) = (drive.time, drive.v_da, drive.x_s);
     let mut sim = starting_simulation(model, recording, start, x_s[0], time[0], tolerance)?;
+    let accelerations = drive.accelerations(model, recording);
+    if let Some(a) = &accelerations {
+        sim.set_stopper_acceleration(a[0])?;
+    }
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();
     for k in 0..=drive.last {
@@ -223,9 +235,15 @@ fn replay_from(
         let dt = time[k + 1] - time[k];
         sim.set_command(v_da[k])?;
         sim.set_stopper_rate((x_s[k + 1] - x_s[k]) / dt)?;
+        if let Some(a) = &accelerations {
+            sim.set_stopper_acceleration_rate((a[k + 1] - a[k]) / dt)?;
+        }
         sim.step(dt).map_err(|e| describe(e, k + 1))?;
         // Land exactly on the recorded stopper position (no drift from rounding).
         sim.land_stopper_at(x_s[k + 1]);
+        if let Some(a) = &accelerations {
+            sim.set_stopper_acceleration(a[k + 1])?;
+        }
     }
     out.steps = sim.statistics().steps;
     Ok(out)
@@ -269,6 +287,7 @@ pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, sta
         Some(sim) => sim,
         None => return replay_from(model, recording, 1e-5, end, start),
     };
+    let accelerations = drive.accelerations(model, recording);
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();
     for k in 0..=drive.last {
@@ -281,6 +300,9 @@ pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, sta
         sim.set_command(v_da[k])?;
         // the stopper moves linearly between samples
         let parts = ((t[k + 1] - t[k]) / recording.fast_replay_step).ceil().max(1.0) as usize;
+        if let Some(a) = &accelerations {
+            sim.set_stopper_acceleration(a[k + 1])?;
+        }
         sim.step_to_in_parts(t[k + 1], x_s[k + 1], parts)
             .map_err(|e| describe(e, k + 1))?;
     }
@@ -329,6 +351,7 @@ mod tests {
             p2: None,
             full_rate: None,
             fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
         }
     }
 

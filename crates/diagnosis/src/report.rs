@@ -197,6 +197,10 @@ impl Diagnosis {
                 "the model was driven with x_s_m as recorded (sampled every 1.5 ms or slower, where the smoothing applied at faster rates would round the motion's corners), as the FMU must be to reproduce these errors"
             },
             "stopper_positions_smoothed": self.stopper_smoothed,
+            "stopper_acceleration_input": (self.acceleration_window > 0.0).then(|| json!({
+                "half_width_s": self.acceleration_window,
+                "recipe": "the model read the stopper acceleration from its input a_s (stopper_acceleration_input_share = 1): at each sample time t, (x(t + T) - 2 x(t) + x(t - T)) / T^2 with T = half_width_s, x the positions the model was driven with, linear between samples; T shrinks to the time left near either end, and a_s = 0 at the first and last samples. Feed the FMU the same a_s to reproduce these errors",
+            })),
             "joint_refit": self.joint_refit.map(|(a, b)| json!({"heldout_before_rms_N": a, "heldout_after_rms_N": b})),
             "withdrawn": self.withdrawn.as_ref().map(|w| json!({
                 "names": w.names,

@@ -1,6 +1,7 @@
 //! The recording's channels and the model's, sample by sample: the residuals the
 //! diagnosis works on and the signals along the chain that a residual may follow.
 
+use crate::acceleration;
 use crate::blocks::Block;
 use crate::recording::Recording;
 use crate::replay::Replay;
@@ -17,22 +18,47 @@ pub const CHANNELS: usize = 3;
 pub const CHANNEL_NAMES: [&str; CHANNELS] = ["force", "p1", "p2"];
 
 /// Stopper velocity as the replays' forces read it at sample k: the slope of the interval
-/// that ends there carried to the sample with the acceleration the model forms
-/// (`jetpipe_model::physics::extra_force::stopper_velocities`; zero at the first sample).
+/// that ends there carried to the sample with the acceleration the model reads
+/// ([`jetpipe_model::physics::extra_force::velocity_at_sample`]; zero at the first sample).
 /// For a recording thinned for the fits, the full-rate recording's at the row.
 pub fn stopper_velocity(recording: &Recording) -> Vec<f64> {
-    at_rows(recording, extra_force::stopper_velocities)
+    let window = recording.acceleration_window;
+    if window <= 0.0 {
+        return at_rows(recording, &extra_force::stopper_velocities);
+    }
+    at_rows(recording, &|time: &[f64], x_s: &[f64]| {
+        let a = acceleration::smoothed_accelerations(time, x_s, window);
+        (0..x_s.len())
+            .map(|k| {
+                if k == 0 {
+                    return 0.0;
+                }
+                let h = time[k] - time[k - 1];
+                extra_force::velocity_at_sample((x_s[k] - x_s[k - 1]) / h, h, a[k])
+            })
+            .collect()
+    })
 }
 
-/// The stopper acceleration as the model forms it at each sample
-/// (`jetpipe_model::physics::extra_force::stopper_accelerations`), of the full-rate
-/// recording at the rows of a thinned one.
+/// The stopper acceleration the model reads at each sample: formed from the positions
+/// (`jetpipe_model::physics::extra_force::stopper_accelerations`), or, with an
+/// acceleration window, the input the replays give it ([`crate::acceleration`]); of the
+/// full-rate recording at the rows of a thinned one.
 pub fn stopper_acceleration(recording: &Recording) -> Vec<f64> {
-    at_rows(recording, extra_force::stopper_accelerations)
+    let window = recording.acceleration_window;
+    if window <= 0.0 {
+        return at_rows(recording, &extra_force::stopper_accelerations);
+    }
+    at_rows(recording, &|time: &[f64], x_s: &[f64]| {
+        acceleration::smoothed_accelerations(time, x_s, window)
+    })
 }
+
+/// A series formed from a motion's sample times and positions.
+type StopperMotionOf<'a> = dyn Fn(&[f64], &[f64]) -> Vec<f64> + 'a;
 
 /// `motion` of the recording's stopper positions at its rows.
-fn at_rows(recording: &Recording, motion: fn(&[f64], &[f64]) -> Vec<f64>) -> Vec<f64> {
+fn at_rows(recording: &Recording, motion: &StopperMotionOf<'_>) -> Vec<f64> {
     match &recording.full_rate {
         Some(full) => {
             let all = motion(&full.time, &full.x_s);

@@ -200,6 +200,7 @@ mod tests {
             p2: Some(read(&p2_model, -1.0)),
             full_rate: None,
             fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
         };
         let replay = Replay {
             force,

@@ -97,6 +97,19 @@ fn initialised<M: CoSimModel>(before_exit: impl FnOnce(&mut M) -> Result<(), Str
 /// Compare `M::info().dependencies` with what perturbations show (see the module doc).
 /// `step_size` is the one step taken before the `<Outputs>` perturbations.
 pub fn check_dependencies<M: CoSimModel>(step_size: f64) -> DependencyReport {
+    check_dependencies_with::<M>(step_size, &[])
+}
+
+/// [`check_dependencies`] with the Real parameters `settings` (value reference, value) set
+/// before every initialisation: for an input that acts only where a parameter switches on
+/// what reads it.
+pub fn check_dependencies_with<M: CoSimModel>(step_size: f64, settings: &[(u32, f64)]) -> DependencyReport {
+    let apply = |m: &mut M| -> Result<(), String> {
+        for &(value_reference, value) in settings {
+            m.set_real(value_reference, value)?;
+        }
+        Ok(())
+    };
     let info = M::info();
     let mut report = DependencyReport::default();
     let outs: Vec<&Variable> = info
@@ -110,7 +123,7 @@ pub fn check_dependencies<M: CoSimModel>(step_size: f64) -> DependencyReport {
         return report;
     }
     // <Outputs>
-    let mut stepped = match initialised::<M>(|_| Ok(())) {
+    let mut stepped = match initialised::<M>(apply) {
         Ok(m) => m,
         Err(e) => {
             report
@@ -171,7 +184,7 @@ pub fn check_dependencies<M: CoSimModel>(step_size: f64) -> DependencyReport {
         }
     }
     // <InitialUnknowns>
-    let base = match initialised::<M>(|_| Ok(())).and_then(|m| outputs(&m, info)) {
+    let base = match initialised::<M>(apply).and_then(|m| outputs(&m, info)) {
         Ok(y) => y,
         Err(e) => {
             report.problems.push(format!("initial outputs: {e}"));
@@ -184,7 +197,7 @@ pub fn check_dependencies<M: CoSimModel>(step_size: f64) -> DependencyReport {
         .filter(|v| matches!(v.causality, Causality::Input | Causality::Parameter))
     {
         let value = nearby(info, k);
-        let y = match initialised::<M>(|m| set(m, k, value)).and_then(|m| outputs(&m, info)) {
+        let y = match initialised::<M>(|m| apply(m).and_then(|()| set(m, k, value))).and_then(|m| outputs(&m, info)) {
             Ok(y) => y,
             Err(e) => {
                 report

@@ -6,12 +6,16 @@ pub use crate::variable::{Causality, VarType, Variability, Variable};
 
 mod extra_flow;
 mod extra_force;
+mod interface_table;
 mod modulation;
+
+pub use interface_table::interface_table;
 
 /// Value references, named so code never uses bare numbers.
 pub mod vr {
     pub const V_DA: u32 = 1;
     pub const X_S: u32 = 2;
+    pub const A_S: u32 = 3;
 
     pub const F_ACT: u32 = 10;
     pub const P1: u32 = 11;
@@ -118,6 +122,7 @@ pub mod vr {
     pub const EXTRA_FORCE_SIGN_PRESSURE: u32 = 475;
     pub const EXTRA_FORCE_PRESSURE_DIFFERENCE: u32 = 476;
     pub const EXTRA_FORCE_SIGN_VELOCITY: u32 = 477;
+    pub const STOPPER_ACCELERATION_INPUT_SHARE: u32 = 478;
     pub const RETURN_VENT_AREA: u32 = 480;
     pub const SUPPLY_DRIFT: u32 = 490;
     pub const SUPPLY_RIPPLE_SINE: u32 = 491;
@@ -402,6 +407,16 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         0.054,
         "rod stopper position (valid while both chamber volumes are positive)",
     ).cite("(2.32)"),
+    input(
+        "a_s",
+        vr::A_S,
+        "m/s2",
+        0.0,
+        "stopper acceleration, read by the extra forces on the piston as far as stopper_acceleration_input_share says (at 0, the default, it is not read)",
+    )
+        .at_least(-1e4).at_most(1e4)
+        .cite("(2.36)")
+        .because("1e4 m/s2, a thousand g: the stopper is moved by a finger, not struck"),
     output("F_act", vr::F_ACT, "N", "actuator (tendon) force, (2.36)-(2.38)").cite("(2.36)-(2.38)"),
     output("P1", vr::P1, "Pa", "absolute pressure of chamber 1 (charging side)").cite("(2.26)-(2.29)"),
     output("P2", vr::P2, "Pa", "absolute pressure of chamber 2 (venting side)").cite("(2.26)-(2.29)"),
@@ -864,6 +879,10 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(1e-6).at_most(1.0)
         .cite("")
         .because("1 m/s: far beyond the stopper's speeds; 1 um/s: a sharp sign"),
+    parameter("stopper_acceleration_input_share", vr::STOPPER_ACCELERATION_INPUT_SHARE, "1", 0.0, "the stopper acceleration the extra forces read is this share of the input a_s plus the rest of the acceleration formed from the stopper positions: 1 for a master that knows the stopper's acceleration (a finger model, or a smoothed estimate from a recording), 0 to form it from x_s alone")
+        .at_least(0.0).at_most(1.0)
+        .cite("(2.36)")
+        .because("a share of one of two estimates of the same acceleration"),
     parameter("return_vent_area", vr::RETURN_VENT_AREA, "m2", 0.0, "return restriction: the return orifices vent into a plenum that empties to P_r through an orifice of this discharge coefficient times area, (2.18) (0 = off: the return orifices see P_r)")
         .at_least(0.0).at_most(1e-4)
         .cite("(2.18)")
@@ -1083,55 +1102,6 @@ const VARIABLE_ARRAY: [Variable; N_VARIABLES] = variables_of(TABLE);
 /// The variables of [`TABLE`], in its order (the FMU crate's `variables::VARIABLES` are these
 /// as the FMI layer's variables: what the model description, the getters and the setters see).
 pub const VARIABLES: &[Variable] = &VARIABLE_ARRAY;
-
-/// The interface table of docs/model.md, in Markdown (`jetpipe parameters` prints it; a test
-/// checks that the docs carry it unchanged): every variable with its causality, unit, start
-/// value, limits, thesis reference, meaning and the reason for its limits.
-pub fn interface_table() -> String {
-    let mut out = String::from(
-        "| name | causality | unit | start | limits | thesis | meaning | why the limits |\n|---|---|---|---|---|---|---|---|\n",
-    );
-    for row in TABLE {
-        let v = &row.variable;
-        let causality = match v.causality {
-            Causality::Parameter => "parameter",
-            Causality::Input => "input",
-            Causality::Output => "output",
-            Causality::Local => "local",
-        };
-        let start = match (v.causality, v.var_type) {
-            (Causality::Output, _) => String::new(),
-            (_, VarType::Boolean) => (if v.start != 0.0 { "true" } else { "false" }).to_string(),
-            _ => number(v.start),
-        };
-        let limits = match v.value_reference {
-            vr::X_S => {
-                let (lo, hi) = crate::physics::parameters::Parameters::default()
-                    .cylinder()
-                    .stopper_range();
-                format!("in ({}, {}) m with the default geometry", number(lo), number(hi))
-            }
-            vr::V_DA => {
-                let (lo, hi) = V_DA_RANGE;
-                format!("in [{}, {}] V", number(lo), number(hi))
-            }
-            _ => row.limits_text(),
-        };
-        let why = match v.value_reference {
-            vr::X_S => "both chamber volumes positive, (2.30)-(2.31)",
-            vr::V_DA => "the D/A converter's range",
-            _ => row.reason,
-        };
-        out.push_str(&format!(
-            "| `{}` | {causality} | {} | {start} | {limits} | {} | {} | {why} |\n",
-            v.name,
-            v.unit.unwrap_or(""),
-            row.reference,
-            v.description
-        ));
-    }
-    out
-}
 
 #[cfg(test)]
 mod tests {

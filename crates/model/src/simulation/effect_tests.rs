@@ -611,3 +611,45 @@ fn a_transducer_faster_than_the_communication_step_reads_the_same_at_coarse_and_
         );
     }
 }
+
+#[test]
+fn a_stopper_acceleration_given_as_an_input_is_what_the_mass_force_reads_at_once_and_along_its_rate() {
+    // A moving mass of 0.2 kg (extra_force_acceleration = -0.2) with the acceleration taken
+    // whole from the input: the force departs from the plain model's by -0.2 a_s, a_s as set
+    // (read at once, before any step) and as its rate carried it over a step; the pressures
+    // do not change. With the share at 0 the input is not read.
+    let on = with(|p| {
+        p.extra_force_acceleration = -0.2;
+        p.stopper_acceleration_input_share = 1.0;
+    });
+    let mut plain = Simulation::at_equilibrium(thesis_model(), 2.0, 0.054, 0.0, 1e-8).unwrap();
+    let mut sim = Simulation::at_equilibrium(on, 2.0, 0.054, 0.0, 1e-8).unwrap();
+    sim.set_stopper_acceleration(3.0).unwrap();
+    let departure = sim.outputs().f_meas - plain.outputs().f_meas;
+    assert!((departure + 0.6).abs() < 1e-9, "{departure} N against -0.6 N");
+    sim.set_stopper_acceleration_rate(-500.0).unwrap();
+    for s in [&mut plain, &mut sim] {
+        s.set_command(4.0).unwrap();
+        s.step(2e-3).unwrap();
+    }
+    assert!((sim.stopper_acceleration_input() - 2.0).abs() < 1e-12);
+    let (a, b) = (plain.outputs(), sim.outputs());
+    assert_eq!((a.p1, a.p2), (b.p1, b.p2));
+    assert!(
+        (b.f_meas - a.f_meas + 0.4).abs() < 1e-9,
+        "{} N against -0.4 N",
+        b.f_meas - a.f_meas
+    );
+    // The rate lasted one step.
+    for s in [&mut plain, &mut sim] {
+        s.step(2e-3).unwrap();
+    }
+    assert!((sim.stopper_acceleration_input() - 2.0).abs() < 1e-12);
+    let off = with(|p| p.extra_force_acceleration = -0.2);
+    let mut unread = Simulation::at_equilibrium(off, 2.0, 0.054, 0.0, 1e-8).unwrap();
+    let before = unread.outputs().f_meas;
+    unread.set_stopper_acceleration(3.0).unwrap();
+    assert_eq!(unread.outputs().f_meas, before);
+    let e = sim.set_stopper_acceleration(2e4).unwrap_err();
+    assert!(e.starts_with("a_s = 20000 m/s2 is invalid"), "{e}");
+}

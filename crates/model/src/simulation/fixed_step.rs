@@ -79,6 +79,12 @@ impl FixedStep {
         self.simulation.set_command(v_da)
     }
 
+    /// The stopper acceleration input a_s at the next sample, which the outputs there read
+    /// (see `Simulation::set_stopper_acceleration`; set it before [`Self::step_to`]).
+    pub fn set_stopper_acceleration(&mut self, a_s: f64) -> Result<(), String> {
+        self.simulation.set_stopper_acceleration(a_s)
+    }
+
     /// Advance to the sample at `time`, the stopper moving linearly to `x_s` there. Time and
     /// stopper land on the values given, so a recording's samples are met to the last bit.
     /// On failure the state, time and stopper stay at the last sample (the command stage and

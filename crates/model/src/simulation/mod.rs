@@ -132,6 +132,10 @@ pub struct Simulation {
     /// acceleration at the end of the last step (0 when off).
     stopper_motion: StopperMotion,
     stopper_acceleration: f64,
+    /// The stopper acceleration input (a_s) and its rate over the next step: read by the
+    /// forces as far as `stopper_acceleration_input_share` says ([`Self::acceleration_read`]).
+    acceleration_input: f64,
+    acceleration_input_rate: f64,
     /// The command stage's memory (see [`crate::physics::command_stage`]).
     command_stage: CommandStage,
     /// The transducers' memories, in the order of [`Channel::ALL`], for those that filter
@@ -342,6 +346,8 @@ impl Simulation {
             x_s_at_last_step: x_s,
             stopper_motion: StopperMotion::at_rest(),
             stopper_acceleration: 0.0,
+            acceleration_input: 0.0,
+            acceleration_input_rate: 0.0,
             command_stage,
             transducers,
             propagator,
@@ -433,6 +439,20 @@ impl Simulation {
         self.x_s = x_s;
     }
 
+    /// The stopper acceleration the forces read: the share `stopper_acceleration_input_share`
+    /// of the input a_s, the rest formed from the positions (the last two steps' motions).
+    /// A master that knows the acceleration (a finger model; the diagnosis, which smooths a
+    /// recording's positions centred on each sample) gives it whole: formed from positions
+    /// rounded to a micrometre, a second difference at 4 kHz carries 16 m/s² of rounding.
+    pub(super) fn acceleration_read(&self) -> f64 {
+        let share = self.model.params.stopper_acceleration_input_share;
+        if share == 0.0 {
+            self.stopper_acceleration
+        } else {
+            share * self.acceleration_input + (1.0 - share) * self.stopper_acceleration
+        }
+    }
+
     /// The stopper velocity the forces read at the last sample: at the sample, from the
     /// last two steps' motions, where a force reads it ([`extra_force::velocity_at_sample`]).
     pub(super) fn stopper_velocity_at_sample(&self) -> f64 {
@@ -440,7 +460,7 @@ impl Simulation {
             extra_force::velocity_at_sample(
                 self.stopper_velocity,
                 self.stopper_motion.interval,
-                self.stopper_acceleration,
+                self.acceleration_read(),
             )
         } else {
             self.stopper_velocity
@@ -492,6 +512,27 @@ impl Simulation {
         check_finite("der(x_s)", rate, "m/s")?;
         self.x_s_rate = rate;
         Ok(())
+    }
+
+    /// The stopper acceleration input a_s (m/s²), read at once by the outputs, as the share
+    /// `stopper_acceleration_input_share` of the acceleration the forces read (the rest is
+    /// formed from the positions).
+    pub fn set_stopper_acceleration(&mut self, a_s: f64) -> Result<(), String> {
+        crate::variables::check(crate::variables::vr::A_S, a_s)?;
+        self.acceleration_input = a_s;
+        Ok(())
+    }
+
+    /// The rate of the stopper acceleration input over the next step (m/s³): it moves
+    /// linearly to a_s + rate · step, as x_s does with its rate.
+    pub fn set_stopper_acceleration_rate(&mut self, rate: f64) -> Result<(), String> {
+        check_finite("der(a_s)", rate, "m/s3")?;
+        self.acceleration_input_rate = rate;
+        Ok(())
+    }
+
+    pub fn stopper_acceleration_input(&self) -> f64 {
+        self.acceleration_input
     }
 
     fn local_tolerance(&self) -> f64 {

@@ -93,7 +93,7 @@ impl Simulation {
             self.v_da,
             self.x_s,
             self.stopper_velocity_at_sample(),
-            self.stopper_acceleration,
+            self.acceleration_read(),
             time,
         )
     }
@@ -142,7 +142,7 @@ impl Simulation {
     /// The outputs at the last sample (the transducers' static readings), with the slots'
     /// constants at its signals.
     pub(super) fn outputs_at_sample(&self) -> Outputs {
-        let (velocity, acceleration) = (self.stopper_velocity_at_sample(), self.stopper_acceleration);
+        let (velocity, acceleration) = (self.stopper_velocity_at_sample(), self.acceleration_read());
         if !self.plan.modulated_outputs {
             return self
                 .model

@@ -46,17 +46,19 @@ pub struct SimulationSnapshot {
     x_s_at_last_step: f64,
     stopper_motion: StopperMotion,
     stopper_acceleration: f64,
+    acceleration_input: f64,
+    acceleration_input_rate: f64,
     command_stage: CommandStage,
     transducers: [Option<SensorMemory>; 3],
 }
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-pub const SNAPSHOT_LAYOUT: f64 = 6.0;
+pub const SNAPSHOT_LAYOUT: f64 = 7.0;
 
-/// Numbers before the two counted lists: the layout, 21 scalars, the state, the volumes'
+/// Numbers before the two counted lists: the layout, 23 scalars, the state, the volumes'
 /// pressures, the plays, the command stage ([`command_stage::VALUES`]) and the six work counters as two halves each.
-const FIXED_VALUES: usize = 1 + 21 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + 2 * STATISTICS;
+const FIXED_VALUES: usize = 1 + 23 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + 2 * STATISTICS;
 const STATISTICS: usize = 6;
 
 impl Simulation {
@@ -86,6 +88,8 @@ impl Simulation {
             x_s_at_last_step: self.x_s_at_last_step,
             stopper_motion: self.stopper_motion,
             stopper_acceleration: self.stopper_acceleration,
+            acceleration_input: self.acceleration_input,
+            acceleration_input_rate: self.acceleration_input_rate,
             command_stage: self.command_stage,
             transducers: self.transducers.clone(),
         }
@@ -118,6 +122,8 @@ impl Simulation {
         sim.x_s_at_last_step = s.x_s_at_last_step;
         sim.stopper_motion = s.stopper_motion;
         sim.stopper_acceleration = s.stopper_acceleration;
+        sim.acceleration_input = s.acceleration_input;
+        sim.acceleration_input_rate = s.acceleration_input_rate;
         sim.command_stage = s.command_stage;
         sim.transducers = s.transducers.clone();
         sim.plan = StepPlan::of(&sim.model, &sim.transducers);
@@ -138,7 +144,7 @@ impl SimulationSnapshot {
     /// only, 2 SDIRK4), the two integrators' next, largest and first step sizes, input changed
     /// (0 or 1), the step after a change, stopper velocity, x_s at the last step, the stopper
     /// velocity over the step before the last and that step's length, and the stopper
-    /// acceleration they gave; the state;
+    /// acceleration they gave, the acceleration input a_s and its rate; the state;
     /// the pressures of the gas volumes behind restrictions (supply, return, line 1, line 2); the
     /// plays; the command stage (time, held, lagged, filtered and its rate); the work counters (steps, rejected,
     /// right-hand sides, Jacobians, Newton failures, stiff hand-overs), each as its low then
@@ -176,6 +182,8 @@ impl SimulationSnapshot {
             self.stopper_motion.velocity,
             self.stopper_motion.interval,
             self.stopper_acceleration,
+            self.acceleration_input,
+            self.acceleration_input_rate,
         ]);
         v.extend_from_slice(&self.state);
         v.extend_from_slice(&self.nodes);
@@ -222,9 +230,9 @@ impl SimulationSnapshot {
             at += n;
             slice
         };
-        let scalars = next(21);
-        let [time, v_da, x_s, v_da_rate, x_s_rate, relative_tolerance, method, chamber_method, next_step, max_step, first_step, chamber_next_step, chamber_max_step, chamber_first_step, input_changed, step_after_change, stopper_velocity, x_s_at_last_step, motion_velocity, motion_interval, stopper_acceleration]: [f64; 21] =
-            scalars.try_into().expect("21 values");
+        let scalars = next(23);
+        let [time, v_da, x_s, v_da_rate, x_s_rate, relative_tolerance, method, chamber_method, next_step, max_step, first_step, chamber_next_step, chamber_max_step, chamber_first_step, input_changed, step_after_change, stopper_velocity, x_s_at_last_step, motion_velocity, motion_interval, stopper_acceleration, acceleration_input, acceleration_input_rate]: [f64; 23] =
+            scalars.try_into().expect("23 values");
         let mut state = [0.0; N_STATES];
         state.copy_from_slice(next(N_STATES));
         let mut nodes = [0.0; node::STATES];
@@ -296,6 +304,8 @@ impl SimulationSnapshot {
             motion_velocity,
             motion_interval,
             stopper_acceleration,
+            acceleration_input,
+            acceleration_input_rate,
         ];
         let finite = numbers.iter().chain(&state).chain(&nodes).chain(&stage).chain(sensor).all(|v| v.is_finite())
             && command_history.iter().all(|c| c.v_da.is_finite() && c.rate.is_finite())
@@ -358,6 +368,8 @@ impl SimulationSnapshot {
                 interval: motion_interval,
             },
             stopper_acceleration,
+            acceleration_input,
+            acceleration_input_rate,
             command_stage: CommandStage::from_values(stage),
             transducers,
         })

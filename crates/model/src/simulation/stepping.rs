@@ -167,6 +167,8 @@ impl Simulation {
         self.v_da += self.v_da_rate * step;
         self.v_da_rate = 0.0;
         self.x_s_rate = 0.0;
+        self.acceleration_input += self.acceleration_input_rate * step;
+        self.acceleration_input_rate = 0.0;
         self.input_changed = false;
         self.stopper_velocity = (self.x_s - self.x_s_at_last_step) / step;
         if self.plan.after_step {
@@ -194,6 +196,7 @@ impl Simulation {
         self.advance(duration, v, v_rate).map_err(|failure| {
             self.v_da_rate = 0.0;
             self.x_s_rate = 0.0;
+            self.acceleration_input_rate = 0.0;
             failure
         })
     }
@@ -244,6 +247,7 @@ impl Simulation {
         // The forces the transducers read within the step take the step's own velocity; the
         // last interval's is back for the step's end, failed or not.
         let velocity = std::mem::replace(&mut self.stopper_velocity, self.x_s_rate);
+        let acceleration_input = self.acceleration_input;
         let (mut elapsed, mut next_record) = (0.0, part);
         let mut result = Ok(());
         'segments: for &(duration, v, v_rate) in segments {
@@ -261,6 +265,7 @@ impl Simulation {
                 done += piece;
                 elapsed += piece;
                 if elapsed >= next_record - slack && next_record < step - slack {
+                    self.acceleration_input = acceleration_input + self.acceleration_input_rate * elapsed;
                     let mut y = self.outputs_at_sample();
                     self.record_transducers(&mut y);
                     next_record += part;
@@ -268,6 +273,7 @@ impl Simulation {
             }
         }
         self.stopper_velocity = velocity;
+        self.acceleration_input = acceleration_input;
         result
     }
 
