@@ -137,8 +137,12 @@ impl Recording {
     }
 
     /// The rows the fits work on: the whole recording when it has at most `max_rows` samples;
-    /// otherwise every `m`-th stretch of [`FIT_STRETCH_SECONDS`] (a training block and the
-    /// held-out block after it), `m` the smallest that keeps at most about `max_rows` rows.
+    /// otherwise the share `max_rows / n` of its stretches of [`FIT_STRETCH_SECONDS`] (each a
+    /// training block and the held-out block after it), spread evenly from the first: stretch
+    /// j is kept when ⌊(j + 1) f + 1 − f⌋ > ⌊j f + 1 − f⌋, f the share, so at most about
+    /// `max_rows` rows. At
+    /// f = 1/2 every second stretch; just over the limit nearly all of them (keeping one in two
+    /// left out a stopper's moves that told a force sensor's delay from the command's).
     /// The stretches are spread over the whole recording, so slow changes stay visible, and
     /// each is contiguous at the full rate, so lags, delays, rates and spectral lines are seen
     /// as they are. The thinned recording carries the full-rate inputs: its replays integrate
@@ -148,10 +152,12 @@ impl Recording {
         if n <= max_rows || n < 2 {
             return self.clone();
         }
-        let every = n.div_ceil(max_rows);
+        // In whole numbers, f = max_rows / n: no rounding decides a stretch.
+        let at = |j: usize| (j * max_rows + n - max_rows) / n;
+        let kept = |j: usize| at(j + 1) > at(j);
         let t0 = self.time[0];
         let rows: Vec<usize> = (0..n)
-            .filter(|&k| ((self.time[k] - t0) / FIT_STRETCH_SECONDS).floor() as usize % every == 0)
+            .filter(|&k| kept(((self.time[k] - t0) / FIT_STRETCH_SECONDS).floor() as usize))
             .collect();
         let pick = |x: &[f64]| -> Vec<f64> { rows.iter().map(|&k| x[k]).collect() };
         Recording {

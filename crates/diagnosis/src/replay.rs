@@ -466,8 +466,14 @@ mod tests {
         assert_eq!(crate::signals::stopper_velocity(&thinned), at_rows);
         assert!((thinned.sample_rate() - 1000.0).abs() < 1e-6);
         assert!((crate::signals::sample_rate(&thinned.time) - 1000.0).abs() < 1e-6);
-        // A recording within the limit is kept whole.
+        // A recording within the limit is kept whole; one just over it nearly whole: five of
+        // the six stretches for at most 22,000 rows (the second one is left out).
         assert_eq!(recording.rows_for_fits(24_000), recording);
+        let nearly = recording.rows_for_fits(22_000);
+        assert_eq!(nearly.len(), 20_000);
+        let stretches: std::collections::BTreeSet<usize> =
+            nearly.time.iter().map(|t| (t / 4.0).floor() as usize).collect();
+        assert_eq!(stretches.into_iter().collect::<Vec<_>>(), vec![0, 2, 3, 4, 5]);
     }
 
     #[test]
