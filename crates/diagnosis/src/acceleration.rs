@@ -143,6 +143,42 @@ mod tests {
     }
 
     #[test]
+    fn the_half_width_chosen_is_the_one_whose_acceleration_the_residual_follows() {
+        // A stopper stepping between positions on 40 ms ramps, logged to a micrometre at
+        // 2 kHz; a residual of 0.3 kg times the acceleration over 10 ms, and then over 40 ms,
+        // with noise: each is found.
+        let time: Vec<f64> = (0..20_000).map(|k| k as f64 * 5e-4).collect();
+        let x_s: Vec<f64> = time
+            .iter()
+            .map(|&t| {
+                let phase = (t % 1.0).min(0.04) / 0.04;
+                let level = 0.05 + 0.01 * ((t.floor() as i64 % 3) as f64);
+                ((level + 0.004 * phase) * 1e6).round() / 1e6
+            })
+            .collect();
+        let recording = Recording {
+            time: time.clone(),
+            v_da: vec![2.0; time.len()],
+            x_s: x_s.clone(),
+            force: vec![0.0; time.len()],
+            p1: None,
+            p2: None,
+            full_rate: None,
+            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
+        };
+        for window in [0.01, 0.04] {
+            let a = smoothed_accelerations(&time, &x_s, window);
+            let residual: Vec<f64> = a
+                .iter()
+                .enumerate()
+                .map(|(k, a)| -0.3 * a + 0.05 * ((k as f64 * 1.7).sin() * 43758.5).fract())
+                .collect();
+            assert_eq!(choose_window(&recording, &residual), window);
+        }
+    }
+
+    #[test]
     fn positions_rounded_to_a_micrometre_leave_little_rounding_in_the_smoothed_acceleration() {
         // At 4 kHz a second difference of positions rounded to 1 µm is rounded to 16 m/s²;
         // over 20 ms it is 1 µm / (20 ms)² = 0.0025 m/s² at most, and the motion's own

@@ -477,6 +477,58 @@ mod tests {
     }
 
     #[test]
+    fn with_the_acceleration_input_both_replays_give_a_moving_mass_the_smoothed_acceleration() {
+        // A 0.2 kg moving mass reading the input: each replay's force departs from the plain
+        // model's by -0.2 times the smoothed acceleration at every sample, the pressures not
+        // at all; the model forms no acceleration of its own where the share is 1.
+        let mut recording = protocol();
+        recording.acceleration_window = 0.02;
+        let plain = Actuator::new(Parameters {
+            stopper_acceleration_input_share: 1.0,
+            ..Parameters::default()
+        })
+        .unwrap();
+        let mass = Actuator::new(Parameters {
+            extra_force_acceleration: -0.2,
+            stopper_acceleration_input_share: 1.0,
+            ..Parameters::default()
+        })
+        .unwrap();
+        let a = crate::acceleration::smoothed_accelerations(&recording.time, &recording.x_s, 0.02);
+        assert_eq!(crate::signals::stopper_acceleration(&recording), a);
+        let largest = a.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        assert!(largest > 0.03, "the shake's acceleration: {largest} m/s²");
+        let n = recording.len();
+        for (without, with) in [
+            (
+                replay(&plain, &recording, 1e-6, n).unwrap(),
+                replay(&mass, &recording, 1e-6, n).unwrap(),
+            ),
+            (
+                replay_fast(&plain, &recording, n).unwrap(),
+                replay_fast(&mass, &recording, n).unwrap(),
+            ),
+        ] {
+            assert_eq!(without.p1, with.p1);
+            let mut checked = 0;
+            for k in 0..n {
+                // Where the spring floor sets the force, no force on the piston reaches it.
+                if without.force[k] < plain.spring_force(recording.x_s[k]) + 0.5 {
+                    continue;
+                }
+                checked += 1;
+                let departure = with.force[k] - without.force[k];
+                assert!(
+                    (departure + 0.2 * a[k]).abs() < 1e-9,
+                    "sample {k}: {departure} N against {}",
+                    -0.2 * a[k]
+                );
+            }
+            assert!(checked > n / 2, "{checked} samples above the floor");
+        }
+    }
+
+    #[test]
     fn the_fast_replay_follows_the_error_controlled_one_with_every_added_term() {
         let recording = protocol();
         let cases: Vec<(&str, Parameters)> = vec![
