@@ -13,8 +13,12 @@ impl Fuzz {
             let kind = self.rng.below(4);
             let (vrs, xs, e): (Vec<u32>, Vec<f64>, Expect) = match kind {
                 0 | 1 => (
-                    vec![vr::V_DA, vr::X_S],
-                    vec![self.rng.range(-10.0, 10.0), self.rng.range(0.03, 0.09)],
+                    vec![vr::V_DA, vr::X_S, vr::A_S],
+                    vec![
+                        self.rng.range(-10.0, 10.0),
+                        self.rng.range(0.03, 0.09),
+                        self.rng.range(-50.0, 50.0),
+                    ],
                     if settable_input { Expect::Ok } else { Expect::Error },
                 ),
                 2 => {
@@ -61,7 +65,9 @@ impl Fuzz {
             (vr::F_ACT, 1.0),
             (vr::P1, 1e5),
             (vr::START_AT_EQUILIBRIUM, 1.0),
-            (3, 1.0),
+            (vr::A_S, f64::NAN),
+            (vr::A_S, 2e4),
+            (4, 1.0),
             (9999, 1.0),
             (u32::MAX, 1.0),
         ]);

@@ -483,7 +483,7 @@ impl Fuzz {
                     self.check(f, format!("fmi2GetReal({vrs:?})"), s, e, m, None);
                 } else {
                     let mut out = [0.0f64; 2];
-                    let unknown = [*self.rng.pick(&[0u32, 3, 99, 203, 9999, u32::MAX]), vr::V_DA];
+                    let unknown = [*self.rng.pick(&[0u32, 4, 99, 203, 9999, u32::MAX]), vr::V_DA];
                     let boolean = [vr::START_AT_EQUILIBRIUM];
                     let (desc, s) = match self.rng.below(4) {
                         0 => (
