@@ -114,10 +114,13 @@ def test_actuator_structure_and_bounds():
     # Model Exchange: every output may depend on every state; the inputs as in Co-Simulation
     assert all(states <= {d.name for d in u.dependencies} for u in md.outputs)
     direct = {u.variable.name: sorted(d.name for d in u.dependencies if d.name not in states) for u in md.outputs}
-    # Only the stopper acts within a step (it moves at once, conserving the air); v_DA acts
+    # Only the stopper acts within a step (it moves at once, conserving the air), and its
+    # acceleration on the forces (a force that follows it reads it at once); v_DA acts
     # through the current's dynamics.
-    assert direct == {"F_act": ["x_s"], "F_meas": ["x_s"], "P1": ["x_s"], "P2": ["x_s"], "P1_meas": ["x_s"],
-                      "P2_meas": ["x_s"], "i": [], "x_jp": []}
+    assert direct == {"F_act": ["a_s", "x_s"], "F_meas": ["a_s", "x_s"], "P1": ["x_s"], "P2": ["x_s"],
+                      "P1_meas": ["x_s"], "P2_meas": ["x_s"], "i": [], "x_jp": []}
+    a_s = by_name["a_s"]
+    assert a_s.causality == "input" and float(a_s.min) == -1e4 and float(a_s.max) == 1e4
     x_s = by_name["x_s"]
     assert float(x_s.min) == pytest.approx(0.026) and float(x_s.max) == pytest.approx(0.096)
     assert float(by_name["C_d"].min) == 0.0 and float(by_name["C_d"].max) == 1.0
