@@ -9,6 +9,7 @@ import pytest
 INTERFACE = {
     "v_DA": ("input", "V", 1, 0.0),
     "x_s": ("input", "m", 2, 0.054),
+    "a_s": ("input", "m/s2", 3, 0.0),
     "F_act": ("output", "N", 10, None),
     "P1": ("output", "Pa", 11, None),
     "P2": ("output", "Pa", 12, None),
