@@ -31,9 +31,11 @@ pub enum Block {
 
 /// Training samples are those in even-numbered blocks counted from the first sample,
 /// held-out ones those in odd-numbered blocks; those before `settled_from` (s) are settling.
-pub fn blocks(time: &[f64], settled_from: f64) -> Vec<Block> {
+/// A short move of the stopper (`x_s`, m) is cut finer: see [`short_stopper_moves`].
+pub fn blocks(time: &[f64], x_s: &[f64], settled_from: f64) -> Vec<Block> {
     let t0 = time.first().copied().unwrap_or(0.0);
-    time.iter()
+    let mut blocks: Vec<Block> = time
+        .iter()
         .map(|&t| {
             if t < settled_from {
                 Block::Settling
@@ -43,6 +45,61 @@ pub fn blocks(time: &[f64], settled_from: f64) -> Vec<Block> {
                 Block::HeldOut
             }
         })
+        .collect();
+    for (start, end) in short_stopper_moves(time, x_s) {
+        let from = start - MOVE_MARGIN_SECONDS;
+        for k in time.partition_point(|&t| t < from)..time.partition_point(|&t| t <= end + MOVE_MARGIN_SECONDS) {
+            if blocks[k] != Block::Settling {
+                blocks[k] = if ((time[k] - from) / MOVE_PIECE_SECONDS).floor() as i64 % 2 == 0 {
+                    Block::Training
+                } else {
+                    Block::HeldOut
+                };
+            }
+        }
+    }
+    blocks
+}
+
+/// A stopper that rests and moves a few times shows whatever follows its motion (a force
+/// with its acceleration or velocity) in those moves alone, mostly where it starts and stops.
+/// Left in the blocks of [`BLOCK_SECONDS`], a recording with one move has it all in a
+/// training block or all in a held-out one: the fits never see it, or the score never does.
+/// So a move shorter than [`SHORT_MOVE_SECONDS`] and the [`MOVE_MARGIN_SECONDS`] either side
+/// of it are cut in pieces of [`MOVE_PIECE_SECONDS`], fitted and scored in turn.
+pub const SHORT_MOVE_SECONDS: f64 = 1.0;
+/// What follows a stop (the force's response, a smoothed acceleration) lasts tens of ms.
+pub const MOVE_MARGIN_SECONDS: f64 = 0.05;
+/// Four pieces to a start or a stop that lasts 40 ms.
+pub const MOVE_PIECE_SECONDS: f64 = 0.01;
+/// A move is one when the stopper goes further than this (m): a position that only toggles
+/// by its last logged digit is at rest.
+pub const SMALLEST_MOVE: f64 = 1e-4;
+
+/// The stopper's short moves, (first, last) time (s) at which it moves: runs of samples at
+/// which the position changes, joined across gaps under [`MOVE_MARGIN_SECONDS`], shorter
+/// than [`SHORT_MOVE_SECONDS`] and spanning more than [`SMALLEST_MOVE`]. A stopper moving
+/// all along (shaken, or a noisy position) has none.
+pub fn short_stopper_moves(time: &[f64], x_s: &[f64]) -> Vec<(f64, f64)> {
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for k in 1..time.len().min(x_s.len()) {
+        if x_s[k] == x_s[k - 1] {
+            continue;
+        }
+        match runs.last_mut() {
+            Some(run) if time[k - 1] - time[run.1] < MOVE_MARGIN_SECONDS => run.1 = k,
+            _ => runs.push((k - 1, k)),
+        }
+    }
+    runs.into_iter()
+        .filter(|&(a, b)| time[b] - time[a] < SHORT_MOVE_SECONDS)
+        .filter(|&(a, b)| {
+            let (low, high) = x_s[a..=b]
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| (l.min(x), h.max(x)));
+            high - low > SMALLEST_MOVE
+        })
+        .map(|(a, b)| (time[a], time[b]))
         .collect()
 }
 
@@ -136,12 +193,61 @@ mod tests {
     #[test]
     fn samples_before_the_settling_time_are_neither_fitted_nor_scored() {
         let time: Vec<f64> = (0..1000).map(|k| k as f64 * 0.01).collect();
-        let b = blocks(&time, 0.5);
+        let b = blocks(&time, &vec![0.05; time.len()], 0.5);
         assert!(b[..50].iter().all(|&x| x == Block::Settling));
         assert!(b[50..200].iter().all(|&x| x == Block::Training));
         assert!(b[200..400].iter().all(|&x| x == Block::HeldOut));
         assert!(b[400..600].iter().all(|&x| x == Block::Training));
         assert_eq!(count(&b, Block::HeldOut), 400);
+    }
+
+    #[test]
+    fn a_short_stopper_move_inside_one_block_is_both_fitted_and_scored() {
+        // 1 kHz, 10 s; the stopper rests at 67 mm, ramps to 76 mm over 2.4–2.7 s (inside the
+        // held-out block 2–4 s) and rests again.
+        let time: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-3).collect();
+        let x_s: Vec<f64> = time
+            .iter()
+            .map(|&t| 0.067 + 0.009 * ((t - 2.4) / 0.3).clamp(0.0, 1.0))
+            .collect();
+        assert_eq!(short_stopper_moves(&time, &x_s).len(), 1);
+        let b = blocks(&time, &x_s, 0.0);
+        let within = |from: f64, to: f64, which: Block| {
+            (0..time.len())
+                .filter(|&k| time[k] >= from && time[k] <= to && b[k] == which)
+                .count()
+        };
+        // The stop at 2.7 s and the start at 2.4 s each have pieces of both kinds.
+        for at in [2.4, 2.7] {
+            assert!(
+                within(at - 0.02, at + 0.02, Block::Training) >= 10,
+                "training near {at} s"
+            );
+            assert!(
+                within(at - 0.02, at + 0.02, Block::HeldOut) >= 10,
+                "held out near {at} s"
+            );
+        }
+        // Away from the move the blocks of 2 s stay.
+        assert!(within(2.0, 2.3, Block::Training) == 0 && within(2.8, 3.99, Block::Training) == 0);
+        assert!(within(0.0, 1.99, Block::HeldOut) == 0);
+    }
+
+    #[test]
+    fn a_stopper_at_rest_moving_all_along_or_toggling_its_last_digit_keeps_the_plain_blocks() {
+        let time: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-3).collect();
+        let plain = blocks(&time, &vec![0.05; time.len()], 0.0);
+        let shaken: Vec<f64> = time.iter().map(|&t| 0.05 + 0.005 * (6.0 * t).sin()).collect();
+        let toggling: Vec<f64> = (0..time.len()).map(|k| 0.05 + 1e-6 * (k / 7 % 2) as f64).collect();
+        // A single long move (3 s) is already split by the blocks.
+        let long_move: Vec<f64> = time
+            .iter()
+            .map(|&t| 0.05 + 0.01 * ((t - 3.0) / 3.0).clamp(0.0, 1.0))
+            .collect();
+        for x_s in [shaken, toggling, long_move] {
+            assert!(short_stopper_moves(&time, &x_s).is_empty());
+            assert_eq!(blocks(&time, &x_s, 0.0), plain);
+        }
     }
 
     #[test]

@@ -616,7 +616,7 @@ impl<'a> Context<'a> {
             recording,
             full,
             options,
-            blocks: blocks::blocks(&recording.time, settled_from),
+            blocks: blocks::blocks(&recording.time, &recording.x_s, settled_from),
             settled_from,
             n,
             noise,
@@ -927,7 +927,7 @@ fn conclude(
     let (full, noise) = (cx.full, cx.noise);
     drop_terms_at_defaults(&mut found, progress);
     if !Actuator::new(found.params.clone())?.reads_stopper_motion {
-        found.params.stopper_acceleration_input_share = base_share(&start.0);
+        found.params.stopper_acceleration_input_share = start.0.params.stopper_acceleration_input_share;
     }
     // The reported figures come from the accurate, error-controlled replay of every sample.
     progress("final replays with the error-controlled integrator");
@@ -937,7 +937,7 @@ fn conclude(
     let mut after = replay(&final_model, full, 1e-5, n)?;
     let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
     let full_blocks = match thinned {
-        Some(_) => blocks::blocks(&full.time, cx.settled_from),
+        Some(_) => blocks::blocks(&full.time, &full.x_s, cx.settled_from),
         None => cx.blocks.clone(),
     };
     let blocks = &full_blocks;
@@ -1026,11 +1026,6 @@ fn conclude(
             0.0
         },
     })
-}
-
-/// The share of the stopper acceleration input in the model the diagnosis started from.
-fn base_share(before: &Actuator) -> f64 {
-    before.params.stopper_acceleration_input_share
 }
 
 /// Explained when the held-out force error is within its noise; otherwise, or when the

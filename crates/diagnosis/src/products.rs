@@ -327,7 +327,7 @@ mod tests {
             acceleration_window: 0.0,
         };
         let base = Parameters::default();
-        let blocks = crate::blocks::blocks(&recording.time, 0.1);
+        let blocks = crate::blocks::blocks(&recording.time, &recording.x_s, 0.1);
         let problem = Problem::new(&recording, &base, &blocks, [0.05, 0.0, 0.0]);
         let plain = replay_fast(&Actuator::new(base.clone()).unwrap(), &recording, n).unwrap();
         let c = 0.8;

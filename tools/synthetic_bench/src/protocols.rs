@@ -70,6 +70,9 @@ pub enum StopperMotion {
     /// Moves of at least 5 mm between random positions in 35–80 mm at a peak speed of `speed`
     /// (m/s), with a half-cosine velocity profile, dwelling 0.5–2 s between moves.
     Moves { speed: f64 },
+    /// One move from the home position to `to` (m) starting at `at` (s), at a peak speed of
+    /// `speed` (m/s) with a half-cosine velocity profile: a stopper set once during a run.
+    Move { at: f64, to: f64, speed: f64 },
 }
 
 /// The stopper positions a protocol may use (m): inside the cylinder's 26–96 mm with margin.
@@ -168,6 +171,18 @@ impl ProtocolSpec {
                     return Err(format!("stopper speed = {speed} m/s is outside (0, 1] m/s"));
                 }
             }
+            StopperMotion::Move { at, to, speed } => {
+                if !(speed > 0.0 && speed <= 1.0) {
+                    return Err(format!("stopper speed = {speed} m/s is outside (0, 1] m/s"));
+                }
+                if !(at >= 0.0 && at < self.duration) {
+                    return Err(format!(
+                        "stopper move at = {at} s is outside the recording's 0–{} s",
+                        self.duration
+                    ));
+                }
+                inside("stopper move's end", to)?;
+            }
         }
         Ok(())
     }
@@ -178,6 +193,7 @@ impl ProtocolSpec {
             StopperMotion::Fixed { position } => format!("fixed{:.0}", position * 1e3),
             StopperMotion::Sine { frequency, .. } => format!("shake{frequency}hz"),
             StopperMotion::Moves { speed } => format!("moves{:.0}mms", speed * 1e3),
+            StopperMotion::Move { at, to, .. } => format!("move{:.0}at{at}s", to * 1e3),
         };
         format!(
             "{}_{stopper}_{}hz_{}s_{}",
@@ -344,23 +360,33 @@ pub fn stopper_signal(motion: StopperMotion, seed: u64, duration: f64) -> Box<dy
                 x = to;
                 t += length + 0.5 + 1.5 * rng.uniform();
             }
-            Box::new(move |t| {
-                let k = moves.partition_point(|m| m.0 <= t);
-                if k == 0 {
-                    return (STOPPER_HOME, 0.0);
-                }
-                let (t0, t1, x0, x1) = moves[k - 1];
-                if t >= t1 {
-                    return (x1, 0.0);
-                }
-                let phase = PI * (t - t0) / (t1 - t0);
-                (
-                    x0 + (x1 - x0) * 0.5 * (1.0 - phase.cos()),
-                    (x1 - x0) * 0.5 * phase.sin() * PI / (t1 - t0),
-                )
-            })
+            along_moves(moves)
+        }
+        StopperMotion::Move { at, to, speed } => {
+            let length = 0.5 * PI * (to - STOPPER_HOME).abs() / speed;
+            along_moves(vec![(at, at + length, STOPPER_HOME, to)])
         }
     }
+}
+
+/// The stopper through `moves` (start, end of the move, from, to), each with a half-cosine
+/// velocity profile, at home before the first.
+fn along_moves(moves: Vec<(f64, f64, f64, f64)>) -> Box<dyn Fn(f64) -> (f64, f64)> {
+    Box::new(move |t| {
+        let k = moves.partition_point(|m| m.0 <= t);
+        if k == 0 {
+            return (STOPPER_HOME, 0.0);
+        }
+        let (t0, t1, x0, x1) = moves[k - 1];
+        if t >= t1 {
+            return (x1, 0.0);
+        }
+        let phase = PI * (t - t0) / (t1 - t0);
+        (
+            x0 + (x1 - x0) * 0.5 * (1.0 - phase.cos()),
+            (x1 - x0) * 0.5 * phase.sin() * PI / (t1 - t0),
+        )
+    })
 }
 
 /// A recording of `effects` under the protocol `spec` (checked first).

@@ -150,6 +150,22 @@ fn stopper_moves_reach_their_peak_speed_and_stay_inside_the_cylinder() {
 }
 
 #[test]
+fn a_single_stopper_move_rests_at_home_before_and_at_its_end_after_at_its_peak_speed_between() {
+    let (at, to, speed) = (2.6, 0.08, 0.5);
+    let s = stopper_signal(StopperMotion::Move { at, to, speed }, 11, 20.0);
+    // 26 mm with a half-cosine profile at a peak of 0.5 m/s: π/2 · 26 mm / 0.5 m/s = 81.7 ms.
+    let length = 0.5 * std::f64::consts::PI * (to - 0.054) / speed;
+    assert_eq!(s(at - 1e-6), (0.054, 0.0));
+    assert_eq!(s(at + length + 1e-6), (to, 0.0));
+    assert_eq!(s(19.9), (to, 0.0));
+    let (middle, peak) = s(at + 0.5 * length);
+    assert!(
+        (middle - 0.067).abs() < 1e-9 && (peak - speed).abs() < 1e-9,
+        "{middle} m, {peak} m/s"
+    );
+}
+
+#[test]
 fn the_protocol_checks_name_the_field_its_value_and_the_limit() {
     let refused = |spec: ProtocolSpec, words: &[&str]| {
         let err = spec.check().expect_err("refused");

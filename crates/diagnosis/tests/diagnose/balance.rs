@@ -129,6 +129,32 @@ fn a_mass_moving_with_the_stopper_under_a_staircase_at_one_kilohertz_is_a_moving
     );
 }
 
+// One move of the stopper, 26 mm in 82 ms inside the held-out block 2–4 s: what follows its
+// motion shows in that move alone, and the fits see it only because a short move is cut in
+// pieces fitted and scored in turn.
+#[test]
+fn a_mass_moving_with_the_stopper_in_its_one_move_inside_a_held_out_block_is_a_moving_mass() {
+    let once = StopperMotion::Move {
+        at: 2.6,
+        to: 0.08,
+        speed: 0.5,
+    };
+    let d = diagnosed(
+        "mass-once",
+        &spec(CommandProtocol::Staircase, once, 1000.0, true),
+        moving_mass(0.1),
+    );
+    // In a move one way the sign of the velocity is +1 wherever the acceleration is not
+    // small, so a force on sign(v)·a is the moving mass's as well: either, within 10 %.
+    let found = d.discovered.first().expect("nothing discovered");
+    let parameter = match found.candidate {
+        "moving mass" => "extra_force_acceleration",
+        "extra force ∝ sign(v)·a" => "extra_force_product_1_coefficient",
+        other => panic!("mass-once: {other} ({})", found.reading),
+    };
+    discovered_as(&d, "mass-once", found.candidate, parameter, -0.1, 0.1);
+}
+
 #[test]
 fn a_mass_moving_with_the_stopper_under_a_slow_sine_at_two_kilohertz_is_a_moving_mass() {
     let d = diagnosed(

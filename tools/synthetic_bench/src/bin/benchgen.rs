@@ -33,7 +33,8 @@ struct Cli {
     #[arg(long)]
     protocol: Option<String>,
     /// With --protocol: the stopper's motion, `fixed:X` (m), `sine:CENTRE:AMPLITUDE:HZ` (m, m,
-    /// Hz) or `moves:SPEED` (m/s, between random positions).
+    /// Hz), `moves:SPEED` (m/s, between random positions) or `move:AT:TO:SPEED` (s, m, m/s: one
+    /// move from the home position).
     #[arg(long, default_value = "fixed:0.054")]
     stopper: String,
     /// With --protocol: sampling rate, Hz (250–2000, a whole number of 20 µs steps a sample).
@@ -509,9 +510,14 @@ fn protocol_spec(cli: &Cli, name: &str) -> Result<ProtocolSpec, String> {
         ["moves", v] => StopperMotion::Moves {
             speed: number("speed", v)?,
         },
+        ["move", at, to, v] => StopperMotion::Move {
+            at: number("at", at)?,
+            to: number("to", to)?,
+            speed: number("speed", v)?,
+        },
         _ => {
             return Err(format!(
-                "--stopper {:?} is not fixed:X, sine:CENTRE:AMPLITUDE:HZ or moves:SPEED",
+                "--stopper {:?} is not fixed:X, sine:CENTRE:AMPLITUDE:HZ, moves:SPEED or move:AT:TO:SPEED",
                 cli.stopper
             ))
         }
