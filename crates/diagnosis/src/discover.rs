@@ -313,7 +313,14 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
         .map(|&(name, value)| {
             let was = parameter_value(before, name);
             let unit = unit_of(name);
-            if was == 0.0 {
+            let side = match name {
+                "command_upper_limit" => Some("above"),
+                "command_lower_limit" => Some("below"),
+                _ => None,
+            };
+            if let (Some(side), true) = (side, was.abs() >= 100.0) {
+                format!("{name} = {value:.4e} {unit} (off before): the command the current driver sees saturates {side} {value:.3} V")
+            } else if was == 0.0 {
                 format!("{name} = {value:.4e} {unit} (0 before)")
             } else {
                 format!(

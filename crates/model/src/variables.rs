@@ -103,6 +103,8 @@ pub mod vr {
     pub const F3_ALGEBRAIC_SHARE: u32 = 455;
     pub const COMMAND_FILTER_FREQUENCY: u32 = 456;
     pub const COMMAND_FILTER_DAMPING: u32 = 457;
+    pub const COMMAND_UPPER_LIMIT: u32 = 458;
+    pub const COMMAND_LOWER_LIMIT: u32 = 459;
     pub const FORCE_SENSOR_QUADRATIC: u32 = 460;
     pub const FORCE_SENSOR_CUBIC: u32 = 461;
     pub const FORCE_SENSOR_DRIFT: u32 = 462;
@@ -787,6 +789,14 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(100.0)
         .cite("(2.3)")
         .because("the D/A spans 10 V either way; ten times that clips nothing"),
+    parameter("command_upper_limit", vr::COMMAND_UPPER_LIMIT, "V", 100.0, "command limit on one side: the command the current driver sees saturates above this (100 or more = off)")
+        .at_least(-1000.0).at_most(1000.0)
+        .cite("(2.3)")
+        .because("off from 100 V, ten times the D/A's span; the range leaves room either side of it"),
+    parameter("command_lower_limit", vr::COMMAND_LOWER_LIMIT, "V", -100.0, "command limit on one side: the command the current driver sees saturates below this (-100 or less = off)")
+        .at_least(-1000.0).at_most(1000.0)
+        .cite("(2.3)")
+        .because("off from 100 V, ten times the D/A's span; the range leaves room either side of it"),
     parameter("current_limit", vr::CURRENT_LIMIT, "A", 0.0, "current limit: the coil current saturates at plus or minus this, applied to the command through k_cd and i_offset (0 = off)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.1)-(2.3)")

@@ -230,6 +230,9 @@ pub struct UndeclaredEffects {
     /// `command`/`nonlinearity`: half width (V) of a dead zone in the D/A output the current
     /// driver sees: 0 within ±d, v ∓ d outside; 0 = none.
     pub command_dead_zone: f64,
+    /// `command`/`limit`: the D/A output the current driver sees saturates above this (V),
+    /// and nothing below; 0 = none.
+    pub command_upper_limit: f64,
     /// `force_sensor`/`limit`: the force reading saturates at ± this (N), after gain and
     /// offset, before noise and quantisation; 0 = none.
     pub force_sensor_saturation: f64,

@@ -312,6 +312,11 @@ impl Model {
         } else {
             v
         };
+        let v = if self.e.undeclared.command_upper_limit > 0.0 {
+            v.min(self.e.undeclared.command_upper_limit)
+        } else {
+            v
+        };
         if self.cmd_limit {
             let l = self.e.undeclared.command_limit;
             v.clamp(-l, l)

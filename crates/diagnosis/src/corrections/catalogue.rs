@@ -247,6 +247,41 @@ pub fn catalogue(
             None,
             vec![searched("command_limit", "V", Mechanism::CommandLimit, 0.0, inf)],
         ),
+        // A D/A or a driver stage that saturates on one side only (a supply rail): the
+        // symmetric limit would clip the other side too, where a closed loop drives the
+        // command. Off at ±100 V.
+        c(
+            "command upper limit",
+            "command",
+            "limit",
+            None,
+            vec![Term {
+                neutral: 100.0,
+                ..searched(
+                    "command_upper_limit",
+                    "V",
+                    Mechanism::Searched("command_upper_limit"),
+                    -100.0,
+                    100.0,
+                )
+            }],
+        ),
+        c(
+            "command lower limit",
+            "command",
+            "limit",
+            None,
+            vec![Term {
+                neutral: -100.0,
+                ..searched(
+                    "command_lower_limit",
+                    "V",
+                    Mechanism::Searched("command_lower_limit"),
+                    -100.0,
+                    100.0,
+                )
+            }],
+        ),
         c(
             "current driver gain and offset",
             "current_driver",

@@ -818,10 +818,16 @@ impl Problem<'_> {
             .model_parameter()
             .ok_or("a searched term without a parameter")?;
         let mut refined = candidate.clone();
+        // A one-sided limit may lie near 0 V: its step is a fiftieth of a volt, not of it.
+        let step = if is_one_sided_command_limit(&first.mechanism) {
+            0.02
+        } else {
+            0.02 * found.values[0]
+        };
         refined.terms[0] = Term {
             mechanism: Mechanism::Parameter(name),
             neutral: found.values[0],
-            step: 0.02 * found.values[0],
+            step,
             ..first.clone()
         };
         // A searched model parameter's prediction at what the search found is the replay
@@ -863,6 +869,17 @@ impl Problem<'_> {
             Mechanism::CommandLimit => {
                 let largest = commands.map(|v| v.abs()).fold(0.0, f64::max);
                 (0.2 * largest, largest, false)
+            }
+            // A one-sided limit anywhere in the upper or lower four fifths of the commands
+            // recorded: it clips at least a fifth of their span.
+            Mechanism::Searched(name) if is_one_sided_command_limit(&term.mechanism) => {
+                let (low, high) = commands.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+                let span = high - low;
+                if name == "command_upper_limit" {
+                    (low + 0.2 * span, high, false)
+                } else {
+                    (low, high - 0.2 * span, false)
+                }
             }
             // Above the recording's Nyquist frequency the command's filter reads as a delay of
             // 2ζ/ω, which the delay candidate is; and there each step is cut into pieces
@@ -988,6 +1005,15 @@ fn bounded_least_squares(ata: &[Vec<f64>], atb: &[f64], usable: &[bool], lower: 
         }
     }
     x
+}
+
+/// Whether `mechanism` is the command's upper or lower limit, searched over the commands
+/// recorded on a linear scale.
+fn is_one_sided_command_limit(mechanism: &Mechanism) -> bool {
+    matches!(
+        mechanism,
+        Mechanism::Searched("command_upper_limit" | "command_lower_limit")
+    )
 }
 
 #[cfg(test)]

@@ -247,9 +247,21 @@ fn explained_under_a_short_staircase(name: &str) {
     );
     let thesis = Parameters::default();
     for &(parameter, truth) in mechanism.model_parameters {
+        // The staircase never goes below −2.8 V: a clip at ±7 V and one above 7 V alone are the
+        // same recording, and either may be the one found.
+        let parameter = match (parameter, found.candidate) {
+            ("command_limit", "command upper limit") => "command_upper_limit",
+            _ => parameter,
+        };
         let reference = value_reference(parameter);
         let fitted = d.parameters.get(reference).unwrap();
-        let departure = truth - thesis.get(reference).unwrap();
+        // (off at 100 V: judged as the symmetric limit is, off at 0)
+        let off = if parameter == "command_upper_limit" {
+            0.0
+        } else {
+            thesis.get(reference).unwrap()
+        };
+        let departure = truth - off;
         assert!(
             (fitted - truth).abs() <= 0.2 * departure.abs(),
             "{name}: {parameter} = {fitted}, truth {truth}"
@@ -289,6 +301,47 @@ fn a_back_pressure_on_the_exhaust_under_a_short_staircase_is_its_return_pressure
 #[test]
 fn a_saturating_command_under_a_short_staircase_is_a_command_limit() {
     explained_under_a_short_staircase("command_limit");
+}
+
+// A D/A that saturates above 2 V alone: the staircase goes down to −2.8 V, where a symmetric
+// limit at ±2 V would clip as well (14 % of the samples), so the limit on one side is the
+// one that fits.
+#[test]
+fn a_command_saturating_above_two_volts_alone_under_a_short_staircase_is_an_upper_limit() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Staircase,
+        stopper: StopperMotion::Fixed { position: 0.054 },
+        sample_rate: 500.0,
+        duration: 20.0,
+        pressures: true,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let effects = synthetic_bench::BenchEffects {
+        undeclared: synthetic_bench::UndeclaredEffects {
+            command_upper_limit: 2.0,
+            ..synthetic_bench::UndeclaredEffects::default()
+        },
+        ..synthetic_bench::BenchEffects::default()
+    };
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-upper-limit", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("recording.csv");
+    generate_protocol_with(&BenchParams::default(), &spec, &effects)
+        .unwrap()
+        .write_csv(&path)
+        .unwrap();
+    let recording = Recording::read(&path, &Parameters::default()).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    println!("upper limit: {}; {}", d.verdict(), d.summary().join(" | "));
+    assert!(names(&d).is_empty(), "named {:?}", names(&d));
+    let found = d.discovered.first().expect("nothing discovered");
+    assert_eq!(found.candidate, "command upper limit", "{}", found.reading);
+    let limit = d.parameters.get(value_reference("command_upper_limit")).unwrap();
+    assert!((limit - 2.0).abs() < 0.05, "command_upper_limit = {limit} V");
+    assert!(found.reading.contains("saturates above 2.0"), "{}", found.reading);
+    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
 }
 
 #[test]

@@ -6,6 +6,7 @@
 //! | `command_curve_*` (V) | c(v): a static curve of the logged command, piecewise linear through its knots ([`super::static_curve`]) |
 //! | `f3_input_cubic` (V) | v + c (v / 10 V)³: a static curve before f3 (the current driver is linear and fast, so a curve on the tip force k_m i is the same as one on the command) |
 //! | `command_limit` (V) | clipped at ± the limit |
+//! | `command_upper_limit`, `command_lower_limit` (V) | clipped above the one and below the other |
 //! | `current_limit` (A) | clipped where k_cd v + i_offset reaches ± the limit, (2.1) |
 //! | `current_slew_limit` (A/s) | between communication points the held command moves by at most the limit / k_cd per second |
 //! | `command_lag` (s) | a first-order lag, exact for the command held between communication points |
@@ -33,10 +34,16 @@ pub fn is_active(p: &Parameters) -> bool {
     p.f3_input_cubic != 0.0
         || p.command_curve.is_on()
         || p.command_limit > 0.0
+        || has_one_sided_limit(p)
         || p.current_limit > 0.0
         || p.current_slew_limit > 0.0
         || p.command_lag > 0.0
         || p.command_filter_frequency > 0.0
+}
+
+/// Whether a one-sided limit is on: off from ±100 V, ten times the D/A's span.
+fn has_one_sided_limit(p: &Parameters) -> bool {
+    p.command_upper_limit < 100.0 || p.command_lower_limit > -100.0
 }
 
 /// The static part of the stage: the static curve, the cubic, then the command and current
@@ -48,6 +55,9 @@ pub fn static_map(p: &Parameters, v_da: f64) -> f64 {
     }
     if p.command_limit > 0.0 {
         v = v.clamp(-p.command_limit, p.command_limit);
+    }
+    if has_one_sided_limit(p) {
+        v = v.clamp(p.command_lower_limit, p.command_upper_limit);
     }
     if p.current_limit > 0.0 && p.k_cd != 0.0 {
         let (a, b) = (
@@ -275,6 +285,44 @@ mod tests {
         let t = [0.0, 0.001, 0.002, 0.003];
         let v = [1.0, 5.0, -3.0, 0.25];
         assert_eq!(seen_commands(&p, &t, &v), v.to_vec());
+    }
+
+    #[test]
+    fn a_one_sided_limit_clips_its_own_side_alone() {
+        let t = [0.0, 0.001, 0.002, 0.003];
+        let v = [-9.5, 5.0, 7.5, 9.0];
+        let upper = Parameters {
+            command_upper_limit: 7.0,
+            ..Parameters::default()
+        };
+        assert_eq!(seen_commands(&upper, &t, &v), vec![-9.5, 5.0, 7.0, 7.0]);
+        let lower = Parameters {
+            command_lower_limit: 0.5,
+            ..Parameters::default()
+        };
+        assert_eq!(seen_commands(&lower, &t, &v), vec![0.5, 5.0, 7.5, 9.0]);
+        // Beside the symmetric limit, the tighter of the two on each side.
+        let both = Parameters {
+            command_limit: 8.0,
+            command_upper_limit: 9.5,
+            command_lower_limit: -2.0,
+            ..Parameters::default()
+        };
+        assert_eq!(seen_commands(&both, &t, &v), vec![-2.0, 5.0, 7.5, 8.0]);
+    }
+
+    #[test]
+    fn a_lower_limit_at_or_above_the_upper_one_is_refused_naming_both() {
+        let p = Parameters {
+            command_upper_limit: 2.0,
+            command_lower_limit: 2.0,
+            ..Parameters::default()
+        };
+        let e = p.validate().unwrap_err();
+        assert!(
+            e.contains("command_lower_limit = 2 V") && e.contains("command_upper_limit = 2 V"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -83,6 +83,8 @@ pub struct Parameters {
     pub command_filter_frequency: f64,
     pub command_filter_damping: f64,
     pub command_limit: f64,
+    pub command_upper_limit: f64,
+    pub command_lower_limit: f64,
     pub current_limit: f64,
     pub current_slew_limit: f64,
     pub f3_input_cubic: f64,
@@ -234,6 +236,8 @@ impl Default for Parameters {
             command_filter_frequency: 0.0,
             command_filter_damping: 0.0,
             command_limit: 0.0,
+            command_upper_limit: 100.0,
+            command_lower_limit: -100.0,
             current_limit: 0.0,
             current_slew_limit: 0.0,
             f3_input_cubic: 0.0,
@@ -370,6 +374,8 @@ impl Parameters {
         vr::COMMAND_FILTER_FREQUENCY,
         vr::COMMAND_FILTER_DAMPING,
         vr::COMMAND_LIMIT,
+        vr::COMMAND_UPPER_LIMIT,
+        vr::COMMAND_LOWER_LIMIT,
         vr::CURRENT_LIMIT,
         vr::CURRENT_SLEW_LIMIT,
         vr::F3_INPUT_CUBIC,
@@ -629,6 +635,8 @@ impl Parameters {
             vr::COMMAND_FILTER_FREQUENCY => &mut self.command_filter_frequency,
             vr::COMMAND_FILTER_DAMPING => &mut self.command_filter_damping,
             vr::COMMAND_LIMIT => &mut self.command_limit,
+            vr::COMMAND_UPPER_LIMIT => &mut self.command_upper_limit,
+            vr::COMMAND_LOWER_LIMIT => &mut self.command_lower_limit,
             vr::CURRENT_LIMIT => &mut self.current_limit,
             vr::CURRENT_SLEW_LIMIT => &mut self.current_slew_limit,
             vr::F3_INPUT_CUBIC => &mut self.f3_input_cubic,
@@ -779,6 +787,12 @@ impl Parameters {
             return Err(format!(
                 "C_db_A_lpp + C_dm_A_lpp = {} m2 is invalid: the leakage area (2.23) must stay >= 0 for every pressure ratio",
                 self.c_db_a_lpp + self.c_dm_a_lpp
+            ));
+        }
+        if self.command_lower_limit >= self.command_upper_limit {
+            return Err(format!(
+                "command_lower_limit = {} V is invalid: must be below command_upper_limit = {} V",
+                self.command_lower_limit, self.command_upper_limit
             ));
         }
         if self.hysteresis_deadband > self.hysteresis_width {

@@ -146,6 +146,9 @@ struct Cli {
     /// A dead zone in the D/A output the current driver sees: its half width, V (e.g. 0.4).
     #[arg(long)]
     command_dead_zone: Option<f64>,
+    /// The D/A output the current driver sees saturates above this, V, and not below (e.g. 6).
+    #[arg(long)]
+    command_upper_limit: Option<f64>,
     /// The force reading saturates at ± this, N (e.g. 85).
     #[arg(long)]
     force_sensor_saturation: Option<f64>,
@@ -292,6 +295,7 @@ fn main() -> ExitCode {
         cli.force_sensor_pickup_frequency,
     );
     set(&mut und.command_dead_zone, cli.command_dead_zone);
+    set(&mut und.command_upper_limit, cli.command_upper_limit);
     set(&mut und.force_sensor_saturation, cli.force_sensor_saturation);
     set(&mut und.moving_mass, cli.moving_mass);
     set(&mut und.seal_pressure_friction, cli.seal_pressure_friction);
@@ -336,6 +340,7 @@ fn main() -> ExitCode {
         und.port_1_restriction,
         und.force_sensor_pickup_frequency,
         und.command_dead_zone,
+        und.command_upper_limit,
         und.force_sensor_saturation,
         und.moving_mass,
         und.seal_pressure_friction,
