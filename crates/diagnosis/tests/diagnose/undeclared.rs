@@ -202,13 +202,9 @@ fn a_force_sensor_with_backlash_is_found_at_the_force_sensor_as_hysteresis_not_j
     placed("force_sensor_backlash", 317);
 }
 
-/// A mechanism of the table under a 20 s random staircase at 500 Hz with pressures (the
-/// protocol generator's, not the bench's 80 s protocol): the term discovered at the truth's
-/// place and family, nothing named, each parameter within 20 % of the truth's departure from
-/// the thesis, and the held-out force error within 1.5 noise floors. The test command's
-/// cases at the command, the current driver and the return, where the 80 s cases are broad.
-fn explained_under_a_short_staircase(name: &str) {
-    let mechanism = undeclared_mechanism(name).expect("a mechanism of the table");
+/// `effects` recorded by the protocol generator under a 20 s staircase at 500 Hz with
+/// pressures, the stopper fixed, and diagnosed.
+fn diagnosed_under_a_short_staircase(label: &str, effects: &synthetic_bench::BenchEffects) -> Diagnosis {
     let spec = ProtocolSpec {
         command: CommandProtocol::Staircase,
         stopper: StopperMotion::Fixed { position: 0.054 },
@@ -218,10 +214,10 @@ fn explained_under_a_short_staircase(name: &str) {
         seed: 5,
         ..ProtocolSpec::default()
     };
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-short-{name}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-short-{label}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("recording.csv");
-    generate_protocol_with(&BenchParams::default(), &spec, &(mechanism.effects)())
+    generate_protocol_with(&BenchParams::default(), &spec, effects)
         .unwrap()
         .write_csv(&path)
         .unwrap();
@@ -229,11 +225,22 @@ fn explained_under_a_short_staircase(name: &str) {
     let _ = std::fs::remove_dir_all(&dir);
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
     println!(
-        "{name} ({}): {}; {}",
+        "{label} ({}): {}; {}",
         spec.label(),
         d.verdict(),
         d.summary().join(" | ")
     );
+    d
+}
+
+/// A mechanism of the table under a 20 s random staircase at 500 Hz with pressures (the
+/// protocol generator's, not the bench's 80 s protocol): the term discovered at the truth's
+/// place and family, nothing named, each parameter within 20 % of the truth's departure from
+/// the thesis, and the held-out force error within 1.5 noise floors. The test command's
+/// cases at the command, the current driver and the return, where the 80 s cases are broad.
+fn explained_under_a_short_staircase(name: &str) {
+    let mechanism = undeclared_mechanism(name).expect("a mechanism of the table");
+    let d = diagnosed_under_a_short_staircase(name, &(mechanism.effects)());
     assert!(names(&d).is_empty(), "{name}: named {:?}", names(&d));
     let found = d
         .discovered
@@ -308,15 +315,6 @@ fn a_saturating_command_under_a_short_staircase_is_a_command_limit() {
 // one that fits.
 #[test]
 fn a_command_saturating_above_two_volts_alone_under_a_short_staircase_is_an_upper_limit() {
-    let spec = ProtocolSpec {
-        command: CommandProtocol::Staircase,
-        stopper: StopperMotion::Fixed { position: 0.054 },
-        sample_rate: 500.0,
-        duration: 20.0,
-        pressures: true,
-        seed: 5,
-        ..ProtocolSpec::default()
-    };
     let effects = synthetic_bench::BenchEffects {
         undeclared: synthetic_bench::UndeclaredEffects {
             command_upper_limit: 2.0,
@@ -324,17 +322,7 @@ fn a_command_saturating_above_two_volts_alone_under_a_short_staircase_is_an_uppe
         },
         ..synthetic_bench::BenchEffects::default()
     };
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-upper-limit", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    generate_protocol_with(&BenchParams::default(), &spec, &effects)
-        .unwrap()
-        .write_csv(&path)
-        .unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
-    println!("upper limit: {}; {}", d.verdict(), d.summary().join(" | "));
+    let d = diagnosed_under_a_short_staircase("upper-limit", &effects);
     assert!(names(&d).is_empty(), "named {:?}", names(&d));
     let found = d.discovered.first().expect("nothing discovered");
     assert_eq!(found.candidate, "command upper limit", "{}", found.reading);
