@@ -204,12 +204,15 @@ impl SensorLaw {
     }
 }
 
-/// A transducer's memory: past static readings (for the delay) and the lag's, the
-/// second-order filter's and the play's outputs at the last communication point.
+/// A transducer's memory: past static readings at communication points (for the delay) and
+/// the lag's, the second-order filter's and the play's outputs at the last time recorded,
+/// which may lie between communication points (a step taken in parts).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SensorMemory {
-    /// (time, static reading), oldest first; at least one.
+    /// (time, static reading) at communication points, oldest first; at least one.
     history: VecDeque<(f64, f64)>,
+    /// The last time recorded: the end of the history, or a point inside the step after it.
+    last_time: f64,
     /// The delayed reading at the last communication point.
     delayed: f64,
     lagged: f64,
@@ -292,6 +295,7 @@ impl SensorMemory {
         history.push_back((time, reading));
         Self {
             history,
+            last_time: time,
             delayed: reading,
             lagged: reading,
             filtered: reading,
@@ -330,8 +334,7 @@ impl SensorMemory {
     }
 
     fn advanced(&self, law: &SensorLaw, time: f64, reading: f64) -> Advanced {
-        let last = self.history.back().expect("the history is never empty").0;
-        let dt = (time - last).max(0.0);
+        let dt = (time - self.last_time).max(0.0);
         let delayed = self.delayed_at(law, time, reading);
         let lagged = if law.lag > 0.0 {
             // Exact for a reading that moves linearly between communication points: a
@@ -374,25 +377,35 @@ impl SensorMemory {
     /// Record the static reading at the communication point `time` and return the filtered
     /// reading there.
     pub fn record(&mut self, law: &SensorLaw, time: f64, reading: f64) -> f64 {
-        let a = self.advanced(law, time, reading);
-        self.delayed = a.delayed;
-        self.lagged = a.lagged;
-        self.filtered = a.filtered;
-        self.filtered_rate = a.filtered_rate;
-        self.played = a.played;
+        let played = self.record_between(law, time, reading);
         self.history.push_back((time, reading));
         // Keep one point at or before the oldest time a later delay can ask for.
         let oldest = time - law.delay;
         while self.history.len() > 1 && self.history[1].0 <= oldest {
             self.history.pop_front();
         }
+        played
+    }
+
+    /// Advance the lag, the filter and the play to `time`, inside a step taken in parts, and
+    /// return the filtered reading there. The delay keeps interpolating between communication
+    /// points, so a step taken in parts reads what the same step taken whole reads.
+    pub fn record_between(&mut self, law: &SensorLaw, time: f64, reading: f64) -> f64 {
+        let a = self.advanced(law, time, reading);
+        self.delayed = a.delayed;
+        self.lagged = a.lagged;
+        self.filtered = a.filtered;
+        self.filtered_rate = a.filtered_rate;
+        self.played = a.played;
+        self.last_time = time;
         a.played
     }
 
-    /// The memory as numbers (for FMU states): delayed, lagged, filtered, its rate, played,
-    /// then the history's (time, reading) pairs.
+    /// The memory as numbers (for FMU states): the last time recorded, delayed, lagged,
+    /// filtered, its rate, played, then the history's (time, reading) pairs.
     pub fn to_values(&self) -> Vec<f64> {
         let mut v = vec![
+            self.last_time,
             self.delayed,
             self.lagged,
             self.filtered,
@@ -407,16 +420,17 @@ impl SensorMemory {
     }
 
     pub fn from_values(values: &[f64]) -> Option<Self> {
-        if values.len() < 7 || (values.len() - 5) % 2 != 0 {
+        if values.len() < 8 || (values.len() - 6) % 2 != 0 {
             return None;
         }
         Some(Self {
-            delayed: values[0],
-            lagged: values[1],
-            filtered: values[2],
-            filtered_rate: values[3],
-            played: values[4],
-            history: values[5..].chunks(2).map(|c| (c[0], c[1])).collect(),
+            last_time: values[0],
+            delayed: values[1],
+            lagged: values[2],
+            filtered: values[3],
+            filtered_rate: values[4],
+            played: values[5],
+            history: values[6..].chunks(2).map(|c| (c[0], c[1])).collect(),
         })
     }
 }

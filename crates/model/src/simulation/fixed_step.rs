@@ -178,7 +178,7 @@ impl FixedStep {
             }
         }
         let mut y = sim.outputs_at_sample();
-        sim.record_transducers(&mut y);
+        sim.record_transducers(&mut y, interval_start.is_some());
         self.outputs = y;
         Ok(())
     }
@@ -387,6 +387,39 @@ mod tests {
             assert!(worst < bound, "max |ΔF_meas| = {worst} N");
             assert!(worst > 0.0);
         }
+    }
+
+    #[test]
+    fn a_sensor_delay_interpolates_between_samples_when_each_sample_is_reached_in_parts() {
+        // The reading 1.5 samples late is the mean of the two samples around that time, as a
+        // recording's delayed logger would give it, not the force between them, which the
+        // parts of a step pass through (the force moves by most of a newton over a sample
+        // after a 3 V command step).
+        let run = |delay: f64| {
+            let model = Actuator::new(Parameters {
+                force_sensor_delay: delay,
+                ..Parameters::default()
+            })
+            .unwrap();
+            let command = |k: usize| if (k / 50) % 2 == 0 { 2.0 } else { 5.0 };
+            let mut sim = FixedStep::at_equilibrium(model, command(0), 0.054, 0.0)
+                .unwrap()
+                .unwrap();
+            let mut out = vec![];
+            for k in 0..200 {
+                out.push(sim.outputs().f_meas);
+                sim.set_command(command(k)).unwrap();
+                sim.step_to_in_parts((k + 1) as f64 * 1e-3, 0.054, 4).unwrap();
+            }
+            out
+        };
+        let (plain, delayed) = (run(0.0), run(1.5e-3));
+        let worst = (2..200)
+            .map(|k| (delayed[k] - 0.5 * (plain[k - 1] + plain[k - 2])).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "max |ΔF_meas| = {worst} N");
+        let moved = (2..200).map(|k| (plain[k] - plain[k - 1]).abs()).fold(0.0, f64::max);
+        assert!(moved > 0.5, "the force moves by {moved} N over a sample");
     }
 
     #[test]

@@ -54,7 +54,7 @@ pub struct SimulationSnapshot {
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-pub const SNAPSHOT_LAYOUT: f64 = 7.0;
+pub const SNAPSHOT_LAYOUT: f64 = 8.0;
 
 /// Numbers before the two counted lists: the layout, 23 scalars, the state, the volumes'
 /// pressures, the plays, the command stage ([`command_stage::VALUES`]) and the six work counters as two halves each.

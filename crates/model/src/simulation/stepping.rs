@@ -187,7 +187,7 @@ impl Simulation {
         }
         if self.plan.filtering_transducers {
             let mut y = self.outputs_at_sample();
-            self.record_transducers(&mut y);
+            self.record_transducers(&mut y, true);
         }
     }
 
@@ -267,7 +267,7 @@ impl Simulation {
                 if elapsed >= next_record - slack && next_record < step - slack {
                     self.acceleration_input = acceleration_input + self.acceleration_input_rate * elapsed;
                     let mut y = self.outputs_at_sample();
-                    self.record_transducers(&mut y);
+                    self.record_transducers(&mut y, false);
                     next_record += part;
                 }
             }
@@ -278,11 +278,18 @@ impl Simulation {
     }
 
     /// Record the transducers' static readings in `y` (at the simulation's time) in the
-    /// memories of those that filter, and put their filtered readings in `y`.
-    pub(super) fn record_transducers(&mut self, y: &mut Outputs) {
+    /// memories of those that filter, and put their filtered readings in `y`. Inside a step
+    /// (`at_communication_point` false) the delays do not keep the reading: they interpolate
+    /// between communication points.
+    pub(super) fn record_transducers(&mut self, y: &mut Outputs, at_communication_point: bool) {
         for ((memory, reading), channel) in self.transducers.iter_mut().zip(y.readings_mut()).zip(Channel::ALL) {
             if let Some(memory) = memory {
-                *reading = memory.record(&SensorLaw::of(&self.model.params, channel), self.time, *reading);
+                let law = SensorLaw::of(&self.model.params, channel);
+                *reading = if at_communication_point {
+                    memory.record(&law, self.time, *reading)
+                } else {
+                    memory.record_between(&law, self.time, *reading)
+                };
             }
         }
     }
