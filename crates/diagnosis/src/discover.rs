@@ -302,6 +302,9 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
     if let Some(filter) = second_order_reading(location, family, set) {
         return filter;
     }
+    if let Some(quantiser) = crate::quantiser::reading(set) {
+        return format!("At the {location} ({family}): {quantiser}");
+    }
     if let Some(curve) = crate::curves::reading(set) {
         return format!(
             "At the {location} ({}): {curve}",

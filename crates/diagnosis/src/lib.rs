@@ -39,6 +39,7 @@ mod named;
 pub mod noise;
 mod pairs;
 pub mod products;
+mod quantiser;
 pub mod recording;
 pub mod replay;
 mod report;

@@ -126,6 +126,9 @@ pub mod vr {
     pub const EXTRA_FORCE_SIGN_VELOCITY: u32 = 477;
     pub const STOPPER_ACCELERATION_INPUT_SHARE: u32 = 478;
     pub const RETURN_VENT_AREA: u32 = 480;
+    pub const COMMAND_QUANTUM: u32 = 481;
+    pub const COMMAND_QUANTUM_ORIGIN: u32 = 482;
+    pub const COMMAND_QUANTUM_THRESHOLD: u32 = 483;
     pub const SUPPLY_DRIFT: u32 = 490;
     pub const SUPPLY_RIPPLE_SINE: u32 = 491;
     pub const SUPPLY_RIPPLE_FREQUENCY: u32 = 492;
@@ -797,6 +800,18 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1000.0).at_most(1000.0)
         .cite("(2.3)")
         .because("off from 100 V, ten times the D/A's span; the range leaves room either side of it"),
+    parameter("command_quantum", vr::COMMAND_QUANTUM, "V", 0.0, "command quantiser: the command the current driver sees takes only the levels command_quantum_origin + k times this, a D/A of fewer bits than the logged command (0 = off)")
+        .at_least(0.0).at_most(10.0)
+        .cite("(2.3)")
+        .because("10 V: two levels over the D/A's 20 V, a 1-bit converter"),
+    parameter("command_quantum_origin", vr::COMMAND_QUANTUM_ORIGIN, "V", 0.0, "command quantiser: a level its grid passes through (needs command_quantum)")
+        .at_least(-10.0).at_most(10.0)
+        .cite("(2.3)")
+        .because("the grid repeats every step, so one within the D/A's span places it"),
+    parameter("command_quantum_threshold", vr::COMMAND_QUANTUM_THRESHOLD, "1", 0.5, "command quantiser: the share of the way from one level to the next at which the command takes the next (0.5: the nearest level; 1: the level below, as truncation gives; needs command_quantum)")
+        .at_least(0.0).at_most(1.0)
+        .cite("(2.3)")
+        .because("a share of one step"),
     parameter("current_limit", vr::CURRENT_LIMIT, "A", 0.0, "current limit: the coil current saturates at plus or minus this, applied to the command through k_cd and i_offset (0 = off)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.1)-(2.3)")

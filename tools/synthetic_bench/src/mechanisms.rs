@@ -230,6 +230,9 @@ pub struct UndeclaredEffects {
     /// `command`/`nonlinearity`: half width (V) of a dead zone in the D/A output the current
     /// driver sees: 0 within ±d, v ∓ d outside; 0 = none.
     pub command_dead_zone: f64,
+    /// `command`/`nonlinearity`: the D/A output the current driver sees is rounded to
+    /// multiples of this (V): a converter of fewer bits than the logged command; 0 = none.
+    pub command_quantum: f64,
     /// `command`/`limit`: the D/A output the current driver sees saturates above this (V),
     /// and nothing below; 0 = none.
     pub command_upper_limit: f64,

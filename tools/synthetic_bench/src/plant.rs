@@ -306,6 +306,8 @@ impl Model {
     /// Command as the current driver sees it (after the undeclared D/A limit).
     #[inline]
     pub(crate) fn driver_input(&self, v: f64) -> f64 {
+        let q = self.e.undeclared.command_quantum;
+        let v = if q > 0.0 { (v / q).round() * q } else { v };
         let d = self.e.undeclared.command_dead_zone;
         let v = if d > 0.0 {
             v.signum() * (v.abs() - d).max(0.0)

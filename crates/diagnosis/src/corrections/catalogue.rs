@@ -250,6 +250,23 @@ pub fn catalogue(
         // A D/A or a driver stage that saturates on one side only (a supply rail): the
         // symmetric limit would clip the other side too, where a closed loop drives the
         // command. Off at ±100 V.
+        // A D/A of fewer bits than the logger's: the command the driver sees takes its levels.
+        c(
+            "command quantiser",
+            "command",
+            "nonlinearity",
+            None,
+            vec![Term {
+                neutral: 0.0,
+                ..searched(
+                    "command_quantum",
+                    "V",
+                    Mechanism::Searched("command_quantum"),
+                    0.0,
+                    10.0,
+                )
+            }],
+        ),
         c(
             "command upper limit",
             "command",

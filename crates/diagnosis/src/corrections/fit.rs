@@ -858,6 +858,9 @@ impl Problem<'_> {
     fn fit_search(&self, candidate: &Candidate, base_replay: &Replay, golden_steps: usize) -> Result<Fit, String> {
         let p = self.base;
         let term = &candidate.terms[0];
+        if term.mechanism == Mechanism::Searched("command_quantum") {
+            return self.fit_quantiser(candidate, base_replay, golden_steps);
+        }
         let commands = self.recording.v_da.iter();
         let (lower, upper, logarithmic) = match term.mechanism {
             Mechanism::CurrentLimit => {
@@ -945,6 +948,99 @@ impl Problem<'_> {
         Ok(Fit {
             candidate: candidate.clone(),
             values,
+            prediction,
+            train,
+            heldout,
+            replays,
+        })
+    }
+}
+
+impl Problem<'_> {
+    /// The command quantiser ([`crate::quantiser`]): the leading periods of the residual in
+    /// the command, each under the four conventions, and the steps of coarser converters
+    /// over the logger's span, rounding and truncating, are tried in the model; the best is
+    /// polished within 3 % by a golden-section search. The first pass, which only ranks the
+    /// candidates, tries rounding alone. The origin and the threshold the fit takes are its
+    /// candidate's settings.
+    fn fit_quantiser(&self, candidate: &Candidate, base_replay: &Replay, golden_steps: usize) -> Result<Fit, String> {
+        let base = Prediction::of_replay(base_replay);
+        let residual: Vec<f64> = self
+            .recording
+            .force
+            .iter()
+            .zip(&base_replay.force)
+            .map(|(m, y)| m - y)
+            .collect();
+        let training: Vec<bool> = self.blocks.iter().map(|b| *b == Block::Training).collect();
+        let settled = |origin: f64, threshold: f64| Candidate {
+            settings: candidate
+                .settings
+                .iter()
+                .filter(|(name, _)| !name.starts_with("command_quantum_"))
+                .copied()
+                .chain([
+                    ("command_quantum_origin", origin),
+                    ("command_quantum_threshold", threshold),
+                ])
+                .collect(),
+            ..candidate.clone()
+        };
+        let mut replays = 0;
+        let mut best = (
+            self.errors(&base).0.iter().sum::<f64>(),
+            candidate.clone(),
+            candidate.terms[0].neutral,
+            base,
+        );
+        let mut trial =
+            |best: &mut (f64, Candidate, f64, [Vec<f64>; CHANNELS]), q: f64, origin: f64, threshold: f64| {
+                let tried = settled(origin, threshold);
+                replays += 1;
+                let Ok(replay) = self.replay(&tried, &[q]) else {
+                    return f64::INFINITY;
+                };
+                let y = Prediction::of_replay(&replay);
+                let cost: f64 = self.errors(&y).0.iter().sum();
+                if cost < best.0 {
+                    *best = (cost, tried, q, y);
+                }
+                cost
+            };
+        let first_pass = golden_steps < GOLDEN_STEPS;
+        for q in crate::quantiser::leading_steps(&self.recording.time, &self.recording.v_da, &residual, &training) {
+            for (origin, threshold) in crate::quantiser::conventions(q) {
+                if !(first_pass && threshold == 1.0) {
+                    trial(&mut best, q, origin, threshold);
+                }
+            }
+        }
+        for q in crate::quantiser::converter_steps(&self.recording.v_da) {
+            for threshold in [0.5, 1.0] {
+                if !(first_pass && threshold == 1.0) {
+                    trial(&mut best, q, 0.0, threshold);
+                }
+            }
+        }
+        if best.2 > 0.0 {
+            let (q, settings) = (best.2, best.1.settings.clone());
+            let get = |name: &str| settings.iter().find(|(n, _)| *n == name).map_or(0.0, |s| s.1);
+            let (origin, threshold) = (get("command_quantum_origin"), get("command_quantum_threshold"));
+            // The origin is a level: it stays one as the step changes where it is half a step off.
+            let shared = origin / q;
+            let mut polish = |u: f64| {
+                let q = q * (0.97 + 0.06 * u);
+                trial(&mut best, q, shared * q, threshold)
+            };
+            // The first pass only ranks the candidates: a few steps do for that.
+            let steps = if first_pass { 4 } else { COARSE_GOLDEN_STEPS };
+            golden(0.0, 1.0, steps, &mut polish);
+        }
+        let (_, candidate, q, prediction) = best;
+        let (train, heldout) = self.errors(&prediction);
+        Ok(Fit {
+            candidate,
+            values: vec![q],
             prediction,
             train,
             heldout,

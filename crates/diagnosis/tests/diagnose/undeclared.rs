@@ -204,9 +204,13 @@ fn a_force_sensor_with_backlash_is_found_at_the_force_sensor_as_hysteresis_not_j
 
 /// `effects` recorded by the protocol generator under a 20 s staircase at 500 Hz with
 /// pressures, the stopper fixed, and diagnosed.
-fn diagnosed_under_a_short_staircase(label: &str, effects: &synthetic_bench::BenchEffects) -> Diagnosis {
+fn diagnosed_in_twenty_seconds(
+    command: CommandProtocol,
+    label: &str,
+    effects: &synthetic_bench::BenchEffects,
+) -> Diagnosis {
     let spec = ProtocolSpec {
-        command: CommandProtocol::Staircase,
+        command,
         stopper: StopperMotion::Fixed { position: 0.054 },
         sample_rate: 500.0,
         duration: 20.0,
@@ -240,7 +244,7 @@ fn diagnosed_under_a_short_staircase(label: &str, effects: &synthetic_bench::Ben
 /// cases at the command, the current driver and the return, where the 80 s cases are broad.
 fn explained_under_a_short_staircase(name: &str) {
     let mechanism = undeclared_mechanism(name).expect("a mechanism of the table");
-    let d = diagnosed_under_a_short_staircase(name, &(mechanism.effects)());
+    let d = diagnosed_in_twenty_seconds(CommandProtocol::Staircase, name, &(mechanism.effects)());
     assert!(names(&d).is_empty(), "{name}: named {:?}", names(&d));
     let found = d
         .discovered
@@ -322,7 +326,7 @@ fn a_command_saturating_above_two_volts_alone_under_a_short_staircase_is_an_uppe
         },
         ..synthetic_bench::BenchEffects::default()
     };
-    let d = diagnosed_under_a_short_staircase("upper-limit", &effects);
+    let d = diagnosed_in_twenty_seconds(CommandProtocol::Staircase, "upper-limit", &effects);
     assert!(names(&d).is_empty(), "named {:?}", names(&d));
     let found = d.discovered.first().expect("nothing discovered");
     assert_eq!(found.candidate, "command upper limit", "{}", found.reading);
@@ -330,6 +334,34 @@ fn a_command_saturating_above_two_volts_alone_under_a_short_staircase_is_an_uppe
     assert!((limit - 2.0).abs() < 0.05, "command_upper_limit = {limit} V");
     assert!(found.reading.contains("saturates above 2.0"), "{}", found.reading);
     assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+}
+
+// A D/A of 0.6 V steps (not a power of two of the logger's 4.9 mV) behind a 12-bit log:
+// the step is read from the residual's period in the command. Under ramps and under a slow
+// sine; a staircase has too few levels to tell 0.6 V from a neighbouring step.
+#[test]
+fn a_command_on_levels_six_tenths_of_a_volt_apart_under_ramps_and_a_sine_is_a_command_quantiser() {
+    let effects = synthetic_bench::BenchEffects {
+        undeclared: synthetic_bench::UndeclaredEffects {
+            command_quantum: 0.6,
+            ..synthetic_bench::UndeclaredEffects::default()
+        },
+        ..synthetic_bench::BenchEffects::default()
+    };
+    for command in [CommandProtocol::Ramps, CommandProtocol::Sine] {
+        let d = diagnosed_in_twenty_seconds(command, "quantum", &effects);
+        assert!(names(&d).is_empty(), "named {:?}", names(&d));
+        let found = d.discovered.first().expect("nothing discovered");
+        assert_eq!(found.candidate, "command quantiser", "{}", found.reading);
+        let q = d.parameters.get(value_reference("command_quantum")).unwrap();
+        assert!((q / 0.6 - 1.0).abs() < 0.01, "command_quantum = {q} V");
+        assert!(
+            found.reading.contains("rounded to the nearest level"),
+            "{}",
+            found.reading
+        );
+        assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+    }
 }
 
 #[test]

@@ -3,6 +3,7 @@
 //!
 //! | parameter | law |
 //! |---|---|
+//! | `command_quantum`, `_origin`, `_threshold` (V, V, 1) | o + q ⌊(v − o)/q + 1 − r⌋: the levels o + k q of a D/A with fewer bits than the logged command, the next level taken r of the way to it ([`quantised`]) |
 //! | `command_curve_*` (V) | c(v): a static curve of the logged command, piecewise linear through its knots ([`super::static_curve`]) |
 //! | `f3_input_cubic` (V) | v + c (v / 10 V)³: a static curve before f3 (the current driver is linear and fast, so a curve on the tip force k_m i is the same as one on the command) |
 //! | `command_limit` (V) | clipped at ± the limit |
@@ -32,6 +33,7 @@ pub const MAX_FILTER_PIECES: usize = 16;
 /// Whether any term of the command stage is on.
 pub fn is_active(p: &Parameters) -> bool {
     p.f3_input_cubic != 0.0
+        || p.command_quantum > 0.0
         || p.command_curve.is_on()
         || p.command_limit > 0.0
         || has_one_sided_limit(p)
@@ -46,10 +48,22 @@ fn has_one_sided_limit(p: &Parameters) -> bool {
     p.command_upper_limit < 100.0 || p.command_lower_limit > -100.0
 }
 
-/// The static part of the stage: the static curve, the cubic, then the command and current
-/// limits.
+/// The command on the quantiser's levels o + k q: the level below, or the next one from r of
+/// the way to it (r = ½ rounds to the nearest level, r = 1 truncates).
+pub fn quantised(p: &Parameters, v_da: f64) -> f64 {
+    let (q, o) = (p.command_quantum, p.command_quantum_origin);
+    o + q * ((v_da - o) / q + 1.0 - p.command_quantum_threshold).floor()
+}
+
+/// The static part of the stage: the quantiser, the static curve, the cubic, then the
+/// command and current limits.
 pub fn static_map(p: &Parameters, v_da: f64) -> f64 {
-    let mut v = p.command_curve.at(v_da);
+    let v = if p.command_quantum > 0.0 {
+        quantised(p, v_da)
+    } else {
+        v_da
+    };
+    let mut v = p.command_curve.at(v);
     if p.f3_input_cubic != 0.0 {
         v += p.f3_input_cubic * (v / 10.0).powi(3);
     }
@@ -285,6 +299,35 @@ mod tests {
         let t = [0.0, 0.001, 0.002, 0.003];
         let v = [1.0, 5.0, -3.0, 0.25];
         assert_eq!(seen_commands(&p, &t, &v), v.to_vec());
+    }
+
+    #[test]
+    fn a_six_bit_converter_rounds_or_truncates_the_command_onto_its_levels() {
+        // 64 levels over ±10 V: 0.3125 V apart, 0 V among them.
+        let rounding = Parameters {
+            command_quantum: 0.3125,
+            ..Parameters::default()
+        };
+        let t = [0.0, 0.001, 0.002, 0.003, 0.004];
+        let v = [0.1, 0.2, 0.3, -0.2, 9.99];
+        assert_eq!(
+            seen_commands(&rounding, &t, &v),
+            vec![0.0, 0.3125, 0.3125, -0.3125, 10.0]
+        );
+        let truncating = Parameters {
+            command_quantum_threshold: 1.0,
+            ..rounding
+        };
+        assert_eq!(seen_commands(&truncating, &t, &v), vec![0.0, 0.0, 0.0, -0.3125, 9.6875]);
+        // Levels through 0.1 V instead: 0.1 + k 0.3125.
+        let shifted = Parameters {
+            command_quantum_origin: 0.1,
+            ..rounding
+        };
+        let seen = seen_commands(&shifted, &t, &v);
+        for (got, want) in seen.iter().zip([0.1, 0.1, 0.4125, -0.2125, 10.1]) {
+            assert!((got - want).abs() < 1e-12, "{seen:?}");
+        }
     }
 
     #[test]

@@ -146,6 +146,10 @@ struct Cli {
     /// A dead zone in the D/A output the current driver sees: its half width, V (e.g. 0.4).
     #[arg(long)]
     command_dead_zone: Option<f64>,
+    /// The D/A output the current driver sees is rounded to multiples of this, V: a converter
+    /// of fewer bits than the logged command (e.g. 0.3125, 6 bits over ±10 V).
+    #[arg(long)]
+    command_quantum: Option<f64>,
     /// The D/A output the current driver sees saturates above this, V, and not below (e.g. 6).
     #[arg(long)]
     command_upper_limit: Option<f64>,
@@ -296,6 +300,7 @@ fn main() -> ExitCode {
     );
     set(&mut und.command_dead_zone, cli.command_dead_zone);
     set(&mut und.command_upper_limit, cli.command_upper_limit);
+    set(&mut und.command_quantum, cli.command_quantum);
     set(&mut und.force_sensor_saturation, cli.force_sensor_saturation);
     set(&mut und.moving_mass, cli.moving_mass);
     set(&mut und.seal_pressure_friction, cli.seal_pressure_friction);
@@ -341,6 +346,7 @@ fn main() -> ExitCode {
         und.force_sensor_pickup_frequency,
         und.command_dead_zone,
         und.command_upper_limit,
+        und.command_quantum,
         und.force_sensor_saturation,
         und.moving_mass,
         und.seal_pressure_friction,
