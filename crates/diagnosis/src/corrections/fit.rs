@@ -1026,11 +1026,11 @@ impl Problem<'_> {
             let (q, settings) = (best.2, best.1.settings.clone());
             let get = |name: &str| settings.iter().find(|(n, _)| *n == name).map_or(0.0, |s| s.1);
             let (origin, threshold) = (get("command_quantum_origin"), get("command_quantum_threshold"));
-            // The origin is a level: it stays one as the step changes where it is half a step off.
-            let shared = origin / q;
+            // A grid half a step off 0 V stays half a step off as the step changes.
+            let origin_in_steps = origin / q;
             let mut polish = |u: f64| {
                 let q = q * (0.97 + 0.06 * u);
-                trial(&mut best, q, shared * q, threshold)
+                trial(&mut best, q, origin_in_steps * q, threshold)
             };
             // The first pass only ranks the candidates: a few steps do for that.
             let steps = if first_pass { 4 } else { COARSE_GOLDEN_STEPS };
