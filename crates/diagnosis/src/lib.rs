@@ -407,10 +407,11 @@ impl Diagnosis {
     /// recording.
     pub fn explained(&self) -> bool {
         self.force_explained()
-            && self
-                .pressure_split
-                .as_ref()
-                .map_or(true, PressureSplit::pressures_within_noise)
+            && !split::pressures_off(
+                self.pressure_split.as_ref(),
+                self.pressure_noise,
+                self.after.pressure_rms,
+            )
     }
     pub fn verdict(&self) -> &'static str {
         if self.explained() {
@@ -1044,8 +1045,7 @@ fn what_stays_unexplained(
     let explained = after_errors.heldout_rms <= EXPLAINED_WITHIN_NOISE * noise;
     // Every measured channel counts: pressures that depart while the force does not (a
     // pressure transducer, say) leave a remainder too, with its place and signature.
-    let pressures_off = split.map_or(false, |s| !s.pressures_within_noise());
-    if explained && !pressures_off {
+    if explained && !split::pressures_off(split, cx.pressure_noise, after_errors.pressure_rms) {
         return None;
     }
     let (mut location, mut family, mut alternatives) = match localization {
@@ -1097,23 +1097,41 @@ fn what_stays_unexplained(
         )
     };
     let (sentence, signature) = if explained {
-        let s = split.expect("pressures_off needs the split");
+        let noise_pa = cx
+            .pressure_noise
+            .expect("pressures depart only where the recording has them");
+        let whole = after_errors
+            .pressure_rms
+            .expect("pressures depart only where the recording has them");
+        let whole_ratio = [whole[0] / noise_pa[0].max(1e-9), whole[1] / noise_pa[1].max(1e-9)];
+        let worse = split.map_or(
+            usize::from(whole_ratio[1] > whole_ratio[0]),
+            PressureSplit::worse_chamber,
+        );
         let recording = cx.recording;
-        let worse = s.worse_chamber();
         let measured = if worse == 0 { &recording.p1 } else { &recording.p2 };
         let modelled = if worse == 0 { &after.p1 } else { &after.p2 };
         let residual = difference(measured.as_ref().expect("pressures"), modelled);
         let signature = Signature::of(&recording.time, &residual, chain, "Pa");
-        (
-            format!(
-                "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's by {:.0} and {:.0} Pa RMS after the start ({:.1}× and {:.1}× their noise; {:.1}× and {:.1}× over the whole recording); {place}. Chamber {}: {}",
-                after_errors.heldout_rms,
+        let figures = match split {
+            Some(s) => format!(
+                "by {:.0} and {:.0} Pa RMS after the start ({:.1}× and {:.1}× their noise; {:.1}× and {:.1}× over the whole recording)",
                 s.pressure_rms[0],
                 s.pressure_rms[1],
                 s.pressure_ratio[0],
                 s.pressure_ratio[1],
                 s.whole_pressure_ratio[0],
                 s.whole_pressure_ratio[1],
+            ),
+            None => format!(
+                "by {:.0} and {:.0} Pa RMS over the whole recording ({:.1}× and {:.1}× their noise)",
+                whole[0], whole[1], whole_ratio[0], whole_ratio[1],
+            ),
+        };
+        (
+            format!(
+                "The force is explained to within its noise ({:.4} N held out, {ratio:.1}× the noise floor), but the pressures depart from the model's {figures}; {place}. Chamber {}: {}",
+                after_errors.heldout_rms,
                 worse + 1,
                 signature.sentence
             ),

@@ -55,6 +55,21 @@ impl PressureSplit {
     }
 }
 
+/// Whether a measured pressure departs beyond its noise: as the pressure split says where it
+/// could be formed; otherwise (a transducer's static curve, which the split cannot take back)
+/// from the whole recording's pressure errors `whole_rms` against their noise floors.
+pub(crate) fn pressures_off(
+    split: Option<&PressureSplit>,
+    pressure_noise: Option<[f64; 2]>,
+    whole_rms: Option<[f64; 2]>,
+) -> bool {
+    match (split, pressure_noise, whole_rms) {
+        (Some(split), _, _) => !split.pressures_within_noise(),
+        (None, Some(noise), Some(rms)) => (0..2).any(|k| rms[k] > EXPLAINED_WITHIN_NOISE * noise[k]),
+        _ => false,
+    }
+}
+
 /// The pressure channels' split: the force against A_p (p1 − p2), the pressures against
 /// the model's.
 pub(crate) fn pressure_split(
@@ -209,6 +224,15 @@ mod tests {
             ..Replay::default()
         };
         (recording, replay)
+    }
+
+    #[test]
+    fn without_a_split_a_pressure_off_by_four_noise_floors_over_the_recording_departs() {
+        // A chamber 1 transducer's static curve left 793 Pa against a 182 Pa floor.
+        let noise = Some([182.0, 173.0]);
+        assert!(pressures_off(None, noise, Some([793.0, 197.0])));
+        assert!(!pressures_off(None, noise, Some([200.0, 197.0])));
+        assert!(!pressures_off(None, None, None));
     }
 
     #[test]
