@@ -861,22 +861,37 @@ impl Problem<'_> {
         if term.mechanism == Mechanism::Searched("command_quantum") {
             return self.fit_quantiser(candidate, base_replay, golden_steps);
         }
-        let commands = self.recording.v_da.iter();
+        // A limit beyond every command the fits train on changes nothing they see: the search
+        // spans the training rows' commands, or a flat stretch of misfit above them takes a
+        // golden section away from a limit that clips only the highest training level.
+        let commands: Vec<f64> = self
+            .recording
+            .v_da
+            .iter()
+            .zip(self.blocks)
+            .filter(|(_, b)| **b == Block::Training)
+            .map(|(v, _)| *v)
+            .collect();
+        let (low, high) = commands
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
         let (lower, upper, logarithmic) = match term.mechanism {
+            // A symmetric limit is one only where it clips both sides of what the fits train
+            // on; clipping one side, it is the one-sided limit, which claims nothing about the
+            // other (where a closed loop may drive the command hard in held-out rows).
             Mechanism::CurrentLimit => {
-                let largest = commands
-                    .map(|v| current_driver::static_current(p.k_cd, p.i_offset, *v).abs())
-                    .fold(0.0, f64::max);
-                (0.2 * largest, largest, false)
+                let at = |v: f64| current_driver::static_current(p.k_cd, p.i_offset, v);
+                let (i_low, i_high) = (at(low).min(at(high)), at(low).max(at(high)));
+                let largest = i_low.abs().max(i_high.abs());
+                (0.2 * largest, both_sides_clipped_below(i_low, i_high), false)
             }
             Mechanism::CommandLimit => {
-                let largest = commands.map(|v| v.abs()).fold(0.0, f64::max);
-                (0.2 * largest, largest, false)
+                let largest = low.abs().max(high.abs());
+                (0.2 * largest, both_sides_clipped_below(low, high), false)
             }
             // A one-sided limit anywhere in the upper or lower four fifths of the commands
-            // recorded: it clips at least a fifth of their span.
+            // trained on: it clips at least a fifth of their span.
             Mechanism::Searched(name) if is_one_sided_command_limit(&term.mechanism) => {
-                let (low, high) = commands.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
                 let span = high - low;
                 if name == "command_upper_limit" {
                     (low + 0.2 * span, high, false)
@@ -893,6 +908,18 @@ impl Problem<'_> {
             _ => (term.lower, term.upper, true),
         };
         let base = Prediction::of_replay(base_replay);
+        // (an empty range, or one of NaN where the training rows hold no command)
+        if upper.partial_cmp(&lower) != Some(std::cmp::Ordering::Greater) {
+            let (train, heldout) = self.errors(&base);
+            return Ok(Fit {
+                candidate: candidate.clone(),
+                values: vec![term.neutral],
+                prediction: base,
+                train,
+                heldout,
+                replays: 0,
+            });
+        }
         let mut replays = 0;
         // The prediction at the lowest cost so far: the search ends on it, and it is not
         // replayed again.
@@ -1103,6 +1130,16 @@ fn bounded_least_squares(ata: &[Vec<f64>], atb: &[f64], usable: &[bool], lower: 
     x
 }
 
+/// The largest symmetric limit that clips both ends of a range from `low` to `high`: the
+/// smaller of their magnitudes, or 0 when the range lies on one side of zero.
+fn both_sides_clipped_below(low: f64, high: f64) -> f64 {
+    if low < 0.0 && high > 0.0 {
+        (-low).min(high)
+    } else {
+        0.0
+    }
+}
+
 /// Whether `mechanism` is the command's upper or lower limit, searched over the commands
 /// recorded on a linear scale.
 fn is_one_sided_command_limit(mechanism: &Mechanism) -> bool {
@@ -1113,31 +1150,5 @@ fn is_one_sided_command_limit(mechanism: &Mechanism) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::bounded_least_squares;
-
-    #[test]
-    fn a_term_whose_column_is_all_zeros_gets_no_step_and_the_others_their_least_squares_step() {
-        // Normal equations of two coupled terms (steps 2 and −1) and, between them, a term that
-        // moves nothing: its row and column of zeros.
-        let ata = vec![vec![4.0, 0.0, 2.0], vec![0.0, 0.0, 0.0], vec![2.0, 0.0, 2.0]];
-        let atb = vec![6.0, 0.0, 2.0];
-        let unbounded = [f64::NEG_INFINITY; 3];
-        let step = bounded_least_squares(&ata, &atb, &[true; 3], &unbounded, &[f64::INFINITY; 3]);
-        assert_eq!(step[1], 0.0, "{step:?}");
-        assert!((step[0] - 2.0).abs() < 1e-9 && (step[2] + 1.0).abs() < 1e-9, "{step:?}");
-    }
-
-    #[test]
-    fn a_step_past_a_bound_stops_at_the_bound_and_the_rest_is_solved_again() {
-        // Coupled terms: unbounded, the steps are (1, 1); with the first held at most 0.5 the
-        // second solves 0.5 + 2 x1 = 3, so x1 = 1.25.
-        let ata = vec![vec![2.0, 1.0], vec![1.0, 2.0]];
-        let atb = vec![3.0, 3.0];
-        let step = bounded_least_squares(&ata, &atb, &[true; 2], &[f64::NEG_INFINITY; 2], &[0.5, f64::INFINITY]);
-        assert!(
-            (step[0] - 0.5).abs() < 1e-12 && (step[1] - 1.25).abs() < 1e-9,
-            "{step:?}"
-        );
-    }
-}
+#[path = "fit_tests.rs"]
+mod tests;
