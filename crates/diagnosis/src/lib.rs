@@ -480,12 +480,15 @@ fn apply_named(p: &mut Parameters, scored: &Scored) -> Result<Vec<(&'static str,
     Ok(set)
 }
 
-/// The named effect's own signature in the current residual.
+/// The named effect's own signature in the current residual; `fitted_force` is the force of
+/// the model with the effect fitted.
+#[allow(clippy::too_many_arguments)]
 fn named_signature(
     name: &str,
     recording: &Recording,
     model: &Actuator,
     replay: &Replay,
+    fitted_force: &[f64],
     blocks: &[Block],
     noise: f64,
     mechanical_noise: f64,
@@ -500,7 +503,12 @@ fn named_signature(
     match name {
         "sensor_offset_gain" => named::sensor_is_affine(&residual, &reference, blocks, judged_noise),
         "piston_friction" => named::friction_changes_sign(&residual, recording, judged_noise),
-        "jet_pipe_hysteresis" => named::loop_with_command_direction(&force_residual, recording, noise),
+        "jet_pipe_hysteresis" => named::loop_with_command_direction(
+            &force_residual,
+            &difference(fitted_force, &replay.force),
+            recording,
+            noise,
+        ),
         _ => named::SignatureTest {
             present: true,
             sentence: String::new(),

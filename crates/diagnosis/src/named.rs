@@ -102,9 +102,10 @@ pub fn friction_changes_sign(residual: &[f64], recording: &Recording, noise: f64
     }
 }
 
-/// Hysteresis after f3: at equal command the force is lower while the command rises than
-/// while it falls, bin after bin of command level.
-pub fn loop_with_command_direction(residual: &[f64], recording: &Recording, noise: f64) -> SignatureTest {
+/// The mean of `signal` while the command rises less its mean while the command falls, in
+/// each bin of command level both directions visit for at least 200 samples: the loop a
+/// signal draws against the command.
+fn rising_less_falling(signal: &[f64], recording: &Recording) -> Vec<Option<f64>> {
     let direction = command_direction(&recording.v_da);
     let (lo, hi) = recording
         .v_da
@@ -112,36 +113,56 @@ pub fn loop_with_command_direction(residual: &[f64], recording: &Recording, nois
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     let width = (hi - lo).max(1e-9) / BINS as f64;
     let mut sums = vec![[0.0f64; 4]; BINS];
-    for k in 0..residual.len() {
+    for (k, &value) in signal.iter().enumerate() {
         let bin = (((recording.v_da[k] - lo) / width) as usize).min(BINS - 1);
         if direction[k] > 0.0 {
-            sums[bin][0] += residual[k];
+            sums[bin][0] += value;
             sums[bin][1] += 1.0;
         } else if direction[k] < 0.0 {
-            sums[bin][2] += residual[k];
+            sums[bin][2] += value;
             sums[bin][3] += 1.0;
         }
     }
-    let gaps: Vec<f64> = sums
-        .iter()
-        .filter(|s| s[1] >= 200.0 && s[3] >= 200.0)
-        .map(|s| s[0] / s[1] - s[2] / s[3])
+    sums.iter()
+        .map(|s| (s[1] >= 200.0 && s[3] >= 200.0).then(|| s[0] / s[1] - s[2] / s[3]))
+        .collect()
+}
+
+/// Hysteresis after f3 draws a loop against the command: at equal command the force differs
+/// while the command rises from while it falls. Which way depends on how fast the command
+/// moves: followed quasi-statically the force is lower while rising; under a command faster
+/// than the chambers (a chirp to 20 Hz) the force lags by more than a quarter period and the
+/// loop turns over. So the residual's loop is held against the loop the fitted effect draws
+/// (`effect`, the fitted model's force less the current one): the same way bin after bin of
+/// command level, and by more than twice the noise on average.
+pub fn loop_with_command_direction(
+    residual: &[f64],
+    effect: &[f64],
+    recording: &Recording,
+    noise: f64,
+) -> SignatureTest {
+    let pairs: Vec<(f64, f64)> = rising_less_falling(residual, recording)
+        .into_iter()
+        .zip(rising_less_falling(effect, recording))
+        .filter_map(|(r, e)| Some((r?, e?)))
         .collect();
-    if gaps.len() < 3 {
+    if pairs.len() < 3 {
         return SignatureTest {
             present: false,
             sentence: "the command does not sweep both ways over enough of its range to show a loop".to_string(),
         };
     }
-    let lower_rising = gaps.iter().filter(|g| **g < 0.0).count();
-    let mean_gap = gaps.iter().sum::<f64>() / gaps.len() as f64;
-    let present = 3 * lower_rising >= 2 * gaps.len() && -mean_gap > 2.0 * noise;
+    // The residual's gap counted positive where it runs the way the effect's does.
+    let aligned: Vec<f64> = pairs.iter().map(|(r, e)| r * e.signum()).collect();
+    let same_way = aligned.iter().filter(|g| **g > 0.0).count();
+    let mean_gap = aligned.iter().sum::<f64>() / aligned.len() as f64;
+    let effect_lower_rising = pairs.iter().filter(|(_, e)| *e < 0.0).count();
+    let present = 3 * same_way >= 2 * aligned.len() && mean_gap > 2.0 * noise;
     SignatureTest {
         present,
         sentence: format!(
-            "at equal command the residual is lower while the command rises than while it falls in {lower_rising} of {} command bins, by {:.4} N on average",
-            gaps.len(),
-            -mean_gap
+            "at equal command the residual differs between rising and falling commands the way the fitted hysteresis makes it in {same_way} of {} command bins, by {mean_gap:.4} N on average (the hysteresis lowers the force while the command rises in {effect_lower_rising} of them)",
+            aligned.len(),
         ),
     }
 }
@@ -149,4 +170,65 @@ pub fn loop_with_command_direction(residual: &[f64], recording: &Recording, nois
 /// Whether a named effect has a signature test of its own here (the others pass by default).
 pub fn has_signature_test(name: &str) -> bool {
     matches!(name, "sensor_offset_gain" | "piston_friction" | "jet_pipe_hysteresis")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::loop_with_command_direction;
+    use crate::recording::Recording;
+
+    /// A triangle command from 0 to 10 V, 2 s a period, for 20 s at 1 kHz.
+    fn triangle() -> Recording {
+        let n = 20_000;
+        let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let v_da = time
+            .iter()
+            .map(|t| {
+                let phase = t % 2.0;
+                if phase < 1.0 {
+                    10.0 * phase
+                } else {
+                    10.0 * (2.0 - phase)
+                }
+            })
+            .collect();
+        Recording {
+            time,
+            v_da,
+            x_s: vec![0.06; n],
+            force: vec![0.0; n],
+            p1: None,
+            p2: None,
+            full_rate: None,
+            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_loop_is_the_hysteresis_signature_when_it_turns_the_way_the_fitted_hysteresis_turns_it_either_way() {
+        let recording = triangle();
+        let rising: Vec<f64> = (1..recording.v_da.len())
+            .map(|k| recording.v_da[k] - recording.v_da[k - 1])
+            .chain([0.0])
+            .map(|dv| dv.signum())
+            .collect();
+        let noise = 0.05;
+        // A loop 0.5 N high while the command rises (as under a command faster than the
+        // chambers), and a fitted hysteresis that draws it so: present.
+        let higher_rising: Vec<f64> = rising.iter().map(|s| 0.25 * s).collect();
+        assert!(loop_with_command_direction(&higher_rising, &higher_rising, &recording, noise).present);
+        // The quasi-static loop, lower while rising: present with an effect that turns that way.
+        let lower_rising: Vec<f64> = higher_rising.iter().map(|x| -x).collect();
+        assert!(loop_with_command_direction(&lower_rising, &lower_rising, &recording, noise).present);
+        // A residual whose loop runs against the fitted one's: absent.
+        let against = loop_with_command_direction(&lower_rising, &higher_rising, &recording, noise);
+        assert!(!against.present, "{}", against.sentence);
+        // A loop within twice the noise: absent.
+        let small: Vec<f64> = higher_rising.iter().map(|x| 0.1 * x).collect();
+        assert!(!loop_with_command_direction(&small, &higher_rising, &recording, noise).present);
+        // A drift in time draws no loop against the command: absent.
+        let drift: Vec<f64> = recording.time.iter().map(|t| 0.05 * t).collect();
+        assert!(!loop_with_command_direction(&drift, &higher_rising, &recording, noise).present);
+    }
 }
