@@ -139,6 +139,7 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
             plays: *plays,
             turning_point,
             settled: None,
+            at_settled: std::cell::Cell::new(None),
             kinks: vec![],
             panel_ends: std::cell::RefCell::new(vec![]),
             late: None,
@@ -163,10 +164,10 @@ impl<C: StaticCurve> ElectromechanicalPropagator<C> {
             }
         }
         if trajectory.series.is_empty() && ramp == 0.0 {
-            // |δ| e^{−ω s} below 1e-15 A: the input is constant to rounding.
-            let settled = drive.transient_below(1e-15);
-            let integral = trajectory.quadrature(settled);
-            trajectory.settled = Some((settled, integral, trajectory.jet_input(settled)));
+            // |δ| e^{−ω s} below 1e-15 A: the input is constant to rounding. The integral up
+            // to then is taken when a query goes past it: a replay's step is often a tenth
+            // of the settling time, and its quadrature all the way cost ten times the step's.
+            trajectory.settled = Some(drive.transient_below(1e-15));
         }
         trajectory
     }
@@ -188,9 +189,11 @@ pub struct Trajectory<'a, C = F3> {
     /// Hysteresis play states at the start of the step.
     pub(super) plays: [f64; PLAY_OPERATORS],
     /// For a held command integrated by quadrature: the time after which the current
-    /// transient no longer moves the jet pipe input, the modal integrals up to then, and
-    /// the input from then on.
-    pub(super) settled: Option<(f64, [C64; 3], f64)>,
+    /// transient no longer moves the jet pipe input.
+    pub(super) settled: Option<f64>,
+    /// The modal integrals up to [`Self::settled`] and the input from then on, once a query
+    /// has gone past it.
+    pub(super) at_settled: std::cell::Cell<Option<([C64; 3], f64)>>,
     /// Where the current stops rising and starts falling or back, if within the step.
     pub(super) turning_point: Option<f64>,
     /// Instants where the quadrature's integrand has a kink (the turning point, plays of
@@ -414,9 +417,17 @@ impl<C: StaticCurve> Trajectory<'_, C> {
             }
         } else if let Some(form) = self.ramp_form.as_ref().filter(|f| f.covers(s)) {
             return form.modes(p, s);
-        } else if let Some((settled, at_settled, u_final)) = self.settled.filter(|(settled, _, _)| s > *settled) {
+        } else if let Some(settled) = self.settled.filter(|&settled| s > settled) {
             // Past the current transient the input is constant: carry the integral up to
             // the settling time forward and add the constant input's part exactly.
+            let (at_settled, u_final) = match self.at_settled.get() {
+                Some(known) => known,
+                None => {
+                    let known = (self.quadrature(settled), self.jet_input(settled));
+                    self.at_settled.set(Some(known));
+                    known
+                }
+            };
             for k in 0..3 {
                 let carry = (p.lambda[k] * (s - settled)).exp();
                 integral[k] = carry * at_settled[k] + (carry - 1.0) / p.lambda[k] * u_final;
