@@ -32,8 +32,14 @@ const FINE_KNOTS: usize = 25;
 const END_QUANTILE: f64 = 0.01;
 /// The most modulation candidates a round fits through the model.
 pub const MOST_CANDIDATES: usize = 4;
-/// …of which at most this many modulate the same constant.
+/// …of which at most this many modulate the same constant…
 const MOST_PER_CONSTANT: usize = 2;
+/// …and at most this many follow the same signal. The screen is first order: it reads an
+/// increment as acting at once, so a shape that switches faster than the chambers answer
+/// (the sign of the stopper's velocity) is under-scored against a smoother one of the
+/// same signal family, and only a fit through the model tells them apart; four constants
+/// of the current driver and jet pipe on one signal would leave it nothing to compare.
+const MOST_PER_SIGNAL: usize = 2;
 
 /// What a round asks the localization to screen: every modulation, with the residual's
 /// spectral line if it has one.
@@ -48,6 +54,16 @@ pub enum Follows {
     Signal(ModulationSignal),
     /// A sinusoid of time at this frequency (Hz): both slots, sine and cosine.
     Periodic(f64),
+}
+
+impl Follows {
+    /// The signal followed, a sinusoid at any frequency counting as one.
+    fn kind(&self) -> Option<ModulationSignal> {
+        match self {
+            Follows::Signal(signal) => Some(*signal),
+            Follows::Periodic(_) => None,
+        }
+    }
 }
 
 impl std::fmt::Display for Follows {
@@ -515,14 +531,27 @@ pub fn screen(
             penalised: scored,
         })
     });
-    let mut all: Vec<Screened> = screened.into_iter().flatten().collect();
+    leading(screened.into_iter().flatten().collect())
+}
+
+/// The best screened pairs, at most [`MOST_CANDIDATES`], [`MOST_PER_CONSTANT`] of a constant
+/// and [`MOST_PER_SIGNAL`] of a signal, and one of each constant against each signal.
+fn leading(mut all: Vec<Screened>) -> Vec<Screened> {
     all.sort_by(|a, b| a.penalised.total_cmp(&b.penalised));
     let mut kept: Vec<Screened> = vec![];
     for s in all {
         if kept.len() >= MOST_CANDIDATES {
             break;
         }
-        if kept.iter().filter(|k| k.constant == s.constant).count() < MOST_PER_CONSTANT {
+        let same_constant = kept.iter().filter(|k| k.constant == s.constant).count();
+        let same_signal = kept.iter().filter(|k| k.follows.kind() == s.follows.kind()).count();
+        // The residual's spectral line and a constant's own traced line are often one line
+        // read twice: a second sinusoid of the same constant would take the place of another
+        // constant's.
+        let repeated = kept
+            .iter()
+            .any(|k| k.constant == s.constant && k.follows.kind() == s.follows.kind());
+        if same_constant < MOST_PER_CONSTANT && same_signal < MOST_PER_SIGNAL && !repeated {
             kept.push(s);
         }
     }
@@ -1034,6 +1063,59 @@ mod tests {
                 "time {time_score} against the band's {band_score}"
             );
         }
+    }
+
+    #[test]
+    fn the_leading_modulations_follow_more_than_one_signal_though_one_signal_screens_best_for_every_constant() {
+        let pair = |constant: &'static str, signal: ModulationSignal, penalised: f64| Screened {
+            constant,
+            follows: Follows::Signal(signal),
+            knots: vec![-1.0, 1.0],
+            increments: vec![0.0, 0.0],
+            penalised,
+        };
+        let velocity = ModulationSignal::StopperVelocity;
+        let sign = ModulationSignal::StopperVelocitySign;
+        let all = vec![
+            pair("k_m", velocity, 3.0),
+            pair("i_offset", velocity, 1.0),
+            pair("k_cd", velocity, 2.0),
+            pair("F_jp_sat", velocity, 4.0),
+            pair("i_offset", sign, 5.0),
+            pair("k_cd", sign, 6.0),
+            pair("i_offset", ModulationSignal::Force, 7.0),
+        ];
+        let sinusoid = |constant: &'static str, hz: f64, penalised: f64| Screened {
+            follows: Follows::Periodic(hz),
+            ..pair(constant, velocity, penalised)
+        };
+        let kept: Vec<(&str, Follows)> = leading(all).iter().map(|s| (s.constant, s.follows)).collect();
+        assert_eq!(
+            kept,
+            vec![
+                ("i_offset", Follows::Signal(velocity)),
+                ("k_cd", Follows::Signal(velocity)),
+                ("i_offset", Follows::Signal(sign)),
+                ("k_cd", Follows::Signal(sign)),
+            ]
+        );
+        // One line read twice (from the residual and from the constant's trace) is one
+        // candidate.
+        let lines = vec![
+            sinusoid("x_jp_sat", 9.060, 1.0),
+            sinusoid("x_jp_sat", 9.061, 1.1),
+            sinusoid("k_m", 9.060, 2.0),
+            pair("force_sensor_offset", ModulationSignal::Force, 3.0),
+        ];
+        let kept: Vec<(&str, Follows)> = leading(lines).iter().map(|s| (s.constant, s.follows)).collect();
+        assert_eq!(
+            kept,
+            vec![
+                ("x_jp_sat", Follows::Periodic(9.060)),
+                ("k_m", Follows::Periodic(9.060)),
+                ("force_sensor_offset", Follows::Signal(ModulationSignal::Force)),
+            ]
+        );
     }
 
     #[test]

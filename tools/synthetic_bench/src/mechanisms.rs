@@ -136,6 +136,8 @@
 //! * `position_sign_force` (`mechanics`/`extra_force`, k, with `position_sign_origin` x₀):
 //!   the force gains k (x_s − x₀) tanh(v / 1 mm/s) with the stopper's own velocity.
 //!   `chamber_1_pressure_force` (`mechanics`/`extra_force`, μ): it gains μ (P1 − P_r).
+//! * `current_offset_direction` (`current_driver`/`asymmetry`, d): the driver's offset is
+//!   i_offset + d tanh(v / 0.5 mm/s) with the stopper's own velocity.
 //! * `force_sensor_filter_frequency` (`force_sensor`/`dynamics`, f_n, with
 //!   `force_sensor_filter_damping` ζ): the force reading passes, after any lag, through
 //!   y'' + 2ζω y' + ω² y = ω² u, ω = 2π f_n (an amplifier's anti-aliasing filter; ζ = 1/√2
@@ -293,6 +295,10 @@ pub struct UndeclaredEffects {
     pub position_sign_force: f64,
     /// Its origin x₀ (m).
     pub position_sign_origin: f64,
+    /// `current_driver`/`asymmetry`: the current driver's offset differs with the direction of
+    /// the stopper's travel, i_offset + d tanh(v / 0.5 mm/s), v the stopper's own velocity (a
+    /// pick-up from the stopper drive's direction line); d in A; 0 = none.
+    pub current_offset_direction: f64,
     /// `mechanics`/`extra_force`: a force that adds to the pressure force, μ (P1 − P_r), μ in
     /// m² (chamber 1's pressure acting on an annulus the thesis leaves out); 0 = none.
     pub chamber_1_pressure_force: f64,

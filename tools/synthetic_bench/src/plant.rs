@@ -467,7 +467,11 @@ impl Model {
             dy[S_CF] = 0.0;
             dy[S_CF_RATE] = 0.0;
         }
-        let mut di = p.omega_cd * (p.k_cd * v_cmd + p.i_offset - i);
+        let mut offset = p.i_offset;
+        if self.e.undeclared.current_offset_direction != 0.0 {
+            offset += self.e.undeclared.current_offset_direction * (xs_dot / 0.5e-3).tanh();
+        }
+        let mut di = p.omega_cd * (p.k_cd * v_cmd + offset - i);
         if self.slew {
             let s = self.e.undeclared.current_slew_limit;
             di = di.clamp(-s, s);
