@@ -197,6 +197,16 @@ pub fn run(
         }
     };
 
+    // the current driver's offset ripple (a pick-up at a frequency), 0 unless it is on
+    let w_offset = 2.0 * PI * und.current_offset_ripple_frequency;
+    let offset_ripple_at = |t: f64| {
+        if und.current_offset_ripple != 0.0 {
+            und.current_offset_ripple * (w_offset * t).sin()
+        } else {
+            0.0
+        }
+    };
+
     // gas temperature: the thesis constant unless it drifts over the recording
     let recording_span = (n_samples as f64 * sample).max(sample);
     let tgas_at = |t: f64| params.temperature + und.gas_temperature_drift * (t / recording_span).clamp(0.0, 1.0);
@@ -248,24 +258,31 @@ pub fn run(
         // inputs evaluated inside the step (left/right limits at its ends)
         let inp = |t: f64| {
             let te = t.clamp(t_lo + eps, t_hi - eps);
-            (cmd_at(cmds, te), stop_at(te), stopv_at(te), psrc_at(te), tgas_at(te))
+            (
+                cmd_at(cmds, te),
+                stop_at(te),
+                stopv_at(te),
+                psrc_at(te),
+                tgas_at(te),
+                offset_ripple_at(te),
+            )
         };
-        let (v, xs, xd, ps, tg) = inp(t_lo);
-        m.rhs(y, v, xs, xd, ps, tg, &mut k1);
-        let (v, xs, xd, ps, tg) = inp(t_lo + 0.5 * H);
+        let (v, xs, xd, ps, tg, ir) = inp(t_lo);
+        m.rhs(y, v, xs, xd, ps, tg, ir, &mut k1);
+        let (v, xs, xd, ps, tg, ir) = inp(t_lo + 0.5 * H);
         for j in 0..NS {
             tmp[j] = y[j] + 0.5 * H * k1[j];
         }
-        m.rhs(&tmp, v, xs, xd, ps, tg, &mut k2);
+        m.rhs(&tmp, v, xs, xd, ps, tg, ir, &mut k2);
         for j in 0..NS {
             tmp[j] = y[j] + 0.5 * H * k2[j];
         }
-        m.rhs(&tmp, v, xs, xd, ps, tg, &mut k3);
-        let (v, xs, xd, ps, tg) = inp(t_hi);
+        m.rhs(&tmp, v, xs, xd, ps, tg, ir, &mut k3);
+        let (v, xs, xd, ps, tg, ir) = inp(t_hi);
         for j in 0..NS {
             tmp[j] = y[j] + H * k3[j];
         }
-        m.rhs(&tmp, v, xs, xd, ps, tg, &mut k4);
+        m.rhs(&tmp, v, xs, xd, ps, tg, ir, &mut k4);
         for j in 0..NS {
             y[j] += H / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
         }

@@ -138,6 +138,8 @@
 //!   `chamber_1_pressure_force` (`mechanics`/`extra_force`, μ): it gains μ (P1 − P_r).
 //! * `current_offset_direction` (`current_driver`/`asymmetry`, d): the driver's offset is
 //!   i_offset + d tanh(v / 0.5 mm/s) with the stopper's own velocity.
+//!   `current_offset_ripple` (`current_driver`/`periodic`, r, with
+//!   `current_offset_ripple_frequency` f): it is i_offset + r sin(2π f t).
 //! * `force_sensor_filter_frequency` (`force_sensor`/`dynamics`, f_n, with
 //!   `force_sensor_filter_damping` ζ): the force reading passes, after any lag, through
 //!   y'' + 2ζω y' + ω² y = ω² u, ω = 2π f_n (an amplifier's anti-aliasing filter; ζ = 1/√2
@@ -299,6 +301,12 @@ pub struct UndeclaredEffects {
     /// the stopper's travel, i_offset + d tanh(v / 0.5 mm/s), v the stopper's own velocity (a
     /// pick-up from the stopper drive's direction line); d in A; 0 = none.
     pub current_offset_direction: f64,
+    /// `current_driver`/`periodic`: the current driver's offset carries a ripple
+    /// i_offset + r sin(2π f t), t from the first sample (a pick-up in the coil's loop); r in
+    /// A, 0 = none.
+    pub current_offset_ripple: f64,
+    /// Its frequency f (Hz).
+    pub current_offset_ripple_frequency: f64,
     /// `mechanics`/`extra_force`: a force that adds to the pressure force, μ (P1 − P_r), μ in
     /// m² (chamber 1's pressure acting on an annulus the thesis leaves out); 0 = none.
     pub chamber_1_pressure_force: f64,

@@ -444,7 +444,18 @@ impl Model {
     /// supply drift or ripple is on).
     /// `t_gas` is the gas temperature (the thesis constant unless an undeclared drift is on).
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn rhs(&self, y: &State, v_cmd: f64, xs: f64, xs_dot: f64, p_src: f64, t_gas: f64, dy: &mut State) {
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn rhs(
+        &self,
+        y: &State,
+        v_cmd: f64,
+        xs: f64,
+        xs_dot: f64,
+        p_src: f64,
+        t_gas: f64,
+        offset_ripple: f64,
+        dy: &mut State,
+    ) {
         let p = &self.p;
         let t0 = t_gas;
         let rt = p.r_gas * t0;
@@ -467,7 +478,7 @@ impl Model {
             dy[S_CF] = 0.0;
             dy[S_CF_RATE] = 0.0;
         }
-        let mut offset = p.i_offset;
+        let mut offset = p.i_offset + offset_ripple;
         if self.e.undeclared.current_offset_direction != 0.0 {
             offset += self.e.undeclared.current_offset_direction * (xs_dot / 0.5e-3).tanh();
         }
