@@ -6,15 +6,13 @@
 //! recording.
 
 use jetpipe_diagnosis::diagnose;
-use jetpipe_diagnosis::recording::Recording;
 use jetpipe_model::physics::modulation::ModulationSignal;
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::variables::vr;
-use synthetic_bench::{
-    generate_protocol, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
-};
+use synthetic_bench::{BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects};
 
 use super::names;
+use super::protocols::recorded;
 
 #[test]
 fn a_friction_over_a_band_of_the_bore_is_the_coulomb_friction_varying_with_the_stopper_position() {
@@ -39,12 +37,7 @@ fn a_friction_over_a_band_of_the_bore_is_the_coulomb_friction_varying_with_the_s
         },
         ..BenchEffects::default()
     };
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-friction-band", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    generate_protocol(&spec, &effects).unwrap().write_csv(&path).unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
+    let recording = recorded("friction-band", &spec, &effects);
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
     println!("friction band: {}", d.summary().join(" | "));
     assert!(names(&d).is_empty(), "named {:?}", names(&d));
@@ -107,12 +100,7 @@ fn a_current_offset_that_turns_with_the_stoppers_direction_is_the_offset_varying
         },
         ..BenchEffects::default()
     };
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-offset-direction", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    generate_protocol(&spec, &effects).unwrap().write_csv(&path).unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
+    let recording = recorded("offset-direction", &spec, &effects);
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
     println!("offset with the direction: {}", d.summary().join(" | "));
     assert!(names(&d).is_empty(), "named {:?}", names(&d));
@@ -169,12 +157,7 @@ fn a_current_offset_rippling_at_16_hz_is_found_as_a_periodic_modulation_of_the_j
         },
         ..BenchEffects::default()
     };
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-offset-ripple", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    generate_protocol(&spec, &effects).unwrap().write_csv(&path).unwrap();
-    let recording = Recording::read(&path, &Parameters::default()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
+    let recording = recorded("offset-ripple", &spec, &effects);
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
     println!("offset ripple: {}", d.summary().join(" | "));
     assert!(names(&d).is_empty(), "named {:?}", names(&d));
