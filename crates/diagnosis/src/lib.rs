@@ -37,6 +37,7 @@ mod localize;
 pub mod modulation;
 mod named;
 pub mod noise;
+mod oscillation;
 mod pairs;
 pub mod products;
 mod quantiser;

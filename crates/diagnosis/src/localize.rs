@@ -218,7 +218,16 @@ pub(crate) fn localize(
     if let Some(screen) = screen {
         let penalty = discovery_penalty_per_term(heldout_count(problem.blocks) as f64);
         let started = std::time::Instant::now();
-        let found = crate::modulation::screen(problem, base_replay, &shared, screen.periodic_hz, penalty, jobs);
+        let (found, answered) = crate::modulation::screen(
+            problem,
+            base_replay,
+            &shared,
+            candidates,
+            screen.periodic_hz,
+            penalty,
+            jobs,
+        );
+        replays += answered;
         progress(&format!(
             "modulations screened in {:.1} s: {}",
             started.elapsed().as_secs_f64(),
@@ -237,13 +246,9 @@ pub(crate) fn localize(
                 crate::modulation::candidate(s, problem.base, candidates),
                 shared(s.constant),
             ) {
-                scored.push(score(crate::modulation::first_order_fit(
-                    problem,
-                    base_replay,
-                    s,
-                    c,
-                    &sensitivity,
-                )));
+                let fit = crate::modulation::first_order_fit(problem, base_replay, s, c, &sensitivity);
+                replays += fit.replays;
+                scored.push(score(fit));
             }
         }
     }
@@ -284,7 +289,11 @@ pub(crate) fn localize(
     for better in refined.into_iter().flatten() {
         replays += better.fit.replays;
         if let Some(s) = scored.iter_mut().find(|s| s.fit.candidate == better.fit.candidate) {
-            if better.explained > s.explained {
+            // A modulation's first fit is the screen's linear estimate, not a replay of its
+            // values: where the model's fit of the same candidate gives less, the estimate
+            // claimed a share the model does not give, and the model's fit replaces it.
+            let estimated = crate::modulation::is_modulation(&s.fit.candidate);
+            if estimated || better.explained > s.explained {
                 *s = better;
             }
         }

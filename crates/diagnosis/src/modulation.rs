@@ -13,10 +13,13 @@
 //! residual of every measured channel is projected, on the training blocks, scored on the
 //! held-out ones. Every pair costs one pass over the samples; the few best become candidates
 //! whose knot values the model carries in a modulation slot (`modulation_k_*`), fitted and
-//! checked through the model like every other candidate.
+//! checked through the model like every other candidate. A sinusoid is screened on the
+//! model's answers to the constant oscillating (`oscillation.rs`), not on S(t) times sin
+//! and cos: faster than the chambers, the product has the phase wrong.
 
 use crate::blocks::Block;
 use crate::corrections::{interned, parameter_value, Candidate, Fit, Mechanism, Problem, Sensitivity, Term};
+use crate::oscillation;
 use crate::replay::Replay;
 use crate::signals::{stopper_velocity, CHANNELS, FORCE, P1, P2};
 use jetpipe_model::physics::modulation::{ModulationSignal, MAX_KNOTS, MODULATABLE, SIGN_VELOCITY};
@@ -273,7 +276,7 @@ fn simplified(x: &[f64], y: &[f64]) -> Vec<Vec<usize>> {
 
 /// Normal equations of the columns w S(t) φ_j(s(t)) against the weighted residual, on the
 /// training and the held-out samples.
-struct Normal {
+pub(crate) struct Normal {
     size: usize,
     train: Vec<f64>,
     train_rhs: Vec<f64>,
@@ -283,7 +286,7 @@ struct Normal {
 }
 
 impl Normal {
-    fn new(size: usize) -> Self {
+    pub(crate) fn new(size: usize) -> Self {
         Self {
             size,
             train: vec![0.0; size * size],
@@ -294,7 +297,7 @@ impl Normal {
         }
     }
 
-    fn add(&mut self, block: Block, row: &[f64], target: f64) {
+    pub(crate) fn add(&mut self, block: Block, row: &[f64], target: f64) {
         let (matrix, rhs) = match block {
             Block::Training => (&mut self.train, &mut self.train_rhs),
             Block::HeldOut => {
@@ -316,7 +319,7 @@ impl Normal {
 
     /// The least-squares coefficients of the columns combined by `map` (size × m), and the
     /// held-out sum of squares they leave.
-    fn solve_in(&self, map: &[Vec<f64>]) -> Option<(Vec<f64>, f64)> {
+    pub(crate) fn solve_in(&self, map: &[Vec<f64>]) -> Option<(Vec<f64>, f64)> {
         let m = map[0].len();
         let project = |matrix: &[f64], rhs: &[f64]| {
             let mut a = vec![0.0; m * m];
@@ -395,7 +398,7 @@ fn solve(mut a: Vec<f64>, mut b: Vec<f64>, m: usize) -> Option<Vec<f64>> {
 }
 
 /// The weighted residual of each measured channel against `replay`.
-fn residuals(problem: &Problem, replay: &Replay) -> [Vec<f64>; CHANNELS] {
+pub(crate) fn residuals(problem: &Problem, replay: &Replay) -> [Vec<f64>; CHANNELS] {
     let modelled = [&replay.force, &replay.p1, &replay.p2];
     let mut out: [Vec<f64>; CHANNELS] = [vec![], vec![], vec![]];
     for c in 0..CHANNELS {
@@ -474,16 +477,19 @@ fn screen_pair(
 
 /// Screen every modulatable constant whose sensitivity `shared` holds against every signal
 /// (and the spectral line `periodic_hz`), best first, at most [`MOST_CANDIDATES`].
+/// A sinusoid is screened on the model's answers to it (two replays a constant and a line),
+/// counted in the second value returned.
 pub fn screen(
     problem: &Problem,
     replay: &Replay,
     shared: &dyn Fn(&'static str) -> Option<Sensitivity>,
+    catalogue: &[Candidate],
     periodic_hz: Option<f64>,
     penalty: f64,
     jobs: usize,
-) -> Vec<Screened> {
+) -> (Vec<Screened>, usize) {
     let residual = residuals(problem, replay);
-    let periodic_hz = periodic_hz.filter(|hz| !carried_by_inputs(problem, *hz));
+    let periodic_hz = periodic_hz.filter(|hz| !oscillation::carried_by_inputs(problem, *hz));
     let mut signals: Vec<(ModulationSignal, Vec<f64>, Vec<f64>)> = vec![];
     for signal in ModulationSignal::ALL {
         if matches!(
@@ -505,8 +511,9 @@ pub fn screen(
     // (a sinusoid that modulates a constant shows in the residual at the sum and difference
     // of its frequency with the signals', and in the trace at its own).
     let lines: Vec<Option<f64>> = crate::localize::parallel_map(&constants, jobs, |(_, sensitivity)| {
-        traced_line(problem, &residual, sensitivity)
+        oscillation::traced_line(problem, &residual, sensitivity)
     });
+    let answered = std::sync::atomic::AtomicUsize::new(0);
     let pairs: Vec<(usize, usize)> = (0..constants.len())
         .flat_map(|c| (0..signals.len() + 2).map(move |s| (c, s)))
         .collect();
@@ -514,13 +521,18 @@ pub fn screen(
         let (constant, sensitivity) = &constants[c];
         if s >= signals.len() {
             let hz = if s == signals.len() { periodic_hz? } else { lines[c]? };
-            return screen_periodic(problem, &residual, sensitivity, hz, penalty).map(|(knots, y, scored)| Screened {
-                constant,
-                follows: Follows::Periodic(hz),
-                knots,
-                increments: y,
-                penalised: scored,
-            });
+            let step = sensitivity_step(constant, problem.base, catalogue);
+            let answers = oscillation::responses(problem, replay, constant, step, hz)?;
+            answered.fetch_add(2, std::sync::atomic::Ordering::Relaxed);
+            return oscillation::screen_periodic(problem, &residual, sensitivity, &answers, penalty).map(
+                |(knots, y, scored)| Screened {
+                    constant,
+                    follows: Follows::Periodic(hz),
+                    knots,
+                    increments: y,
+                    penalised: scored,
+                },
+            );
         }
         let (signal, values, knots) = &signals[s];
         screen_pair(problem, &residual, sensitivity, values, knots, penalty).map(|(knots, y, scored)| Screened {
@@ -531,7 +543,7 @@ pub fn screen(
             penalised: scored,
         })
     });
-    leading(screened.into_iter().flatten().collect())
+    (leading(screened.into_iter().flatten().collect()), answered.into_inner())
 }
 
 /// The best screened pairs, at most [`MOST_CANDIDATES`], [`MOST_PER_CONSTANT`] of a constant
@@ -556,107 +568,6 @@ fn leading(mut all: Vec<Screened>) -> Vec<Screened> {
         }
     }
     kept
-}
-
-/// The spectral line of a constant's increment traced over short windows (the least-squares
-/// increment of each window, shrunk where the constant barely moves the outputs), if it has
-/// a clear one above the slowest wander the time knots follow.
-fn traced_line(problem: &Problem, residual: &[Vec<f64>; CHANNELS], sensitivity: &Sensitivity) -> Option<f64> {
-    let time = &problem.recording.time;
-    let n = time.len();
-    let rate = crate::signals::sample_rate(time);
-    let window = ((TRACE_WINDOW_S * rate).round() as usize).max(MIN_TRACE_SAMPLES);
-    let mut centres = vec![];
-    let mut sums = vec![];
-    let mut k = 0;
-    while k + window <= n {
-        let (mut rs, mut ss) = (0.0, 0.0);
-        for j in k..k + window {
-            if problem.blocks[j] == Block::Settling {
-                continue;
-            }
-            for c in 0..CHANNELS {
-                if residual[c].is_empty() || sensitivity[c].is_empty() {
-                    continue;
-                }
-                let s = problem.weights[c] * f64::from(sensitivity[c][j]);
-                rs += residual[c][j] * s;
-                ss += s * s;
-            }
-        }
-        if ss > 0.0 {
-            centres.push(0.5 * (time[k] + time[k + window - 1]));
-            sums.push((rs, ss));
-        }
-        k += window;
-    }
-    if sums.len() < 32 {
-        return None;
-    }
-    let mut information: Vec<f64> = sums.iter().map(|s| s.1).collect();
-    information.sort_by(|a, b| a.total_cmp(b));
-    let shrink = 0.1 * information[information.len() / 2];
-    let trace: Vec<f64> = sums.iter().map(|(rs, ss)| rs / (ss + shrink)).collect();
-    let line = crate::signature::spectrum(&centres, &trace);
-    (line.peak_over_median > TRACE_LINE_OVER_MEDIAN
-        && line.peak_hz > TRACE_LOWEST_HZ
-        && !carried_by_inputs(problem, line.peak_hz))
-    .then_some(line.peak_hz)
-}
-
-/// Whether the command or the stopper position carries a line at `hz` (its power there a
-/// hundred times that at ±10 % and ±20 %): a constant's increment that follows it is the
-/// plant's answer to that input, not a disturbance (a shaken stopper's 2.5 Hz).
-fn carried_by_inputs(problem: &Problem, hz: f64) -> bool {
-    let recording = problem.recording;
-    let rate = crate::signals::sample_rate(&recording.time);
-    [&recording.v_da, &recording.x_s].iter().any(|x| {
-        let mean = x.iter().sum::<f64>() / x.len() as f64;
-        let centred: Vec<f64> = x.iter().map(|v| v - mean).collect();
-        let at = crate::lines::power_at(&centred, hz, rate);
-        let around = [0.8, 0.9, 1.1, 1.2]
-            .iter()
-            .map(|k| crate::lines::power_at(&centred, k * hz, rate))
-            .fold(0.0, f64::max);
-        at > 100.0 * around
-    })
-}
-
-/// Windows of the traced increment ([`traced_line`]), s, and at least this many samples.
-const TRACE_WINDOW_S: f64 = 0.005;
-const MIN_TRACE_SAMPLES: usize = 8;
-/// A traced line must stand this far above the median of the spectrum…
-const TRACE_LINE_OVER_MEDIAN: f64 = 50.0;
-/// …and lie above this frequency (Hz): slower ones are the time knots' wander.
-const TRACE_LOWEST_HZ: f64 = 0.15;
-
-/// A sinusoidal modulation at `hz`: the constant's sensitivity times sin and cos of 2π hz t,
-/// against a constant shift.
-fn screen_periodic(
-    problem: &Problem,
-    residual: &[Vec<f64>; CHANNELS],
-    sensitivity: &Sensitivity,
-    hz: f64,
-    penalty: f64,
-) -> Option<(Vec<f64>, Vec<f64>, f64)> {
-    let mut normal = Normal::new(3);
-    for (k, &block) in problem.blocks.iter().enumerate() {
-        if block == Block::Settling {
-            continue;
-        }
-        let phase = 2.0 * std::f64::consts::PI * hz * problem.recording.time[k];
-        for c in 0..CHANNELS {
-            if residual[c].is_empty() || sensitivity[c].is_empty() {
-                continue;
-            }
-            let s = problem.weights[c] * f64::from(sensitivity[c][k]);
-            normal.add(block, &[s, s * phase.sin(), s * phase.cos()], residual[c][k]);
-        }
-    }
-    let (_, constant_ss) = normal.solve_in(&[vec![1.0], vec![0.0], vec![0.0]])?;
-    let (y, ss) = normal.solve_in(&[vec![0.0, 0.0], vec![1.0, 0.0], vec![0.0, 1.0]])?;
-    let scored = ss + 2.0 * penalty;
-    (scored < constant_ss + penalty).then(|| (vec![-1.0, 1.0, -1.0, 1.0], y, scored))
 }
 
 /// Whether a candidate is a modulation (it fills a modulation slot).
@@ -696,7 +607,7 @@ pub fn free_slots(params: &Parameters) -> Vec<usize> {
         .collect()
 }
 
-fn value_reference(name: &str) -> f64 {
+pub(crate) fn value_reference(name: &str) -> f64 {
     VARIABLES
         .iter()
         .find(|v| v.name == name)
@@ -777,30 +688,41 @@ pub fn first_order_fit(
         .zip(&candidate.terms)
         .map(|(y, t)| y.clamp(t.lower, t.upper))
         .collect();
-    let increments: Vec<f64> = match screened.follows {
+    let mut replays = 0;
+    match screened.follows {
         Follows::Signal(signal) => {
             let signal_at = signal_values(signal, problem, replay);
             let mut phi = vec![0.0; screened.knots.len()];
-            (0..n)
+            let increments: Vec<f64> = (0..n)
                 .map(|k| {
                     hats(&screened.knots, signal_at[k], &mut phi);
                     phi.iter().zip(&values).map(|(p, y)| p * y).sum()
                 })
-                .collect()
+                .collect();
+            for c in [FORCE, P1, P2] {
+                if sensitivity[c].is_empty() || prediction[c].is_empty() {
+                    continue;
+                }
+                for k in 0..n {
+                    prediction[c][k] += f64::from(sensitivity[c][k]) * increments[k];
+                }
+            }
         }
-        Follows::Periodic(hz) => (0..n)
-            .map(|k| {
-                let phase = 2.0 * std::f64::consts::PI * hz * problem.recording.time[k];
-                values[0] * phase.sin() + values[1] * phase.cos()
-            })
-            .collect(),
-    };
-    for c in [FORCE, P1, P2] {
-        if sensitivity[c].is_empty() || prediction[c].is_empty() {
-            continue;
-        }
-        for k in 0..n {
-            prediction[c][k] += f64::from(sensitivity[c][k]) * increments[k];
+        // The model's answers, as the screen read them; without them (no replay), no claim.
+        Follows::Periodic(hz) => {
+            let step = candidate.terms[0].step;
+            if let Some(answers) = oscillation::responses(problem, replay, screened.constant, step, hz) {
+                replays = 2;
+                for c in [FORCE, P1, P2] {
+                    if answers[0][c].is_empty() || prediction[c].is_empty() {
+                        continue;
+                    }
+                    for k in 0..n {
+                        prediction[c][k] +=
+                            values[0] * f64::from(answers[0][c][k]) + values[1] * f64::from(answers[1][c][k]);
+                    }
+                }
+            }
         }
     }
     let (train, heldout) = problem.errors(&prediction);
@@ -815,7 +737,7 @@ pub fn first_order_fit(
         prediction,
         train,
         heldout,
-        replays: 0,
+        replays,
     }
 }
 

@@ -362,9 +362,18 @@ impl Problem<'_> {
 
     /// Sensitivity of the outputs to one parameter at a point of the base model.
     pub fn sensitivity(&self, name: &'static str, step: f64, at: &Replay) -> Option<Sensitivity> {
+        let value = parameter_value(self.base, name);
+        self.sensitivity_to(&[(name, value + step)], step, at)
+    }
+
+    /// The outputs' change, divided by `step`, when the base model takes `settings` (a
+    /// parameter moved by `step`, or a modulation slot filled with an increment of that
+    /// size).
+    pub fn sensitivity_to(&self, settings: &[(&'static str, f64)], step: f64, at: &Replay) -> Option<Sensitivity> {
         let mut p = self.base.clone();
-        let value = parameter_value(&p, name);
-        set_parameter(&mut p, name, value + step).ok()?;
+        for &(name, value) in settings {
+            set_parameter(&mut p, name, value).ok()?;
+        }
         let model = Actuator::new(p).ok()?;
         let moved = replay_fast(&model, self.recording, self.recording.len()).ok()?;
         Some([

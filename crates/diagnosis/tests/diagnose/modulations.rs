@@ -181,3 +181,68 @@ fn a_current_offset_rippling_at_16_hz_is_found_as_a_periodic_modulation_of_the_j
         found.reading
     );
 }
+
+/// The same ripple at 15.4 Hz under ramps to 9 V that drive the jet pipe into its stops
+/// while the stopper moves: there the offset's ripple is clipped and the jet pipe's null's
+/// is not. Screened as the constants' sensitivities times sin and cos, the null's ripple
+/// ranked first (the phase of either wrong) and left 1.9 noise floors; screened on the
+/// model's answers to each constant oscillating, the offset's is found.
+#[test]
+fn a_current_offset_rippling_while_the_jet_pipe_hits_its_stops_is_found_at_the_current_driver() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Ramps,
+        stopper: StopperMotion::Moves { speed: 0.2 },
+        sample_rate: 2000.0,
+        duration: 30.0,
+        force_noise: 0.055,
+        pressures: true,
+        seed: 17,
+        ..ProtocolSpec::default()
+    };
+    let (hz, amplitude) = (15.4, 10e-3);
+    let effects = BenchEffects {
+        undeclared: UndeclaredEffects {
+            current_offset_ripple: amplitude,
+            current_offset_ripple_frequency: hz,
+            ..UndeclaredEffects::default()
+        },
+        ..BenchEffects::default()
+    };
+    let recording = recorded("offset-ripple-at-the-stops", &spec, &effects);
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    println!("offset ripple at the stops: {}", d.summary().join(" | "));
+    assert!(names(&d).is_empty(), "named {:?}", names(&d));
+    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+    let found = d
+        .discovered
+        .iter()
+        .find(|f| (f.location, f.family) == ("current_driver", "periodic"))
+        .unwrap_or_else(|| panic!("{}", d.summary().join(" | ")));
+    let sine = d
+        .parameters
+        .modulation
+        .iter()
+        .find(|s| s.constant() == vr::I_OFFSET && s.signal() == ModulationSignal::Sine)
+        .unwrap_or_else(|| panic!("no sine slot carries i_offset: {}", found.reading));
+    let cosine = d
+        .parameters
+        .modulation
+        .iter()
+        .find(|s| s.constant() == vr::I_OFFSET && s.signal() == ModulationSignal::Cosine)
+        .unwrap_or_else(|| panic!("no cosine slot carries i_offset: {}", found.reading));
+    assert!(
+        (sine.frequency - hz).abs() < 0.01 * hz,
+        "{} Hz ({})",
+        sine.frequency,
+        found.reading
+    );
+    // Each slot's two knots are fitted apart: the amplitude is half their difference (their
+    // means are a constant shift of the offset, shared between the slots).
+    let half_swing = |s: &jetpipe_model::physics::modulation::Slot| 0.5 * (s.increment(1.0) - s.increment(-1.0));
+    let fitted = half_swing(sine).hypot(half_swing(cosine));
+    assert!(
+        (fitted - amplitude).abs() <= 0.15 * amplitude,
+        "{fitted} A against the bench's {amplitude} A ({})",
+        found.reading
+    );
+}
