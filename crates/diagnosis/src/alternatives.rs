@@ -164,7 +164,12 @@ pub(crate) fn alternative_at_place(
         let ok = if terms < added_terms {
             score <= added_score && force <= added_force + 0.05 * noise
         } else if terms > added_terms {
-            score < added_score - penalty && force < added_force
+            // While another departure dominates what the named effect leaves, a richer term
+            // at its place gains by taking a sliver of that departure: it must take a real
+            // share of the way to the noise.
+            let gap = (added_force - noise).max(0.0);
+            let taken = added_force - force >= RICHER_SHARE_OF_GAP * gap;
+            score < added_score - penalty && force < added_force && taken
         } else {
             // a discovered term must be beaten by its penalty, a named effect by any margin
             let margin = if added.named { 0.0 } else { penalty };
@@ -177,6 +182,10 @@ pub(crate) fn alternative_at_place(
     }
     Ok(simplest(adequate, name, progress))
 }
+
+/// A term richer than the named effect it would replace must close at least this share of
+/// the gap between the named effect's held-out force error and the noise floor.
+const RICHER_SHARE_OF_GAP: f64 = 0.2;
 
 /// An addition with at least this many parameters (a static curve through its knots) can
 /// stand in for a simpler term at another place of the chain: those are re-tried after it.

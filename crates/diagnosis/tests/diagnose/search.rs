@@ -309,3 +309,48 @@ fn a_gas_temperature_drift_is_found_at_the_chambers_when_the_pressures_are_too_n
         },
     );
 }
+
+/// The force sensor's offset and gain (named) beside a 2.3 ms command delay, under a PRBS:
+/// once the offset and gain are fitted, the delay leaves 20 noise floors, and a richer curve
+/// of the force sensor that takes a sliver of the delay's misfit beat the named effect by
+/// its penalty and replaced it (a cubic curve, the named effect never given). A richer term
+/// must now close a fifth of the way to the noise; the named effect stays.
+#[test]
+fn a_sensor_offset_and_gain_beside_a_command_delay_stays_the_named_effect_not_a_richer_curve() {
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Prbs,
+        stopper: StopperMotion::Moves { speed: 0.1 },
+        sample_rate: 500.0,
+        duration: 20.0,
+        force_noise: 0.09,
+        pressures: true,
+        seed: 4,
+        ..ProtocolSpec::default()
+    };
+    let (gain, offset) = (0.971, -0.494);
+    let effects = BenchEffects {
+        command_delay: 2.27e-3,
+        force_sensor_gain: gain,
+        force_sensor_offset: offset,
+        ..BenchEffects::default()
+    };
+    let recording = super::protocols::recorded("offset-gain-beside-delay", &spec, &effects);
+    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
+    println!("offset and gain beside a delay: {}", d.summary().join(" | "));
+    assert!(names(&d).contains(&"sensor_offset_gain"), "{}", d.summary().join(" | "));
+    assert!(
+        d.discovered.iter().all(|t| t.location != "force_sensor"),
+        "{}",
+        d.summary().join(" | ")
+    );
+    assert!(
+        (d.parameters.force_sensor_gain - gain).abs() < 0.01 * gain,
+        "{}",
+        d.parameters.force_sensor_gain
+    );
+    assert!(
+        (d.parameters.force_sensor_offset - offset).abs() < 0.05,
+        "{}",
+        d.parameters.force_sensor_offset
+    );
+}
