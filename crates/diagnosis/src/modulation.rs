@@ -398,7 +398,7 @@ fn solve(mut a: Vec<f64>, mut b: Vec<f64>, m: usize) -> Option<Vec<f64>> {
 }
 
 /// The weighted residual of each measured channel against `replay`.
-pub(crate) fn residuals(problem: &Problem, replay: &Replay) -> [Vec<f64>; CHANNELS] {
+fn residuals(problem: &Problem, replay: &Replay) -> [Vec<f64>; CHANNELS] {
     let modelled = [&replay.force, &replay.p1, &replay.p2];
     let mut out: [Vec<f64>; CHANNELS] = [vec![], vec![], vec![]];
     for c in 0..CHANNELS {
@@ -708,7 +708,9 @@ pub fn first_order_fit(
                 }
             }
         }
-        // The model's answers, as the screen read them; without them (no replay), no claim.
+        // The model's answers, as the screen read them, replayed again: the screen keeps no
+        // answers, whose series for every constant would be the diagnosis's peak of memory.
+        // Without them (no replay), no claim.
         Follows::Periodic(hz) => {
             let step = candidate.terms[0].step;
             if let Some(answers) = oscillation::responses(problem, replay, screened.constant, step, hz) {
