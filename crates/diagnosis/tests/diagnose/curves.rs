@@ -168,6 +168,7 @@ fn pressures_explained(label: &str, d: &Diagnosis, term: &DiscoveredTerm) {
 }
 
 #[test]
+#[ignore = "a broad case (about 50 s of wall time two at a time; its kind has other cases here: a transducer's curve, a saturating sensor); scripts/bench_cases.sh runs every case"]
 fn a_chamber_1_transducer_whose_range_ends_at_450_kilopascals_is_a_static_curve_flat_there_under_two_protocols() {
     let effects = undeclared(UndeclaredEffects {
         pressure_sensor_saturation_1: 450e3,
