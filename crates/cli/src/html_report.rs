@@ -130,14 +130,25 @@ fn additions_section(report: &Value) -> String {
         html.push_str("<p>Nothing: no effect or term was added to the thesis model.</p>");
     }
     if let Some(names) = report["withdrawn"]["names"].as_array() {
+        let listed = |v: &Value| -> Vec<String> {
+            v.as_array()
+                .map(|a| a.iter().filter_map(Value::as_str).map(escape).collect())
+                .unwrap_or_default()
+        };
         let names: Vec<String> = names.iter().filter_map(Value::as_str).map(escape).collect();
+        let kept = listed(&report["withdrawn"]["kept"]);
         html.push_str(&format!(
-            "<p id=withdrawn>Withdrawn: {}. Replayed accurately, the model with them had a force error of {} held out and {}              over the whole recording, worse than the starting model's {} and {}; the model reported is the starting model.</p>",
+            "<p id=withdrawn>Withdrawn: {}. Replayed accurately, the model with every addition had a force error of {} held out and {} over the whole recording, worse than the starting model's {} and {}; {}.</p>",
             names.join(" and "),
             newtons(&report["withdrawn"]["heldout_with_rms_N"]),
             newtons(&report["withdrawn"]["whole_with_rms_N"]),
             newtons(&report["heldout"]["before_rms_N"]),
             newtons(&report["before"]["force_rms_N"]),
+            if kept.is_empty() {
+                "the model reported is the starting model".to_string()
+            } else {
+                format!("the model reported keeps {} as an earlier round fitted them", kept.join(" and "))
+            }
         ));
     }
     for e in &effects {

@@ -936,39 +936,58 @@ fn conclude(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
     let (full, noise) = (cx.full, cx.noise);
-    drop_terms_at_defaults(&mut found, progress);
-    if !Actuator::new(found.params.clone())?.reads_stopper_motion {
-        found.params.stopper_acceleration_input_share = start.0.params.stopper_acceleration_input_share;
+    // A model without a force on the stopper's motion reads no acceleration.
+    let start_share = start.0.params.stopper_acceleration_input_share;
+    for params in std::iter::once(&mut found.params).chain(found.stages.iter_mut().map(|s| &mut s.params)) {
+        if !Actuator::new(params.clone())?.reads_stopper_motion {
+            params.stopper_acceleration_input_share = start_share;
+        }
     }
     // The reported figures come from the accurate, error-controlled replay of every sample.
     progress("final replays with the error-controlled integrator");
     let (before_model, before, fast_replay) = start;
-    let mut final_model = Actuator::new(found.params.clone())?;
     let n = full.len();
-    let mut after = replay(&final_model, full, 1e-5, n)?;
     let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
     let full_blocks = match thinned {
         Some(_) => blocks::blocks(&full.time, &full.x_s, cx.settled_from),
         None => cx.blocks.clone(),
     };
     let blocks = &full_blocks;
+    let replay_accurately = |params: &Parameters| -> Result<(Replay, Errors), String> {
+        let with = replay(&Actuator::new(params.clone())?, full, 1e-5, n)?;
+        let e = errors(&with, full, blocks);
+        Ok((with, e))
+    };
+    let (mut after, mut after_errors) = replay_accurately(&found.params)?;
     let before_errors = errors(&before, full, blocks);
-    let mut after_errors = errors(&after, full, blocks);
-    let withdrawn = withdraw::withdraw_if_worse(&mut found, &before_model.params, &before_errors, &after_errors, noise);
-    if let Some(w) = &withdrawn {
+    let withdrawn = withdraw::withdraw_if_worse(
+        &mut found,
+        &before_model.params,
+        &before_errors,
+        &after_errors,
+        noise,
+        &mut |params: &Parameters| {
+            progress("  an earlier round's model replayed with the error-controlled integrator");
+            replay_accurately(params)
+        },
+    )?;
+    let withdrawn = withdrawn.map(|(w, kept)| {
         progress(&format!(
-            "the accurate replay finds the model with {} worse than the starting model (held-out {:.4} against {:.4} N, whole {:.4} against {:.4} N): they are withdrawn",
+            "the accurate replay finds the model with {} worse than the starting model (held-out {:.4} against {:.4} N, whole {:.4} against {:.4} N): {} withdrawn{}",
             w.names.join(" and "),
             w.heldout_with,
             before_errors.heldout_rms,
             w.whole_with,
-            before_errors.rms
+            before_errors.rms,
+            w.names.join(" and "),
+            if w.kept.is_empty() { String::new() } else { format!(", {} kept", w.kept.join(" and ")) }
         ));
-        joint_refit = None;
-        final_model = Actuator::new(found.params.clone())?;
-        after = before.clone();
-        after_errors = before_errors;
-    }
+        joint_refit = found.joint_refit;
+        (after, after_errors) = kept.unwrap_or_else(|| (before.clone(), before_errors));
+        w
+    });
+    drop_terms_at_defaults(&mut found, progress);
+    let final_model = Actuator::new(found.params.clone())?;
     let after = after;
     let split = cx
         .pressure_noise

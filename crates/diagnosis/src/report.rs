@@ -49,12 +49,20 @@ impl Diagnosis {
         }
         if let Some(w) = &self.withdrawn {
             lines.push(format!(
-                "Withdrawn: {} lowered the error of the replay the search fits with, but replayed accurately the model with them is worse than the starting model (held-out force error {:.4} N against {:.4} N, whole recording {:.4} N against {:.4} N); the model reported is the starting model.",
+                "Withdrawn: {} lowered the error of the replay the search fits with, but replayed accurately the model with every addition is worse than the starting model (held-out force error {:.4} N against {:.4} N, whole recording {:.4} N against {:.4} N); {}.",
                 w.names.join(" and "),
                 w.heldout_with,
                 self.before.heldout_rms,
                 w.whole_with,
-                self.before.rms
+                self.before.rms,
+                if w.kept.is_empty() {
+                    "the model reported is the starting model".to_string()
+                } else {
+                    format!(
+                        "the model reported keeps {} as an earlier round fitted them, no worse than the starting model",
+                        w.kept.join(" and ")
+                    )
+                }
             ));
         }
         lines.extend(self.input_checks.iter().cloned());
@@ -206,6 +214,7 @@ impl Diagnosis {
                 "names": w.names,
                 "heldout_with_rms_N": w.heldout_with,
                 "whole_with_rms_N": w.whole_with,
+                "kept": w.kept,
             })),
             "replays": self.replays,
             "fast_replay": {

@@ -19,6 +19,18 @@ pub(crate) struct Findings {
     pub start: Parameters,
     /// The latest addition: a named effect (`true`) or a discovered term, by index.
     pub newest: Option<(bool, usize)>,
+    /// The findings as each round with an addition left them, earliest first, to which the
+    /// final check can go back (`withdraw.rs`).
+    pub stages: Vec<Stage>,
+}
+
+/// The findings as one round left them.
+#[derive(Clone)]
+pub(crate) struct Stage {
+    pub params: Parameters,
+    pub effects: Vec<AddedEffect>,
+    pub discovered: Vec<DiscoveredTerm>,
+    pub joint_refit: Option<(f64, f64)>,
 }
 
 /// One round's replay of the current model and how far it is from the recording.
@@ -60,6 +72,7 @@ pub(crate) fn run_rounds(
         first_candidates: vec![],
         localization: None,
         joint_refit: None,
+        stages: vec![],
     };
     // An effect added on the force side of the piston leaves the pressures, and so the
     // upstream places' scores, as they were.
@@ -218,6 +231,12 @@ pub(crate) fn run_rounds(
                 f.joint_refit = Some(refit);
             }
         }
+        f.stages.push(Stage {
+            params: f.params.clone(),
+            effects: f.effects.clone(),
+            discovered: f.discovered.clone(),
+            joint_refit: f.joint_refit,
+        });
     }
     crate::eliminate::attribute_from_joint_fit(cx, &mut f, replays, progress)?;
     Ok(f)

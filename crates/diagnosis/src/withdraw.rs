@@ -1,5 +1,5 @@
 //! Never a worse model: additions the accurate replay finds worse than the starting model
-//! are taken out again.
+//! are taken out again, the latest first.
 
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -9,11 +9,15 @@ use crate::{rounds, Errors};
 /// the starting model's, held out or over the whole recording.
 #[derive(Clone, Debug)]
 pub struct Withdrawn {
-    /// The named effects and discovered terms, by name.
+    /// The named effects and discovered terms taken out, by name.
     pub names: Vec<&'static str>,
-    /// The force RMS errors of the model with them, N: held out, then over the whole recording.
+    /// The force RMS errors of the model with every addition, N: held out, then over the
+    /// whole recording.
     pub heldout_with: f64,
     pub whole_with: f64,
+    /// The earlier additions that stay, as a round fitted them before the ones taken out
+    /// (empty: the model reported is the starting model).
+    pub kept: Vec<&'static str>,
 }
 
 /// A force error larger than the starting model's by at most this share of the noise floor
@@ -22,43 +26,89 @@ pub struct Withdrawn {
 /// the chambers' start, which the transducers' readings set.
 pub const NEGLIGIBLE_SHARE_OF_NOISE: f64 = 1e-3;
 
+/// At most this many earlier rounds' models are replayed accurately before every addition
+/// goes: each costs an error-controlled replay of the whole recording.
+pub const EARLIER_ROUNDS_TRIED: usize = 3;
+
+fn names(effects: &[crate::AddedEffect], discovered: &[crate::DiscoveredTerm]) -> Vec<&'static str> {
+    effects
+        .iter()
+        .map(|e| e.name)
+        .chain(discovered.iter().map(|d| d.candidate))
+        .collect()
+}
+
 /// The search scores its additions on the fast replay; the accurate one decides. When it
 /// finds the model with them worse than the model the diagnosis started from (`start`), held
 /// out or over the whole recording, by more than [`NEGLIGIBLE_SHARE_OF_NOISE`] of the force's
-/// `noise` floor, they are taken out and `found` is the starting model again.
-pub(crate) fn withdraw_if_worse(
+/// `noise` floor, the additions are taken out the latest first: the models earlier rounds
+/// left (`found.stages`, up to [`EARLIER_ROUNDS_TRIED`] of them) are replayed accurately by
+/// `replay_accurately`, and the latest that is not worse than the start is kept, with its
+/// replay; when none is, `found` is the starting model again.
+pub(crate) fn withdraw_if_worse<R>(
     found: &mut rounds::Findings,
     start: &Parameters,
     before: &Errors,
     after: &Errors,
     noise: f64,
-) -> Option<Withdrawn> {
+    replay_accurately: &mut dyn FnMut(&Parameters) -> Result<(R, Errors), String>,
+) -> Result<Option<(Withdrawn, Option<(R, Errors)>)>, String> {
     let negligible = NEGLIGIBLE_SHARE_OF_NOISE * noise;
-    if after.heldout_rms <= before.heldout_rms + negligible && after.rms <= before.rms + negligible {
-        return None;
+    let worse = |e: &Errors| e.heldout_rms > before.heldout_rms + negligible || e.rms > before.rms + negligible;
+    if !worse(after) {
+        return Ok(None);
     }
-    let names = found
-        .effects
+    let every = names(&found.effects, &found.discovered);
+    let earlier: Vec<rounds::Stage> = found
+        .stages
         .iter()
-        .map(|e| e.name)
-        .chain(found.discovered.iter().map(|d| d.candidate))
+        .rev()
+        .filter(|s| !(s.effects.is_empty() && s.discovered.is_empty()) && s.params != found.params)
+        .take(EARLIER_ROUNDS_TRIED)
+        .cloned()
         .collect();
+    for stage in earlier {
+        let (with, errors) = replay_accurately(&stage.params)?;
+        if worse(&errors) {
+            continue;
+        }
+        let kept = names(&stage.effects, &stage.discovered);
+        found.params = stage.params;
+        found.effects = stage.effects;
+        found.discovered = stage.discovered;
+        found.joint_refit = stage.joint_refit;
+        found.newest = None;
+        return Ok(Some((
+            Withdrawn {
+                names: every.into_iter().filter(|n| !kept.contains(n)).collect(),
+                heldout_with: after.heldout_rms,
+                whole_with: after.rms,
+                kept,
+            },
+            Some((with, errors)),
+        )));
+    }
     found.effects.clear();
     found.discovered.clear();
     found.newest = None;
     found.joint_refit = None;
     found.params = start.clone();
-    Some(Withdrawn {
-        names,
-        heldout_with: after.heldout_rms,
-        whole_with: after.rms,
-    })
+    Ok(Some((
+        Withdrawn {
+            names: every,
+            heldout_with: after.heldout_rms,
+            whole_with: after.rms,
+            kept: vec![],
+        },
+        None,
+    )))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::{AddedEffect, DiscoveredTerm};
+    use std::cell::Cell;
 
     fn errors(heldout_rms: f64, rms: f64) -> Errors {
         Errors {
@@ -70,23 +120,32 @@ mod tests {
         }
     }
 
-    /// Findings with one named effect and one discovered term, whose parameters differ from
-    /// the start's.
+    /// Findings with one named effect, added in a first round at an offset of 0.7 N, and one
+    /// discovered term added in a second, beside which the offset was refitted to 0.72 N.
     fn findings(start: &Parameters) -> rounds::Findings {
         let mut params = start.clone();
-        params.force_sensor_offset = 0.7;
+        params.force_sensor_offset = 0.72;
+        let mut first = start.clone();
+        first.force_sensor_offset = 0.7;
+        let effects = vec![AddedEffect {
+            name: "sensor_offset_gain",
+            location: "force_sensor",
+            parameters: vec![("force_sensor_offset", 0.7)],
+            evidence: String::new(),
+            heldout_before: 0.3,
+            heldout_after: 0.1,
+            share: 0.9,
+            remainder_follows: String::new(),
+        }];
         rounds::Findings {
             params,
-            effects: vec![AddedEffect {
-                name: "sensor_offset_gain",
-                location: "force_sensor",
-                parameters: vec![("force_sensor_offset", 0.7)],
-                evidence: String::new(),
-                heldout_before: 0.3,
-                heldout_after: 0.1,
-                share: 0.9,
-                remainder_follows: String::new(),
+            stages: vec![rounds::Stage {
+                params: first,
+                effects: effects.clone(),
+                discovered: vec![],
+                joint_refit: None,
             }],
+            effects,
             discovered: vec![DiscoveredTerm {
                 location: "jet_pipe",
                 family: "dynamics",
@@ -107,24 +166,88 @@ mod tests {
         }
     }
 
-    #[test]
-    fn additions_that_lower_both_errors_stay() {
-        let start = Parameters::default();
-        let mut found = findings(&start);
-        assert!(withdraw_if_worse(&mut found, &start, &errors(0.3, 0.4), &errors(0.1, 0.2), 0.05).is_none());
-        assert_eq!((found.effects.len(), found.discovered.len()), (1, 1));
-        assert_eq!(found.params.force_sensor_offset, 0.7);
+    /// An accurate replay that finds `first_round`'s errors for the first round's model and
+    /// counts its calls.
+    fn replayed(
+        first_round: Errors,
+        calls: &Cell<usize>,
+    ) -> impl FnMut(&Parameters) -> Result<((), Errors), String> + '_ {
+        move |p: &Parameters| {
+            calls.set(calls.get() + 1);
+            assert_eq!(p.force_sensor_offset, 0.7, "only the first round's model is replayed");
+            Ok(((), first_round))
+        }
     }
 
     #[test]
-    fn additions_that_make_the_held_out_error_larger_are_withdrawn_and_the_start_comes_back() {
+    fn additions_that_lower_both_errors_stay_and_nothing_is_replayed_again() {
         let start = Parameters::default();
         let mut found = findings(&start);
-        let withdrawn = withdraw_if_worse(&mut found, &start, &errors(0.3, 0.4), &errors(0.31, 0.2), 0.05).unwrap();
-        assert_eq!(withdrawn.names, ["sensor_offset_gain", "jet pipe extra lag"]);
+        let calls = Cell::new(0);
+        let mut replay = replayed(errors(0.2, 0.3), &calls);
+        let out = withdraw_if_worse(
+            &mut found,
+            &start,
+            &errors(0.3, 0.4),
+            &errors(0.1, 0.2),
+            0.05,
+            &mut replay,
+        )
+        .unwrap();
+        assert!(out.is_none());
+        assert_eq!(calls.get(), 0);
+        assert_eq!((found.effects.len(), found.discovered.len()), (1, 1));
+        assert_eq!(found.params.force_sensor_offset, 0.72);
+    }
+
+    #[test]
+    fn when_the_latest_addition_makes_the_model_worse_the_earlier_rounds_model_is_kept() {
+        let start = Parameters::default();
+        let mut found = findings(&start);
+        let calls = Cell::new(0);
+        let mut replay = replayed(errors(0.2, 0.3), &calls);
+        let (withdrawn, kept) = withdraw_if_worse(
+            &mut found,
+            &start,
+            &errors(0.3, 0.4),
+            &errors(0.31, 0.2),
+            0.05,
+            &mut replay,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!(calls.get(), 1);
+        assert_eq!(withdrawn.names, ["jet pipe extra lag"]);
+        assert_eq!(withdrawn.kept, ["sensor_offset_gain"]);
         assert_eq!((withdrawn.heldout_with, withdrawn.whole_with), (0.31, 0.2));
+        assert_eq!(kept.unwrap().1, errors(0.2, 0.3));
+        assert_eq!((found.effects.len(), found.discovered.len()), (1, 0));
+        assert_eq!(found.params.force_sensor_offset, 0.7);
+        assert!(found.joint_refit.is_none() && found.newest.is_none());
+    }
+
+    #[test]
+    fn when_every_rounds_model_is_worse_every_addition_is_withdrawn_and_the_start_comes_back() {
+        let start = Parameters::default();
+        let mut found = findings(&start);
+        let calls = Cell::new(0);
+        // The first round's model is worse over the whole recording.
+        let mut replay = replayed(errors(0.2, 0.45), &calls);
+        let (withdrawn, kept) = withdraw_if_worse(
+            &mut found,
+            &start,
+            &errors(0.3, 0.4),
+            &errors(0.31, 0.2),
+            0.05,
+            &mut replay,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!(calls.get(), 1);
+        assert!(kept.is_none() && withdrawn.kept.is_empty());
+        assert_eq!(withdrawn.names, ["sensor_offset_gain", "jet pipe extra lag"]);
         assert!(found.effects.is_empty() && found.discovered.is_empty());
-        assert_eq!(found.params.force_sensor_offset, start.force_sensor_offset);
+        assert_eq!(found.params, start);
         assert!(found.joint_refit.is_none() && found.newest.is_none());
     }
 
@@ -132,7 +255,17 @@ mod tests {
     fn additions_that_make_only_the_whole_recording_worse_are_withdrawn_too() {
         let start = Parameters::default();
         let mut found = findings(&start);
-        assert!(withdraw_if_worse(&mut found, &start, &errors(0.3, 0.4), &errors(0.1, 0.41), 0.05).is_some());
+        let calls = Cell::new(0);
+        let mut replay = replayed(errors(0.3, 0.41), &calls);
+        let out = withdraw_if_worse(
+            &mut found,
+            &start,
+            &errors(0.3, 0.4),
+            &errors(0.1, 0.41),
+            0.05,
+            &mut replay,
+        );
+        assert!(out.unwrap().is_some());
         assert!(found.effects.is_empty());
     }
 
@@ -140,9 +273,27 @@ mod tests {
     fn a_force_error_larger_by_a_thousandth_of_the_noise_or_less_is_not_worse() {
         let start = Parameters::default();
         let mut found = findings(&start);
+        let calls = Cell::new(0);
+        let mut replay = replayed(errors(0.3, 0.41), &calls);
         // 0.05 N of noise: up to 5e-5 N is negligible, 6e-5 N is not.
-        assert!(withdraw_if_worse(&mut found, &start, &errors(0.3, 0.4), &errors(0.30004, 0.40004), 0.05).is_none());
+        let near = withdraw_if_worse(
+            &mut found,
+            &start,
+            &errors(0.3, 0.4),
+            &errors(0.30004, 0.40004),
+            0.05,
+            &mut replay,
+        );
+        assert!(near.unwrap().is_none());
         assert_eq!(found.effects.len(), 1);
-        assert!(withdraw_if_worse(&mut found, &start, &errors(0.3, 0.4), &errors(0.3, 0.40006), 0.05).is_some());
+        let beyond = withdraw_if_worse(
+            &mut found,
+            &start,
+            &errors(0.3, 0.4),
+            &errors(0.3, 0.40006),
+            0.05,
+            &mut replay,
+        );
+        assert!(beyond.unwrap().is_some());
     }
 }
