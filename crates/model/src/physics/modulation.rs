@@ -9,12 +9,13 @@
 //! Like the constants that vary in time ([`super::time_varying`]), a simulation holds each
 //! modulated constant over a step: at the signals at the step's start (the time signals at
 //! mid-step, as the time-varying constants are), with what the model derives from it
-//! (the valve's discharge factors, the orifices' 1/√T, the current driver's and jet pipe's
-//! propagator), then restores it. The outputs at a communication point read the constants at
+//! (the valve's discharge factors, the orifices' 1/√T, the chambers' dead volumes, the
+//! current driver's and jet pipe's propagator), then restores it. The outputs at a communication point read the constants at
 //! that point's signals (the ones the next step holds). A modulation on top of a drift adds to
 //! the drifted value.
 //!
-//! The chamber volumes' constants are not modulatable: [`NOT_MODULATABLE`] says why.
+//! The cylinder's bore is not modulatable: [`NOT_MODULATABLE`] says why. The chambers' dead
+//! volumes are, as the pressure equations' capacity ([`DEAD_VOLUMES`]).
 
 use super::actuator::Actuator;
 use super::parameters::{variable_name, Parameters};
@@ -49,6 +50,8 @@ pub const MODULATABLE: &[u32] = &[
     vr::P_S,
     vr::P_R,
     vr::T_GAS,
+    vr::DEAD_VOLUME_1,
+    vr::DEAD_VOLUME_2,
     vr::K_SPRING,
     vr::FRICTION_COULOMB,
     vr::VISCOUS_FRICTION,
@@ -61,15 +64,17 @@ pub const MODULATABLE: &[u32] = &[
     vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
 ];
 
-const VOLUME_JUMP: &str = "a chamber volume that changed from one step to the next would keep its pressure, creating or destroying air, where a moved stopper conserves it (P V^gamma); the model has no such jump for a constant";
+const BORE_AND_AREA: &str = "the bore sets the piston's area, which the force and both chambers' volumes read, and the chambers' volume rates; a bore that changed between steps would change the force at once and move air between the chambers, with no physical account of either";
 
 /// Constants one might expect in [`MODULATABLE`] that the model cannot modulate correctly, with
 /// the reason.
-pub const NOT_MODULATABLE: &[(u32, &str)] = &[
-    (vr::D_CYL, VOLUME_JUMP),
-    (vr::DEAD_VOLUME_1, VOLUME_JUMP),
-    (vr::DEAD_VOLUME_2, VOLUME_JUMP),
-];
+pub const NOT_MODULATABLE: &[(u32, &str)] = &[(vr::D_CYL, BORE_AND_AREA)];
+
+/// The chambers' dead volumes. Modulated, a dead volume is the capacity of the pressure
+/// equations (2.30)–(2.31) at that instant: the pressure is continuous across a change, and the
+/// change itself neither compresses nor lets out air (a volume that really moved would need
+/// its own dV/dt term, which the model does not have).
+const DEAD_VOLUMES: &[u32] = &[vr::DEAD_VOLUME_1, vr::DEAD_VOLUME_2];
 
 /// The constants the current driver's and jet pipe's propagator is built from.
 const ELECTROMECHANICAL: &[u32] = &[
@@ -579,12 +584,14 @@ pub(crate) struct Held {
     discharge: [f64; 4],
     area_scales: [f64; 4],
     inv_sqrt_temperature: f64,
+    dead_volumes: [f64; 2],
 }
 
 /// Each slot's constant set to its value plus the slot's increment at `signals`, with what
-/// the model derives from it (the discharge factors, 1/√T; the propagator is the
-/// simulation's); an error, with the model unchanged, when a constant would leave its limits
-/// (a drift adding to a modulation) or the supply fall below the return pressure.
+/// the model derives from it (the discharge factors, 1/√T, the chambers' dead volumes; the
+/// propagator is the simulation's); an error, with the model unchanged, when a constant would
+/// leave its limits (a drift adding to a modulation) or the supply fall below the return
+/// pressure.
 pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, String> {
     let mut held = Held {
         values: [(0, 0.0); SLOTS],
@@ -592,6 +599,7 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         discharge: model.discharge,
         area_scales: model.area_scales,
         inv_sqrt_temperature: model.flow.inv_sqrt_temperature,
+        dead_volumes: [model.cylinder.dead_volume_1, model.cylinder.dead_volume_2],
     };
     let slots = model.params.modulation;
     for (k, slot) in slots.iter().enumerate() {
@@ -655,6 +663,10 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
     if modulates_any_of(p, &[vr::T_GAS]) {
         model.flow.inv_sqrt_temperature = 1.0 / p.temperature.sqrt();
     }
+    if modulates_any_of(p, DEAD_VOLUMES) {
+        model.cylinder.dead_volume_1 = p.dead_volume_1;
+        model.cylinder.dead_volume_2 = p.dead_volume_2;
+    }
     Ok(held)
 }
 
@@ -669,6 +681,7 @@ pub(crate) fn restore(model: &mut Actuator, held: Held) {
     model.discharge = held.discharge;
     model.area_scales = held.area_scales;
     model.flow.inv_sqrt_temperature = held.inv_sqrt_temperature;
+    [model.cylinder.dead_volume_1, model.cylinder.dead_volume_2] = held.dead_volumes;
 }
 
 /// A copy of `model` with the slots' constants at `signals` (for the outputs and the

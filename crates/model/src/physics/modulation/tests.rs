@@ -178,7 +178,7 @@ fn a_constant_that_is_not_modulatable_is_refused_naming_the_slot_the_value_and_w
     );
     assert!(e.contains("k_cd (110)") && e.contains("p2_sensor_gain (511)"), "{e}");
     let e = refused(vr::MODULATION_1_PARAMETER, vr::D_CYL as f64);
-    assert!(e.contains("D_cyl is not") && e.contains("conserves"), "{e}");
+    assert!(e.contains("D_cyl is not") && e.contains("piston's area"), "{e}");
     let e = refused(vr::MODULATION_1_PARAMETER, vr::K_CD as f64 + 0.5);
     assert!(e.starts_with("modulation_1_parameter = 110.5 is invalid"), "{e}");
     let e = refused(vr::MODULATION_1_SIGNAL, 2.5);
@@ -256,7 +256,7 @@ fn a_slot_whose_increments_are_zero_changes_no_bit_of_the_outputs() {
 
 #[test]
 fn a_slot_with_one_knot_equals_the_model_with_the_constant_set_to_its_value_plus_the_increment() {
-    let cases: [(u32, f64); 8] = [
+    let cases: [(u32, f64); 10] = [
         (vr::K_CD, 0.004),
         (vr::OMEGA_2, -150.0),
         (vr::P_S, -4e4),
@@ -265,6 +265,9 @@ fn a_slot_with_one_knot_equals_the_model_with_the_constant_set_to_its_value_plus
         (vr::FORCE_SENSOR_GAIN, 0.05),
         (vr::FRICTION_COULOMB, 1.5),
         (vr::K_SPRING, 300.0),
+        // Half chamber 1's volume at mid-stroke, and chamber 2's.
+        (vr::DEAD_VOLUME_1, 2e-6),
+        (vr::DEAD_VOLUME_2, 2e-6),
     ];
     for (constant, delta) in cases {
         let slotted = with_slot(Slot::through(
