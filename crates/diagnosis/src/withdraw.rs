@@ -30,6 +30,12 @@ pub const NEGLIGIBLE_SHARE_OF_NOISE: f64 = 1e-3;
 /// goes: each costs an error-controlled replay of the whole recording.
 pub const EARLIER_ROUNDS_TRIED: usize = 3;
 
+/// A model's replay with its errors.
+pub(crate) type Replayed<R> = (R, Errors);
+
+/// What was withdrawn and, when an earlier round's model stays, its replay.
+pub(crate) type Withdrawal<R> = (Withdrawn, Option<Replayed<R>>);
+
 fn names(effects: &[crate::AddedEffect], discovered: &[crate::DiscoveredTerm]) -> Vec<&'static str> {
     effects
         .iter()
@@ -51,8 +57,8 @@ pub(crate) fn withdraw_if_worse<R>(
     before: &Errors,
     after: &Errors,
     noise: f64,
-    replay_accurately: &mut dyn FnMut(&Parameters) -> Result<(R, Errors), String>,
-) -> Result<Option<(Withdrawn, Option<(R, Errors)>)>, String> {
+    replay_accurately: &mut dyn FnMut(&Parameters) -> Result<Replayed<R>, String>,
+) -> Result<Option<Withdrawal<R>>, String> {
     let negligible = NEGLIGIBLE_SHARE_OF_NOISE * noise;
     let worse = |e: &Errors| e.heldout_rms > before.heldout_rms + negligible || e.rms > before.rms + negligible;
     if !worse(after) {
