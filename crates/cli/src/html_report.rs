@@ -529,4 +529,27 @@ mod tests {
         assert_eq!(row.heldout_after_n, Some(0.05));
         assert!(row.remainder_location.is_empty());
     }
+
+    #[test]
+    fn a_withdrawal_that_keeps_an_earlier_round_names_what_went_and_what_stayed() {
+        let mut report = serde_json::json!({
+            "heldout": {"before_rms_N": 1.1441}, "before": {"force_rms_N": 1.0067},
+            "effects": [], "discovered": [{"location": "command", "family": "nonlinearity", "parameters": {}}],
+            "withdrawn": {"names": ["x_jp_offset varying with v_DA"], "heldout_with_rms_N": 0.9566,
+                          "whole_with_rms_N": 1.168, "kept": ["command static curve"]},
+        });
+        let html = additions_section(&report);
+        assert!(html.contains("Withdrawn: x_jp_offset varying with v_DA."), "{html}");
+        assert!(
+            html.contains("1.1680 N over the whole recording, worse than the starting model's 1.1441 N and 1.0067 N"),
+            "{html}"
+        );
+        assert!(
+            html.contains("the model reported keeps command static curve as an earlier round fitted them"),
+            "{html}"
+        );
+        report["withdrawn"]["kept"] = serde_json::json!([]);
+        let html = additions_section(&report);
+        assert!(html.contains("the model reported is the starting model"), "{html}");
+    }
 }
