@@ -75,6 +75,20 @@ print(f'| {name} | {rate} | {times[-1]:.0f} | {pressures} | {d["verdict"]} | {";
 PY
 done
 echo
+python3 - "$work/reports" <<'PY'
+import glob, json, sys
+reports = [json.load(open(p)) for p in sorted(glob.glob(sys.argv[1] + "/*.json"))]
+withdrawn = [d["withdrawn"] for d in reports if d.get("withdrawn")]
+kept = sum(1 for w in withdrawn if w.get("kept"))
+finals = [d["fast_replay"].get("final_force_departure_ratio_to_noise") for d in reports]
+finals = [r for r in finals if r is not None]
+parted = [r for r in finals if r > 0.2]
+print(f"Additions withdrawn on {len(withdrawn)} of {len(reports)} draws ({kept} keeping an earlier round's model). "
+      f"The final model's fixed-step replay departed from its accurate one by more than a fifth of the "
+      f"force's noise floor on {len(parted)} of the {len(finals)} draws with additions"
+      + (f" (largest {max(finals):.2f} noise floors)." if finals else "."))
+PY
+echo
 echo "The scorer's account (truth revealed only here):"
 echo
 echo '```'

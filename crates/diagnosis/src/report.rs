@@ -223,6 +223,8 @@ impl Diagnosis {
                 "force_departure_ratio_to_noise": self.fast_replay.force_ratio,
                 "pressure_departure_rms_Pa": self.fast_replay.pressure_departure.map(|p| p.to_vec()),
                 "agrees": self.fast_replay.agrees,
+                "final_force_departure_rms_N": self.fast_replay_final.map(|f| f.0),
+                "final_force_departure_ratio_to_noise": self.fast_replay_final.map(|f| f.1),
             },
         });
         let object = report.as_object_mut().expect("a JSON object");
