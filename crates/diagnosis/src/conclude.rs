@@ -69,8 +69,7 @@ pub(crate) fn conclude(
     )?;
     let withdrawn = withdrawn.map(|(w, kept)| {
         progress(&format!(
-            "the accurate replay finds the model with {} worse than the starting model (held-out {:.4} against {:.4} N, whole {:.4} against {:.4} N): {} withdrawn{}",
-            w.names.join(" and "),
+            "the accurate replay finds the model with every addition worse than the starting model (held-out {:.4} against {:.4} N, whole {:.4} against {:.4} N): {} withdrawn{}",
             w.heldout_with,
             before_errors.heldout_rms,
             w.whole_with,
