@@ -253,7 +253,12 @@ pub(crate) fn localize(
         }
     }
     scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
-    // Refine the leaders (and every named effect near them) with more iterations.
+    // Refine the leaders (and every named effect near them) with more iterations. One
+    // constant's modulations by two signals count once: the second would take the place of a
+    // written candidate whose first-order fit understates it (a port's areas scaled to 0.8,
+    // refined, explain all that a return area varying with the jet position and with the
+    // pressure difference explain in part).
+    let mut modulated: Vec<f64> = vec![];
     let leaders: Vec<Candidate> = scored
         .iter()
         .filter(|s| {
@@ -264,6 +269,14 @@ pub(crate) fn localize(
                 .any(|t| !matches!(t.mechanism, Mechanism::Output { .. }))
         })
         .filter(|s| s.explained >= WORTH_REFINING)
+        .filter(|s| match modulated_constant(&s.fit.candidate) {
+            Some(constant) if modulated.contains(&constant) => false,
+            Some(constant) => {
+                modulated.push(constant);
+                true
+            }
+            None => true,
+        })
         .take(REFINED)
         .map(|s| s.fit.candidate.clone())
         .collect();
@@ -389,4 +402,13 @@ mod tests {
         assert_eq!(l.undecided_beside(l.location, false), None);
         assert!(l.alternatives().is_empty());
     }
+}
+
+/// The value reference of the constant a modulation candidate modulates; none for another
+/// candidate.
+fn modulated_constant(c: &Candidate) -> Option<f64> {
+    c.settings
+        .iter()
+        .find(|(name, _)| name.starts_with("modulation_") && name.ends_with("_parameter"))
+        .map(|(_, value)| *value)
 }
