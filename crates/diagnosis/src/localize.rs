@@ -253,37 +253,38 @@ pub(crate) fn localize(
         }
     }
     scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
-    // Refine the leaders (and every named effect near them) with more iterations. One
-    // constant's modulations by two signals count once: the second would take the place of a
-    // written candidate whose first-order fit understates it (a port's areas scaled to 0.8,
-    // refined, explain all that a return area varying with the jet position and with the
-    // pressure difference explain in part).
-    let mut modulated: Vec<f64> = vec![];
-    let leaders: Vec<Candidate> = scored
+    // Refine the leaders (and every named effect near them) with more iterations.
+    let not_output_only = |s: &&Scored| {
+        s.fit
+            .candidate
+            .terms
+            .iter()
+            .any(|t| !matches!(t.mechanism, Mechanism::Output { .. }))
+    };
+    let mut leaders: Vec<Candidate> = scored
         .iter()
-        .filter(|s| {
-            s.fit
-                .candidate
-                .terms
-                .iter()
-                .any(|t| !matches!(t.mechanism, Mechanism::Output { .. }))
-        })
+        .filter(not_output_only)
         .filter(|s| s.explained >= WORTH_REFINING)
-        .filter(|s| match modulated_constant(&s.fit.candidate) {
-            Some(constant) if modulated.contains(&constant) => false,
-            Some(constant) => {
-                modulated.push(constant);
-                true
-            }
-            None => true,
-        })
         .take(REFINED)
         .map(|s| s.fit.candidate.clone())
         .collect();
+    // Modulations among the leaders leave fewer places for the written candidates, whose
+    // first-order fit can understate them: the best of those is refined too (a port's areas
+    // scaled to 0.8, refined, explain all that a return area varying with the jet position
+    // and with the pressure difference, the two leading modulations, explain in part).
+    if leaders.iter().filter(|c| crate::modulation::is_modulation(c)).count() >= 2 {
+        if let Some(written) = scored
+            .iter()
+            .filter(not_output_only)
+            .filter(|s| s.explained >= WORTH_REFINING)
+            .find(|s| !crate::modulation::is_modulation(&s.fit.candidate) && !leaders.contains(&s.fit.candidate))
+        {
+            leaders.push(written.fit.candidate.clone());
+        }
+    }
     // The static curves fitted through the model (the command's, the discharge
     // coefficient's) are always refined when worth it: one Gauss–Newton step from the
     // identity leaves them behind the single-constant candidates they compete with.
-    let mut leaders = leaders;
     for s in scored.iter().filter(|s| s.explained >= WORTH_REFINING) {
         let curve =
             crate::curves::is_command_curve(&s.fit.candidate) || crate::discharge::is_discharge_curve(&s.fit.candidate);
@@ -402,13 +403,4 @@ mod tests {
         assert_eq!(l.undecided_beside(l.location, false), None);
         assert!(l.alternatives().is_empty());
     }
-}
-
-/// The value reference of the constant a modulation candidate modulates; none for another
-/// candidate.
-fn modulated_constant(c: &Candidate) -> Option<f64> {
-    c.settings
-        .iter()
-        .find(|(name, _)| name.starts_with("modulation_") && name.ends_with("_parameter"))
-        .map(|(_, value)| *value)
 }
