@@ -15,7 +15,7 @@
 //! the drifted value.
 //!
 //! The cylinder's bore is not modulatable: [`NOT_MODULATABLE`] says why. The chambers' dead
-//! volumes are, as the pressure equations' capacity ([`DEAD_VOLUMES`]).
+//! volumes are, as the pressure equations' capacity (`DEAD_VOLUMES`).
 
 use super::actuator::Actuator;
 use super::parameters::{variable_name, Parameters};
