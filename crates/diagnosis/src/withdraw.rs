@@ -185,44 +185,32 @@ mod tests {
         }
     }
 
-    #[test]
-    fn additions_that_lower_both_errors_stay_and_nothing_is_replayed_again() {
+    /// The diagnosis started at 0.3 N held out and 0.4 N whole; its final model is at
+    /// `after`, its first round's model at `first_round`. Returns what was withdrawn, how many
+    /// accurate replays ran and the findings left.
+    fn withdrawn_when(first_round: Errors, after: Errors) -> (Option<Withdrawal<()>>, usize, rounds::Findings) {
         let start = Parameters::default();
         let mut found = findings(&start);
         let calls = Cell::new(0);
-        let mut replay = replayed(errors(0.2, 0.3), &calls);
-        let out = withdraw_if_worse(
-            &mut found,
-            &start,
-            &errors(0.3, 0.4),
-            &errors(0.1, 0.2),
-            0.05,
-            &mut replay,
-        )
-        .unwrap();
+        let mut replay = replayed(first_round, &calls);
+        let out = withdraw_if_worse(&mut found, &start, &errors(0.3, 0.4), &after, 0.05, &mut replay).unwrap();
+        (out, calls.get(), found)
+    }
+
+    #[test]
+    fn additions_that_lower_both_errors_stay_and_nothing_is_replayed_again() {
+        let (out, calls, found) = withdrawn_when(errors(0.2, 0.3), errors(0.1, 0.2));
         assert!(out.is_none());
-        assert_eq!(calls.get(), 0);
+        assert_eq!(calls, 0);
         assert_eq!((found.effects.len(), found.discovered.len()), (1, 1));
         assert_eq!(found.params.force_sensor_offset, 0.72);
     }
 
     #[test]
     fn when_the_latest_addition_makes_the_model_worse_the_earlier_rounds_model_is_kept() {
-        let start = Parameters::default();
-        let mut found = findings(&start);
-        let calls = Cell::new(0);
-        let mut replay = replayed(errors(0.2, 0.3), &calls);
-        let (withdrawn, kept) = withdraw_if_worse(
-            &mut found,
-            &start,
-            &errors(0.3, 0.4),
-            &errors(0.31, 0.2),
-            0.05,
-            &mut replay,
-        )
-        .unwrap()
-        .unwrap();
-        assert_eq!(calls.get(), 1);
+        let (out, calls, found) = withdrawn_when(errors(0.2, 0.3), errors(0.31, 0.2));
+        let (withdrawn, kept) = out.unwrap();
+        assert_eq!(calls, 1);
         assert_eq!(withdrawn.names, ["jet pipe extra lag"]);
         assert_eq!(withdrawn.kept, ["sensor_offset_gain"]);
         assert_eq!((withdrawn.heldout_with, withdrawn.whole_with), (0.31, 0.2));
@@ -234,44 +222,21 @@ mod tests {
 
     #[test]
     fn when_every_rounds_model_is_worse_every_addition_is_withdrawn_and_the_start_comes_back() {
-        let start = Parameters::default();
-        let mut found = findings(&start);
-        let calls = Cell::new(0);
         // The first round's model is worse over the whole recording.
-        let mut replay = replayed(errors(0.2, 0.45), &calls);
-        let (withdrawn, kept) = withdraw_if_worse(
-            &mut found,
-            &start,
-            &errors(0.3, 0.4),
-            &errors(0.31, 0.2),
-            0.05,
-            &mut replay,
-        )
-        .unwrap()
-        .unwrap();
-        assert_eq!(calls.get(), 1);
+        let (out, calls, found) = withdrawn_when(errors(0.2, 0.45), errors(0.31, 0.2));
+        let (withdrawn, kept) = out.unwrap();
+        assert_eq!(calls, 1);
         assert!(kept.is_none() && withdrawn.kept.is_empty());
         assert_eq!(withdrawn.names, ["sensor_offset_gain", "jet pipe extra lag"]);
         assert!(found.effects.is_empty() && found.discovered.is_empty());
-        assert_eq!(found.params, start);
+        assert_eq!(found.params, Parameters::default());
         assert!(found.joint_refit.is_none() && found.newest.is_none());
     }
 
     #[test]
     fn additions_that_make_only_the_whole_recording_worse_are_withdrawn_too() {
-        let start = Parameters::default();
-        let mut found = findings(&start);
-        let calls = Cell::new(0);
-        let mut replay = replayed(errors(0.3, 0.41), &calls);
-        let out = withdraw_if_worse(
-            &mut found,
-            &start,
-            &errors(0.3, 0.4),
-            &errors(0.1, 0.41),
-            0.05,
-            &mut replay,
-        );
-        assert!(out.unwrap().is_some());
+        let (out, _, found) = withdrawn_when(errors(0.3, 0.41), errors(0.1, 0.41));
+        assert!(out.is_some());
         assert!(found.effects.is_empty());
     }
 
