@@ -18,26 +18,12 @@ pub const CHANNELS: usize = 3;
 pub const CHANNEL_NAMES: [&str; CHANNELS] = ["force", "p1", "p2"];
 
 /// Stopper velocity as the replays' forces read it at sample k: the slope of the interval
-/// that ends there carried to the sample with the acceleration the model reads
-/// ([`jetpipe_model::physics::extra_force::velocity_at_sample`]; zero at the first sample).
-/// For a recording thinned for the fits, the full-rate recording's at the row.
+/// that ends there carried to the sample with the acceleration the positions form
+/// ([`jetpipe_model::physics::extra_force::stopper_velocities`]; zero at the first sample),
+/// whatever acceleration input the replays are given. For a recording thinned for the fits,
+/// the full-rate recording's at the row.
 pub fn stopper_velocity(recording: &Recording) -> Vec<f64> {
-    let window = recording.acceleration_window;
-    if window <= 0.0 {
-        return at_rows(recording, &extra_force::stopper_velocities);
-    }
-    at_rows(recording, &|time: &[f64], x_s: &[f64]| {
-        let a = acceleration::smoothed_accelerations(time, x_s, window);
-        (0..x_s.len())
-            .map(|k| {
-                if k == 0 {
-                    return 0.0;
-                }
-                let h = time[k] - time[k - 1];
-                extra_force::velocity_at_sample((x_s[k] - x_s[k - 1]) / h, h, a[k])
-            })
-            .collect()
-    })
+    at_rows(recording, &extra_force::stopper_velocities)
 }
 
 /// The stopper acceleration the model reads at each sample: formed from the positions

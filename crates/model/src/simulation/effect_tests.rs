@@ -653,3 +653,32 @@ fn a_stopper_acceleration_given_as_an_input_is_what_the_mass_force_reads_at_once
     let e = sim.set_stopper_acceleration(2e4).unwrap_err();
     assert!(e.starts_with("a_s = 20000 m/s2 is invalid"), "{e}");
 }
+
+#[test]
+fn a_friction_reads_the_velocity_the_positions_make_not_a_smoothed_acceleration_input() {
+    // A stopper at rest with an acceleration input of 50 m/s², as an acceleration smoothed
+    // over a few samples shows just before a ramp starts: carried half a 2 ms step, it would
+    // make 50 mm/s of velocity and switch a 2 N friction fully on while nothing moves.
+    let friction = |share: f64| {
+        with(|p| {
+            p.friction_coulomb = 2.0;
+            p.friction_velocity = 2e-4;
+            p.stopper_acceleration_input_share = share;
+        })
+    };
+    let mut unread = Simulation::at_equilibrium(friction(0.0), 2.0, 0.054, 0.0, 1e-8).unwrap();
+    let mut read = Simulation::at_equilibrium(friction(1.0), 2.0, 0.054, 0.0, 1e-8).unwrap();
+    for s in [&mut unread, &mut read] {
+        s.set_command(4.0).unwrap();
+        s.step(2e-3).unwrap();
+    }
+    read.set_stopper_acceleration(50.0).unwrap();
+    let (a, b) = (unread.outputs(), read.outputs());
+    assert_eq!((a.p1, a.p2), (b.p1, b.p2));
+    assert!(
+        (b.f_meas - a.f_meas).abs() < 1e-9,
+        "{} N against {} N",
+        b.f_meas,
+        a.f_meas
+    );
+}

@@ -455,12 +455,16 @@ impl Simulation {
 
     /// The stopper velocity the forces read at the last sample: at the sample, from the
     /// last two steps' motions, where a force reads it ([`extra_force::velocity_at_sample`]).
+    /// The positions, linear between samples, are the motion: the velocity is carried to the
+    /// sample with the acceleration they form, not with the input a_s, which a master may
+    /// smooth over several samples and which would then switch a friction on before a ramp
+    /// starts.
     pub(super) fn stopper_velocity_at_sample(&self) -> f64 {
         if self.plan.stopper_acceleration {
             extra_force::velocity_at_sample(
                 self.stopper_velocity,
                 self.stopper_motion.interval,
-                self.acceleration_read(),
+                self.stopper_acceleration,
             )
         } else {
             self.stopper_velocity
