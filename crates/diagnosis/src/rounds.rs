@@ -699,8 +699,14 @@ fn discover_term(
         Block::Training,
     );
     let mut modulation: Option<(DiscoveredTerm, Parameters, Scored)> = None;
+    let mut written_best: Option<(DiscoveredTerm, Parameters, Scored)> = None;
     for s in at_place {
         let label = s.fit.candidate.label;
+        if let Some((w, _, _)) = &written_best {
+            if s.force_heldout_rms > PROMISE_BEYOND_WRITTEN * w.heldout_after {
+                continue;
+            }
+        }
         let penalty = used_terms(s) * discovery_penalty_per_term(count);
         let worse_pressures =
             (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
@@ -796,10 +802,17 @@ fn discover_term(
                     ));
                     modulation = Some((term, trial, s.clone()));
                 }
-                None => return Ok(Some((term, trial, s.clone()))),
+                None if after <= EXPLAINED_WITHIN_NOISE * noise => return Ok(Some((term, trial, s.clone()))),
+                None => {
+                    if written_best.as_ref().map_or(true, |(w, _, _)| after < w.heldout_after) {
+                        progress(&format!(
+                            "  {label}: kept unless a later trial, promising half of what it leaves, does better in the model"
+                        ));
+                        written_best = Some((term, trial, s.clone()));
+                    }
+                }
                 Some((kept, _, _)) if !is_modulation => {
-                    let bar = (EXPLAINED_WITHIN_NOISE * noise).max(WRITTEN_INSTEAD_WITHIN * kept.heldout_after);
-                    if after <= bar {
+                    if after <= written_instead_bar(kept.heldout_after, noise) {
                         progress(&format!(
                             "  {label} instead of the {}: nearly as good and written",
                             kept.candidate
@@ -811,8 +824,26 @@ fn discover_term(
             }
         }
     }
-    Ok(modulation)
+    // A written term wins over a modulation that does not do clearly better in the model.
+    Ok(match (written_best, modulation) {
+        (Some(w), Some(m)) if w.0.heldout_after > written_instead_bar(m.0.heldout_after, noise) => Some(m),
+        (Some(w), _) => Some(w),
+        (None, m) => m,
+    })
 }
+
+/// The held-out force error (N) at or below which a written term is taken instead of a
+/// modulation that leaves `modulation_after`: within [`WRITTEN_INSTEAD_WITHIN`] of it, or
+/// within the verdict's bar.
+fn written_instead_bar(modulation_after: f64, noise: f64) -> f64 {
+    (EXPLAINED_WITHIN_NOISE * noise).max(WRITTEN_INSTEAD_WITHIN * modulation_after)
+}
+
+/// A written term that earns its place but leaves more than the verdict's bar ends the
+/// trials only when no later trial's fit promises to leave at most this share of its
+/// held-out force error: a current driver's gain, as good as tied with the jet pipe, is
+/// tried after the jet pipe's curve that leaves 7 noise floors.
+const PROMISE_BEYOND_WRITTEN: f64 = 0.5;
 
 /// Whether a term earns its place on a departure that the training blocks hold more of than
 /// the held-out ones (a command saturating near the top of a slow sine whose peaks fell in
