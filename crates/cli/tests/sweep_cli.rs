@@ -228,3 +228,47 @@ fn the_thesis_measured_preset_is_a_base_the_sweep_accepts_and_it_changes_the_for
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_reports_start_values_are_a_base_the_sweep_accepts_naming_the_start_state_it_does_not_read() {
+    // fmu_start_values as a diagnosis writes them: constants, and the start state the FMU
+    // reproduces the recording from.
+    let dir = scratch("start_values");
+    let base = dir.join("start_values.json");
+    let run = |text: &str, name: &str| -> Output {
+        std::fs::write(&base, text).unwrap();
+        sweep_cli(
+            &[
+                "--param",
+                "k_spring=88.14",
+                "--no-serial",
+                "--base-params",
+                base.to_str().unwrap(),
+            ],
+            &dir.join(name),
+        )
+    };
+    let o = run(
+        r#"{"P1_start": 351745.6, "P2_start": 510402.7, "start_at_equilibrium": false, "friction_coulomb": 2.08}"#,
+        "accepted.csv",
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("start_at_equilibrium") && stderr.contains("P1_start") && stderr.contains("does not read"),
+        "{stderr}"
+    );
+    for (text, expected) in [
+        (r#"{"P1_start": -5}"#, "P1_start = -5 Pa is invalid"),
+        (
+            r#"{"start_at_equilibrium": 2}"#,
+            "'start_at_equilibrium' = 2 is invalid",
+        ),
+        (r#"{"start_at_equilibrium": "yes"}"#, "must be a number or a boolean"),
+    ] {
+        let o = run(text, "refused.csv");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && stderr.contains(expected), "{text}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

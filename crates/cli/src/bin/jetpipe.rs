@@ -345,11 +345,30 @@ fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String>
     let object = value
         .as_object()
         .ok_or_else(|| format!("{}: expected a JSON object of parameter values", path.display()))?;
+    let mut start_state = vec![];
     for (name, v) in object {
         let variable = jetpipe_model::variables::VARIABLES
             .iter()
             .find(|var| var.name == name && var.causality == jetpipe_model::variables::Causality::Parameter)
             .ok_or_else(|| format!("{}: '{name}' is not a parameter of the model", path.display()))?;
+        if START_STATE.contains(&name.as_str()) {
+            // A report's fmu_start_values carry the FMU's start state; the commands that take
+            // a parameter file start from their own (the recording's, or an equilibrium).
+            let x = v
+                .as_f64()
+                .or_else(|| v.as_bool().map(f64::from))
+                .ok_or_else(|| format!("{}: '{name}' must be a number or a boolean, got {v}", path.display()))?;
+            if variable.var_type == jetpipe_model::variables::VarType::Boolean && x != 0.0 && x != 1.0 {
+                return Err(format!(
+                    "{}: '{name}' = {v} is invalid: must be true or false",
+                    path.display()
+                ));
+            }
+            jetpipe_model::variables::check(variable.value_reference, x)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            start_state.push(variable.name);
+            continue;
+        }
         let x = v
             .as_f64()
             .ok_or_else(|| format!("{}: '{name}' must be a number, got {v}", path.display()))?;
@@ -357,8 +376,18 @@ fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String>
             .map_err(|e| format!("{}: {e}", path.display()))?;
     }
     p.validate().map_err(|e| format!("{}: {e}", path.display()))?;
+    if !start_state.is_empty() {
+        eprintln!(
+            "{}: {} set the FMU's start state, which this command does not read: a diagnosis starts from the recording's first samples, a sweep at the equilibrium of its first inputs",
+            path.display(),
+            start_state.join(", ")
+        );
+    }
     Ok(p)
 }
+
+/// The FMU parameters that set the start state rather than the model's constants.
+const START_STATE: [&str; 3] = ["start_at_equilibrium", "P1_start", "P2_start"];
 
 /// Progress of the diagnosis's long phases on stderr: on a terminal a bar with the time left
 /// (indicatif); in a log, where the bar is hidden, a plain line when a phase starts and when it
