@@ -290,14 +290,7 @@ fn explained_under_a_short_staircase(name: &str) {
     let pressure_ratio = d.pressure_split.as_ref().expect("pressures").pressure_ratio;
     let pressures_within = pressure_ratio.iter().all(|r| *r <= 1.5);
     assert_eq!(d.explained(), pressures_within, "{name}: {}", d.summary()[0]);
-    if PRESSURES_LEFT_OFF.contains(&name) {
-        assert!(
-            !pressures_within,
-            "{name}: the pressures are now within their noise: {pressure_ratio:?}"
-        );
-    } else {
-        assert_eq!(d.verdict(), "explained", "{name}: {}", d.summary()[0]);
-    }
+    assert_eq!(d.verdict(), "explained", "{name}: {}", d.summary()[0]);
 }
 
 /// The parameter a found candidate is judged on. A clip at ±7 V on commands that never go
@@ -309,11 +302,6 @@ fn judged_as(parameter: &'static str, candidate: &str) -> &'static str {
         _ => parameter,
     }
 }
-
-/// Mechanisms whose term, found at its place with its size, leaves a pressure above its noise:
-/// the current slew limit leaves chamber 1 at 1.7 noise floors (253 Pa against 150 Pa of noise)
-/// while the force is at 1.4, so the verdict, which reads every channel, is a remainder.
-const PRESSURES_LEFT_OFF: &[&str] = &["current_slew_limit"];
 
 #[test]
 fn a_back_pressure_on_the_exhaust_under_a_short_staircase_is_its_return_pressure() {

@@ -91,24 +91,40 @@ impl FixedStep {
     /// the delay line have taken the step's command).
     pub fn step_to(&mut self, time: f64, x_s: f64) -> Result<(), StepFailure> {
         let start = (self.simulation.time, self.simulation.x_s);
-        self.step_part(time, x_s, Some(start))
+        self.step_part(time, x_s, Some(start), None)
     }
 
     /// [`Self::step_to`] in `parts` equal steps, the stopper moving linearly: the stopper
     /// acceleration of the extra force is formed once, over the whole interval, as a
-    /// simulation stepped once to `time` forms it.
+    /// simulation stepped once to `time` forms it; so is the command the current driver sees
+    /// through the command stage and the delay line (a slew limit moves the held command once
+    /// per interval, as the error-controlled steps to each sample move it, not once per part).
     pub fn step_to_in_parts(&mut self, time: f64, x_s: f64, parts: usize) -> Result<(), StepFailure> {
         let (t0, x0) = (self.simulation.time, self.simulation.x_s);
+        let interval = time - t0;
+        let seen = (parts > 1 && self.simulation.plan.command_path && interval.is_finite() && interval > 0.0)
+            .then(|| self.simulation.seen_command_segments(interval));
+        let part_of = |from: f64, to: f64| seen.as_ref().map(|whole| command_between(whole, from - t0, to - t0));
         for j in 1..parts {
             let share = j as f64 / parts as f64;
-            self.step_part(t0 + share * (time - t0), x0 + share * (x_s - x0), None)?;
+            let from = t0 + (j - 1) as f64 / parts as f64 * interval;
+            let to = t0 + share * interval;
+            self.step_part(to, x0 + share * (x_s - x0), None, part_of(from, to))?;
         }
-        self.step_part(time, x_s, Some((t0, x0)))
+        let from = t0 + (parts.max(1) - 1) as f64 / parts.max(1) as f64 * interval;
+        self.step_part(time, x_s, Some((t0, x0)), part_of(from, time))
     }
 
     /// A step to `time`, `x_s`; `interval_start` (time, x_s) when it ends an interval of the
-    /// stopper's motion, which began there.
-    fn step_part(&mut self, time: f64, x_s: f64, interval_start: Option<(f64, f64)>) -> Result<(), StepFailure> {
+    /// stopper's motion, which began there; `seen`, the command the driver sees over the step
+    /// when the interval's command was formed once for all its parts.
+    fn step_part(
+        &mut self,
+        time: f64,
+        x_s: f64,
+        interval_start: Option<(f64, f64)>,
+        seen: Option<CommandPieces>,
+    ) -> Result<(), StepFailure> {
         let t0 = self.simulation.time;
         let step = time - t0;
         if !(step.is_finite() && step > 0.0) {
@@ -146,9 +162,9 @@ impl FixedStep {
             }
         }
         let result = if self.simulation.model.has_volume_states() {
-            advance(&mut self.simulation, &mut self.with_volumes, step, rate)
+            advance(&mut self.simulation, &mut self.with_volumes, step, rate, seen)
         } else {
-            advance(&mut self.simulation, &mut self.chambers, step, rate)
+            advance(&mut self.simulation, &mut self.chambers, step, rate, seen)
         };
         if let Some(held) = held {
             self.simulation.release_modulated(held);
@@ -184,20 +200,57 @@ impl FixedStep {
     }
 }
 
+/// The command the current driver sees, as (duration, value at the piece's start, rate)
+/// pieces.
+type CommandPieces = smallvec::SmallVec<[(f64, f64, f64); 2]>;
+
+/// The pieces of `whole` (which start at 0) between `from` and `to`.
+fn command_between(whole: &CommandPieces, from: f64, to: f64) -> CommandPieces {
+    let mut out = CommandPieces::new();
+    let mut start = 0.0;
+    for &(duration, value, rate) in whole {
+        let end = start + duration;
+        let (a, b) = (from.max(start), to.min(end));
+        if b > a {
+            out.push((b - a, value + rate * (a - start), rate));
+        }
+        start = end;
+    }
+    // Rounding can leave the last part's end a hair past the pieces': the last piece goes on.
+    match (out.is_empty(), whole.last()) {
+        (true, Some(&(duration, value, rate))) => {
+            let piece_start = start - duration;
+            out.push((to - from, value + rate * (from - piece_start), rate));
+        }
+        _ => {
+            let covered: f64 = out.iter().map(|p| p.0).sum();
+            if let Some(last) = out.last_mut() {
+                last.0 += (to - from) - covered;
+            }
+        }
+    }
+    out
+}
+
 /// The state `step` later, the volumes' pressures then and the work done, the simulation
-/// otherwise unchanged but for its command stage, delay line and play operators.
+/// otherwise unchanged but for its command stage, delay line and play operators; `seen`, the
+/// command over the step when it was formed for the whole interval the step is part of.
 fn advance<const N: usize>(
     sim: &mut Simulation,
     ros2: &mut Ros2<N>,
     step: f64,
     rate: f64,
+    seen: Option<CommandPieces>,
 ) -> Result<(State, [f64; node::STATES], Statistics), StepFailure>
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>>,
 {
     let t0 = sim.time;
     let jacobians = ros2.jacobians;
-    let segments = sim.seen_command_segments(step);
+    let segments = match seen {
+        Some(pieces) => pieces,
+        None => sim.seen_command_segments(step),
+    };
     let mut em = sim.electromechanical_state();
     let mut pressures = sim.pressures::<N>();
     let propagator = sim.propagator.as_ref().expect("checked at construction");
@@ -386,6 +439,47 @@ mod tests {
                 .fold(0.0, f64::max);
             assert!(worst < bound, "max |ΔF_meas| = {worst} N");
             assert!(worst > 0.0);
+        }
+    }
+
+    #[test]
+    fn a_command_stage_moves_once_per_sample_when_each_sample_is_reached_in_parts() {
+        // A slew limit, a lag and a delay act on the command held between samples: reached in
+        // 8 parts, a 4 ms sample must see the stage move as the error-controlled step to it
+        // does, once. Moved at every part, a 3 A/s slew limit under a command that switches
+        // every 8 ms followed the command eight times as often and left newtons between them.
+        let command = |k: usize| if (k / 2) % 2 == 0 { 2.0 } else { 6.0 };
+        for params in [
+            Parameters {
+                current_slew_limit: 3.0,
+                ..Parameters::default()
+            },
+            Parameters {
+                command_lag: 5e-3,
+                command_delay: 1e-3,
+                current_slew_limit: 10.0,
+                ..Parameters::default()
+            },
+        ] {
+            let model = Actuator::new(params).unwrap();
+            let mut fixed = FixedStep::at_equilibrium(model.clone(), command(0), 0.054, 0.0)
+                .unwrap()
+                .unwrap();
+            let mut accurate = Simulation::at_equilibrium(model, command(0), 0.054, 0.0, 1e-8).unwrap();
+            let (mut worst, mut moved) = (0.0f64, 0.0f64);
+            let mut last = accurate.outputs().f_meas;
+            for k in 0..250 {
+                fixed.set_command(command(k)).unwrap();
+                accurate.set_command(command(k)).unwrap();
+                fixed.step_to_in_parts((k + 1) as f64 * 4e-3, 0.054, 8).unwrap();
+                accurate.step(4e-3).unwrap();
+                let f = accurate.outputs().f_meas;
+                worst = worst.max((fixed.outputs().f_meas - f).abs());
+                moved = moved.max((f - last).abs());
+                last = f;
+            }
+            assert!(moved > 0.3, "the force moves by {moved} N over a sample");
+            assert!(worst < 0.02, "max |ΔF_meas| = {worst} N");
         }
     }
 
