@@ -816,7 +816,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(10.0)
         .cite("(2.1)-(2.3)")
         .because("10 A: 25 times the coil's rated 0.4 A"),
-    parameter("current_slew_limit", vr::CURRENT_SLEW_LIMIT, "A/s", 0.0, "current slew limit: the held command changes by at most this over k_cd per second between communication points (0 = off)")
+    parameter("current_slew_limit", vr::CURRENT_SLEW_LIMIT, "A/s", 0.0, "current slew limit: the command the driver sees moves towards the applied one at most this over k_cd per second, continuously (0 = off)")
         .at_least(0.0).at_most(1e6)
         .cite("(2.1)-(2.3)")
         .because("1e6 A/s: far beyond what the driver's 7050 rad/s corner slews (about 3000 A/s on a full step)"),
@@ -840,7 +840,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1000.0).at_most(1000.0)
         .cite("")
         .because("1000 N/s: nine times the largest force every second"),
-    parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
+    parameter("force_sensor_lag", vr::FORCE_SENSOR_LAG, "s", 0.0, "force sensor dynamics: F_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, parts of the step no longer than its time constant (lag, or 1/(2 pi f)) nor than 1 ms (at most 16) (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: a sensor that slow reads no dynamics at all"),
@@ -864,7 +864,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1000.0).at_most(1000.0)
         .cite("")
         .because("1000 N: nine times the largest force"),
-    parameter("force_sensor_filter_frequency", vr::FORCE_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "force sensor dynamics: F_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
+    parameter("force_sensor_filter_frequency", vr::FORCE_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "force sensor dynamics: F_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, parts of the step no longer than its time constant (lag, or 1/(2 pi f)) nor than 1 ms (at most 16) (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("")
         .because(FILTER_FREQUENCY),
@@ -948,7 +948,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1e5).at_most(1e5)
         .cite("")
         .because("1e5 Pa/s: the supply's gauge pressure in under six seconds"),
-    parameter("p1_sensor_lag", vr::P1_SENSOR_LAG, "s", 0.0, "pressure transducer 1: P1_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
+    parameter("p1_sensor_lag", vr::P1_SENSOR_LAG, "s", 0.0, "pressure transducer 1: P1_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, parts of the step no longer than its time constant (lag, or 1/(2 pi f)) nor than 1 ms (at most 16) (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: a transducer that slow reads no dynamics at all"),
@@ -956,7 +956,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: as the command delay"),
-    parameter("p1_sensor_filter_frequency", vr::P1_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 1: P1_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
+    parameter("p1_sensor_filter_frequency", vr::P1_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 1: P1_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, parts of the step no longer than its time constant (lag, or 1/(2 pi f)) nor than 1 ms (at most 16) (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("")
         .because(FILTER_FREQUENCY),
@@ -976,7 +976,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(-1e5).at_most(1e5)
         .cite("")
         .because("1e5 Pa/s: the supply's gauge pressure in under six seconds"),
-    parameter("p2_sensor_lag", vr::P2_SENSOR_LAG, "s", 0.0, "pressure transducer 2: P2_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
+    parameter("p2_sensor_lag", vr::P2_SENSOR_LAG, "s", 0.0, "pressure transducer 2: P2_meas follows the reading through a first-order lag of this time constant, the reading taken as linear between the points it is recorded at: each communication point and, parts of the step no longer than its time constant (lag, or 1/(2 pi f)) nor than 1 ms (at most 16) (0 = off)")
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: a transducer that slow reads no dynamics at all"),
@@ -984,7 +984,7 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("")
         .because("1 s: as the command delay"),
-    parameter("p2_sensor_filter_frequency", vr::P2_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 2: P2_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, where its time constant (lag, or 1/(2 pi f)) is shorter than the step, parts of the step no longer than it (at most 16) (0 = off)")
+    parameter("p2_sensor_filter_frequency", vr::P2_SENSOR_FILTER_FREQUENCY, "Hz", 0.0, "pressure transducer 2: P2_meas follows the reading through a second-order low-pass filter of this natural frequency, the reading taken as linear between the points it is recorded at: each communication point and, parts of the step no longer than its time constant (lag, or 1/(2 pi f)) nor than 1 ms (at most 16) (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("")
         .because(FILTER_FREQUENCY),

@@ -613,6 +613,39 @@ fn a_transducer_faster_than_the_communication_step_reads_the_same_at_coarse_and_
 }
 
 #[test]
+fn a_transducer_slower_than_the_communication_step_reads_the_force_within_it_not_its_chord() {
+    // A 10 ms force-sensor lag under a command that switches every 4 ms (a PRBS at 250 Hz):
+    // stepped at 4 ms, its readings agree with those of a run stepped at 0.1 ms with the
+    // same held commands, where one chord of the force over each 4 ms step reached the lag
+    // early.
+    let model = with(|p| p.force_sensor_lag = 10e-3);
+    let commands = [6.0, -2.0, 4.0, 4.0, -5.0, 1.0, 7.0, -3.0, -3.0, 2.0, 5.0, -6.0];
+    let run = |step: f64| -> Vec<f64> {
+        let mut sim = Simulation::at_equilibrium(model.clone(), 1.0, 0.054, 0.0, 1e-8).unwrap();
+        let per_sample = (4e-3 / step).round() as usize;
+        let mut out = vec![];
+        for &v in &commands {
+            sim.set_command(v).unwrap();
+            for _ in 0..per_sample {
+                sim.step(step).unwrap();
+            }
+            out.push(sim.outputs().f_meas);
+        }
+        out
+    };
+    let (coarse, fine) = (run(4e-3), run(1e-4));
+    let span = fine.iter().cloned().fold(f64::MIN, f64::max) - fine.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(span > 3.0, "the reading moved over {span} N");
+    for (k, (c, f)) in coarse.iter().zip(&fine).enumerate() {
+        assert!(
+            (c - f).abs() < 2e-3 * span,
+            "at {} ms: {c} N against {f} N",
+            4 * (k + 1)
+        );
+    }
+}
+
+#[test]
 fn a_stopper_acceleration_given_as_an_input_is_what_the_mass_force_reads_at_once_and_along_its_rate() {
     // A moving mass of 0.2 kg (extra_force_acceleration = -0.2) with the acceleration taken
     // whole from the input: the force departs from the plain model's by -0.2 a_s, a_s as set
