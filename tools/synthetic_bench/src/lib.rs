@@ -210,6 +210,8 @@ pub fn run(
     // gas temperature: the thesis constant unless it drifts over the recording
     let recording_span = (n_samples as f64 * sample).max(sample);
     let tgas_at = |t: f64| params.temperature + und.gas_temperature_drift * (t / recording_span).clamp(0.0, 1.0);
+    // the bore: its nominal size unless it drifts over the recording
+    let area_scale_at = |t: f64| (1.0 + und.bore_drift * (t / recording_span).clamp(0.0, 1.0)).powi(2);
 
     // initial state at the first command: static jet pipe, pressures at mid values
     let mut y: State = [0.0; NS];
@@ -258,6 +260,7 @@ pub fn run(
         // inputs evaluated inside the step (left/right limits at its ends)
         let inp = |t: f64| {
             let te = t.clamp(t_lo + eps, t_hi - eps);
+            m.area_scale.set(area_scale_at(te));
             (
                 cmd_at(cmds, te),
                 stop_at(te),

@@ -273,6 +273,10 @@ pub struct UndeclaredEffects {
     /// `chambers`/`drift`: the gas temperature rises linearly by this (K) from the start to the
     /// end of the recording (supply air warming up); the chamber walls follow it.
     pub gas_temperature_drift: f64,
+    /// `mechanics`/`drift`: the cylinder's bore D changes linearly by this fraction of itself
+    /// from the start to the end of the recording (−0.01: 1 % narrower at the end, a seal
+    /// swelling); the piston's area π D²/4 in the force and both chambers' volumes follows it.
+    pub bore_drift: f64,
     /// `valve`/`nonlinearity`: the valve orifices' discharge coefficient rises as the flow
     /// chokes, C_d (1 + s (1 − r)²) with r = P_down/P_up across each; s this; 0 = none.
     pub discharge_ratio_rise: f64,

@@ -198,6 +198,8 @@ pub(crate) struct Model {
     pub(crate) p: BenchParams,
     pub(crate) e: BenchEffects,
     pub(crate) a_p: f64,
+    /// The piston's area over its nominal `a_p` at the time last evaluated (the bore drift).
+    pub(crate) area_scale: std::cell::Cell<f64>,
     pub(crate) l_dead: f64, // L_p + L_s + L_sup
     pub(crate) r_crit: f64,
     pub(crate) c1: f64,
@@ -269,6 +271,7 @@ impl Model {
             p: p.clone(),
             e: e.clone(),
             a_p,
+            area_scale: std::cell::Cell::new(1.0),
             l_dead: p.l_p + p.l_s + p.l_sup,
             r_crit: (2.0 / (g + 1.0)).powf(g / (g - 1.0)),
             c1: (g / p.r_gas * (2.0 / (g + 1.0)).powf((g + 1.0) / (g - 1.0))).sqrt(),
@@ -372,10 +375,15 @@ impl Model {
         }
     }
 
+    /// The piston's area at the time last evaluated.
+    pub(crate) fn area(&self) -> f64 {
+        self.a_p * self.area_scale.get()
+    }
+
     pub(crate) fn volumes(&self, xs: f64) -> (f64, f64) {
         let xp = xs - self.l_dead;
-        let v1 = self.a_p * xp + 0.0;
-        let v2 = self.a_p * (self.p.l_cyl - xp - self.p.l_p);
+        let v1 = self.area() * xp + 0.0;
+        let v2 = self.area() * (self.p.l_cyl - xp - self.p.l_p);
         (v1, v2)
     }
 
@@ -410,7 +418,7 @@ impl Model {
     /// The actuator force with the stopper accelerating at `xs_acc`: a moving mass between
     /// piston and sensor takes m · xs_acc of the pressure force.
     pub(crate) fn force_moving(&self, y: &State, xs: f64, xs_dot: f64, xs_acc: f64) -> f64 {
-        let mut fp = self.a_p * (y[S_P1] - y[S_P2]) - self.friction(xs_dot);
+        let mut fp = self.area() * (y[S_P1] - y[S_P2]) - self.friction(xs_dot);
         if self.viscous {
             fp -= self.e.undeclared.viscous_friction * xs_dot;
         }
@@ -650,7 +658,7 @@ impl Model {
         }
         // chambers
         let (v1, v2) = self.volumes(x_pist);
-        let (dv1, dv2) = (self.a_p * x_pist_dot, -self.a_p * x_pist_dot);
+        let (dv1, dv2) = (self.area() * x_pist_dot, -self.area() * x_pist_dot);
         let mut m1 = if self.line1 {
             m_ln - m_l - m_d1
         } else {

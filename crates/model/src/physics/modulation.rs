@@ -14,8 +14,9 @@
 //! that point's signals (the ones the next step holds). A modulation on top of a drift adds to
 //! the drifted value.
 //!
-//! The cylinder's bore is not modulatable: [`NOT_MODULATABLE`] says why. The chambers' dead
-//! volumes are, as the pressure equations' capacity (`DEAD_VOLUMES`).
+//! The chambers' dead volumes are modulatable as the pressure equations' capacity
+//! (`DEAD_VOLUMES`), and the cylinder's bore as the piston's area (`BORE`), which the force and
+//! both chambers' volumes read.
 
 use super::actuator::Actuator;
 use super::parameters::{variable_name, Parameters};
@@ -52,6 +53,7 @@ pub const MODULATABLE: &[u32] = &[
     vr::T_GAS,
     vr::DEAD_VOLUME_1,
     vr::DEAD_VOLUME_2,
+    vr::D_CYL,
     vr::K_SPRING,
     vr::FRICTION_COULOMB,
     vr::VISCOUS_FRICTION,
@@ -64,11 +66,16 @@ pub const MODULATABLE: &[u32] = &[
     vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
 ];
 
-const BORE_AND_AREA: &str = "the bore sets the piston's area, which the force and both chambers' volumes read, and the chambers' volume rates; a bore that changed between steps would change the force at once and move air between the chambers, with no physical account of either";
-
 /// Constants one might expect in [`MODULATABLE`] that the model cannot modulate correctly, with
-/// the reason.
-pub const NOT_MODULATABLE: &[(u32, &str)] = &[(vr::D_CYL, BORE_AND_AREA)];
+/// the reason (none at present).
+pub const NOT_MODULATABLE: &[(u32, &str)] = &[];
+
+/// The cylinder's bore. Modulated, it is the piston's area A_p = π D²/4 at that instant: the
+/// force A_p (P1 − P2) reads it, and the chambers' volumes and their rates A_p ẋ_s, as the
+/// dead volumes' capacity is read (the pressure continuous across a change; a bore that really
+/// widened would add its own dV/dt, which the model does not have: for a drift of 1 % over a
+/// minute that term is some 1e-4 of the volume a second).
+const BORE: &[u32] = &[vr::D_CYL];
 
 /// The chambers' dead volumes. Modulated, a dead volume is the capacity of the pressure
 /// equations (2.30)–(2.31) at that instant: the pressure is continuous across a change, and the
@@ -126,6 +133,7 @@ const OUTPUTS: &[u32] = &[
     vr::K_SPRING,
     vr::P_R,
     vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
+    vr::D_CYL,
 ];
 
 /// The stopper velocity at which the sign signal, tanh(v / this), is 0.76.
@@ -585,6 +593,7 @@ pub(crate) struct Held {
     area_scales: [f64; 4],
     inv_sqrt_temperature: f64,
     dead_volumes: [f64; 2],
+    bore_and_area: (f64, f64),
 }
 
 /// Each slot's constant set to its value plus the slot's increment at `signals`, with what
@@ -600,6 +609,7 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         area_scales: model.area_scales,
         inv_sqrt_temperature: model.flow.inv_sqrt_temperature,
         dead_volumes: [model.cylinder.dead_volume_1, model.cylinder.dead_volume_2],
+        bore_and_area: (model.cylinder.d_cyl, model.piston_area),
     };
     let slots = model.params.modulation;
     for (k, slot) in slots.iter().enumerate() {
@@ -622,7 +632,7 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
                 "{} = {value} is invalid: must be finite",
                 variable_name(constant)
             ))
-        } else if constant == vr::T_GAS || constant == vr::P_S || constant == vr::P_R {
+        } else if [vr::T_GAS, vr::P_S, vr::P_R, vr::D_CYL].contains(&constant) {
             variables::check(constant, value).err()
         } else {
             None
@@ -667,6 +677,10 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         model.cylinder.dead_volume_1 = p.dead_volume_1;
         model.cylinder.dead_volume_2 = p.dead_volume_2;
     }
+    if modulates_any_of(p, BORE) {
+        model.cylinder.d_cyl = p.d_cyl;
+        model.piston_area = model.cylinder.piston_area();
+    }
     Ok(held)
 }
 
@@ -682,6 +696,7 @@ pub(crate) fn restore(model: &mut Actuator, held: Held) {
     model.area_scales = held.area_scales;
     model.flow.inv_sqrt_temperature = held.inv_sqrt_temperature;
     [model.cylinder.dead_volume_1, model.cylinder.dead_volume_2] = held.dead_volumes;
+    (model.cylinder.d_cyl, model.piston_area) = held.bore_and_area;
 }
 
 /// A copy of `model` with the slots' constants at `signals` (for the outputs and the

@@ -187,6 +187,10 @@ struct Cli {
     /// The gas temperature rises linearly by this over the recording, K (e.g. 20).
     #[arg(long, allow_hyphen_values = true)]
     gas_temperature_drift: Option<f64>,
+    /// The cylinder's bore changes linearly by this fraction of itself over the recording
+    /// (e.g. -0.01: 1 % narrower at the end), the piston's area in the force and the volumes with it.
+    #[arg(long, allow_hyphen_values = true)]
+    bore_drift: Option<f64>,
     /// The valve orifices' C_d grows to C_d (1 + s (1 − r)²) at pressure ratio r: s (e.g. 0.3).
     #[arg(long)]
     discharge_ratio_rise: Option<f64>,
@@ -311,6 +315,7 @@ fn main() -> ExitCode {
     set(&mut und.stopper_position_offset, cli.stopper_position_offset);
     set(&mut und.contact_lag, cli.contact_lag);
     set(&mut und.gas_temperature_drift, cli.gas_temperature_drift);
+    set(&mut und.bore_drift, cli.bore_drift);
     set(&mut und.discharge_ratio_rise, cli.discharge_ratio_rise);
     set(&mut und.supply_leak_2, cli.supply_leak_2);
     set(&mut und.laminar_leak_1, cli.laminar_leak_1);
@@ -378,6 +383,7 @@ fn main() -> ExitCode {
             und.pressure_sensor_quadratic_2,
             und.stopper_position_offset,
             und.gas_temperature_drift,
+            und.bore_drift,
             und.difference_inflow_2,
             und.position_sign_force,
             und.position_sign_origin,
@@ -388,6 +394,7 @@ fn main() -> ExitCode {
     let und_bad = und_bad
         || und.stopper_position_offset.abs() > 5e-3
         || und.gas_temperature_drift.abs() > 100.0
+        || und.bore_drift.abs() > 0.1
         || und.discharge_ratio_rise > 1.0;
     let und_bad = und_bad || und.jet_pipe_curve_blend > 1.0 || und.return_area_reduction > 1.0;
     if und_bad {
@@ -395,7 +402,7 @@ fn main() -> ExitCode {
             "benchgen: undeclared mechanism parameters must be finite; limits, lags, leak, \
              friction, moving mass, seal friction, damping, filter frequencies and dampings, stiffness, delay, backlash, restriction and ripple frequency non-negative; curve \
              blend, return area reduction and discharge ratio rise in 0..1; stopper position \
-             offset within ±5 mm, gas temperature drift within ±100 K"
+             offset within ±5 mm, gas temperature drift within ±100 K, bore drift within ±0.1"
         );
         return ExitCode::from(2);
     }
