@@ -74,7 +74,7 @@ pub const NOT_MODULATABLE: &[(u32, &str)] = &[];
 /// force A_p (P1 − P2) reads it, and the chambers' volumes and their rates A_p ẋ_s, as the
 /// dead volumes' capacity is read (the pressure continuous across a change; a bore that really
 /// widened would add its own dV/dt, which the model does not have: for a drift of 1 % over a
-/// minute that term is some 1e-4 of the volume a second).
+/// minute that term is 3e-4 of the volume a second, 2 dD/D).
 const BORE: &[u32] = &[vr::D_CYL];
 
 /// The chambers' dead volumes. Modulated, a dead volume is the capacity of the pressure
