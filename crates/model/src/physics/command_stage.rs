@@ -11,7 +11,7 @@
 //! | `current_limit` (A) | clipped where k_cd v + i_offset reaches ± the limit, (2.1) |
 //! | `current_slew_limit` (A/s) | the command moves towards the applied one at most the limit / k_cd per second, continuously: a ramp within the step that ends where it reaches it ([`CommandStage::pieces_over`]) |
 //! | `command_lag` (s) | a first-order lag, exact for the command held between communication points |
-//! | `command_filter_frequency` (Hz), `command_filter_damping` | a second-order low-pass filter after the lag, exact for its input held between communication points |
+//! | `command_filter_frequency` (Hz), `command_filter_damping` | a second-order low-pass filter after the lag, exact for its input held between communication points (or, without the lag, for the slew limit's ramp and hold) |
 //!
 //! The slew limit, the lag and the filter act on the command as it is held between communication
 //! points (a sampled D/A stage): the FMU stepped at a recording's sample times and the
@@ -19,8 +19,8 @@
 //! driver's corner at 7050 rad/s, a command slewing at S / k_cd gives a current that slews at S
 //! to within 0.14 ms, as a driver whose own di/dt is limited does. Held at each communication
 //! point instead, a 3 A/s limit sampled at 250 Hz moved in 4 ms stairs and left 0.5 N between
-//! such a driver and the model with the true limit. The output of the last of them, the filter's
-//! or else the lag's, moves linearly from its value at the step's start to its exact value at
+//! such a driver and the model with the true limit. The output of the last of them, the filter's,
+//! the lag's or else the slew limit's, moves linearly from its value at the step's start to its exact value at
 //! the step's end ([`CommandStage::rate_over`]), or, where it is fast beside the step, through
 //! its exact values at up to [`MAX_FILTER_PIECES`] nodes within it
 //! ([`CommandStage::pieces_over`]). Held over the step instead, a 5.8 ms lag sampled at
