@@ -329,6 +329,10 @@ pub struct UndeclaredEffects {
     pub command_filter_frequency: f64,
     /// Its damping ratio (0: 1/√2).
     pub command_filter_damping: f64,
+    /// `piston_friction`'s shape: when positive, F_c tanh(v / this) (m/s) replaces the
+    /// Stribeck curve, with neither stiction nor the viscous part (seals that deform over a
+    /// wide speed range); 0 = the Stribeck curve.
+    pub friction_smoothing_velocity: f64,
 }
 
 impl Default for BenchEffects {

@@ -405,6 +405,10 @@ impl Model {
         if fc <= 0.0 {
             return 0.0;
         }
+        let smoothing = self.e.undeclared.friction_smoothing_velocity;
+        if smoothing > 0.0 {
+            return fc * (v / smoothing).tanh();
+        }
         let fs = 1.5 * fc;
         let (v_s, v_eps, b) = (5e-3, 0.2e-3, fc * 1.0);
         (fc + (fs - fc) * (-(v / v_s) * (v / v_s)).exp()) * (v / v_eps).tanh() + b * v
@@ -736,6 +740,41 @@ pub(crate) fn second_order(frequency: f64, damping: f64, input: f64, y: f64, rat
 #[cfg(test)]
 mod tests {
     use super::BenchParams;
+    use crate::{BenchEffects, UndeclaredEffects};
+
+    #[test]
+    fn a_smoothed_friction_is_the_coulomb_level_times_tanh_of_the_speed_over_its_scale() {
+        let smooth = BenchEffects {
+            friction_coulomb: 2.0,
+            undeclared: UndeclaredEffects {
+                friction_smoothing_velocity: 0.01,
+                ..UndeclaredEffects::default()
+            },
+            ..BenchEffects::default()
+        };
+        let plant = super::Model::new(&BenchParams::default(), &smooth);
+        for v in [-0.05, -0.01, -0.002, 0.0, 0.005, 0.01, 0.03] {
+            let expected = 2.0 * (v / 0.01_f64).tanh();
+            assert!(
+                (plant.friction(v) - expected).abs() < 1e-12,
+                "v = {v}: {}",
+                plant.friction(v)
+            );
+        }
+        // The Stribeck curve without the smoothing: 1.5 F_c of stiction at a crawl.
+        let stribeck = super::Model::new(
+            &BenchParams::default(),
+            &BenchEffects {
+                friction_coulomb: 2.0,
+                ..BenchEffects::default()
+            },
+        );
+        assert!(
+            (stribeck.friction(0.002) - 2.9).abs() < 0.1,
+            "{}",
+            stribeck.friction(0.002)
+        );
+    }
 
     #[test]
     fn every_constant_is_found_by_its_own_name_and_no_other() {

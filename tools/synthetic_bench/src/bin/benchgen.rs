@@ -187,6 +187,10 @@ struct Cli {
     /// The gas temperature rises linearly by this over the recording, K (e.g. 20).
     #[arg(long, allow_hyphen_values = true)]
     gas_temperature_drift: Option<f64>,
+    /// With --friction-coulomb: the friction is F_c tanh(v / this), v the stopper's velocity,
+    /// m/s, instead of the Stribeck curve (e.g. 0.01).
+    #[arg(long)]
+    friction_smoothing_velocity: Option<f64>,
     /// The cylinder's bore changes linearly by this fraction of itself over the recording
     /// (e.g. -0.01: 1 % narrower at the end), the piston's area in the force and the volumes with it.
     #[arg(long, allow_hyphen_values = true)]
@@ -316,6 +320,7 @@ fn main() -> ExitCode {
     set(&mut und.contact_lag, cli.contact_lag);
     set(&mut und.gas_temperature_drift, cli.gas_temperature_drift);
     set(&mut und.bore_drift, cli.bore_drift);
+    set(&mut und.friction_smoothing_velocity, cli.friction_smoothing_velocity);
     set(&mut und.discharge_ratio_rise, cli.discharge_ratio_rise);
     set(&mut und.supply_leak_2, cli.supply_leak_2);
     set(&mut und.laminar_leak_1, cli.laminar_leak_1);
@@ -370,6 +375,7 @@ fn main() -> ExitCode {
         und.pressure_sensor_filter_damping_1,
         und.command_filter_frequency,
         und.command_filter_damping,
+        und.friction_smoothing_velocity,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
