@@ -110,7 +110,8 @@ pub(crate) struct Added<'a> {
 /// parameters): that term, as discovered, with the parameters that carry it. The candidates
 /// with no more parameters than the addition are tried (after a named effect, those with
 /// more too, which must leave a penalised misfit lower by a further penalty and a smaller
-/// force error), best first by their penalised held-out misfit, at most
+/// force error; one as rich as it or a discovered term must leave a penalised misfit lower
+/// by a penalty, and after a named effect also close a share of the way to the noise), best first by their penalised held-out misfit, at most
 /// [`DISCOVERY_TRIALS`]; among those adequate, the fewest parameters win, then the smaller
 /// penalised misfit.
 pub(crate) fn alternative_at_place(
@@ -170,10 +171,18 @@ pub(crate) fn alternative_at_place(
             let gap = (added_force - noise).max(0.0);
             let taken = added_force - force >= RICHER_SHARE_OF_GAP * gap;
             score < added_score - penalty && force < added_force && taken
+        } else if added.named {
+            // As close as the two come while another departure is still to be found, the
+            // named effect stays: an unnamed term as rich as it replaces it by a penalty and
+            // a share of the way to the noise (a seal friction growing with the pressures
+            // matched a smooth friction to 0.1 % beside a force sensor lag).
+            let gap = (added_force - noise).max(0.0);
+            let taken = added_force - force >= EQUAL_SHARE_OF_GAP * gap
+                || added_misfit - misfit >= EQUAL_SHARE_OF_GAP * added_misfit;
+            score < added_score - penalty && force <= added_force && taken
         } else {
-            // a discovered term must be beaten by its penalty, a named effect by any margin
-            let margin = if added.named { 0.0 } else { penalty };
-            score < added_score - margin && force <= added_force
+            // a discovered term must be beaten by its penalty
+            score < added_score - penalty && force <= added_force
         };
         if !ok {
             continue;
@@ -186,6 +195,10 @@ pub(crate) fn alternative_at_place(
 /// A term richer than the named effect it would replace must close at least this share of
 /// the gap between the named effect's held-out force error and the noise floor.
 const RICHER_SHARE_OF_GAP: f64 = 0.2;
+/// A term as rich as the named effect it would replace must close at least this share of
+/// that gap, or take this share of the named effect's held-out misfit (a departure in the
+/// pressures).
+const EQUAL_SHARE_OF_GAP: f64 = 0.05;
 
 /// An addition with at least this many parameters (a static curve through its knots) can
 /// stand in for a simpler term at another place of the chain: those are re-tried after it.

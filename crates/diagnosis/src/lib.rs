@@ -37,6 +37,7 @@ pub mod lines;
 mod localize;
 pub mod modulation;
 mod named;
+mod named_instead;
 pub mod noise;
 mod oscillation;
 mod pairs;
@@ -65,7 +66,7 @@ use signals::{difference, force_from_pressures, rms, rms_where, ChainSignals, CH
 use signature::Signature;
 
 use localize::{
-    discovery_penalised, discovery_penalty_per_term, heldout_count, localize, parallel_map, penalised, rank, used_terms,
+    discovery_penalised, discovery_penalty_per_term, heldout_count, localize, parallel_map, penalised, used_terms,
 };
 
 /// Length of the alternating training / held-out blocks.
@@ -822,7 +823,6 @@ pub(crate) fn refit_jointly(
     if found.effects.len() + found.discovered.len() < 2 {
         return Ok(None);
     }
-    let (recording, n) = (cx.recording, cx.n);
     let params = &found.params;
     let names: Vec<&'static str> = found
         .effects
@@ -834,9 +834,33 @@ pub(crate) fn refit_jointly(
         .filter(|name| refittable(name))
         .collect();
     progress(&format!("joint refit of the {} parameters added", names.len()));
+    let Some((trial, before_joint, after_joint)) = refit_constants(cx, params, &names, replays)? else {
+        return Ok(None);
+    };
+    progress(&format!(
+        "  held-out force error {before_joint:.4} -> {after_joint:.4} N"
+    ));
+    if after_joint >= before_joint {
+        return Ok(None);
+    }
+    found.params = trial;
+    retire_switched_off(found, progress);
+    Ok(Some((before_joint, after_joint)))
+}
+
+/// The constants `names` of `params` refitted together (three Gauss–Newton iterations from
+/// where they stand): the parameters with them, and the held-out force error before and
+/// after, N. `None` when the fit fails or its values are not a valid model.
+pub(crate) fn refit_constants(
+    cx: &Context,
+    params: &Parameters,
+    names: &[&'static str],
+    replays: &mut usize,
+) -> Result<Option<(Parameters, f64, f64)>, String> {
+    let (recording, n) = (cx.recording, cx.n);
     let problem = Problem::new(recording, params, &cx.blocks, cx.channel_noise);
     problem.set_jobs(cx.options.jobs);
-    let candidate = joint_candidate(params, &names);
+    let candidate = joint_candidate(params, names);
     let current = replay_fast(&Actuator::new(params.clone())?, recording, n)?;
     let before_joint = rms_where(
         &difference(&recording.force, &current.force),
@@ -864,15 +888,7 @@ pub(crate) fn refit_jointly(
     let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
     *replays += 1;
     let after_joint = rms_where(&difference(&recording.force, &with.force), &cx.blocks, Block::HeldOut);
-    progress(&format!(
-        "  held-out force error {before_joint:.4} -> {after_joint:.4} N"
-    ));
-    if after_joint >= before_joint {
-        return Ok(None);
-    }
-    found.params = trial;
-    retire_switched_off(found, progress);
-    Ok(Some((before_joint, after_joint)))
+    Ok(Some((trial, before_joint, after_joint)))
 }
 
 /// After the joint refit: a named effect the refit turned off (its amplitude at zero:

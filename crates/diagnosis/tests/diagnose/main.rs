@@ -5,6 +5,7 @@
 //! * `undeclared`: the synthetic bench's undeclared mechanisms;
 //! * `protocols`: the general discovery pieces on recordings under other protocols;
 //! * `balance`: an extra force in the piston's balance picked from a library of local signals;
+//! * `beside`: a named friction beside another effect;
 //! * `flows`: an extra mass flow into one chamber alone, from the generated class;
 //! * `curves`: the static-curve class at the command and the transducers;
 //! * `search`: compounds and mechanisms that a search locking in on its first choice missed;
@@ -22,6 +23,7 @@
 //! diagnoses whenever one ends, and both cores stay busy until the last few.
 
 mod balance;
+mod beside;
 mod constants;
 mod curves;
 mod flows;
