@@ -11,7 +11,8 @@
 //! * `piston_friction` (`friction_coulomb` = F_c, N): Stribeck curve on the stopper velocity v,
 //!   F_f = [F_c + (F_s − F_c) exp(−(v/v_s)²)] tanh(v/v_ε) + b v with F_s = 1.5 F_c,
 //!   v_s = 5 mm/s, v_ε = 0.2 mm/s, b = F_c · 1 s/m; F_act = max(A_p(P1 − P2) − F_f, F_spring).
-//!   Zero while the stopper is still.
+//!   Zero while the stopper is still. With `friction_smoothing_velocity` v_t > 0 the law is
+//!   F_c tanh(v/v_t) instead, with neither stiction nor the viscous part.
 //! * `dead_volume` (`dead_volume_1`, `dead_volume_2`, m³): a side volume per chamber (lines,
 //!   transducer port) joined to the chamber through a short laminar line, ṁ = (P_i − P_di)/R_l,
 //!   R_l = γ R T τ_l / V_d with τ_l = 1 ms, so the line fills in about 1 ms and the volume acts as
