@@ -5,7 +5,8 @@
 //! brings both to the noise (a force sensor's 50 Hz filter, fitted first at 34 Hz beside an
 //! unseen smooth friction, left the friction 73 % of the next round, and a force in the
 //! position times the velocity's sign took it). After the rounds, each discovered term at a
-//! place with a named effect of its family that has its own signature test is tried as that effect
+//! place with a named effect of its family that has its own signature test (and on the force
+//! side of the piston, any such effect there) is tried as that effect
 //! instead: the term goes back to its start values, the named effect is fitted in its place,
 //! every addition is refitted beside it, and where the held-out misfit with the named
 //! parameters' penalty is within one penalty of the term's and the effect's signature shows,
@@ -14,6 +15,13 @@
 use super::*;
 use crate::localize::terms_used;
 use crate::rounds::Findings;
+
+/// Whether a place is on the force side of the piston, where a force the stopper's motion
+/// sets reads the same whether it acts on the piston or is added by the sensor: a smooth
+/// friction was found as the force sensor's offset varying with the stopper velocity.
+fn force_side(place: &str) -> bool {
+    matches!(place, "mechanics" | "force_sensor")
+}
 
 /// Gauss–Newton iterations of the named effect's fit in the term's place.
 const ITERATIONS: usize = 3;
@@ -65,7 +73,7 @@ fn named_in_place_of(
         &crate::curves::CurveKnots::default(),
     )
     .into_iter()
-    .filter(|c| c.location == place && c.family == term.family)
+    .filter(|c| c.location == place && c.family == term.family || force_side(place) && force_side(c.location))
     .filter(|c| {
         c.named.map_or(false, |n| {
             named::has_signature_test(n) && !f.effects.iter().any(|e| e.name == n)
