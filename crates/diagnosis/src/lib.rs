@@ -699,7 +699,30 @@ impl<'a> Context<'a> {
 }
 
 /// Diagnose a recording with the given options: the steps of the module's account, in order.
+/// A fault of the diagnosis itself (a panic) comes back as an error that says so, not as the
+/// end of the caller's process: a batch goes on with its other recordings.
 pub fn diagnose_with(
+    recording: &Recording,
+    base: &Parameters,
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        diagnose_unguarded(recording, base, options, progress)
+    }));
+    run.unwrap_or_else(|fault| {
+        let message = fault
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| fault.downcast_ref::<&str>().copied())
+            .unwrap_or("no message");
+        Err(format!(
+            "the diagnosis failed on a fault of its own, not of the recording ({message}); please report it with the recording"
+        ))
+    })
+}
+
+fn diagnose_unguarded(
     recording: &Recording,
     base: &Parameters,
     options: &Options,

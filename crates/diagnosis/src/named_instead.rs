@@ -124,8 +124,10 @@ fn named_in_place_of(
             .map_or(0.0, |t| t.step);
         problem.sensitivity(name, step, &current)
     };
-    // (score, force, candidate's fit, parameters) of the best named fit.
-    let mut best: Option<(f64, f64, Scored, Parameters)> = None;
+    // (score, force, candidate's fit, the model parameters that carry it, parameters) of
+    // the best named fit.
+    #[allow(clippy::type_complexity)]
+    let mut best: Option<(f64, f64, Scored, Vec<&'static str>, Parameters)> = None;
     for candidate in &named {
         let Ok(fit) = problem.fit(candidate, ITERATIONS, &current, &sensitivity) else {
             continue;
@@ -164,10 +166,11 @@ fn named_in_place_of(
             term_terms * penalty
         ));
         if best.as_ref().map_or(true, |b| score < b.0) {
-            best = Some((score, force, scored, trial));
+            let carried = set.iter().map(|(name, _)| *name).collect();
+            best = Some((score, force, scored, carried, trial));
         }
     }
-    let Some((score, force, scored, trial)) = best else {
+    let Some((score, force, scored, carried, trial)) = best else {
         return Ok(None);
     };
     if score > term_score + penalty || force > term_force + 0.05 * cx.noise {
@@ -190,10 +193,11 @@ fn named_in_place_of(
         progress(&format!("  {name}: its signature is absent"));
         return Ok(None);
     }
-    let parameters: Vec<(&'static str, f64)> = scored
-        .parameters()
+    // The model's parameters, as `apply_named` set them: a sensor's offset and gain are
+    // fitted as errors of the values it had.
+    let parameters: Vec<(&'static str, f64)> = carried
         .iter()
-        .map(|(name, _)| (*name, parameter_value(&trial, name)))
+        .map(|name| (*name, parameter_value(&trial, name)))
         .collect();
     let values: Vec<String> = parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
     let before = term.heldout_before;
