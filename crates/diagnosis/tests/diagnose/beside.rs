@@ -4,11 +4,8 @@
 //! the friction lies below its Coulomb level. Each case holds the friction and one other
 //! effect and asks for both, the friction by its name, each within a tenth of its size.
 
-use jetpipe_diagnosis::{diagnose, Diagnosis};
-use jetpipe_model::physics::parameters::Parameters;
-use synthetic_bench::{
-    generate_protocol_with, BenchEffects, BenchParams, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
-};
+use jetpipe_diagnosis::Diagnosis;
+use synthetic_bench::{BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects};
 
 use super::{names, value_reference};
 
@@ -26,23 +23,7 @@ fn friction_beside(coulomb: f64, other: BenchEffects) -> BenchEffects {
 
 /// The diagnosis of `spec`'s protocol with `effects`, printed.
 fn diagnosed(label: &str, spec: ProtocolSpec, effects: &BenchEffects) -> Diagnosis {
-    let dir = std::env::temp_dir().join(format!("jetpipe-diagnose-{}-beside-{label}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("recording.csv");
-    generate_protocol_with(&BenchParams::default(), &spec, effects)
-        .unwrap()
-        .write_csv(&path)
-        .unwrap();
-    let recording = jetpipe_diagnosis::recording::Recording::read(&path, &Parameters::default()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
-    println!(
-        "{label} ({}): {}; {}",
-        spec.label(),
-        d.verdict(),
-        d.summary().join(" | ")
-    );
-    d
+    super::protocols::diagnosed(&format!("beside-{label}"), &spec, effects)
 }
 
 fn parameter(d: &Diagnosis, name: &str) -> f64 {

@@ -23,7 +23,8 @@ pub(crate) fn recorded(label: &str, spec: &ProtocolSpec, effects: &BenchEffects)
     recording
 }
 
-fn diagnosed(label: &str, spec: &ProtocolSpec, effects: &BenchEffects) -> Diagnosis {
+/// The diagnosis of that recording, printed with its time.
+pub(crate) fn diagnosed(label: &str, spec: &ProtocolSpec, effects: &BenchEffects) -> Diagnosis {
     let recording = recorded(label, spec, effects);
     let started = std::time::Instant::now();
     let d = diagnose(&recording, &Parameters::default(), false, &mut |_| {}).unwrap();
