@@ -33,6 +33,17 @@ pub(crate) struct Stage {
     pub joint_refit: Option<(f64, f64)>,
 }
 
+impl Stage {
+    fn of(f: &Findings) -> Stage {
+        Stage {
+            params: f.params.clone(),
+            effects: f.effects.clone(),
+            discovered: f.discovered.clone(),
+            joint_refit: f.joint_refit,
+        }
+    }
+}
+
 /// One round's replay of the current model and how far it is from the recording.
 struct Round {
     model: Actuator,
@@ -211,20 +222,11 @@ pub(crate) fn run_rounds(
                 f.joint_refit = Some(refit);
             }
         }
-        f.stages.push(Stage {
-            params: f.params.clone(),
-            effects: f.effects.clone(),
-            discovered: f.discovered.clone(),
-            joint_refit: f.joint_refit,
-        });
+        f.stages.push(Stage::of(&f));
     }
     if crate::named_instead::named_instead_of_discovered(cx, &mut f, replays, progress)? {
-        let stage = Stage {
-            params: f.params.clone(),
-            effects: f.effects.clone(),
-            discovered: f.discovered.clone(),
-            joint_refit: f.joint_refit,
-        };
+        // The last round's findings are these now: going back to it keeps the name.
+        let stage = Stage::of(&f);
         match f.stages.last_mut() {
             Some(last) => *last = stage,
             None => f.stages.push(stage),
@@ -1049,6 +1051,23 @@ fn add_effect(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_named_share_counts_what_is_above_the_noise_in_the_channels_the_candidate_moves() {
+        let (all, count) = ([1.0; CHANNELS], 1000.0);
+        // 1.5 floors of force and 1.4 of each pressure: half of it is noise. Taking the
+        // channels to their noise takes all that could be taken, half the misfit.
+        let before = [2250.0, 1960.0, 1960.0];
+        assert!((share_of_reach(&before, &[1000.0; CHANNELS], &all, count) - 1.0).abs() < 1e-12);
+        let halfway = [1625.0, 1480.0, 1480.0];
+        assert!((share_of_reach(&before, &halfway, &all, count) - 0.5).abs() < 1e-12);
+        // A force-side term leaves the pressures exactly: their departure is not its to take.
+        let before = [4000.0, 3000.0, 1000.0];
+        assert!((share_of_reach(&before, &[1000.0, 3000.0, 1000.0], &all, count) - 1.0).abs() < 1e-12);
+        assert!((share_of_reach(&before, &[2500.0, 3000.0, 1000.0], &all, count) - 0.5).abs() < 1e-12);
+        // Nothing above the noise: nothing to take.
+        assert_eq!(share_of_reach(&[900.0; CHANNELS], &[800.0; CHANNELS], &all, count), 0.0);
+    }
 
     #[test]
     fn a_term_that_takes_many_floors_off_the_training_blocks_needs_less_of_the_held_out_ones() {
