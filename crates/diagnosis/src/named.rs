@@ -104,17 +104,27 @@ pub fn friction_changes_sign(residual: &[f64], recording: &Recording, noise: f64
 
 /// The mean of `signal` while the command rises less its mean while the command falls, in
 /// each bin of command level both directions visit for at least 200 samples: the loop a
-/// signal draws against the command.
+/// signal draws against the command. The bins are quantiles of the command while it moves,
+/// not equal widths of its whole range: a recording that sweeps both ways over a narrow
+/// band (a multisine about a mean) and crosses the rest once (ramps between levels) shows
+/// its loop in that band, which equal widths of the whole range would give two bins.
 fn rising_less_falling(signal: &[f64], recording: &Recording) -> Vec<Option<f64>> {
     let direction = command_direction(&recording.v_da);
-    let (lo, hi) = recording
+    let mut moving: Vec<f64> = recording
         .v_da
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-    let width = (hi - lo).max(1e-9) / BINS as f64;
+        .zip(&direction)
+        .filter(|(_, d)| **d != 0.0)
+        .map(|(v, _)| *v)
+        .collect();
+    if moving.is_empty() {
+        return vec![];
+    }
+    moving.sort_by(|a, b| a.total_cmp(b));
+    let edges: Vec<f64> = (1..BINS).map(|b| moving[b * moving.len() / BINS]).collect();
     let mut sums = vec![[0.0f64; 4]; BINS];
     for (k, &value) in signal.iter().enumerate() {
-        let bin = (((recording.v_da[k] - lo) / width) as usize).min(BINS - 1);
+        let bin = edges.partition_point(|edge| *edge <= recording.v_da[k]);
         if direction[k] > 0.0 {
             sums[bin][0] += value;
             sums[bin][1] += 1.0;
@@ -230,5 +240,35 @@ mod tests {
         // A drift in time draws no loop against the command: absent.
         let drift: Vec<f64> = recording.time.iter().map(|t| 0.05 * t).collect();
         assert!(!loop_with_command_direction(&drift, &higher_rising, &recording, noise).present);
+    }
+
+    #[test]
+    fn a_loop_drawn_in_a_narrow_band_the_command_sweeps_both_ways_shows_though_ramps_cross_the_rest_once() {
+        // Ramps up from 0 to 10 V in 5 s, a fall to 5 V, then a 1 Hz sine of ±0.8 V about
+        // 5 V for 20 s, at 1 kHz: equal widths of the whole range would give the sine two
+        // bins of 1 V, too few to show a loop.
+        let n = 25_000;
+        let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let v_da: Vec<f64> = time
+            .iter()
+            .map(|&t| {
+                if t < 5.0 {
+                    2.0 * t
+                } else {
+                    5.0 + 0.8 * (2.0 * std::f64::consts::PI * (t - 5.0)).sin()
+                }
+            })
+            .collect();
+        let mut recording = triangle();
+        recording.time = time;
+        recording.v_da = v_da;
+        recording.x_s = vec![0.06; n];
+        recording.force = vec![0.0; n];
+        let direction = crate::signals::command_direction(&recording.v_da);
+        let loop_in_sine: Vec<f64> = (0..n)
+            .map(|k| if k >= 5_000 { 0.25 * direction[k] } else { 0.0 })
+            .collect();
+        let test = loop_with_command_direction(&loop_in_sine, &loop_in_sine, &recording, 0.05);
+        assert!(test.present, "{}", test.sentence);
     }
 }
