@@ -11,6 +11,8 @@
 //! every addition is refitted beside it, and where the held-out misfit with the named
 //! parameters' penalty is within one penalty of the term's and the effect's signature shows,
 //! the named effect replaces the term: a name is the simpler reading of the same departure.
+//! It does so only where the named effect brings the force to the noise: beside a remainder,
+//! the term may be standing in for part of it, and a name would claim what it cannot show.
 
 use super::*;
 use crate::localize::terms_used;
@@ -174,6 +176,19 @@ fn named_in_place_of(
         return Ok(None);
     };
     if score > term_score + penalty || force > term_force + 0.05 * cx.noise {
+        return Ok(None);
+    }
+    // A name claims the mechanism. While a remainder above the noise stays, the term may be
+    // a stand-in for part of what remains, and a named effect fitted in its place takes on
+    // the stand-in's evidence: without pressures, a 0.79 ms force sensor delay beside a
+    // supply restriction left a force sensor curve standing in for the restriction at 2.1
+    // noise floors, and the sensor's offset and gain in its place read it as a gain of 0.98.
+    if force > EXPLAINED_WITHIN_NOISE * cx.noise {
+        progress(&format!(
+            "  {}: not named in the {}'s place while {force:.4} N stays, above {EXPLAINED_WITHIN_NOISE} noise floors",
+            scored.fit.candidate.named.unwrap_or(scored.fit.candidate.label),
+            term.candidate
+        ));
         return Ok(None);
     }
     let name = scored.fit.candidate.named.expect("a named candidate");
