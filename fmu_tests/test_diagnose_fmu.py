@@ -67,12 +67,16 @@ def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values
         if a is not None:
             fmu.setReal(vr_a, [a[0]])
         for k in range(len(t)):
+            # The stopper's motion on to the next sample is set before the outputs at this
+            # one are read: they read the velocity between the two intervals, as the
+            # diagnosis's replays do.
+            if k + 1 < len(t):
+                fmu.setRealInputDerivatives(vr_x, [1], [(x[k + 1] - x[k]) / (t[k + 1] - t[k])])
             read[:, k] = fmu.getReal(vr_out)
             if k + 1 == len(t):
                 break
             dt = t[k + 1] - t[k]
             fmu.setReal(vr_v, [v[k]])
-            fmu.setRealInputDerivatives(vr_x, [1], [(x[k + 1] - x[k]) / dt])
             if a is not None:
                 fmu.setRealInputDerivatives(vr_a, [1], [(a[k + 1] - a[k]) / dt])
             fmu.doStep(currentCommunicationPoint=t[k], communicationStepSize=dt)

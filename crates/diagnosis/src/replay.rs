@@ -226,15 +226,18 @@ fn replay_from(
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();
     for k in 0..=drive.last {
+        // The outputs at a sample read the stopper's motion on to the next one, where known.
+        let dt = if k < drive.last { time[k + 1] - time[k] } else { 0.0 };
+        if k < drive.last {
+            sim.set_stopper_rate((x_s[k + 1] - x_s[k]) / dt)?;
+        }
         if keep(k) {
             out.record(&sim.outputs());
         }
         if k == drive.last {
             break;
         }
-        let dt = time[k + 1] - time[k];
         sim.set_command(v_da[k])?;
-        sim.set_stopper_rate((x_s[k + 1] - x_s[k]) / dt)?;
         if let Some(a) = &accelerations {
             sim.set_stopper_acceleration_rate((a[k + 1] - a[k]) / dt)?;
         }
@@ -291,6 +294,9 @@ pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, sta
     let mut out = Replay::with_capacity(drive.rows());
     let mut keep = drive.keeps();
     for k in 0..=drive.last {
+        if k < drive.last {
+            sim.set_next_stopper_rate((x_s[k + 1] - x_s[k]) / (t[k + 1] - t[k]))?;
+        }
         if keep(k) {
             out.record(&sim.outputs());
         }

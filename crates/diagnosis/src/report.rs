@@ -200,9 +200,9 @@ impl Diagnosis {
             "residual_tests": self.residual_tests,
             "fmu_start_values": start_values,
             "stopper_positions": if self.stopper_smoothed {
-                "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21 (the recorded positions at the first and last three samples), as the FMU must be to reproduce these errors"
+                "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21 (the recorded positions at the first and last three samples), as the FMU must be to reproduce these errors, with der(x_s) on to the next sample set before the outputs at a sample are read"
             } else {
-                "the model was driven with x_s_m as recorded (sampled every 1.5 ms or slower, where the smoothing applied at faster rates would round the motion's corners), as the FMU must be to reproduce these errors"
+                "the model was driven with x_s_m as recorded (sampled every 1.5 ms or slower, where the smoothing applied at faster rates would round the motion's corners), as the FMU must be to reproduce these errors, with der(x_s) on to the next sample set before the outputs at a sample are read"
             },
             "stopper_positions_smoothed": self.stopper_smoothed,
             "stopper_acceleration_input": (self.acceleration_window > 0.0).then(|| json!({

@@ -238,19 +238,24 @@ fn a_line_volume_keeps_the_static_force_and_slows_the_step() {
 
 /// A stopper shaken 10 mm at 2.5 Hz about 54 mm under a 2.5 V command, sampled at `rate` Hz:
 /// the outputs at each sample from a simulation stepped once per sample, the stopper moving
-/// linearly between samples, with the times and positions.
+/// linearly between samples and its rate on to the next sample set before the outputs are
+/// read (as the diagnosis replays a recording), with the times and positions.
 fn shaken(model: &Actuator, rate: f64, samples: usize) -> (Vec<Outputs>, Vec<f64>, Vec<f64>) {
     let w = 2.0 * std::f64::consts::PI * 2.5;
     let h = 1.0 / rate;
     let time: Vec<f64> = (0..samples).map(|k| k as f64 * h).collect();
     let x: Vec<f64> = time.iter().map(|t| 0.054 + 0.01 * (w * t).sin()).collect();
     let mut sim = Simulation::at_equilibrium(model.clone(), 2.5, x[0], 0.0, 1e-6).unwrap();
-    let mut out = vec![sim.outputs()];
-    for k in 1..samples {
-        sim.set_stopper_rate((x[k] - x[k - 1]) / h).unwrap();
-        sim.step(h).unwrap();
-        sim.land_stopper_at(x[k]);
+    let mut out = vec![];
+    for k in 0..samples {
+        if k + 1 < samples {
+            sim.set_stopper_rate((x[k + 1] - x[k]) / h).unwrap();
+        }
         out.push(sim.outputs());
+        if k + 1 < samples {
+            sim.step(h).unwrap();
+            sim.land_stopper_at(x[k + 1]);
+        }
     }
     (out, time, x)
 }

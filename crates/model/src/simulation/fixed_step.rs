@@ -74,6 +74,19 @@ impl FixedStep {
         self.outputs
     }
 
+    /// The stopper's rate to the next sample, `rate`, known before the outputs at this one
+    /// are read: they read the velocity between the two intervals
+    /// ([`crate::physics::extra_force::velocity_between_intervals`]). The step to the next
+    /// sample takes its rate from the position it is given. A model whose transducers filter
+    /// or delay keeps the readings formed at the end of the step.
+    pub fn set_next_stopper_rate(&mut self, rate: f64) -> Result<(), String> {
+        self.simulation.set_stopper_rate(rate)?;
+        if !self.simulation.plan.filtering_transducers {
+            self.outputs = self.simulation.outputs_at_sample();
+        }
+        Ok(())
+    }
+
     /// The command applied from now to the next sample.
     pub fn set_command(&mut self, v_da: f64) -> Result<(), String> {
         self.simulation.set_command(v_da)
@@ -91,6 +104,7 @@ impl FixedStep {
     /// the delay line have taken the step's command).
     pub fn step_to(&mut self, time: f64, x_s: f64) -> Result<(), StepFailure> {
         let start = (self.simulation.time, self.simulation.x_s);
+        self.simulation.note_stopper_turn((x_s - start.1) / (time - start.0));
         self.step_part(time, x_s, Some(start), None)
     }
 
@@ -102,6 +116,7 @@ impl FixedStep {
     pub fn step_to_in_parts(&mut self, time: f64, x_s: f64, parts: usize) -> Result<(), StepFailure> {
         let (t0, x0) = (self.simulation.time, self.simulation.x_s);
         let interval = time - t0;
+        self.simulation.note_stopper_turn((x_s - x0) / interval);
         let seen = (parts > 1 && self.simulation.plan.command_path && interval.is_finite() && interval > 0.0)
             .then(|| self.simulation.seen_command_segments(interval));
         let part_of = |from: f64, to: f64| seen.as_ref().map(|whole| command_between(whole, from - t0, to - t0));
@@ -183,6 +198,7 @@ impl FixedStep {
         sim.stopper_velocity = rate;
         sim.v_da_rate = 0.0;
         sim.x_s_rate = 0.0;
+        sim.next_stopper_rate = None;
         sim.input_changed = false;
         sim.nodes = pressures;
         sim.chamber_rates_at_end = None;

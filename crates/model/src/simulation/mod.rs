@@ -125,6 +125,13 @@ pub struct Simulation {
     command_history: Vec<CommandChange>,
     /// Mean stopper velocity over the last step.
     stopper_velocity: f64,
+    /// The stopper's rate over the coming step, once set for it (der(x_s)): the outputs at
+    /// the sample then read the velocity between the two intervals
+    /// ([`crate::physics::extra_force::velocity_between_intervals`]).
+    next_stopper_rate: Option<f64>,
+    /// The motion turned at the last sample but one ([`crate::physics::extra_force::turns_at_sample`]):
+    /// its corner lay within the last step.
+    stopper_turned_before: bool,
     x_s_at_last_step: f64,
     /// The stopper's motion over the last step, from which the acceleration and the velocity
     /// at the sample that the forces on the piston read are formed
@@ -343,6 +350,8 @@ impl Simulation {
                 rate: 0.0,
             }],
             stopper_velocity: 0.0,
+            next_stopper_rate: None,
+            stopper_turned_before: false,
             x_s_at_last_step: x_s,
             stopper_motion: StopperMotion::at_rest(),
             stopper_acceleration: 0.0,
@@ -453,19 +462,28 @@ impl Simulation {
         }
     }
 
-    /// The stopper velocity the forces read at the last sample: at the sample, from the
-    /// last two steps' motions, where a force reads it ([`extra_force::velocity_at_sample`]).
+    /// The stopper velocity the forces read at the last sample: between the last step's
+    /// motion and the coming one once its rate is set, else at the sample from the last two
+    /// steps' motions, where a force reads it ([`extra_force::velocity_at_sample`]).
     /// The positions, linear between samples, are the motion: the velocity is carried to the
     /// sample with the acceleration they form, not with the input a_s, which a master may
     /// smooth over several samples and which would then switch a friction on before a ramp
     /// starts.
     pub(super) fn stopper_velocity_at_sample(&self) -> f64 {
         if self.plan.stopper_acceleration {
-            extra_force::velocity_at_sample(
-                self.stopper_velocity,
-                self.stopper_motion.interval,
-                self.stopper_acceleration,
-            )
+            match self.next_stopper_rate {
+                Some(next) => extra_force::velocity_between_intervals(
+                    self.stopper_velocity,
+                    self.stopper_acceleration * self.stopper_motion.interval,
+                    next,
+                    self.stopper_turned_before,
+                ),
+                None => extra_force::velocity_at_sample(
+                    self.stopper_velocity,
+                    self.stopper_motion.interval,
+                    self.stopper_acceleration,
+                ),
+            }
         } else {
             self.stopper_velocity
         }
@@ -512,9 +530,21 @@ impl Simulation {
         Ok(())
     }
 
+    /// Whether the stopper turns at this sample into a step at `rate`, remembered over the
+    /// step ([`Self::stopper_turned_before`]); called as the step starts.
+    pub(super) fn note_stopper_turn(&mut self, rate: f64) {
+        self.stopper_turned_before = self.plan.stopper_acceleration
+            && extra_force::turns_at_sample(
+                self.stopper_velocity,
+                self.stopper_acceleration * self.stopper_motion.interval,
+                rate,
+            );
+    }
+
     pub fn set_stopper_rate(&mut self, rate: f64) -> Result<(), String> {
         check_finite("der(x_s)", rate, "m/s")?;
         self.x_s_rate = rate;
+        self.next_stopper_rate = Some(rate);
         Ok(())
     }
 

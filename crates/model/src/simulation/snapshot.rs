@@ -43,6 +43,8 @@ pub struct SimulationSnapshot {
     plays: [f64; PLAY_OPERATORS],
     command_history: Vec<CommandChange>,
     stopper_velocity: f64,
+    next_stopper_rate: Option<f64>,
+    stopper_turned_before: bool,
     x_s_at_last_step: f64,
     stopper_motion: StopperMotion,
     stopper_acceleration: f64,
@@ -54,11 +56,11 @@ pub struct SimulationSnapshot {
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-pub const SNAPSHOT_LAYOUT: f64 = 8.0;
+pub const SNAPSHOT_LAYOUT: f64 = 9.0;
 
-/// Numbers before the two counted lists: the layout, 23 scalars, the state, the volumes'
+/// Numbers before the two counted lists: the layout, 26 scalars, the state, the volumes'
 /// pressures, the plays, the command stage ([`command_stage::VALUES`]) and the six work counters as two halves each.
-const FIXED_VALUES: usize = 1 + 23 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + 2 * STATISTICS;
+const FIXED_VALUES: usize = 1 + 26 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + 2 * STATISTICS;
 const STATISTICS: usize = 6;
 
 impl Simulation {
@@ -85,6 +87,8 @@ impl Simulation {
             plays: self.plays,
             command_history: self.command_history.clone(),
             stopper_velocity: self.stopper_velocity,
+            next_stopper_rate: self.next_stopper_rate,
+            stopper_turned_before: self.stopper_turned_before,
             x_s_at_last_step: self.x_s_at_last_step,
             stopper_motion: self.stopper_motion,
             stopper_acceleration: self.stopper_acceleration,
@@ -119,6 +123,8 @@ impl Simulation {
         sim.plays = s.plays;
         sim.command_history = s.command_history.clone();
         sim.stopper_velocity = s.stopper_velocity;
+        sim.next_stopper_rate = s.next_stopper_rate;
+        sim.stopper_turned_before = s.stopper_turned_before;
         sim.x_s_at_last_step = s.x_s_at_last_step;
         sim.stopper_motion = s.stopper_motion;
         sim.stopper_acceleration = s.stopper_acceleration;
@@ -184,6 +190,9 @@ impl SimulationSnapshot {
             self.stopper_acceleration,
             self.acceleration_input,
             self.acceleration_input_rate,
+            if self.next_stopper_rate.is_some() { 1.0 } else { 0.0 },
+            self.next_stopper_rate.unwrap_or(0.0),
+            if self.stopper_turned_before { 1.0 } else { 0.0 },
         ]);
         v.extend_from_slice(&self.state);
         v.extend_from_slice(&self.nodes);
@@ -230,9 +239,9 @@ impl SimulationSnapshot {
             at += n;
             slice
         };
-        let scalars = next(23);
-        let [time, v_da, x_s, v_da_rate, x_s_rate, relative_tolerance, method, chamber_method, next_step, max_step, first_step, chamber_next_step, chamber_max_step, chamber_first_step, input_changed, step_after_change, stopper_velocity, x_s_at_last_step, motion_velocity, motion_interval, stopper_acceleration, acceleration_input, acceleration_input_rate]: [f64; 23] =
-            scalars.try_into().expect("23 values");
+        let scalars = next(26);
+        let [time, v_da, x_s, v_da_rate, x_s_rate, relative_tolerance, method, chamber_method, next_step, max_step, first_step, chamber_next_step, chamber_max_step, chamber_first_step, input_changed, step_after_change, stopper_velocity, x_s_at_last_step, motion_velocity, motion_interval, stopper_acceleration, acceleration_input, acceleration_input_rate, next_rate_set, next_rate, turned_before]: [f64; 26] =
+            scalars.try_into().expect("26 values");
         let mut state = [0.0; N_STATES];
         state.copy_from_slice(next(N_STATES));
         let mut nodes = [0.0; node::STATES];
@@ -306,6 +315,7 @@ impl SimulationSnapshot {
             stopper_acceleration,
             acceleration_input,
             acceleration_input_rate,
+            next_rate,
         ];
         let finite = numbers.iter().chain(&state).chain(&nodes).chain(&stage).chain(sensor).all(|v| v.is_finite())
             && command_history.iter().all(|c| c.v_da.is_finite() && c.rate.is_finite())
@@ -362,6 +372,8 @@ impl SimulationSnapshot {
             plays,
             command_history,
             stopper_velocity,
+            next_stopper_rate: (whole_number(next_rate_set, 1, "next stopper rate flag")? == 1).then_some(next_rate),
+            stopper_turned_before: whole_number(turned_before, 1, "stopper turn flag")? == 1,
             x_s_at_last_step,
             stopper_motion: StopperMotion {
                 velocity: motion_velocity,
