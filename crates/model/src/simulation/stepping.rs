@@ -146,9 +146,6 @@ impl Simulation {
             )));
         }
         let x_s_end = self.x_s + self.x_s_rate * step;
-        // Inside the step the stopper moves at its rate; the rate is the past step's after it.
-        self.note_stopper_turn(self.x_s_rate);
-        self.next_stopper_rate = None;
         if self.x_s_rate != 0.0 {
             self.model.params.check_stopper(x_s_end).map_err(|e| {
                 StepFailure::InvalidRequest(format!(
@@ -157,6 +154,9 @@ impl Simulation {
                 ))
             })?;
         }
+        // Inside the step the stopper moves at its rate; the rate is the past step's after it.
+        self.note_stopper_turn(self.x_s_rate);
+        self.next_stopper_rate = None;
         let t_end = self.time + step;
         let segments = if self.plan.command_path {
             self.seen_command_segments(step)
