@@ -21,17 +21,26 @@ ROOT = Path(__file__).resolve().parent.parent
 BIN = ROOT / "target" / "release"
 
 
-def stopper_positions(x, smoothed):
-    """The report's `stopper_positions`: where `stopper_positions_smoothed` (1 kHz and faster),
-    x_s smoothed over samples k-3..k+3 with the weights (-2, 3, 6, 7, 6, 3, -2)/21, the
-    recorded positions at the first and last three samples; else x_s as recorded."""
+def stopper_positions(x, residual_limit):
+    """The report's `stopper_positions`: where it gives a
+    `stopper_positions_smoothing_residual_limit_m2` (1 kHz and faster), x_s smoothed over
+    samples k-3..k+3 with the weights (-2, 3, 6, 7, 6, 3, -2)/21 at each sample whose seven
+    positions leave at most that sum of squares about their least-squares quadratic, the
+    recorded positions elsewhere and at the first and last three samples; else (None) x_s as
+    recorded."""
     x = np.asarray(x, dtype=float)
-    if not smoothed:
+    if residual_limit is None:
         return x.copy()
     weights = np.array([-2.0, 3.0, 6.0, 7.0, 6.0, 3.0, -2.0]) / 21.0
+    i = np.arange(-3.0, 4.0)
+    basis = np.vstack([np.ones(7), i, i * i]).T
     out = x.copy()
     for k in range(3, len(x) - 3):
-        out[k] = x[k] + np.sum(weights * (x[k - 3:k + 4] - x[k]))
+        d = x[k - 3:k + 4] - x[k]
+        _, residual, _, _ = np.linalg.lstsq(basis, d, rcond=None)
+        if residual.size and residual[0] > residual_limit:
+            continue
+        out[k] = x[k] + np.sum(weights * d)
     return out
 
 
@@ -47,14 +56,14 @@ def stopper_accelerations(t, x, half_width):
     return a
 
 
-def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, smoothed, outputs=("F_meas",),
+def replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, smoothing, outputs=("F_meas",),
                        acceleration=None):
     """The FMU's `outputs` at every sample of the recording (one array, or a tuple of them),
-    the stopper driven with the positions the diagnosis replays (`smoothed`: the report's
-    `stopper_positions_smoothed`) and, where the report's `stopper_acceleration_input`
+    the stopper driven with the positions the diagnosis replays (`smoothing`: the report's
+    `stopper_positions_smoothing_residual_limit_m2`) and, where the report's `stopper_acceleration_input`
     (`acceleration`) says so, its acceleration fed to the input a_s."""
     fmu = make_slave(unzipdir, model_description)
-    t, v, x = recording["time_s"], recording["v_da_V"], stopper_positions(recording["x_s_m"], smoothed)
+    t, v, x = recording["time_s"], recording["v_da_V"], stopper_positions(recording["x_s_m"], smoothing)
     a = None if acceleration is None else stopper_accelerations(t, x, acceleration["half_width_s"])
     try:
         # The report's start values are Reals but for start_at_equilibrium, a Boolean (false
@@ -105,7 +114,7 @@ def generated_and_diagnosed(tmp_path, name, *benchgen_args):
 def force_errors_through_fmu(unzipdir, model_description, vrs, recording, report, name):
     """The force's RMS error with the report's start values through the FMU, the one the
     report gives after, and the one before."""
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothing_residual_limit_m2"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported, before = report["after"]["force_rms_N"], report["before"]["force_rms_N"]
     print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; before {before:.4f} N")
@@ -116,7 +125,7 @@ def force_errors_through_fmu(unzipdir, model_description, vrs, recording, report
 def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description, vrs, tmp_path):
     recording, report = generated_and_diagnosed(tmp_path, "friction", "--seed", "31", "--friction-coulomb", "2.5")
     assert [e["name"] for e in report["effects"]][:1] == ["piston_friction"], report["effects"]
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothing_residual_limit_m2"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
@@ -156,7 +165,7 @@ def test_fmu_start_values_of_a_bouc_wen_hysteresis_reproduce_the_after_error(
     start_values = report["fmu_start_values"]
     assert start_values.get("hysteresis_exponent", 0) > 0, start_values
     assert start_values.get("hysteresis_start", 0) < -0.5, start_values
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothing_residual_limit_m2"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"after error: reported {reported:.5f} N, FMU replay {rms:.5f} N; before {report['before']['force_rms_N']:.4f} N")
@@ -176,7 +185,7 @@ def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors
     assert report["effects"] == [], report["effects"]
     assert parameter in report["discovered"][0]["parameters"], report["discovered"]
     assert report["discovered"][0]["location"] == "pressure_sensors", report["discovered"]
-    p1, p2 = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"],
+    p1, p2 = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothing_residual_limit_m2"],
                                 outputs=("P1_meas", "P2_meas"), acceleration=report.get("stopper_acceleration_input"))
     through_fmu = [float(np.sqrt(np.mean((recording[c] - p) ** 2))) for c, p in (("p1_Pa", p1), ("p2_Pa", p2))]
     reported = report["after"]["pressure_rms_Pa"]
@@ -204,7 +213,7 @@ def test_fmu_start_values_of_an_extra_force_on_the_piston_reproduce_the_after_er
     # A force on the stopper's motion reads the acceleration the report says how to form.
     assert report["fmu_start_values"]["stopper_acceleration_input_share"] == 1.0
     assert report["stopper_acceleration_input"]["half_width_s"] > 0
-    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothed"], acceleration=report.get("stopper_acceleration_input"))
+    force = replay_through_fmu(unzipdir, model_description, vrs, recording, report["fmu_start_values"], report["stopper_positions_smoothing_residual_limit_m2"], acceleration=report.get("stopper_acceleration_input"))
     rms = float(np.sqrt(np.mean((recording["force_N"] - force) ** 2)))
     reported = report["after"]["force_rms_N"]
     print(f"{name}: after error reported {reported:.5f} N, FMU replay {rms:.5f} N; "
@@ -228,7 +237,7 @@ def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
     start_values = report["fmu_start_values"]
     assert start_values.get(f"{prefix}_knots", 0) >= 3, start_values
     assert report["discovered"][0]["family"] == "limit", report["discovered"]
-    read = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothed"], outputs=outputs, acceleration=report.get("stopper_acceleration_input"))
+    read = replay_through_fmu(unzipdir, model_description, vrs, recording, start_values, report["stopper_positions_smoothing_residual_limit_m2"], outputs=outputs, acceleration=report.get("stopper_acceleration_input"))
     if outputs == ("F_meas",):
         rms = float(np.sqrt(np.mean((recording["force_N"] - read) ** 2)))
         reported = report["after"]["force_rms_N"]

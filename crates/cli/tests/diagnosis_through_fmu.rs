@@ -20,13 +20,15 @@ use synthetic_bench::{
     generate_protocol_with, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,
 };
 
-/// The report's `stopper_positions`: where `stopper_positions_smoothed`, x_s smoothed over
-/// samples k-3..k+3 with the weights (-2, 3, 6, 7, 6, 3, -2)/21, the recorded positions at
-/// the first and last three samples; else x_s as recorded.
-fn stopper_positions(x: &[f64], smoothed: bool) -> Vec<f64> {
-    if !smoothed {
+/// The report's `stopper_positions`: where it gives a
+/// `stopper_positions_smoothing_residual_limit_m2`, x_s smoothed over samples k-3..k+3 with
+/// the weights (-2, 3, 6, 7, 6, 3, -2)/21 at each sample whose seven positions leave at most
+/// that sum of squares about their least-squares quadratic (by the normal equations), the
+/// recorded positions elsewhere and at the first and last three samples; else x_s as recorded.
+fn stopper_positions(x: &[f64], residual_limit: Option<f64>) -> Vec<f64> {
+    let Some(limit) = residual_limit else {
         return x.to_vec();
-    }
+    };
     let n = x.len();
     let weights = [-2.0, 3.0, 6.0, 7.0, 6.0, 3.0, -2.0];
     (0..n)
@@ -34,16 +36,53 @@ fn stopper_positions(x: &[f64], smoothed: bool) -> Vec<f64> {
             if k < 3 || k + 3 >= n {
                 return x[k];
             }
-            x[k] + (0..7).map(|j| weights[j] / 21.0 * (x[k + j - 3] - x[k])).sum::<f64>()
+            let d: Vec<f64> = (0..7).map(|j| x[k + j - 3] - x[k]).collect();
+            if quadratic_fit_residual(&d) > limit {
+                return x[k];
+            }
+            x[k] + (0..7).map(|j| weights[j] / 21.0 * d[j]).sum::<f64>()
         })
         .collect()
 }
 
+/// The sum of squares seven values at i = -3..=3 leave about their least-squares quadratic
+/// a + b i + c i², solved from the normal equations by Cramer's rule.
+fn quadratic_fit_residual(d: &[f64]) -> f64 {
+    let moment = |p: i32| (-3..=3).map(|i: i32| f64::from(i).powi(p)).sum::<f64>();
+    let projection = |p: i32| (-3..=3).zip(d).map(|(i, y)| f64::from(i).powi(p) * y).sum::<f64>();
+    let m = [
+        [moment(0), moment(1), moment(2)],
+        [moment(1), moment(2), moment(3)],
+        [moment(2), moment(3), moment(4)],
+    ];
+    let r = [projection(0), projection(1), projection(2)];
+    let det = |a: [[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let whole = det(m);
+    let coefficient = |c: usize| {
+        let mut a = m;
+        for (row, value) in a.iter_mut().zip(r) {
+            row[c] = value;
+        }
+        det(a) / whole
+    };
+    let (a, b, c) = (coefficient(0), coefficient(1), coefficient(2));
+    (-3..=3)
+        .zip(d)
+        .map(|(i, y)| {
+            let i = f64::from(i);
+            (y - a - b * i - c * i * i).powi(2)
+        })
+        .sum()
+}
+
 /// F_meas at every sample of `recording` from the FMU with `start_values` set, the stopper
 /// driven with the positions the diagnosis replayed.
-fn replayed_force(recording: &Recording, start_values: &[(u32, f64)], smoothed: bool) -> Vec<f64> {
+fn replayed_force(recording: &Recording, start_values: &[(u32, f64)], smoothing: Option<f64>) -> Vec<f64> {
     let (t, v) = (&recording.time, &recording.v_da);
-    let x = stopper_positions(&recording.x_s, smoothed);
+    let x = stopper_positions(&recording.x_s, smoothing);
     let sink = Sink::default();
     let mut force = Vec::with_capacity(t.len());
     unsafe {
@@ -136,8 +175,8 @@ fn the_fmu_with_the_start_values_of_a_drifting_gas_temperature_reproduces_the_re
         "no T_drift among {:?}",
         report["fmu_start_values"]
     );
-    let smoothed = report["stopper_positions_smoothed"].as_bool().unwrap();
-    let force = replayed_force(&recording, &start_values, smoothed);
+    let smoothing = report["stopper_positions_smoothing_residual_limit_m2"].as_f64();
+    let force = replayed_force(&recording, &start_values, smoothing);
     let n = force.len() as f64;
     let rms = (force
         .iter()

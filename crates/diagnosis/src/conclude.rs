@@ -165,7 +165,7 @@ pub(crate) fn conclude(
         fast_replay,
         fast_replay_final,
         start_pressures: replay::start_pressures(&final_model, full),
-        stopper_smoothed: recording::stopper_smoothing_applies(&full.time),
+        stopper_smoothing: cx.stopper_smoothing,
         acceleration_window: if final_model.params.stopper_acceleration_input_share > 0.0 {
             full.acceleration_window
         } else {

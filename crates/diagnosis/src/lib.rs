@@ -392,9 +392,10 @@ pub struct Diagnosis {
     /// The chamber pressures the final model's replay started from, where the recording has
     /// pressure channels ([`replay::start_pressures`]); at the equilibrium otherwise.
     pub start_pressures: Option<[f64; 2]>,
-    /// Whether the replays drove the stopper with the smoothed positions
-    /// ([`recording::Recording::with_stopper_smoothed`]) or the recorded ones.
-    pub stopper_smoothed: bool,
+    /// Where the replays drove the stopper with the smoothed positions
+    /// ([`recording::Recording::with_stopper_smoothed`]), the smoothing's residual limit, m²;
+    /// `None` where they drove it with the recorded ones.
+    pub stopper_smoothing: Option<f64>,
     /// The half-width (s) of the stopper acceleration the final model reads as its input a_s
     /// ([`acceleration`]); 0 where it reads none (no force on the stopper's motion).
     pub acceleration_window: f64,
@@ -557,6 +558,9 @@ struct Context<'a> {
     mechanical_noise: f64,
     /// The piston's area, m², once known ([`Self::with_piston_area`]; 0 before).
     piston_area: f64,
+    /// Where the replays drive the stopper with smoothed positions, the residual limit of
+    /// the smoothing ([`recording::smoothed_stopper_positions`]), m².
+    stopper_smoothing: Option<f64>,
 }
 
 impl<'a> Context<'a> {
@@ -640,6 +644,7 @@ impl<'a> Context<'a> {
             channel_noise,
             mechanical_noise: noise,
             piston_area: 0.0,
+            stopper_smoothing: None,
         })
     }
 
@@ -744,7 +749,9 @@ fn diagnose_unguarded(
     }
     smoothed.acceleration_window =
         acceleration::choose_window(&smoothed, &signals::difference(&smoothed.force, &before_accurate.force));
-    let fitted = smoothed.rows_for_fits(recording::MAX_FIT_ROWS);
+    let departures = before_departures(&smoothed, &before_accurate);
+    let departures: Vec<&[f64]> = departures.iter().map(Vec::as_slice).collect();
+    let fitted = smoothed.rows_for_fits_where_departing(recording::MAX_FIT_ROWS, &departures);
     let cx = Context::measure(&smoothed, &fitted, &before_model, options, &mut input_checks, progress)?;
     let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
     input_checks.extend(checks::check_against_model(
@@ -763,6 +770,7 @@ fn diagnose_unguarded(
     // (a model without such a force reads none: the share goes back to 0 at the end).
     params.stopper_acceleration_input_share = 1.0;
     let mut cx = cx.with_piston_area(before_model.piston_area);
+    cx.stopper_smoothing = recording.stopper_smoothing();
     // 3–5. Replay, localize, add what earns its place; then refit the additions together.
     let mut replays = 1;
     let found = rounds::run_rounds(&mut cx, params, &mut replays, progress)?;
@@ -778,6 +786,16 @@ fn diagnose_unguarded(
         replays,
         progress,
     )
+}
+
+/// The starting model's error on each measured channel at every sample.
+fn before_departures(recording: &Recording, before: &Replay) -> Vec<Vec<f64>> {
+    let mut departures = vec![signals::difference(&recording.force, &before.force)];
+    if let (Some(p1), Some(p2)) = (&recording.p1, &recording.p2) {
+        departures.push(signals::difference(p1, &before.p1));
+        departures.push(signals::difference(p2, &before.p2));
+    }
+    departures
 }
 
 /// Re-identify what the thesis identified from static loops (§3.3.1).

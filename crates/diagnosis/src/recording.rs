@@ -45,6 +45,41 @@ pub const FIT_STRETCH_SECONDS: f64 = 2.0 * crate::BLOCK_SECONDS;
 const REQUIRED: [&str; 4] = ["time_s", "v_da_V", "x_s_m", "force_N"];
 const OPTIONAL: [&str; 2] = ["p1_Pa", "p2_Pa"];
 
+/// How much more a stretch's mean-square departure, over the median stretch's, must be
+/// than that of the kept stretch it replaces ([`Recording::rows_for_fits_where_departing`]):
+/// four, twice the RMS.
+pub const DEPARTING_STRETCH_RATIO: f64 = 4.0;
+
+/// Each stretch's mean-square departure over the median stretch's, the largest over the
+/// channels; 1 everywhere without departures.
+fn departing_scores(stretch_of: &[usize], stretches: usize, departures: &[&[f64]]) -> Vec<f64> {
+    let mut score = vec![1.0_f64; stretches];
+    for departure in departures.iter().filter(|d| d.len() == stretch_of.len()) {
+        let mut sum = vec![0.0; stretches];
+        let mut count = vec![0usize; stretches];
+        for (&j, &d) in stretch_of.iter().zip(departure.iter()) {
+            if d.is_finite() {
+                sum[j] += d * d;
+                count[j] += 1;
+            }
+        }
+        let mean: Vec<f64> = sum
+            .iter()
+            .zip(&count)
+            .map(|(s, &c)| if c > 0 { s / c as f64 } else { 0.0 })
+            .collect();
+        let mut sorted = mean.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted[sorted.len() / 2];
+        if median > 0.0 {
+            for (s, m) in score.iter_mut().zip(&mean) {
+                *s = s.max(m / median);
+            }
+        }
+    }
+    score
+}
+
 /// The weights of the stopper smoothing at samples k − 3 ..= k + 3
 /// ([`Recording::with_stopper_smoothed`]): the least-squares quadratic through seven
 /// samples, read at its centre. They sum to one.
@@ -68,8 +103,41 @@ pub fn stopper_smoothing_applies(time: &[f64]) -> bool {
     time.len() > 1 && 1.0 / crate::signals::sample_rate(time) <= STOPPER_SMOOTHING_LONGEST_INTERVAL
 }
 
-/// [`Recording::with_stopper_smoothed`]'s positions.
-pub fn smoothed_stopper_positions(x: &[f64]) -> Vec<f64> {
+/// The largest sum of squares (m²) the least-squares quadratic through seven stopper
+/// positions may leave for the centre one to be smoothed ([`smoothed_stopper_positions`]):
+/// three times what rounding leaves on average (four degrees of freedom of σ² each, σ² =
+/// q²/12 for a quantisation step q), so q²; or, where the positions are not quantised,
+/// twelve times the square of their noise floor. The smoothing undoes the rounding's jitter
+/// in the velocity of a slow motion; a window holding a turn sharper than a quadratic (a
+/// triangle's reversal between two samples) leaves far more, and there the recorded
+/// positions are kept: at 2 kHz, with 7 µm a sample, the filter rounded such reversals and
+/// left 4.9 force noise floors where the recorded positions left 2.9.
+pub fn stopper_smoothing_residual_limit(x: &[f64]) -> f64 {
+    match crate::noise::quantisation_step(x) {
+        Some(step) => step * step,
+        None => 12.0 * crate::noise::noise_floor(x).powi(2),
+    }
+}
+
+/// The sum of squares the least-squares quadratic through the seven `deviations` (of the
+/// positions at k − 3 ..= k + 3 from the one at k) leaves: the orthogonal polynomials 1, i
+/// and i² − 4 on i = −3 ..= 3 have squared norms 7, 28 and 84.
+fn quadratic_residual(deviations: &[f64]) -> f64 {
+    let (mut sum, mut first, mut second, mut squares) = (0.0, 0.0, 0.0, 0.0);
+    for (j, d) in deviations.iter().enumerate() {
+        let i = j as f64 - 3.0;
+        sum += d;
+        first += i * d;
+        second += (i * i - 4.0) * d;
+        squares += d * d;
+    }
+    (squares - sum * sum / 7.0 - first * first / 28.0 - second * second / 84.0).max(0.0)
+}
+
+/// [`Recording::with_stopper_smoothed`]'s positions: the filter's value where the seven
+/// samples around leave at most `residual_limit` about their quadratic, the recorded
+/// position elsewhere.
+pub fn smoothed_stopper_positions(x: &[f64], residual_limit: f64) -> Vec<f64> {
     let n = x.len();
     (0..n)
         .map(|k| {
@@ -77,10 +145,14 @@ pub fn smoothed_stopper_positions(x: &[f64]) -> Vec<f64> {
                 return x[k];
             }
             // Deviations from x_k: a still stopper keeps its position to the bit.
+            let deviations: Vec<f64> = x[k - 3..=k + 3].iter().map(|&xi| xi - x[k]).collect();
+            if quadratic_residual(&deviations) > residual_limit {
+                return x[k];
+            }
             let deviation: f64 = STOPPER_SMOOTHING_WEIGHTS
                 .iter()
-                .zip(&x[k - 3..=k + 3])
-                .map(|(w, &xi)| w * (xi - x[k]))
+                .zip(&deviations)
+                .map(|(w, d)| w * d)
                 .sum();
             x[k] + deviation
         })
@@ -127,13 +199,19 @@ impl Recording {
     /// driven with them (`fmu_tests/test_diagnose_fmu.py` does the same filtering, as the
     /// report's `stopper_positions_smoothed` says).
     pub fn with_stopper_smoothed(&self) -> Recording {
-        if !stopper_smoothing_applies(&self.time) {
-            return self.clone();
+        match self.stopper_smoothing() {
+            None => self.clone(),
+            Some(limit) => Recording {
+                x_s: smoothed_stopper_positions(&self.x_s, limit),
+                ..self.clone()
+            },
         }
-        Recording {
-            x_s: smoothed_stopper_positions(&self.x_s),
-            ..self.clone()
-        }
+    }
+
+    /// Where [`Self::with_stopper_smoothed`] smooths the stopper positions, its residual
+    /// limit ([`stopper_smoothing_residual_limit`]), m².
+    pub fn stopper_smoothing(&self) -> Option<f64> {
+        stopper_smoothing_applies(&self.time).then(|| stopper_smoothing_residual_limit(&self.x_s))
     }
 
     /// The rows the fits work on: the whole recording when it has at most `max_rows` samples;
@@ -148,17 +226,51 @@ impl Recording {
     /// as they are. The thinned recording carries the full-rate inputs: its replays integrate
     /// every sample and keep the outputs at its rows.
     pub fn rows_for_fits(&self, max_rows: usize) -> Recording {
+        self.rows_for_fits_where_departing(max_rows, &[])
+    }
+
+    /// [`Self::rows_for_fits`], with the stretches where the starting model departs most
+    /// kept in place of the evenly spread ones where it departs least. `departures` holds one
+    /// series per measured channel, the starting model's error at every sample. A departure
+    /// confined to a few seconds (a command saturating only in one segment) would otherwise
+    /// be left out of every fit: a stretch left out whose mean square, over the median
+    /// stretch's of its channel, exceeds [`DEPARTING_STRETCH_RATIO`] and that of the kept
+    /// stretch departing least by as much, takes that stretch's place. The count of stretches
+    /// stays, and so the rows; where the departure is spread evenly nothing moves.
+    pub fn rows_for_fits_where_departing(&self, max_rows: usize, departures: &[&[f64]]) -> Recording {
         let n = self.len();
         if n <= max_rows || n < 2 {
             return self.clone();
         }
         // In whole numbers, f = max_rows / n: no rounding decides a stretch.
         let at = |j: usize| (j * max_rows + n - max_rows) / n;
-        let kept = |j: usize| at(j + 1) > at(j);
         let t0 = self.time[0];
-        let rows: Vec<usize> = (0..n)
-            .filter(|&k| kept(((self.time[k] - t0) / FIT_STRETCH_SECONDS).floor() as usize))
+        let stretch_of: Vec<usize> = self
+            .time
+            .iter()
+            .map(|t| ((t - t0) / FIT_STRETCH_SECONDS).floor() as usize)
             .collect();
+        let stretches = stretch_of[n - 1] + 1;
+        let mut kept: Vec<bool> = (0..stretches).map(|j| at(j + 1) > at(j)).collect();
+        let score = departing_scores(&stretch_of, stretches, departures);
+        loop {
+            let outside = (0..stretches)
+                .filter(|&j| !kept[j])
+                .max_by(|&a, &b| score[a].total_cmp(&score[b]));
+            let inside = (0..stretches)
+                .filter(|&j| kept[j])
+                .min_by(|&a, &b| score[a].total_cmp(&score[b]));
+            match (outside, inside) {
+                (Some(o), Some(i))
+                    if score[o] > DEPARTING_STRETCH_RATIO && score[o] > DEPARTING_STRETCH_RATIO * score[i].max(1.0) =>
+                {
+                    kept[o] = true;
+                    kept[i] = false;
+                }
+                _ => break,
+            }
+        }
+        let rows: Vec<usize> = (0..n).filter(|&k| kept[stretch_of[k]]).collect();
         let pick = |x: &[f64]| -> Vec<f64> { rows.iter().map(|&k| x[k]).collect() };
         Recording {
             time: pick(&self.time),
@@ -346,28 +458,33 @@ mod tests {
     const GOOD: &str =
         "time_s,v_da_V,x_s_m,force_N,p1_Pa,p2_Pa\n0.000,1.0,0.054,10.0,3e5,2e5\n0.001,1.1,0.054,10.1,3e5,2e5\n";
 
+    fn stopper_recording(time: Vec<f64>, x_s: Vec<f64>) -> Recording {
+        let n = time.len();
+        Recording {
+            time,
+            v_da: vec![1.0; n],
+            x_s,
+            force: vec![10.0; n],
+            p1: None,
+            p2: None,
+            full_rate: None,
+            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            acceleration_window: 0.0,
+        }
+    }
+
+    /// Positions logged to 1 µm.
+    fn logged(x: f64) -> f64 {
+        (x * 1e6).round() * 1e-6
+    }
+
     #[test]
     fn the_stopper_is_smoothed_at_one_kilohertz_and_faster_and_driven_as_recorded_below() {
-        // A triangle's corner at 40 mm/s, logged to 1 µm.
+        // A ramp at 0.7 mm/s, logged to 1 µm.
         let recording_at = |rate: f64| -> Recording {
-            let time: Vec<f64> = (0..200).map(|k| k as f64 / rate).collect();
-            let corner = 100.0 / rate;
-            let x_s: Vec<f64> = time
-                .iter()
-                .map(|&t| (1e6 * (0.05 + 0.04 * (corner - (t - corner).abs()))).round() * 1e-6)
-                .collect();
-            let n = time.len();
-            Recording {
-                time,
-                v_da: vec![1.0; n],
-                x_s,
-                force: vec![10.0; n],
-                p1: None,
-                p2: None,
-                full_rate: None,
-                fast_replay_step: crate::replay::MAX_FAST_STEP,
-                acceleration_window: 0.0,
-            }
+            let time: Vec<f64> = (0..2000).map(|k| k as f64 / rate).collect();
+            let x_s = time.iter().map(|&t| logged(0.05 + 0.7e-3 * t)).collect();
+            stopper_recording(time, x_s)
         };
         for rate in [250.0, 500.0] {
             let recording = recording_at(rate);
@@ -377,9 +494,11 @@ mod tests {
         for rate in [1000.0, 4000.0] {
             let recording = recording_at(rate);
             assert!(stopper_smoothing_applies(&recording.time), "{rate} Hz");
+            let limit = stopper_smoothing_residual_limit(&recording.x_s);
+            assert!((limit - 1e-12).abs() < 1e-15, "{limit} m² for a 1 µm step");
             assert_eq!(
                 recording.with_stopper_smoothed().x_s,
-                smoothed_stopper_positions(&recording.x_s),
+                smoothed_stopper_positions(&recording.x_s, limit),
                 "{rate} Hz"
             );
             assert_ne!(recording.with_stopper_smoothed().x_s, recording.x_s, "{rate} Hz");
@@ -387,24 +506,53 @@ mod tests {
     }
 
     #[test]
+    fn a_triangle_reversing_between_two_samples_keeps_its_recorded_corner_and_has_the_rounding_of_its_sides_averaged() {
+        // 14.6 mm/s at 2 kHz (7.3 µm a sample), turning at 50.1 ms, logged to 1 µm.
+        let rate = 2000.0;
+        let line = |t: f64| 0.05 + 14.6e-3 * (0.0501 - (t - 0.0501).abs());
+        let time: Vec<f64> = (0..200).map(|k| k as f64 / rate).collect();
+        let x_s: Vec<f64> = time.iter().map(|&t| logged(line(t))).collect();
+        let recording = stopper_recording(time.clone(), x_s.clone());
+        let smoothed = recording.with_stopper_smoothed().x_s;
+        // The seven windows holding the turn keep the recorded positions.
+        for k in 98..=103 {
+            assert_eq!(smoothed[k], x_s[k], "sample {k} beside the turn");
+        }
+        // Along the sides, the filter brings the positions nearer the true motion.
+        let rms = |x: &[f64]| {
+            let sides: Vec<usize> = (3..197).filter(|k| !(94..=106).contains(k)).collect();
+            (sides.iter().map(|&k| (x[k] - line(time[k])).powi(2)).sum::<f64>() / sides.len() as f64).sqrt()
+        };
+        assert!(
+            rms(&smoothed) < 0.6 * rms(&x_s),
+            "{} against {} m",
+            rms(&smoothed),
+            rms(&x_s)
+        );
+        // Unfiltered, the turn would be rounded by more than the rounding: 2.4 µm at it.
+        let rounded = smoothed_stopper_positions(&x_s, f64::INFINITY);
+        assert!((rounded[100] - x_s[100]).abs() > 2e-6, "{} m", rounded[100] - x_s[100]);
+    }
+
+    #[test]
     fn the_stopper_smoothing_keeps_a_still_stopper_to_the_bit_and_a_quadratic_motion_exactly() {
         let still = vec![0.0537; 20];
-        assert_eq!(smoothed_stopper_positions(&still), still);
+        assert_eq!(smoothed_stopper_positions(&still, 1e-12), still);
         let quadratic: Vec<f64> = (0..40)
             .map(|k| 0.05 + 1e-4 * k as f64 - 2e-6 * (k * k) as f64)
             .collect();
-        for (s, x) in smoothed_stopper_positions(&quadratic).iter().zip(&quadratic) {
+        for (s, x) in smoothed_stopper_positions(&quadratic, 1e-12).iter().zip(&quadratic) {
             assert!((s - x).abs() < 1e-15, "{s} against {x}");
         }
         assert!((STOPPER_SMOOTHING_WEIGHTS.iter().sum::<f64>() - 1.0).abs() < 1e-15);
     }
 
     #[test]
-    fn a_fast_shake_sampled_slowly_keeps_its_amplitude_through_the_stopper_smoothing() {
+    fn a_fast_shake_sampled_slowly_keeps_its_amplitude_through_the_stopper_filter() {
         // 2.5 Hz, 10 mm, at 250 Hz: a plain mean of seven samples shrinks it by 79 µm.
         let sine = |k: usize| 0.054 + 0.01 * (2.0 * std::f64::consts::PI * 2.5 * k as f64 / 250.0).sin();
         let x: Vec<f64> = (0..1000).map(sine).collect();
-        let smoothed = smoothed_stopper_positions(&x);
+        let smoothed = smoothed_stopper_positions(&x, f64::INFINITY);
         let worst = (0..1000).map(|k| (smoothed[k] - sine(k)).abs()).fold(0.0, f64::max);
         assert!(worst < 0.1e-6, "{worst} m from the sine");
     }
@@ -412,10 +560,8 @@ mod tests {
     #[test]
     fn the_stopper_smoothing_averages_the_rounding_of_a_slow_ramp() {
         // 0.3 mm/s at 1 kHz rounded to 1 µm: the raw slopes are 0 or 1 mm/s.
-        let x: Vec<f64> = (0..2000)
-            .map(|k| ((0.054 + 0.3e-3 * k as f64 * 1e-3) * 1e6).round() * 1e-6)
-            .collect();
-        let smoothed = smoothed_stopper_positions(&x);
+        let x: Vec<f64> = (0..2000).map(|k| logged(0.054 + 0.3e-3 * k as f64 * 1e-3)).collect();
+        let smoothed = smoothed_stopper_positions(&x, stopper_smoothing_residual_limit(&x));
         for k in 3..1996 {
             let slope = (smoothed[k + 1] - smoothed[k]) / 1e-3;
             assert!((slope - 0.3e-3).abs() < 0.2e-3, "slope {slope} m/s at sample {k}");

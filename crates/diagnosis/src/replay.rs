@@ -483,6 +483,36 @@ mod tests {
     }
 
     #[test]
+    fn a_departure_confined_to_a_stretch_left_out_takes_the_place_of_a_kept_stretch_at_the_noise() {
+        // 24 s: stretches 0, 2 and 4 kept by the even spread. The starting model departs
+        // three times its noise in stretch 3 (12-16 s) alone, on the second channel.
+        let recording = protocol_of(24_000);
+        let noise: Vec<f64> = (0..24_000).map(|k| if k % 2 == 0 { 0.05 } else { -0.05 }).collect();
+        let departing: Vec<f64> = recording
+            .time
+            .iter()
+            .zip(&noise)
+            .map(|(t, e)| if (12.0..16.0).contains(t) { 3.0 * e } else { *e })
+            .collect();
+        let stretches = |r: &Recording| -> Vec<usize> {
+            let set: std::collections::BTreeSet<usize> = r.time.iter().map(|t| (t / 4.0).floor() as usize).collect();
+            set.into_iter().collect()
+        };
+        let thinned = recording.rows_for_fits_where_departing(12_000, &[&noise, &departing]);
+        assert_eq!(thinned.len(), 12_000);
+        assert!(stretches(&thinned).contains(&3), "{:?}", stretches(&thinned));
+        assert_eq!(stretches(&thinned).len(), 3);
+        // Twice the noise's RMS is not enough to move a stretch, nor is a departure spread
+        // over the whole recording.
+        let slightly: Vec<f64> = departing.iter().zip(&noise).map(|(d, e)| e + 0.4 * (d - e)).collect();
+        let spread: Vec<f64> = noise.iter().map(|e| 3.0 * e).collect();
+        for departures in [[&noise[..], &slightly[..]], [&noise[..], &spread[..]]] {
+            let thinned = recording.rows_for_fits_where_departing(12_000, &departures);
+            assert_eq!(stretches(&thinned), vec![0, 2, 4]);
+        }
+    }
+
+    #[test]
     fn with_the_acceleration_input_both_replays_give_a_moving_mass_the_smoothed_acceleration() {
         // A 0.2 kg moving mass reading the input: each replay's force departs from the plain
         // model's by -0.2 times the smoothed acceleration at every sample, the pressures not
