@@ -102,6 +102,13 @@ pub(crate) struct Added<'a> {
     /// do better by a penalty) or a discovered term (one with as many must do strictly
     /// better).
     pub named: bool,
+    /// The named effect's shape was measured apart from the model: a force sensor's offset
+    /// and gain against the force the pressures make, where a cubic did no better than the
+    /// affine map. A richer term at its place then gains only by taking a sliver of a
+    /// departure elsewhere (a force sensor curve took 37 % of the way to the noise beside a
+    /// torque-motor gain stepping with P1 − P2, and displaced the true offset and gain), so
+    /// none is tried.
+    pub measured_shape: bool,
 }
 
 /// The simplest other term at the place of what was added that, replayed, leaves a
@@ -133,7 +140,7 @@ pub(crate) fn alternative_at_place(
         .filter(|s| s.fit.candidate.location == place && s.fit.candidate.named.is_none())
         .filter(|s| s.fit.candidate.label != scored.fit.candidate.label)
         .filter(|s| s.explained >= LOCATED_SHARE && used_terms(s) > 0.0)
-        .filter(|s| used_terms(s) <= added_terms || added.named)
+        .filter(|s| used_terms(s) <= added_terms || (added.named && !added.measured_shape))
         // A modulation can take any shape: it is no simpler form of a written term, and it
         // replaces only another modulation.
         .filter(|s| {
