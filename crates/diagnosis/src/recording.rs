@@ -236,7 +236,8 @@ impl Recording {
     /// be left out of every fit: a stretch left out whose mean square, over the median
     /// stretch's of its channel, exceeds [`DEPARTING_STRETCH_RATIO`] and that of the kept
     /// stretch departing least by as much, takes that stretch's place. The count of stretches
-    /// stays, and so the rows; where the departure is spread evenly nothing moves.
+    /// stays, and so the rows but for a shorter last stretch moving in or out; where the
+    /// departure is spread evenly nothing moves.
     pub fn rows_for_fits_where_departing(&self, max_rows: usize, departures: &[&[f64]]) -> Recording {
         let n = self.len();
         if n <= max_rows || n < 2 {
