@@ -38,6 +38,7 @@ mod localize;
 pub mod modulation;
 mod named;
 mod named_instead;
+mod named_rivals;
 pub mod noise;
 mod oscillation;
 mod pairs;
@@ -324,6 +325,13 @@ pub struct AddedEffect {
     /// Share of the held-out force mean square it removes.
     pub share: f64,
     pub remainder_follows: String,
+    /// Other named effects at its place that explained nearly as much when it was named
+    /// (name, share of the held-out misfit), tried in its place once every round is done
+    /// (`named_rivals.rs`).
+    pub rivals: Vec<(&'static str, f64)>,
+    /// The named effects this recording cannot tell it from, its own name first; empty when
+    /// it tells them apart.
+    pub tied_effects: Vec<&'static str>,
 }
 
 /// A term outside the named effects that was added (see `discover.rs`).

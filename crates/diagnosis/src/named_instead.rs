@@ -85,94 +85,40 @@ fn named_in_place_of(
     if named.is_empty() {
         return Ok(None);
     }
-    let (recording, n) = (cx.recording, cx.n);
     let mut without = f.params.clone();
     for (name, _) in &term.parameters {
         set_parameter(&mut without, name, parameter_value(&f.start, name))?;
     }
-    let model = Actuator::new(without.clone())?;
-    let current = replay_fast(&model, recording, n)?;
-    *replays += 1;
-    let problem = Problem::new(recording, &without, &cx.blocks, cx.channel_noise);
-    problem.set_jobs(cx.options.jobs);
     let count = heldout_count(&cx.blocks) as f64;
     let penalty = discovery_penalty_per_term(count);
-    let (term_misfit, term_force) = alternatives::judge(cx, &problem, &f.params, replays)?;
+    let (term_misfit, term_force) = alternatives::judge(
+        cx,
+        &Problem::new(cx.recording, &without, &cx.blocks, cx.channel_noise),
+        &f.params,
+        replays,
+    )?;
     let term_terms = term
         .parameters
         .iter()
         .filter(|(name, value)| *value != parameter_value(&f.start, name))
         .count() as f64;
     let term_score = term_misfit + term_terms * penalty;
-    let others: Vec<&'static str> = f
-        .effects
-        .iter()
-        .flat_map(|e| e.parameters.iter())
-        .chain(
-            f.discovered
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != k)
-                .flat_map(|(_, d)| d.parameters.iter()),
-        )
-        .map(|(name, _)| *name)
-        .filter(|name| parameter_value(&without, name) != 0.0 && refittable(name))
-        .collect();
-    let sensitivity = |name: &'static str| {
-        let step = named
-            .iter()
-            .flat_map(|c| c.terms.iter())
-            .find(|t| t.name == name)
-            .map_or(0.0, |t| t.step);
-        problem.sensitivity(name, step, &current)
-    };
-    // (score, force, candidate's fit, the model parameters that carry it, parameters) of
-    // the best named fit.
-    #[allow(clippy::type_complexity)]
-    let mut best: Option<(f64, f64, Scored, Vec<&'static str>, Parameters)> = None;
-    for candidate in &named {
-        let Ok(fit) = problem.fit(candidate, ITERATIONS, &current, &sensitivity) else {
-            continue;
-        };
-        *replays += fit.replays;
-        let used = terms_used(&fit);
-        if used == 0.0 {
-            continue;
-        }
-        let scored = Scored {
-            fit,
-            explained: 0.0,
-            force_heldout_rms: 0.0,
-        };
-        let mut trial = without.clone();
-        let Ok(set) = apply_named(&mut trial, &scored) else {
-            continue;
-        };
-        if trial.validate().is_err() {
-            continue;
-        }
-        let mut names = others.clone();
-        names.extend(set.iter().map(|(name, _)| *name).filter(|name| refittable(name)));
-        let trial = match crate::refit_constants(cx, &trial, &names, replays)? {
-            Some((refitted, before, after)) if after < before => refitted,
-            _ => trial,
-        };
-        let (misfit, force) = alternatives::judge(cx, &problem, &trial, replays)?;
-        let score = misfit + used * penalty;
-        progress(&format!(
-            "  {} ({}) in place of the {}, every addition refitted: {misfit:.0} held out + penalty {:.0} against {term_misfit:.0} + {:.0} (noise floors squared), force {force:.4} against {term_force:.4} N",
-            candidate.named.unwrap_or(candidate.label),
-            candidate.label,
-            term.candidate,
-            used * penalty,
-            term_terms * penalty
-        ));
-        if best.as_ref().map_or(true, |b| score < b.0) {
-            let carried = set.iter().map(|(name, _)| *name).collect();
-            best = Some((score, force, scored, carried, trial));
-        }
-    }
-    let Some((score, force, scored, carried, trial)) = best else {
+    let others = refitted_beside(f, |d| !std::ptr::eq(d, term), |_| true, &without);
+    let against = format!(
+        "in place of the {}, every addition refitted: {{misfit}} held out + penalty {{penalty}} against {term_misfit:.0} + {:.0} (noise floors squared), force {{force}} against {term_force:.4} N",
+        term.candidate,
+        term_terms * penalty
+    );
+    let Some(NamedFit {
+        score,
+        force,
+        scored,
+        carried,
+        params: trial,
+        without_model: model,
+        without_replay: current,
+    }) = best_named_fit(cx, &without, &others, &named, &against, replays, progress)?
+    else {
         return Ok(None);
     };
     if score > term_score + penalty || force > term_force + 0.05 * cx.noise {
@@ -191,6 +137,7 @@ fn named_in_place_of(
         ));
         return Ok(None);
     }
+    let (recording, n) = (cx.recording, cx.n);
     let name = scored.fit.candidate.named.expect("a named candidate");
     let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
     *replays += 1;
@@ -237,7 +184,130 @@ fn named_in_place_of(
             heldout_after: force,
             share: 1.0 - (force / before).powi(2),
             remainder_follows: String::new(),
+            rivals: vec![],
+            tied_effects: vec![],
         },
         trial,
     )))
+}
+
+/// The refittable parameters of every addition but those `keep_term` / `keep_effect` leave
+/// out, that are set in `without`.
+pub(crate) fn refitted_beside(
+    f: &Findings,
+    keep_term: impl Fn(&DiscoveredTerm) -> bool,
+    keep_effect: impl Fn(&AddedEffect) -> bool,
+    without: &Parameters,
+) -> Vec<&'static str> {
+    f.effects
+        .iter()
+        .filter(|e| keep_effect(e))
+        .flat_map(|e| e.parameters.iter())
+        .chain(
+            f.discovered
+                .iter()
+                .filter(|d| keep_term(d))
+                .flat_map(|d| d.parameters.iter()),
+        )
+        .map(|(name, _)| *name)
+        .filter(|name| parameter_value(without, name) != 0.0 && refittable(name))
+        .collect()
+}
+
+/// A named effect fitted in the place of something taken out of the model.
+pub(crate) struct NamedFit {
+    /// Held-out misfit (noise floors squared) plus the penalty of the terms it uses.
+    pub score: f64,
+    /// Held-out force RMS, N.
+    pub force: f64,
+    pub scored: Scored,
+    /// The model parameters that carry it.
+    pub carried: Vec<&'static str>,
+    /// The model with it and every other addition refitted.
+    pub params: Parameters,
+    /// The model it was fitted into, and its replay.
+    pub without_model: Actuator,
+    pub without_replay: Replay,
+}
+
+/// The best of the `named` candidates fitted into `without` (the model with what they would
+/// replace taken out), each with the parameters `others` refitted beside it. `against`
+/// completes the progress line, with `{misfit}`, `{penalty}` and `{force}` filled in.
+pub(crate) fn best_named_fit(
+    cx: &Context,
+    without: &Parameters,
+    others: &[&'static str],
+    named: &[Candidate],
+    against: &str,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<NamedFit>, String> {
+    let (recording, n) = (cx.recording, cx.n);
+    let model = Actuator::new(without.clone())?;
+    let current = replay_fast(&model, recording, n)?;
+    *replays += 1;
+    let problem = Problem::new(recording, without, &cx.blocks, cx.channel_noise);
+    problem.set_jobs(cx.options.jobs);
+    let penalty = discovery_penalty_per_term(heldout_count(&cx.blocks) as f64);
+    let sensitivity = |name: &'static str| {
+        let step = named
+            .iter()
+            .flat_map(|c| c.terms.iter())
+            .find(|t| t.name == name)
+            .map_or(0.0, |t| t.step);
+        problem.sensitivity(name, step, &current)
+    };
+    let mut best: Option<(f64, f64, Scored, Vec<&'static str>, Parameters)> = None;
+    for candidate in named {
+        let Ok(fit) = problem.fit(candidate, ITERATIONS, &current, &sensitivity) else {
+            continue;
+        };
+        *replays += fit.replays;
+        let used = terms_used(&fit);
+        if used == 0.0 {
+            continue;
+        }
+        let scored = Scored {
+            fit,
+            explained: 0.0,
+            force_heldout_rms: 0.0,
+        };
+        let mut trial = without.clone();
+        let Ok(set) = apply_named(&mut trial, &scored) else {
+            continue;
+        };
+        if trial.validate().is_err() {
+            continue;
+        }
+        let mut names = others.to_vec();
+        names.extend(set.iter().map(|(name, _)| *name).filter(|name| refittable(name)));
+        let trial = match crate::refit_constants(cx, &trial, &names, replays)? {
+            Some((refitted, before, after)) if after < before => refitted,
+            _ => trial,
+        };
+        let (misfit, force) = alternatives::judge(cx, &problem, &trial, replays)?;
+        let score = misfit + used * penalty;
+        progress(&format!(
+            "  {} ({}) {}",
+            candidate.named.unwrap_or(candidate.label),
+            candidate.label,
+            against
+                .replace("{misfit}", &format!("{misfit:.0}"))
+                .replace("{penalty}", &format!("{:.0}", used * penalty))
+                .replace("{force}", &format!("{force:.4}"))
+        ));
+        if best.as_ref().map_or(true, |b| score < b.0) {
+            let carried = set.iter().map(|(name, _)| *name).collect();
+            best = Some((score, force, scored, carried, trial));
+        }
+    }
+    Ok(best.map(|(score, force, scored, carried, params)| NamedFit {
+        score,
+        force,
+        scored,
+        carried,
+        params,
+        without_model: model,
+        without_replay: current,
+    }))
 }

@@ -162,6 +162,7 @@ impl Diagnosis {
                 "heldout_after_rms_N": e.heldout_after,
                 "share_of_heldout_explained": e.share,
                 "remainder_follows": e.remainder_follows,
+                "tied_effects": e.tied_effects,
                 "evidence": e.evidence,
             })).collect::<Vec<_>>(),
             "discovered": self.discovered.iter().map(|d| json!({

@@ -228,7 +228,10 @@ pub(crate) fn run_rounds(
         }
         f.stages.push(Stage::of(&f));
     }
-    if crate::named_instead::named_instead_of_discovered(cx, &mut f, replays, progress)? {
+    let renamed = crate::named_rivals::settle_rivals(cx, &mut f, replays, progress)?;
+    if crate::named_instead::named_instead_of_discovered(cx, &mut f, replays, progress)? || renamed {
+        // The last joint refit was of the additions before the names changed.
+        f.joint_refit = None;
         // The last round's findings are these now: going back to it keeps the name.
         let stage = Stage::of(&f);
         match f.stages.last_mut() {
@@ -1049,6 +1052,12 @@ fn add_effect(
         remainder_follows: top
             .map(|f| format!("{} (η² = {:.2})", f.signal, f.eta_squared))
             .unwrap_or_default(),
+        rivals: if downstream {
+            vec![]
+        } else {
+            crate::named_rivals::rivals_of(name, place, s.explained, &found.candidates)
+        },
+        tied_effects: vec![],
     })
 }
 

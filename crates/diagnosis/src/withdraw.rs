@@ -142,6 +142,8 @@ mod tests {
             heldout_after: 0.1,
             share: 0.9,
             remainder_follows: String::new(),
+            rivals: vec![],
+            tied_effects: vec![],
         }];
         rounds::Findings {
             params,
