@@ -337,12 +337,8 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
         .iter()
         .filter_map(|&(name, value)| physical_reading(name, value - parameter_value(before, name)))
         .collect();
-    let article = if label.starts_with(['a', 'e', 'i', 'o', 'u']) {
-        "an"
-    } else {
-        "a"
-    };
-    let mut sentence = format!("At the {location} ({family}), {article} {label}: {}.", parts.join(", "));
+    // "The", not "a": labels name one thing ("supply pressure") or several ("dead volumes").
+    let mut sentence = format!("At the {location} ({family}), the {label}: {}.", parts.join(", "));
     if let Some(products) = crate::products::reading(set, before) {
         sentence.push(' ');
         sentence.push_str(&products);

@@ -206,10 +206,16 @@ fn rival_in_place_of(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn scored(label: &'static str, location: &'static str, named: Option<&'static str>, explained: f64) -> Scored {
+    /// A candidate's score with no fit behind it: its label, place, named effect and share.
+    pub(crate) fn scored(
+        label: &'static str,
+        location: &'static str,
+        named: Option<&'static str>,
+        explained: f64,
+    ) -> Scored {
         Scored {
             fit: Fit {
                 candidate: Candidate {
