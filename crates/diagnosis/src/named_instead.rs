@@ -109,18 +109,10 @@ fn named_in_place_of(
         term.candidate,
         term_terms * penalty
     );
-    let Some(NamedFit {
-        score,
-        force,
-        scored,
-        carried,
-        params: trial,
-        without_model: model,
-        without_replay: current,
-    }) = best_named_fit(cx, &without, &others, &named, &against, replays, progress)?
-    else {
+    let Some(fit) = best_named_fit(cx, &without, &others, &named, &against, replays, progress)? else {
         return Ok(None);
     };
+    let (score, force) = (fit.score, fit.force);
     if score > term_score + penalty || force > term_force + 0.05 * cx.noise {
         return Ok(None);
     }
@@ -132,35 +124,17 @@ fn named_in_place_of(
     if force > EXPLAINED_WITHIN_NOISE * cx.noise {
         progress(&format!(
             "  {}: not named in the {}'s place while {force:.4} N stays, above {EXPLAINED_WITHIN_NOISE} noise floors",
-            scored.fit.candidate.named.unwrap_or(scored.fit.candidate.label),
+            fit.scored.fit.candidate.named.unwrap_or(fit.scored.fit.candidate.label),
             term.candidate
         ));
         return Ok(None);
     }
-    let (recording, n) = (cx.recording, cx.n);
-    let name = scored.fit.candidate.named.expect("a named candidate");
-    let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
-    *replays += 1;
-    let test = named_signature(
-        name,
-        recording,
-        &model,
-        &current,
-        &with.force,
-        &cx.blocks,
-        cx.noise,
-        cx.mechanical_noise,
-    );
+    let name = fit.scored.fit.candidate.named.expect("a named candidate");
+    let (test, parameters) = fit.signature(cx, replays)?;
     if !test.present {
         progress(&format!("  {name}: its signature is absent"));
         return Ok(None);
     }
-    // The model's parameters, as `apply_named` set them: a sensor's offset and gain are
-    // fitted as errors of the values it had.
-    let parameters: Vec<(&'static str, f64)> = carried
-        .iter()
-        .map(|name| (*name, parameter_value(&trial, name)))
-        .collect();
     let values: Vec<String> = parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
     let before = term.heldout_before;
     let evidence = format!(
@@ -187,7 +161,7 @@ fn named_in_place_of(
             rivals: vec![],
             tied_effects: vec![],
         },
-        trial,
+        fit.params,
     )))
 }
 
@@ -228,6 +202,38 @@ pub(crate) struct NamedFit {
     /// The model it was fitted into, and its replay.
     pub without_model: Actuator,
     pub without_replay: Replay,
+}
+
+impl NamedFit {
+    /// The named effect's signature in the residual of the model it was fitted into, and
+    /// the model parameters that carry it as `apply_named` set them (a sensor's offset and
+    /// gain are fitted as errors of the values it had).
+    #[allow(clippy::type_complexity)]
+    pub(crate) fn signature(
+        &self,
+        cx: &Context,
+        replays: &mut usize,
+    ) -> Result<(named::SignatureTest, Vec<(&'static str, f64)>), String> {
+        let name = self.scored.fit.candidate.named.expect("a named candidate");
+        let with = replay_fast(&Actuator::new(self.params.clone())?, cx.recording, cx.n)?;
+        *replays += 1;
+        let test = named_signature(
+            name,
+            cx.recording,
+            &self.without_model,
+            &self.without_replay,
+            &with.force,
+            &cx.blocks,
+            cx.noise,
+            cx.mechanical_noise,
+        );
+        let parameters = self
+            .carried
+            .iter()
+            .map(|name| (*name, parameter_value(&self.params, name)))
+            .collect();
+        Ok((test, parameters))
+    }
 }
 
 /// The best of the `named` candidates fitted into `without` (the model with what they would

@@ -10,7 +10,7 @@
 //! within a penalty either way leaves the two tied, which the report says.
 
 use super::*;
-use crate::named_instead::{best_named_fit, refitted_beside, NamedFit};
+use crate::named_instead::{best_named_fit, refitted_beside};
 use crate::rounds::Findings;
 
 /// A named effect at the same place whose share of the held-out misfit was at most this much
@@ -131,19 +131,11 @@ fn rival_in_place_of(
         own_terms * penalty
     );
     progress(&format!("{}'s rivals at the {}", effect.name, effect.location));
-    let Some(NamedFit {
-        score,
-        force,
-        scored,
-        carried,
-        params: trial,
-        without_model,
-        without_replay,
-    }) = best_named_fit(cx, &without, &others, &rivals, &against, replays, progress)?
-    else {
+    let Some(fit) = best_named_fit(cx, &without, &others, &rivals, &against, replays, progress)? else {
         return Ok(Settled::Kept);
     };
-    let rival = scored.fit.candidate.named.expect("a named candidate");
+    let (score, force) = (fit.score, fit.force);
+    let rival = fit.scored.fit.candidate.named.expect("a named candidate");
     let share_then = effect.rivals.iter().find(|(r, _)| *r == rival).map_or(0.0, |r| r.1);
     if score > own_score - penalty || force > own_force {
         if score <= own_score + penalty {
@@ -154,26 +146,11 @@ fn rival_in_place_of(
         }
         return Ok(Settled::Kept);
     }
-    let with = replay_fast(&Actuator::new(trial.clone())?, cx.recording, cx.n)?;
-    *replays += 1;
-    let test = named_signature(
-        rival,
-        cx.recording,
-        &without_model,
-        &without_replay,
-        &with.force,
-        &cx.blocks,
-        cx.noise,
-        cx.mechanical_noise,
-    );
+    let (test, parameters) = fit.signature(cx, replays)?;
     if !test.present {
         progress(&format!("  {rival}: its signature is absent"));
         return Ok(Settled::Kept);
     }
-    let parameters: Vec<(&'static str, f64)> = carried
-        .iter()
-        .map(|name| (*name, parameter_value(&trial, name)))
-        .collect();
     let values: Vec<String> = parameters.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect();
     let evidence = format!(
         "Named {} first, which the round that found it could hardly tell from {rival} ({rival} explained {:.1} % of that round's held-out misfit); with every later addition in and refitted beside it, {rival} ({}) leaves the held-out force error at {force:.4} N against {own_force:.4} N with {} (noise floor {:.4} N){}.",
@@ -201,7 +178,7 @@ fn rival_in_place_of(
             rivals: vec![],
             tied_effects: vec![],
         },
-        Box::new(trial),
+        Box::new(fit.params),
     ))
 }
 

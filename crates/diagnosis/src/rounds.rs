@@ -404,8 +404,8 @@ fn nameable(s: &Scored, discovered: &[DiscoveredTerm]) -> bool {
 /// Whether a candidate may be added as a discovered term, which claims no name: one outside
 /// the named effects, or a named effect whose name this round cannot give (see [`nameable`]).
 /// A term may be found first and the named effect after it: beside chamber leaks found in a
-/// first round, the dead volumes explained 98 % of the
-/// second and could be neither named nor added, and 12 noise floors stayed.
+/// first round, the dead volumes explained 98 % of the second and could be neither named nor
+/// added, and 12 noise floors stayed.
 fn unclaimed(s: &Scored, discovered: &[DiscoveredTerm]) -> bool {
     s.fit.candidate.named.is_none() || !nameable(s, discovered)
 }
