@@ -104,7 +104,9 @@ fn diagnose_one(item: &Item, options: &BatchOptions, jobs: usize) -> Result<Summ
         jobs,
         bars: None,
     };
-    let diagnosis = jetpipe_diagnosis::diagnose_with(&recording, &options.base, &diagnosis_options, &mut |_| {})?;
+    // Read again for the figures: the diagnosis keeps the one it was given.
+    let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &options.base, &diagnosis_options, &mut |_| {})?;
+    let recording = Recording::read(&item.path, &options.base)?;
     let report = diagnosis.to_json(&item.name);
     let (report_file, page_file) = (format!("{}.json", item.name), format!("{}.html", item.name));
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())? + "\n";

@@ -942,7 +942,12 @@ mod tests {
                 }
             })
             .collect();
-        (recording, blocks, [sensitivity_force, vec![], vec![]], x_s)
+        (
+            recording,
+            blocks,
+            std::sync::Arc::new([sensitivity_force, vec![], vec![]]),
+            x_s,
+        )
     }
 
     #[test]

@@ -169,9 +169,25 @@ impl<'a> Drive<'a> {
     /// The stopper acceleration input at every sample of the drive, where the model takes
     /// it ([`crate::acceleration`]): formed over the whole recording, so that a replay of its
     /// first rows reads the same values as one of all.
-    fn accelerations(&self, model: &Actuator, recording: &Recording) -> Option<Vec<f64>> {
-        (model.params.stopper_acceleration_input_share > 0.0 && recording.acceleration_window > 0.0)
-            .then(|| crate::acceleration::smoothed_accelerations(self.time, self.x_s, recording.acceleration_window))
+    /// A thinned recording carries them, formed once ([`crate::recording::FullRateInputs`]).
+    fn accelerations(&self, model: &Actuator, recording: &'a Recording) -> Option<std::borrow::Cow<'a, [f64]>> {
+        if model.params.stopper_acceleration_input_share <= 0.0 || recording.acceleration_window <= 0.0 {
+            return None;
+        }
+        let formed = recording.full_rate.as_ref().and_then(|full| {
+            full.accelerations
+                .as_ref()
+                .filter(|(window, _)| *window == recording.acceleration_window)
+                .map(|(_, a)| a.as_slice())
+        });
+        Some(match formed {
+            Some(a) => std::borrow::Cow::Borrowed(a),
+            None => std::borrow::Cow::Owned(crate::acceleration::smoothed_accelerations(
+                self.time,
+                self.x_s,
+                recording.acceleration_window,
+            )),
+        })
     }
 
     fn rows(&self) -> usize {

@@ -505,7 +505,10 @@ fn diagnose(
     if let Some(jobs) = jobs {
         options.jobs = jobs;
     }
-    let diagnosis = jetpipe_diagnosis::diagnose_with(&recording, &base, &options, &mut progress)?;
+    // The diagnosis keeps the recording; the figures read it again once it is done, so a
+    // long recording is not held twice meanwhile.
+    let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &base, &options, &mut progress)?;
+    let recording = jetpipe_diagnosis::recording::Recording::read(recording_path, &base)?;
     let name = recording_path.display().to_string();
     let json = diagnosis.to_json(&name);
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";

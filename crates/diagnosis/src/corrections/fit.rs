@@ -254,8 +254,10 @@ impl Fit {
 /// start from the same point. Single precision: a finite difference of two replays carries
 /// the integrator's relative error (1e-6 and more) in its lowest digits, so 24 bits lose
 /// nothing a Gauss–Newton step can use, and the thirty-odd shared columns of a long
-/// recording take half the memory (72 MB in double precision at 100,000 rows).
-pub type Sensitivity = [Vec<f32>; CHANNELS];
+/// recording take half the memory (72 MB in double precision at 100,000 rows). Shared, not
+/// copied: the screen and the fits read the same columns (copies of the shared ones were
+/// 41 MB of a 600 s recording's peak).
+pub type Sensitivity = std::sync::Arc<[Vec<f32>; CHANNELS]>;
 
 /// A column of a [`Sensitivity`] from one in double precision.
 fn single(column: Vec<f64>) -> Vec<f32> {
@@ -376,11 +378,11 @@ impl Problem<'_> {
         }
         let model = Actuator::new(p).ok()?;
         let moved = replay_fast(&model, self.recording, self.recording.len()).ok()?;
-        Some([
+        Some(std::sync::Arc::new([
             divided_difference(&moved.force, &at.force, step),
             divided_difference(&moved.p1, &at.p1, step),
             divided_difference(&moved.p2, &at.p2, step),
-        ])
+        ]))
     }
 
     /// Fit a candidate: bounded Gauss–Newton from its neutral values, at most `iterations`
@@ -494,11 +496,11 @@ impl Problem<'_> {
                 let mut moved = point.values.clone();
                 moved[j] += step;
                 self.replay(candidate, &moved).ok().map(|r| {
-                    [
+                    std::sync::Arc::new([
                         divided_difference(&r.force, &point.replay.force, step),
                         divided_difference(&r.p1, &point.replay.p1, step),
                         divided_difference(&r.p2, &point.replay.p2, step),
-                    ]
+                    ])
                 })
             });
             replays += differenced.len();
@@ -522,15 +524,15 @@ impl Problem<'_> {
                             replay: point.replay.clone(),
                         };
                         let with = self.predict(terms, &only, &modulated);
-                        Some([
+                        Some(std::sync::Arc::new([
                             single(difference(&with[0], &point.replay.force)),
                             single(difference(&with[1], &point.replay.p1)),
                             single(difference(&with[2], &point.replay.p2)),
-                        ])
+                        ]))
                     }
                     _ => None,
                 };
-                columns.push(column.unwrap_or_else(|| [vec![], vec![], vec![]]));
+                columns.push(column.unwrap_or_else(|| std::sync::Arc::new([vec![], vec![], vec![]])));
             }
             let step = self.solve(terms, &point.values, &columns, &prediction, 0.0);
             // Line search on the true model; then, for a damped fit, Marquardt's steps.
