@@ -195,6 +195,27 @@ fn misfit(knots: &[f64], x: &[f64], y: &[f64], scale: &[f64]) -> f64 {
         .sum()
 }
 
+/// A stretch of the signal's range that no training sample visits, wider than this share of
+/// the range, offers its two edges as knots.
+pub const GAP_EDGE_SHARE: f64 = 0.05;
+
+/// The samples on either side of each stretch of `values` wider than `width` that holds
+/// none. The 1/64 quantiles hold no knot at a visited stretch's end when few samples lie
+/// near it: a force sensor saturating at 40 N under force tracking, whose training samples
+/// read up to 26.7 N and then only above 89.7 N, got its knot at 41 N, and the chord from
+/// 17.4 N to it, fitted to the samples up to 26.7 N, read the level 0.08 N high and left
+/// 1.85 noise floors. With a knot at the edge, the stretch beyond is unvisited and takes
+/// its neighbours' corner ([`corners_across_unvisited`]).
+fn gap_edges(values: &[f64], width: f64) -> Vec<f64> {
+    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    sorted
+        .windows(2)
+        .filter(|w| w[1] - w[0] > width)
+        .flat_map(|w| [w[0], w[1]])
+        .collect()
+}
+
 /// Knots for a curve taking the model's reading `own` to the measured `measured` on the
 /// training samples: the ends of `own`'s range, knots added one at a time at whichever of
 /// its 1/64 quantiles lowers the least-squares misfit most, then each interior knot moved
@@ -231,12 +252,15 @@ fn placed(x_all: &[f64], y_all: &[f64], s_all: &[f64], blocks: &[Block], n: usiz
     // The ends, then knots added one at a time where they lower the misfit most, from
     // the 1/64 quantiles of the signal: a curve's corners (a dead zone's two, a
     // saturation's one) are found first.
-    let grid = quantile_knots(&x, 65);
+    let mut grid = quantile_knots(&x, 65);
     if grid.len() < 3 {
         return vec![];
     }
     let (first, last) = (grid[0], grid[grid.len() - 1]);
     let gap = 0.01 * (last - first);
+    grid.extend(gap_edges(&x, GAP_EDGE_SHARE * (last - first)));
+    grid.sort_by(f64::total_cmp);
+    grid.dedup();
     let mut knots = vec![first, last];
     while knots.len() < n {
         let best = grid

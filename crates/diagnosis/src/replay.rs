@@ -23,34 +23,64 @@ pub const START_READINGS: usize = 4;
 /// from rest, where a transducer's memory holds what it reads, and the law's inverse would
 /// differentiate the readings, which over four samples is their noise times the lag over
 /// the sampling interval (an 11 ms lag read at 2 kHz started the chambers kPa away and made
-/// the model with the lag worse over its first tenth of a second). `None` without pressure
-/// channels, or where a law has no inverse or the pressures would not be positive.
+/// the model with the lag worse over its first tenth of a second). A static curve is undone
+/// by [`jetpipe_model::physics::static_curve::StaticCurve::inverse`]; where it is flat (a
+/// saturated reading), the chamber is taken from the other and the force. `None` without
+/// pressure channels, or where a law has no inverse or the pressures would not be positive.
 pub fn start_pressures(model: &Actuator, recording: &Recording) -> Option<[f64; 2]> {
     let k = START_READINGS.min(recording.len());
     if k == 0 {
         return None;
     }
     let time = &recording.time[..k];
-    let back = |channel: Channel, readings: &Option<Vec<f64>>| -> Option<f64> {
-        let readings = &readings.as_ref()?[..k];
+    // The mean quantity behind the first readings, and whether the law's static curve is
+    // flat there (the reading then bounds the quantity from below only).
+    let back = |channel: Channel, readings: &[f64]| -> Option<(f64, bool)> {
         let law = SensorLaw {
             lag: 0.0,
             delay: 0.0,
             ..SensorLaw::of(&model.params, channel)
         };
-        let pressures = if law.is_identity() {
-            readings.to_vec()
-        } else {
-            law.unread(time, readings)?
+        // The static curve is undone on the mean, after the rest of the law.
+        let curve = law.curve;
+        let law = SensorLaw {
+            curve: Default::default(),
+            ..law
         };
-        let mean = pressures.iter().sum::<f64>() / k as f64;
-        (mean.is_finite() && mean > 0.0).then_some(mean)
+        let values = if law.is_identity() {
+            readings[..k].to_vec()
+        } else {
+            law.unread(time, &readings[..k])?
+        };
+        let value = curve.inverse(values.iter().sum::<f64>() / k as f64)?;
+        let probe = FLAT_PROBE * value.abs().max(1.0);
+        let flat = curve.is_on() && (curve.at(value + probe) - curve.at(value)) < FLAT_SLOPE * probe;
+        value.is_finite().then_some((value, flat))
     };
-    Some([
-        back(Channel::Pressure1, &recording.p1)?,
-        back(Channel::Pressure2, &recording.p2)?,
-    ])
+    let (p1, flat_1) = back(Channel::Pressure1, recording.p1.as_ref()?)?;
+    let (p2, flat_2) = back(Channel::Pressure2, recording.p2.as_ref()?)?;
+    // A transducer whose range ends below its chamber's first pressure: the chamber from
+    // the other and the force the piston carries, A_p (P1 − P2), where the spring does not
+    // hold it (a P1 transducer flat from 449.75 kPa under force tracking started chamber 1
+    // 20 kPa low, or both chambers at an equilibrium the bench had not reached: 21 noise
+    // floors of P2 over the first seconds).
+    let across = || -> Option<f64> {
+        let (force, flat) = back(Channel::Force, &recording.force)?;
+        (!flat && force > model.spring_force(recording.x_s[0]) && model.piston_area > 0.0)
+            .then(|| force / model.piston_area)
+    };
+    let (p1, p2) = match (flat_1, flat_2) {
+        (true, false) => (across().map_or(p1, |d| p2 + d), p2),
+        (false, true) => (p1, across().map_or(p2, |d| p1 - d)),
+        _ => (p1, p2),
+    };
+    (p1 > 0.0 && p2 > 0.0).then_some([p1, p2])
 }
+
+/// The relative step at which [`start_pressures`] probes whether a curve is flat, and the
+/// slope below which it is.
+const FLAT_PROBE: f64 = 1e-6;
+const FLAT_SLOPE: f64 = 1e-3;
 
 /// Where a replay starts: at rest at the command held before the recording, with the
 /// chamber pressures where the transducers read them when the recording has them

@@ -80,6 +80,44 @@ impl StaticCurve {
         y0 + (v - x0) * (y1 - y0) / (x1 - x0)
     }
 
+    /// The least v that the curve takes to `y` or above: the curve undone where it rises,
+    /// and the start of a flat end for a reading at or beyond its level (a saturated
+    /// transducer's lowest quantity that reads so). `y` itself when off; `None` for a curve
+    /// that falls anywhere, which has no such inverse.
+    pub fn inverse(&self, y: f64) -> Option<f64> {
+        let n = self.len();
+        if n < 2 {
+            return Some(y);
+        }
+        // Knot values a rounding apart are one level (a fitted curve's flat end is a sum of
+        // increments, and its knots differ in the last bit).
+        let level = 1e-12 * self.y[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if (1..n).any(|k| self.y[k] < self.y[k - 1] - level) {
+            return None;
+        }
+        let rises = |k: usize| self.y[k + 1] > self.y[k] + level;
+        let along = |k: usize| self.x[k] + (y - self.y[k]) * (self.x[k + 1] - self.x[k]) / (self.y[k + 1] - self.y[k]);
+        if y <= self.y[0] {
+            // Below the first knot, along the first segment when it rises.
+            return Some(if rises(0) { along(0) } else { self.x[0] });
+        }
+        for k in 0..n - 1 {
+            if y <= self.y[k + 1] && rises(k) {
+                return Some(along(k));
+            }
+        }
+        // At or above the last knot's level: along the last segment when it rises, else
+        // where the flat stretch at the top begins.
+        if rises(n - 2) {
+            return Some(along(n - 2));
+        }
+        let mut k = n - 1;
+        while k > 0 && self.y[k - 1] >= self.y[n - 1] - level {
+            k -= 1;
+        }
+        Some(self.x[k])
+    }
+
     /// Checks of a curve whose parameters are named `prefix`_knots, `prefix`_x_k,
     /// `prefix`_y_k: the count a whole number in {0, 2, …, 8}, the abscissae in use
     /// strictly increasing.
@@ -108,6 +146,31 @@ impl StaticCurve {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_curve_is_undone_where_it_rises_and_at_the_start_of_a_flat_end() {
+        // The identity up to 40, flat at 40 beyond: a saturation.
+        let c = StaticCurve::through(&[0.0, 20.0, 40.0, 90.0], &[0.0, 20.0, 40.0, 40.0]);
+        for v in [-5.0, 3.0, 25.0, 39.5] {
+            let back = c.inverse(c.at(v)).unwrap();
+            assert!((back - v).abs() < 1e-12, "{v} came back as {back}");
+        }
+        assert_eq!(c.inverse(40.0), Some(40.0));
+        assert_eq!(c.inverse(40.3), Some(40.0), "a reading above the level");
+        // A dead zone: flat from -1 to 1 at 0; a reading of 0 goes to the zone's start.
+        let dz = StaticCurve::through(&[-5.0, -1.0, 1.0, 5.0], &[-4.0, 0.0, 0.0, 4.0]);
+        assert_eq!(dz.inverse(0.0), Some(-1.0));
+        assert!((dz.inverse(2.0).unwrap() - 3.0).abs() < 1e-12);
+        assert_eq!(StaticCurve::default().inverse(7.0), Some(7.0));
+        let falls = StaticCurve::through(&[0.0, 1.0, 2.0], &[0.0, 2.0, 1.0]);
+        assert_eq!(falls.inverse(1.5), None);
+        // A flat end whose knots differ in the last bit is flat.
+        let rounded = StaticCurve::through(
+            &[0.0, 1.0, 2.0, 3.0],
+            &[0.0, 449992.5683787812, 449992.56837878114, 449992.56837878114],
+        );
+        assert_eq!(rounded.inverse(450000.0), Some(1.0));
+    }
 
     #[test]
     fn an_off_curve_is_the_identity_bit_for_bit() {
