@@ -163,6 +163,16 @@ pub(crate) fn run_rounds(
             }
             other => other,
         };
+        // A term put in another's place is tied to the places that one was.
+        let added = match added {
+            Some(Addition::Discovered(mut term, trial, s)) if term.tied_locations.is_empty() => {
+                term.tied_locations = found.tied_with(term.location);
+                let undecided = found.undecided_beside(term.location, cx.pressure_noise.is_some());
+                term.reading = with_undecided(std::mem::take(&mut term.reading), undecided);
+                Some(Addition::Discovered(term, trial, s))
+            }
+            other => other,
+        };
         match added {
             Some(Addition::Discovered(term, trial, _)) => {
                 match f.discovered.iter().position(|d| same_term(d, &term)) {
