@@ -167,8 +167,20 @@ fn keep_large_allocations_apart() {
     }
 }
 
+/// A reader that closes the output early (`jetpipe diagnose r.csv | head`) ends the program
+/// as it ends other Unix tools, without a panic's message: Rust ignores SIGPIPE, and a
+/// `println!` to a closed pipe then panics.
+fn end_quietly_on_a_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: restores the default disposition of one signal before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
     keep_large_allocations_apart();
+    end_quietly_on_a_closed_pipe();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
