@@ -104,14 +104,15 @@ fn diagnose_one(item: &Item, options: &BatchOptions, jobs: usize) -> Result<Summ
         jobs,
         bars: None,
     };
-    // Read again for the figures: the diagnosis keeps the one it was given.
+    // The diagnosis keeps the recording; the figures read it again once the report is written.
     let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &options.base, &diagnosis_options, &mut |_| {})?;
-    let recording = Recording::read(&item.path, &options.base)?;
     let report = diagnosis.to_json(&item.name);
     let (report_file, page_file) = (format!("{}.json", item.name), format!("{}.html", item.name));
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())? + "\n";
     // The report first: should the figures fail, the diagnosis is not lost with them.
     write_atomically(&options.out.join(&report_file), &text)?;
+    let recording = Recording::read(&item.path, &options.base)
+        .map_err(|e| format!("{e} (the report {report_file} was written)"))?;
     let figures = diagnosis_figures(&FigureInputs {
         recording: &recording,
         diagnosis: &diagnosis,

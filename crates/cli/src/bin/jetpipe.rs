@@ -517,22 +517,22 @@ fn diagnose(
     if let Some(jobs) = jobs {
         options.jobs = jobs;
     }
-    // The diagnosis keeps the recording; the figures read it again once it is done, so a
-    // long recording is not held twice meanwhile.
+    // The diagnosis keeps the recording; the figures read it again once the report is
+    // written, so a long recording is not held twice meanwhile.
     let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &base, &options, &mut progress)?;
-    let recording = jetpipe_diagnosis::recording::Recording::read(recording_path, &base)?;
     let name = recording_path.display().to_string();
     let json = diagnosis.to_json(&name);
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
     // An existing report is never left half-written; it is written before the figures, so
     // that should they fail, the diagnosis is not lost with them.
     jetpipe_cli::output::write_atomically(report, &text)?;
+    let figures_failed = |e: String| format!("{e} (the report {} was written)", report.display());
+    let recording = jetpipe_diagnosis::recording::Recording::read(recording_path, &base).map_err(figures_failed)?;
     let inputs = jetpipe_cli::plots::FigureInputs {
         recording: &recording,
         diagnosis: &diagnosis,
         base: &base,
     };
-    let figures_failed = |e: String| format!("{e} (the report {} was written)", report.display());
     let figures = match destination.plots {
         Some(dir) => {
             let figures = jetpipe_cli::plots::write_diagnosis_plots(dir, &inputs).map_err(figures_failed)?;
