@@ -15,6 +15,16 @@ use super::search::{diagnosed_with, fixed, get, spec};
 /// Diagnose the plant with `set` applied to its constants under `spec`: the first term at
 /// `place` (location, family), explained, nothing named.
 fn re_identified(label: &str, spec: &ProtocolSpec, set: impl Fn(&mut BenchParams), place: (&str, &str)) -> Diagnosis {
+    re_identified_at_one_of(label, spec, set, &[place])
+}
+
+/// [`re_identified`], the first term at one of `places`.
+fn re_identified_at_one_of(
+    label: &str,
+    spec: &ProtocolSpec,
+    set: impl Fn(&mut BenchParams),
+    places: &[(&str, &str)],
+) -> Diagnosis {
     let mut plant = BenchParams::default();
     set(&mut plant);
     let d = diagnosed_with(label, &plant, spec, UndeclaredEffects::default());
@@ -27,7 +37,11 @@ fn re_identified(label: &str, spec: &ProtocolSpec, set: impl Fn(&mut BenchParams
         .discovered
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered"));
-    assert_eq!((first.location, first.family), place, "{label}: {}", first.reading);
+    assert!(
+        places.contains(&(first.location, first.family)),
+        "{label}: {}",
+        first.reading
+    );
     assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
     d
 }
@@ -77,26 +91,13 @@ fn a_longer_return_spring_under_ramps_with_a_moving_stopper_is_found_as_its_free
 #[ignore = "a broad case (about 20 s of wall time two at a time); scripts/bench_cases.sh runs every case"]
 fn a_slow_current_driver_under_a_multisine_without_pressures_is_a_lag_tied_between_the_command_and_the_driver() {
     let label = "slow-driver-multisine";
-    let plant = BenchParams {
-        omega_cd: 700.0,
-        ..BenchParams::default()
-    };
-    let spec = spec(CommandProtocol::Multisine, fixed(), 500.0, false);
-    let d = diagnosed_with(label, &plant, &spec, UndeclaredEffects::default());
-    assert!(
-        d.effects.is_empty(),
-        "{label}: named {:?}",
-        d.effects.iter().map(|e| e.name).collect::<Vec<_>>()
+    let d = re_identified_at_one_of(
+        label,
+        &spec(CommandProtocol::Multisine, fixed(), 500.0, false),
+        |p| p.omega_cd = 700.0,
+        &[("command", "dynamics"), ("current_driver", "dynamics")],
     );
-    let first = d
-        .discovered
-        .first()
-        .unwrap_or_else(|| panic!("{label}: nothing discovered"));
-    assert!(
-        ["command", "current_driver"].contains(&first.location) && first.family == "dynamics",
-        "{label}: {}",
-        first.reading
-    );
+    let first = &d.discovered[0];
     for place in ["command", "current_driver"] {
         assert!(
             first.tied_locations.contains(&place),
@@ -106,7 +107,6 @@ fn a_slow_current_driver_under_a_multisine_without_pressures_is_a_lag_tied_betwe
     }
     let lag = get(&d, "command_lag") + 1.0 / get(&d, "omega_cd");
     assert!((lag * 700.0 - 1.0).abs() < 0.05, "{label}: the lag in all {lag} s");
-    assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
 }
 
 /// The gas's isentropic exponent at 1.3 instead of 1.4 under a multisine at 1 kHz with
