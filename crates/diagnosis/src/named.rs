@@ -157,10 +157,7 @@ pub fn loop_with_command_direction(
         .filter_map(|(r, e)| Some((r?, e?)))
         .collect();
     if pairs.len() < 3 {
-        return SignatureTest {
-            present: false,
-            sentence: "the command does not sweep both ways over enough of its range to show a loop".to_string(),
-        };
+        return branch_gap_at_held_levels(residual, effect, recording, noise);
     }
     // The residual's gap counted positive where it runs the way the effect's does.
     let aligned: Vec<f64> = pairs.iter().map(|(r, e)| r * e.signum()).collect();
@@ -177,6 +174,80 @@ pub fn loop_with_command_direction(
     }
 }
 
+/// The gap between the branches, rising less falling, with a cubic in the command taken
+/// out, over the samples after the command's first move, and the share of the branch's
+/// variance the cubic leaves (how far the branch is told apart from the level).
+fn branch_gap(signal: &[f64], recording: &Recording, direction: &[f64]) -> Option<(f64, f64)> {
+    let samples: Vec<usize> = (0..signal.len()).filter(|&k| direction[k] != 0.0).collect();
+    if samples.len() < 400 {
+        return None;
+    }
+    let row = |k: usize| {
+        let v = recording.v_da[k];
+        [1.0, v, v * v, v * v * v, direction[k]]
+    };
+    let mut ata = nalgebra::Matrix5::<f64>::zeros();
+    let mut atb = nalgebra::Vector5::<f64>::zeros();
+    for &k in &samples {
+        let x = nalgebra::Vector5::from(row(k));
+        ata += x * x.transpose();
+        atb += x * signal[k];
+    }
+    let inverse = ata.try_inverse()?;
+    let coefficients = inverse * atb;
+    // 1 / (A^T A)^-1 [4,4] is the branch's sum of squares left after the cubic.
+    let n = samples.len() as f64;
+    let mean_direction = samples.iter().map(|&k| direction[k]).sum::<f64>() / n;
+    let direction_variance = samples
+        .iter()
+        .map(|&k| (direction[k] - mean_direction).powi(2))
+        .sum::<f64>();
+    let distinct = if inverse[(4, 4)] > 0.0 && direction_variance > 0.0 {
+        1.0 / inverse[(4, 4)] / direction_variance
+    } else {
+        0.0
+    };
+    Some((2.0 * coefficients[4], distinct))
+}
+
+/// A command held at levels (a staircase, a slow PRBS) meets few command bins both ways, but
+/// the hysteresis still draws its loop: each held level sits on the branch of the command's
+/// last move, which a staircase reaches from below at some levels and from above at others.
+/// The branch's step is read with a cubic in the command taken out; it counts only where
+/// the levels reached each way interleave enough that the cubic leaves at least a fifth of
+/// the branch's variance, and the residual's step must run the fitted hysteresis's way, by
+/// more than twice the noise and within a factor two of the effect's.
+fn branch_gap_at_held_levels(residual: &[f64], effect: &[f64], recording: &Recording, noise: f64) -> SignatureTest {
+    let direction = command_direction(&recording.v_da);
+    let (Some((gap, distinct)), Some((effect_gap, _))) = (
+        branch_gap(residual, recording, &direction),
+        branch_gap(effect, recording, &direction),
+    ) else {
+        return SignatureTest {
+            present: false,
+            sentence: "the command hardly moves, so no loop can show".to_string(),
+        };
+    };
+    if distinct < 0.2 {
+        return SignatureTest {
+            present: false,
+            sentence: format!(
+                "the command does not sweep both ways over enough of its range to show a loop, and the levels it reaches rising and falling do not interleave enough to tell the branch from the level ({:.0} % of the branch's variance is left beside a cubic in the command)",
+                100.0 * distinct
+            ),
+        };
+    }
+    let aligned = gap * effect_gap.signum();
+    let ratio = if effect_gap != 0.0 { gap / effect_gap } else { 0.0 };
+    let present = aligned > 2.0 * noise && (0.5..=2.0).contains(&ratio);
+    SignatureTest {
+        present,
+        sentence: format!(
+            "the command is mostly held, so few levels are met both ways; over the levels it reaches rising and falling, with a cubic in the command taken out, the residual is {gap:+.4} N higher on the rising branch and the fitted hysteresis makes it {effect_gap:+.4} N"
+        ),
+    }
+}
+
 /// Whether a named effect has a signature test of its own here (the others pass by default).
 pub fn has_signature_test(name: &str) -> bool {
     matches!(name, "sensor_offset_gain" | "piston_friction" | "jet_pipe_hysteresis")
@@ -184,7 +255,7 @@ pub fn has_signature_test(name: &str) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::loop_with_command_direction;
+    use super::{branch_gap_at_held_levels, loop_with_command_direction};
     use crate::recording::Recording;
 
     /// A triangle command from 0 to 10 V, 2 s a period, for 20 s at 1 kHz.
@@ -270,5 +341,41 @@ mod tests {
             .collect();
         let test = loop_with_command_direction(&loop_in_sine, &loop_in_sine, &recording, 0.05);
         assert!(test.present, "{}", test.sentence);
+    }
+
+    #[test]
+    fn a_staircase_held_at_levels_reached_from_below_and_above_shows_the_loop_on_the_branch_of_the_last_move() {
+        // Sixteen levels held 1 s each at 1 kHz, zigzagging up and then down so that levels
+        // reached from below and from above interleave.
+        let levels = [
+            1.0, 3.0, 2.0, 5.0, 4.0, 7.0, 6.0, 9.0, 8.0, 6.5, 7.5, 4.5, 5.5, 2.5, 3.5, 0.5,
+        ];
+        let n = 1000 * levels.len();
+        let mut recording = triangle();
+        recording.time = (0..n).map(|k| k as f64 * 1e-3).collect();
+        recording.v_da = (0..n).map(|k| levels[k / 1000]).collect();
+        recording.x_s = vec![0.06; n];
+        recording.force = vec![0.0; n];
+        let direction = crate::signals::command_direction(&recording.v_da);
+        let noise = 0.05;
+        let lower_rising: Vec<f64> = direction.iter().map(|d| -0.25 * d).collect();
+        let test = branch_gap_at_held_levels(&lower_rising, &lower_rising, &recording, noise);
+        assert!(test.present, "{}", test.sentence);
+        // Against the fitted hysteresis's way, or a fitted loop four times the residual's: absent.
+        let higher_rising: Vec<f64> = lower_rising.iter().map(|x| -x).collect();
+        assert!(!branch_gap_at_held_levels(&lower_rising, &higher_rising, &recording, noise).present);
+        let four_times: Vec<f64> = lower_rising.iter().map(|x| 4.0 * x).collect();
+        assert!(!branch_gap_at_held_levels(&lower_rising, &four_times, &recording, noise).present);
+        // A curve in the command level (a kink, as a dead zone's), or a drift in time, is no
+        // loop: absent.
+        let curve: Vec<f64> = recording.v_da.iter().map(|v| 0.3 * (v - 5.0).max(0.0)).collect();
+        assert!(!branch_gap_at_held_levels(&curve, &lower_rising, &recording, noise).present);
+        let drift: Vec<f64> = recording.time.iter().map(|t| 0.05 * t).collect();
+        assert!(!branch_gap_at_held_levels(&drift, &lower_rising, &recording, noise).present);
+        // A staircase that only climbs cannot tell the branch from the level: absent.
+        let climbing: Vec<f64> = (0..n).map(|k| 0.5 * (k / 1000) as f64).collect();
+        recording.v_da = climbing;
+        let test = branch_gap_at_held_levels(&lower_rising, &lower_rising, &recording, noise);
+        assert!(!test.present, "{}", test.sentence);
     }
 }
