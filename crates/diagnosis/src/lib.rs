@@ -38,6 +38,7 @@ mod localize;
 pub mod modulation;
 mod named;
 mod named_instead;
+mod named_places;
 mod named_rivals;
 pub mod noise;
 mod oscillation;

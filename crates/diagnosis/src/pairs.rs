@@ -24,7 +24,7 @@ const PAIR_REFINE_ITERATIONS: usize = 4;
 
 /// Whether a candidate can be fitted jointly with another by Gauss–Newton: every term a
 /// constant, a modulated constant or a regressor on a channel, at most two of them.
-fn pairable(c: &Candidate) -> bool {
+pub(crate) fn pairable(c: &Candidate) -> bool {
     c.settings.is_empty()
         && c.terms.len() <= 2
         && c.terms.iter().all(|t| {
@@ -44,6 +44,8 @@ pub(crate) struct Replayed {
     pub after: f64,
     before_total: f64,
     worse_pressures: bool,
+    /// Held-out misfit per channel, in its noise floors squared.
+    pub heldout: [f64; CHANNELS],
 }
 
 impl Replayed {
@@ -68,6 +70,7 @@ impl Replayed {
             before_total: heldout_before.iter().sum(),
             worse_pressures: (1..CHANNELS)
                 .any(|c| problem.weights[c] > 0.0 && heldout[c] > 1.05 * heldout_before[c] + count * 0.01),
+            heldout,
         })
     }
 
@@ -89,6 +92,22 @@ pub(crate) fn joined(a: &Candidate, b: &Candidate) -> Candidate {
         settings: vec![],
         ..a.clone()
     }
+}
+
+/// Sensitivities at the current point of every constant the candidates vary.
+pub(crate) fn wanted_for(candidates: &[&Candidate], params: &Parameters) -> WantedSensitivities {
+    let mut wanted = WantedSensitivities::default();
+    for c in candidates {
+        wanted.add_constants_of(&c.terms);
+    }
+    for c in candidates {
+        for t in &c.terms {
+            if let Mechanism::Modulated { parameter, .. } = t.mechanism {
+                wanted.add(parameter, (1e-3 * parameter_value(params, parameter).abs()).max(1e-12));
+            }
+        }
+    }
+    wanted
 }
 
 /// The best pair of candidates at two places, added as two discovered terms, with the
@@ -155,18 +174,8 @@ pub(crate) fn best_pair(
             }
         }
     }
-    // Sensitivities at the current point of every constant the members vary.
-    let mut wanted = WantedSensitivities::default();
-    for m in &members {
-        wanted.add_constants_of(&m.fit.candidate.terms);
-    }
-    for m in &members {
-        for t in &m.fit.candidate.terms {
-            if let Mechanism::Modulated { parameter, .. } = t.mechanism {
-                wanted.add(parameter, (1e-3 * parameter_value(params, parameter).abs()).max(1e-12));
-            }
-        }
-    }
+    let candidates: Vec<&Candidate> = members.iter().map(|m| &m.fit.candidate).collect();
+    let wanted = wanted_for(&candidates, params);
     progress(&format!(
         "no single candidate explains the force: {} pairs of the best candidates at {} places",
         pairs.len(),

@@ -45,17 +45,17 @@ impl Stage {
 }
 
 /// One round's replay of the current model and how far it is from the recording.
-struct Round {
-    model: Actuator,
-    current: Replay,
-    heldout: [f64; CHANNELS],
+pub(crate) struct Round {
+    pub(crate) model: Actuator,
+    pub(crate) current: Replay,
+    pub(crate) heldout: [f64; CHANNELS],
     /// Held-out samples.
-    count: f64,
-    force_before: f64,
-    pressures_agree: bool,
-    candidates: Vec<Candidate>,
+    pub(crate) count: f64,
+    pub(crate) force_before: f64,
+    pub(crate) pressures_agree: bool,
+    pub(crate) candidates: Vec<Candidate>,
     /// The force residual's spectral line, if it has one.
-    periodic: Option<f64>,
+    pub(crate) periodic: Option<f64>,
 }
 
 /// What a round adds to the model.
@@ -66,6 +66,8 @@ enum Addition {
     Discovered(DiscoveredTerm, Box<Parameters>, Option<Box<Scored>>),
     /// Two discovered terms at two places, fitted together (`pairs.rs`).
     Pair(Vec<DiscoveredTerm>, Box<Parameters>),
+    /// A named effect and a term beside it, fitted together (`named_places.rs`).
+    NamedWithTerm(Box<Scored>, String, DiscoveredTerm, Box<Parameters>),
 }
 
 pub(crate) fn run_rounds(
@@ -216,6 +218,13 @@ pub(crate) fn run_rounds(
                 let effect = add_effect(cx, &mut f.params, &r, &found, s, sentence, progress)?;
                 f.effects.push(effect);
                 f.newest = Some((true, f.effects.len() - 1));
+            }
+            Some(Addition::NamedWithTerm(s, sentence, term, trial)) => {
+                let effect = add_effect(cx, &mut f.params, &r, &found, *s, sentence, progress)?;
+                f.effects.push(effect);
+                f.discovered.push(term);
+                f.newest = Some((false, f.discovered.len() - 1));
+                f.params = *trial;
             }
             None => {
                 f.localization = Some(found);
@@ -404,7 +413,7 @@ fn curve_knots(cx: &Context, problem: &Problem, current: &Replay) -> crate::curv
 /// a named effect found later may be absorbing what that term's form misses, and only those
 /// whose own signature is tested in the residual (friction, the sensor's offset and gain,
 /// hysteresis) are still tried.
-fn nameable(s: &Scored, discovered: &[DiscoveredTerm]) -> bool {
+pub(crate) fn nameable(s: &Scored, discovered: &[DiscoveredTerm]) -> bool {
     s.fit
         .candidate
         .named
@@ -432,8 +441,11 @@ fn find_addition(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Option<Addition>, String> {
     let place = found.location;
+    let mut halves = vec![];
     if place != "unknown" {
-        if let Some((s, sentence)) = named_at_place(cx, r, problem, found, &f.discovered, progress) {
+        if let Some((s, sentence)) =
+            crate::named_places::named_at_place(cx, r, problem, found, &f.discovered, &mut halves, progress)
+        {
             return Ok(Some(Addition::Named(s, sentence)));
         }
     }
@@ -445,8 +457,22 @@ fn find_addition(
     // floors, where the bore varying with time leaves 1.0).
     let downstream_of_elsewhere = !matches!(place, "mechanics" | "force_sensor");
     if !r.pressures_agree && downstream_of_elsewhere {
-        if let Some((s, sentence)) = named_downstream(cx, r, &f.params, &f.discovered, replays, progress)? {
+        if let Some((s, sentence)) =
+            crate::named_places::named_downstream(cx, r, &f.params, &f.discovered, replays, progress)?
+        {
             return Ok(Some(Addition::Named(s, sentence)));
+        }
+    }
+    if !halves.is_empty() {
+        if let Some((s, sentence, term, trial)) =
+            crate::named_places::named_with_term(cx, problem, found, &f.params, r, halves, replays, progress)?
+        {
+            return Ok(Some(Addition::NamedWithTerm(
+                Box::new(s),
+                sentence,
+                term,
+                Box::new(trial),
+            )));
         }
     }
     if let Some((terms, trial)) = crate::pairs::best_pair(
@@ -481,184 +507,6 @@ fn find_addition(
         progress,
     )? {
         return Ok(Some(Addition::Pair(term.into_iter().collect(), Box::new(trial))));
-    }
-    Ok(None)
-}
-
-/// The best named effect at the located place that earns its name (step 5), judged on the
-/// fitted prediction.
-fn named_at_place(
-    cx: &Context,
-    r: &Round,
-    problem: &Problem,
-    found: &Localization,
-    discovered: &[DiscoveredTerm],
-    progress: &mut dyn FnMut(&str),
-) -> Option<(Scored, String)> {
-    let (place, count, force_before, noise) = (found.location, r.count, r.force_before, cx.noise);
-    // Against the written candidates: a modulation can take any shape, a named effect's too.
-    let place_share = found
-        .candidates
-        .iter()
-        .filter(|s| s.fit.candidate.location == place && !crate::modulation::is_modulation(&s.fit.candidate))
-        .map(|s| s.explained)
-        .fold(0.0, f64::max);
-    // Where only a modulation located the place (no written candidate there explains as
-    // much as one elsewhere), a named effect must stand on its own: explain as much as the
-    // best written candidate anywhere (a supply varying with the pressure difference located
-    // a supply set low with the receivers off the null at the supply, where a named supply
-    // restriction at 87 % stood in for the pair).
-    let written_anywhere = found
-        .candidates
-        .iter()
-        .filter(|s| !crate::modulation::is_modulation(&s.fit.candidate))
-        .map(|s| s.explained)
-        .fold(0.0, f64::max);
-    let named_floor = if place_share < written_anywhere
-        && found
-            .best_at(place)
-            .map_or(false, |s| crate::modulation::is_modulation(&s.fit.candidate))
-    {
-        written_anywhere
-    } else {
-        0.0
-    };
-    let mut named: Vec<&Scored> = found
-        .candidates
-        .iter()
-        .filter(|s| s.fit.candidate.location == place)
-        .filter(|s| nameable(s, discovered))
-        .collect();
-    named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
-    for s in named {
-        let name = s.fit.candidate.named.expect("filtered on named");
-        let gain = force_before - s.force_heldout_rms;
-        let worse_pressures =
-            (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
-        let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * place_share
-            && share_of_reach(&r.heldout, &s.fit.heldout, &problem.weights, count) >= NAMED_MIN_SHARE
-            && s.explained >= named_floor;
-        let gain_ok = worth_adding(force_before, force_before - gain, noise, false)
-            || pressures_gain(&r.heldout, &s.fit.heldout, count) && s.force_heldout_rms <= force_before + 0.05 * noise;
-        let test = named_signature(
-            name,
-            cx.recording,
-            &r.model,
-            &r.current,
-            &s.fit.prediction[FORCE],
-            &cx.blocks,
-            noise,
-            cx.mechanical_noise,
-        );
-        progress(&format!(
-            "  {name}: explains {:.1} % (its place {:.1} %), force held-out {force_before:.4} -> {:.4} N, signature {}",
-            100.0 * s.explained,
-            100.0 * place_share,
-            s.force_heldout_rms,
-            if test.present { "present" } else { "absent" }
-        ));
-        if !test.sentence.is_empty() {
-            progress(&format!("    {}", test.sentence));
-        }
-        if share_ok && gain_ok && !worse_pressures && test.present {
-            return Some((s.clone(), test.sentence));
-        }
-    }
-    None
-}
-
-/// The share that a candidate leaving the held-out misfit `after` (per channel, noise
-/// floors squared summed over `count` samples) takes of what it could take from `before`:
-/// the misfit above the noise (one floor squared a sample) of the channels it moves. Where a
-/// departure left for a later round is a few noise floors, the noise is half the misfit or
-/// more (a command delay of 0.5 ms beside a friction took 92 % of what was above the noise,
-/// 52 % of the misfit); a friction does not move the pressures, where a transducer's delay
-/// held a third of the misfit beside it.
-fn share_of_reach(before: &[f64; CHANNELS], after: &[f64; CHANNELS], weights: &[f64; CHANNELS], count: f64) -> f64 {
-    let moved = |c: usize| weights[c] > 0.0 && (after[c] - before[c]).abs() > 1e-6 * before[c];
-    let (mut above_noise, mut taken) = (0.0, 0.0);
-    for c in (0..CHANNELS).filter(|&c| moved(c)) {
-        above_noise += (before[c] - count).max(0.0);
-        taken += before[c] - after[c];
-    }
-    if above_noise <= 0.0 {
-        return 0.0;
-    }
-    (taken / above_noise).min(1.0)
-}
-
-/// With pressures, the mechanics and the force sensor are judged on the force against the
-/// pressures, where an upstream departure does not reach: a second effect there is found
-/// even while a larger one upstream dominates the misfit. (With the pressures within their
-/// noise the round's candidates were these already.) Judged on the replay.
-fn named_downstream(
-    cx: &Context,
-    r: &Round,
-    params: &Parameters,
-    discovered: &[DiscoveredTerm],
-    replays: &mut usize,
-    progress: &mut dyn FnMut(&str),
-) -> Result<Option<(Scored, String)>, String> {
-    let (recording, count, force_before, noise) = (cx.recording, r.count, r.force_before, cx.noise);
-    let Some(through) = force_through_mechanics(&r.model, recording) else {
-        return Ok(None);
-    };
-    let downstream = Problem::new(recording, params, &cx.blocks, [cx.mechanical_noise, 0.0, 0.0]);
-    let (_, misfit) = downstream.errors(&[through.force.clone(), vec![], vec![]]);
-    if (misfit[FORCE] / count).sqrt() <= EXPLAINED_WITHIN_NOISE {
-        return Ok(None);
-    }
-    let near: Vec<Candidate> = r
-        .candidates
-        .iter()
-        .filter(|c| matches!(c.location, "mechanics" | "force_sensor"))
-        .cloned()
-        .collect();
-    progress("the force departs from the pressures too: the mechanics and the force sensor on their own");
-    let (side, used) = localize(&downstream, &through, &near, cx.options, None, progress);
-    *replays += used;
-    let side_share = side.best_at(side.location).map_or(0.0, |s| s.explained);
-    let mut named: Vec<&Scored> = side
-        .candidates
-        .iter()
-        .filter(|s| s.fit.candidate.location == side.location)
-        .filter(|s| nameable(s, discovered))
-        .collect();
-    named.sort_by(|a, b| penalised(a, count).total_cmp(&penalised(b, count)));
-    for s in named {
-        let name = s.fit.candidate.named.expect("filtered on named");
-        let mut trial = params.clone();
-        if apply_named(&mut trial, s).is_err() {
-            continue;
-        }
-        let with = replay_fast(&Actuator::new(trial)?, recording, cx.n)?;
-        *replays += 1;
-        let after = rms_where(&difference(&recording.force, &with.force), &cx.blocks, Block::HeldOut);
-        let gain = force_before - after;
-        let share_ok = s.explained >= NAMED_SHARE_OF_PLACE * side_share
-            && share_of_reach(&misfit, &s.fit.heldout, &downstream.weights, count) >= NAMED_MIN_SHARE;
-        let gain_ok = worth_adding(force_before, force_before - gain, noise, false);
-        let test = named_signature(
-            name,
-            recording,
-            &r.model,
-            &r.current,
-            &with.force,
-            &cx.blocks,
-            noise,
-            cx.mechanical_noise,
-        );
-        progress(&format!(
-            "  {name}: explains {:.1} % of the force against the pressures, force held-out {force_before:.4} -> {after:.4} N, signature {}",
-            100.0 * s.explained,
-            if test.present { "present" } else { "absent" }
-        ));
-        if share_ok && gain_ok && test.present {
-            let mut s = s.clone();
-            s.force_heldout_rms = after;
-            s.fit.prediction[FORCE] = with.force;
-            return Ok(Some((s, test.sentence)));
-        }
     }
     Ok(None)
 }
@@ -1009,7 +857,7 @@ fn pressures_judgement(
 /// their noise, in mean square. Two channels at their noise read √2 floors together, so a
 /// term that takes them from 2.0 to their noise gains 0.6 floor of the RMS but 2 of the mean
 /// square (a chamber 1 transducer saturating over its top 5 kPa: 1.98 -> 1.42).
-fn pressures_gain(was: &[f64; CHANNELS], now: &[f64; CHANNELS], count: f64) -> bool {
+pub(crate) fn pressures_gain(was: &[f64; CHANNELS], now: &[f64; CHANNELS], count: f64) -> bool {
     let in_noise = |h: &[f64; CHANNELS]| ((h[1] + h[2]) / count).sqrt();
     let (was, now) = (in_noise(was), in_noise(now));
     was - now >= MIN_RELATIVE_GAIN * was && was * was - now * now >= MIN_GAIN_IN_NOISE
@@ -1083,23 +931,6 @@ fn add_effect(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_named_share_counts_what_is_above_the_noise_in_the_channels_the_candidate_moves() {
-        let (all, count) = ([1.0; CHANNELS], 1000.0);
-        // 1.5 floors of force and 1.4 of each pressure: half of it is noise. Taking the
-        // channels to their noise takes all that could be taken, half the misfit.
-        let before = [2250.0, 1960.0, 1960.0];
-        assert!((share_of_reach(&before, &[1000.0; CHANNELS], &all, count) - 1.0).abs() < 1e-12);
-        let halfway = [1625.0, 1480.0, 1480.0];
-        assert!((share_of_reach(&before, &halfway, &all, count) - 0.5).abs() < 1e-12);
-        // A force-side term leaves the pressures exactly: their departure is not its to take.
-        let before = [4000.0, 3000.0, 1000.0];
-        assert!((share_of_reach(&before, &[1000.0, 3000.0, 1000.0], &all, count) - 1.0).abs() < 1e-12);
-        assert!((share_of_reach(&before, &[2500.0, 3000.0, 1000.0], &all, count) - 0.5).abs() < 1e-12);
-        // Nothing above the noise: nothing to take.
-        assert_eq!(share_of_reach(&[900.0; CHANNELS], &[800.0; CHANNELS], &all, count), 0.0);
-    }
 
     #[test]
     fn a_term_that_takes_many_floors_off_the_training_blocks_needs_less_of_the_held_out_ones() {

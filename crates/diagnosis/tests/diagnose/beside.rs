@@ -188,3 +188,35 @@ fn a_smooth_friction_beside_a_force_sensor_filter_without_pressures_is_the_named
     );
     assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
 }
+
+/// Dead volumes (1.5 and 1.0 cm³) beside a laminar leak out of chamber 1 to the return
+/// (8e-12 kg/(s·Pa)) under a staircase at 1 kHz with pressures. Alone, each of the dead
+/// volumes and the heat exchange makes a chamber's pressure worse, the leak being the other
+/// half of the pressures' departure, and nothing was added: the dead volumes are named with
+/// the leak beside them, fitted together, each within a tenth of its size.
+#[test]
+fn dead_volumes_beside_a_laminar_leak_out_of_chamber_1_are_the_named_dead_volumes_with_the_leak_beside_them() {
+    let effects = BenchEffects {
+        dead_volume_1: 1.5e-6,
+        dead_volume_2: 1.0e-6,
+        undeclared: UndeclaredEffects {
+            laminar_leak_1: 8e-12,
+            ..UndeclaredEffects::default()
+        },
+        ..BenchEffects::default()
+    };
+    let spec = ProtocolSpec {
+        command: CommandProtocol::Staircase,
+        sample_rate: 1000.0,
+        duration: 20.0,
+        seed: 5,
+        ..ProtocolSpec::default()
+    };
+    let d = diagnosed("dead-volumes-leak", spec, &effects);
+    assert_eq!(names(&d), ["dead_volume"], "{:?}", d.summary());
+    for (name, size) in [("dead_volume_1", 1.5e-6), ("dead_volume_2", 1.0e-6), ("chamber_laminar_vent_1", 8e-12)] {
+        let value = parameter(&d, name);
+        assert!((value / size - 1.0).abs() < 0.1, "{name} = {value}");
+    }
+    assert_eq!(d.verdict(), "explained", "{}", d.summary()[0]);
+}
