@@ -214,7 +214,11 @@ fn dead_volumes_beside_a_laminar_leak_out_of_chamber_1_are_the_named_dead_volume
     };
     let d = diagnosed("dead-volumes-leak", spec, &effects);
     assert_eq!(names(&d), ["dead_volume"], "{:?}", d.summary());
-    for (name, size) in [("dead_volume_1", 1.5e-6), ("dead_volume_2", 1.0e-6), ("chamber_laminar_vent_1", 8e-12)] {
+    for (name, size) in [
+        ("dead_volume_1", 1.5e-6),
+        ("dead_volume_2", 1.0e-6),
+        ("chamber_laminar_vent_1", 8e-12),
+    ] {
         let value = parameter(&d, name);
         assert!((value / size - 1.0).abs() < 0.1, "{name} = {value}");
     }

@@ -82,8 +82,10 @@ impl StaticCurve {
 
     /// The least v that the curve takes to `y` or above: the curve undone where it rises,
     /// and the start of a flat end for a reading at or beyond its level (a saturated
-    /// transducer's lowest quantity that reads so). `y` itself when off; `None` for a curve
-    /// that falls anywhere, which has no such inverse.
+    /// transducer's lowest quantity that reads so). `y` itself when off. A curve that falls
+    /// somewhere (a fitted curve that dips where the noise lets it) has no such inverse, and
+    /// gives the preimage of `y` nearest `y`, as a transducer's curve departs little from
+    /// its identity; `None` when it has none.
     pub fn inverse(&self, y: f64) -> Option<f64> {
         let n = self.len();
         if n < 2 {
@@ -92,11 +94,24 @@ impl StaticCurve {
         // Knot values a rounding apart are one level (a fitted curve's flat end is a sum of
         // increments, and its knots differ in the last bit).
         let level = 1e-12 * self.y[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let along = |k: usize| self.x[k] + (y - self.y[k]) * (self.x[k + 1] - self.x[k]) / (self.y[k + 1] - self.y[k]);
         if (1..n).any(|k| self.y[k] < self.y[k - 1] - level) {
-            return None;
+            let mut nearest: Option<f64> = None;
+            for k in 0..n - 1 {
+                if (self.y[k + 1] - self.y[k]).abs() <= level {
+                    continue;
+                }
+                let v = along(k);
+                // The end segments extend beyond their knots, as `at` does.
+                let from = if k == 0 { f64::NEG_INFINITY } else { self.x[k] };
+                let to = if k == n - 2 { f64::INFINITY } else { self.x[k + 1] };
+                if v >= from && v <= to && nearest.map_or(true, |m| (v - y).abs() < (m - y).abs()) {
+                    nearest = Some(v);
+                }
+            }
+            return nearest;
         }
         let rises = |k: usize| self.y[k + 1] > self.y[k] + level;
-        let along = |k: usize| self.x[k] + (y - self.y[k]) * (self.x[k + 1] - self.x[k]) / (self.y[k + 1] - self.y[k]);
         if y <= self.y[0] {
             // Below the first knot, along the first segment when it rises.
             return Some(if rises(0) { along(0) } else { self.x[0] });
@@ -148,7 +163,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_curve_is_undone_where_it_rises_and_at_the_start_of_a_flat_end() {
+    fn a_curve_is_undone_where_it_rises_at_the_start_of_a_flat_end_and_where_it_dips_nearest_the_reading() {
         // The identity up to 40, flat at 40 beyond: a saturation.
         let c = StaticCurve::through(&[0.0, 20.0, 40.0, 90.0], &[0.0, 20.0, 40.0, 40.0]);
         for v in [-5.0, 3.0, 25.0, 39.5] {
@@ -162,8 +177,18 @@ mod tests {
         assert_eq!(dz.inverse(0.0), Some(-1.0));
         assert!((dz.inverse(2.0).unwrap() - 3.0).abs() < 1e-12);
         assert_eq!(StaticCurve::default().inverse(7.0), Some(7.0));
+        // A curve that dips: the preimage nearest the reading.
         let falls = StaticCurve::through(&[0.0, 1.0, 2.0], &[0.0, 2.0, 1.0]);
-        assert_eq!(falls.inverse(1.5), None);
+        assert_eq!(falls.inverse(1.5), Some(1.5));
+        let dips = StaticCurve::through(&[0.0, 1.0, 2.0, 3.0], &[0.0, 1.1, 1.0, 3.0]);
+        assert!((dips.inverse(1.05).unwrap() - 1.05 / 1.1).abs() < 1e-12);
+        assert!((dips.inverse(2.0).unwrap() - 2.5).abs() < 1e-12);
+        assert!(
+            (dips.inverse(-1.0).unwrap() - -1.0 / 1.1).abs() < 1e-12,
+            "along the first segment"
+        );
+        // A reading above all that a falling last segment leaves it: no preimage.
+        assert_eq!(falls.inverse(5.0), None);
         // A flat end whose knots differ in the last bit is flat.
         let rounded = StaticCurve::through(
             &[0.0, 1.0, 2.0, 3.0],
