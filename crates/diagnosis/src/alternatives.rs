@@ -57,19 +57,7 @@ impl Check<'_> {
         params: &Parameters,
         force: f64,
     ) -> DiscoveredTerm {
-        let before = self.force_before;
-        DiscoveredTerm {
-            location: candidate.location,
-            family: crate::curves::family(candidate.family, &set),
-            candidate: candidate.label,
-            reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
-            parameters: set,
-            heldout_before: before,
-            heldout_after: force,
-            share: 1.0 - (force / before).powi(2),
-            pressures_heldout: None,
-            tied_locations: vec![],
-        }
+        DiscoveredTerm::fitted(candidate, set, params, self.force_before, force)
     }
 }
 

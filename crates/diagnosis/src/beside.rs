@@ -201,18 +201,7 @@ pub(crate) fn best_beside_earlier(
         "adding a {} at the {}, the earlier additions refitted beside it",
         candidate.label, candidate.location
     ));
-    let term = DiscoveredTerm {
-        location: candidate.location,
-        family: candidate.family,
-        candidate: candidate.label,
-        reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
-        parameters: set,
-        heldout_before: force_before,
-        heldout_after: after,
-        share: 1.0 - (after / force_before).powi(2),
-        pressures_heldout: None,
-        tied_locations: vec![],
-    };
+    let term = DiscoveredTerm::fitted(candidate, set, params, force_before, after);
     Ok(Some((Some(term), trial)))
 }
 

@@ -356,6 +356,32 @@ pub struct DiscoveredTerm {
     pub tied_locations: Vec<&'static str>,
 }
 
+impl DiscoveredTerm {
+    /// The fitted `candidate`, carried by the model parameters `set` (read against their
+    /// values in `params`), as a term that takes the held-out force error from `before` to
+    /// `after`; its family as the fitted shape reads (a curve that flattens is a limit).
+    pub(crate) fn fitted(
+        candidate: &Candidate,
+        set: Vec<(&'static str, f64)>,
+        params: &Parameters,
+        before: f64,
+        after: f64,
+    ) -> Self {
+        DiscoveredTerm {
+            location: candidate.location,
+            family: crate::curves::family(candidate.family, &set),
+            candidate: candidate.label,
+            reading: discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+            parameters: set,
+            heldout_before: before,
+            heldout_after: after,
+            share: 1.0 - (after / before).powi(2),
+            pressures_heldout: None,
+            tied_locations: vec![],
+        }
+    }
+}
+
 /// What is left when the verdict is not "explained".
 #[derive(Clone, Debug)]
 pub struct Unexplained {

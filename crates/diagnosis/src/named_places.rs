@@ -267,19 +267,7 @@ pub(crate) fn named_with_term(
         "adding {name} with the {} at the {} beside it",
         member.label, member.location
     ));
-    let share = 1.0 - (judged.after / r.force_before).powi(2);
-    let term = DiscoveredTerm {
-        location: member.location,
-        family: member.family,
-        candidate: member.label,
-        reading: discover::reading(member.label, member.location, member.family, &set, params),
-        parameters: set,
-        heldout_before: r.force_before,
-        heldout_after: judged.after,
-        share,
-        pressures_heldout: None,
-        tied_locations: vec![],
-    };
+    let term = DiscoveredTerm::fitted(member, set, params, r.force_before, judged.after);
     let sentence = format!(
         "{}alone it {}, and fitted together with the {} at the {} beside it (the other half of the departure) the held-out force error goes to {:.4} N",
         if half.sentence.is_empty() { String::new() } else { format!("{}; ", half.sentence) },

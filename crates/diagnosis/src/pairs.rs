@@ -363,18 +363,11 @@ pub(crate) fn best_pair(
         "adding the {} at the {} and the {} at the {} together",
         a.label, a.location, b.label, b.location
     ));
-    let share = 1.0 - (after / force_before).powi(2);
-    let term = |c: &Candidate, set: Vec<(&'static str, f64)>| DiscoveredTerm {
-        location: c.location,
-        family: c.family,
-        candidate: c.label,
-        reading: discover::reading(c.label, c.location, c.family, &set, params),
-        parameters: set,
-        heldout_before: force_before,
-        heldout_after: after,
-        share,
-        pressures_heldout: None,
-        tied_locations: vec![],
-    };
-    Ok(Some((vec![term(a, set_a), term(b, set_b)], trial)))
+    Ok(Some((
+        vec![
+            DiscoveredTerm::fitted(a, set_a, params, force_before, after),
+            DiscoveredTerm::fitted(b, set_b, params, force_before, after),
+        ],
+        trial,
+    )))
 }
