@@ -285,9 +285,13 @@ pub(crate) fn localize(
     // The static curves fitted through the model (the command's, the discharge
     // coefficient's) are always refined when worth it: one Gauss–Newton step from the
     // identity leaves them behind the single-constant candidates they compete with.
+    // So are the transducers' lags, which the refining pass searches through the model where
+    // it reads them between samples (`Problem::fit`): on the samples a lag within one can
+    // rank below a delay of the command.
     for s in scored.iter().filter(|s| s.explained >= WORTH_REFINING) {
-        let curve =
-            crate::curves::is_command_curve(&s.fit.candidate) || crate::discharge::is_discharge_curve(&s.fit.candidate);
+        let curve = crate::curves::is_command_curve(&s.fit.candidate)
+            || crate::discharge::is_discharge_curve(&s.fit.candidate)
+            || is_lag(&s.fit.candidate);
         if curve && !leaders.contains(&s.fit.candidate) {
             leaders.push(s.fit.candidate.clone());
         }
@@ -316,6 +320,14 @@ pub(crate) fn localize(
         progress(&format!("  {l:<16} explains {:5.1} % ({label})", 100.0 * e));
     }
     (rank(&mut scored), replays)
+}
+
+/// Whether a candidate is a transducer's lag alone.
+fn is_lag(candidate: &Candidate) -> bool {
+    matches!(
+        candidate.terms.as_slice(),
+        [t] if matches!(t.mechanism, Mechanism::OutputFilter { filter: crate::corrections::Filter::Lag, .. })
+    )
 }
 
 /// Rank the places of the chain by their best candidate.

@@ -35,6 +35,17 @@ impl Channel {
     pub const ALL: [Channel; 3] = [Channel::Force, Channel::Pressure1, Channel::Pressure2];
 }
 
+/// The most parts a step is recorded in by a transducer that lags or filters
+/// ([`SensorLaw::parts_over`]).
+pub const MAX_RECORDED_PARTS: usize = 16;
+
+/// The longest part of a step a lagging or filtering transducer is recorded over, however
+/// slow it is (s). After a command step the force rises within about a millisecond; read as
+/// one chord over a 4 ms sample, it reached a 10 ms force-sensor lag early, and such a lag
+/// under a PRBS at 250 Hz was 0.028 N (0.56 noise floors) from the same lag recorded every
+/// 0.5 ms. Recorded every millisecond, it is 0.0045 N.
+pub const LONGEST_RECORDED_PART: f64 = 1e-3;
+
 /// One transducer's law, taken from the parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SensorLaw {
@@ -142,6 +153,26 @@ impl SensorLaw {
     /// Whether the transducer filters its reading (and so has a memory).
     pub fn filters(&self) -> bool {
         self.delay > 0.0 || self.lag > 0.0 || self.filter_frequency > 0.0 || self.play > 0.0
+    }
+
+    /// The equal parts a step of `step` seconds is recorded in by this transducer: parts no
+    /// longer than its lag or 1/(2π f) of its filter, nor than [`LONGEST_RECORDED_PART`], at
+    /// most [`MAX_RECORDED_PARTS`]; one where it neither lags nor filters. Its memory takes the
+    /// quantity it reads as linear between the points it is recorded at; a 112 Hz force sensor
+    /// recorded only at the 4 ms samples of a 250 Hz recording read the force's corners as
+    /// chords and left 1.8 noise floors that a sensor following the force itself does not.
+    pub fn parts_over(&self, step: f64) -> usize {
+        let lag = if self.lag > 0.0 { self.lag } else { f64::INFINITY };
+        let filter = if self.filter_frequency > 0.0 {
+            1.0 / (2.0 * std::f64::consts::PI * self.filter_frequency)
+        } else {
+            f64::INFINITY
+        };
+        let fastest = lag.min(filter);
+        if !fastest.is_finite() || step.is_nan() || step <= 0.0 {
+            return 1;
+        }
+        ((step / fastest.min(LONGEST_RECORDED_PART)).ceil() as usize).clamp(1, MAX_RECORDED_PARTS)
     }
 
     /// Whether the reading is the value itself (the second-order filter's damping matters

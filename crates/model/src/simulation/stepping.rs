@@ -16,17 +16,6 @@ use crate::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use crate::physics::sensors::{Channel, SensorLaw};
 use crate::physics::time_varying;
 
-/// The most parts a step is recorded in by the transducers that filter
-/// ([`Simulation::transducer_parts`]).
-pub const MAX_TRANSDUCER_PARTS: usize = 16;
-
-/// The longest part of a step a lagging or filtering transducer is recorded over, however
-/// slow it is (s). After a command step the force rises within about a millisecond; read as
-/// one chord over a 4 ms sample, it reached a 10 ms force-sensor lag early, and such a lag
-/// under a PRBS at 250 Hz was 0.028 N (0.56 noise floors) from the same lag recorded every
-/// 0.5 ms. Recorded every millisecond, it is 0.0045 N.
-pub const LONGEST_TRANSDUCER_PART: f64 = 1e-3;
-
 impl Simulation {
     /// How long into a step of length `step` the jet pipe's ringing still moves the
     /// pressures by more than a hundredth of the tolerance (0 if never; the whole step,
@@ -212,35 +201,18 @@ impl Simulation {
     }
 
     /// How many equal parts a step of `step` seconds is recorded in by the transducers that
-    /// lag or filter: parts no longer than the fastest one's lag or 1/(2π f) of its filter,
-    /// nor than [`LONGEST_TRANSDUCER_PART`], at most [`MAX_TRANSDUCER_PARTS`]. A transducer's
-    /// memory takes the quantity it reads as linear between the points it is recorded at; a
-    /// 112 Hz force sensor recorded only at the 4 ms samples of a 250 Hz recording read the
-    /// force's corners as chords and left 1.8 noise floors that a sensor following the force
-    /// itself does not.
+    /// lag or filter: the most any of them asks for ([`SensorLaw::parts_over`]).
     pub(super) fn transducer_parts(&self, step: f64) -> usize {
-        if !self.plan.filtering_transducers || step.is_nan() || step <= 0.0 {
+        if !self.plan.filtering_transducers {
             return 1;
         }
-        let fastest = Channel::ALL
+        Channel::ALL
             .iter()
             .zip(&self.transducers)
             .filter(|(_, memory)| memory.is_some())
-            .map(|(&channel, _)| {
-                let law = SensorLaw::of(&self.model.params, channel);
-                let lag = if law.lag > 0.0 { law.lag } else { f64::INFINITY };
-                let filter = if law.filter_frequency > 0.0 {
-                    1.0 / (2.0 * std::f64::consts::PI * law.filter_frequency)
-                } else {
-                    f64::INFINITY
-                };
-                lag.min(filter)
-            })
-            .fold(f64::INFINITY, f64::min);
-        if !fastest.is_finite() {
-            return 1;
-        }
-        ((step / fastest.min(LONGEST_TRANSDUCER_PART)).ceil() as usize).clamp(1, MAX_TRANSDUCER_PARTS)
+            .map(|(&channel, _)| SensorLaw::of(&self.model.params, channel).parts_over(step))
+            .max()
+            .unwrap_or(1)
     }
 
     /// Advance over the step's command `segments` (which span `step` seconds), recording the
