@@ -943,7 +943,7 @@ impl Problem<'_> {
             }
             let prediction = match term.mechanism {
                 Mechanism::OutputFilter { channel, filter } => {
-                    match self.lag_read_by_the_model(channel, filter, value, golden_steps) {
+                    match self.lag_read_by_the_model(channel, filter, value, golden_steps >= GOLDEN_STEPS) {
                         Some(name) => {
                             replays += 1;
                             let mut p = self.base.clone();
@@ -1008,43 +1008,6 @@ impl Problem<'_> {
 }
 
 impl Problem<'_> {
-    /// The model parameter through which a lag of `value` seconds on `channel` is searched,
-    /// where it is searched through the model rather than on the samples: where the
-    /// model's transducer reads the quantity between samples ([`SensorLaw::parts_over`]), and
-    /// the base model's transducer there neither lags nor filters. On the samples the
-    /// quantity is a chord from each to the next; a force that a closed loop at 250 Hz drove
-    /// by 7 N from sample to sample read a 0.53 ms lag as anything but one (the force sensor's
-    /// lag explained less than a command delay, which was named), where the model's lag
-    /// follows the force it computes between them. Only the refining pass searches so
-    /// (`golden_steps` of it): a transducer recorded in up to 16 parts of each sample makes
-    /// each replay the slowest of a round, and in the first pass, over every candidate of
-    /// every round, it more than doubled the test cases' time.
-    fn lag_read_by_the_model(
-        &self,
-        channel: usize,
-        filter: Filter,
-        value: f64,
-        golden_steps: usize,
-    ) -> Option<&'static str> {
-        if filter != Filter::Lag || golden_steps < GOLDEN_STEPS {
-            return None;
-        }
-        let time = &self.recording.time;
-        let n = time.len();
-        if n < 2 {
-            return None;
-        }
-        let interval = (time[n - 1] - time[0]) / (n - 1) as f64;
-        let law = SensorLaw::of(self.base, Channel::ALL[channel]);
-        let fresh = law.lag <= 0.0 && law.filter_frequency <= 0.0;
-        let lagged = SensorLaw { lag: value, ..law };
-        if fresh && lagged.parts_over(interval) > 1 {
-            filter.sensor_parameter(channel)
-        } else {
-            None
-        }
-    }
-
     /// The command quantiser ([`crate::quantiser`]): the leading periods of the residual in
     /// the command, each under the four conventions, and the steps of coarser converters
     /// over the logger's span, rounding and truncating, are tried in the model; the best is
