@@ -169,7 +169,15 @@ pub(crate) fn run_rounds(
         let added = match added {
             Some(Addition::Discovered(mut term, trial, s)) if term.tied_locations.is_empty() => {
                 term.tied_locations = found.tied_with(term.location);
-                let undecided = found.undecided_beside(term.location, cx.pressure_noise.is_some());
+                let mut undecided = found.undecided_beside(term.location, cx.pressure_noise.is_some());
+                if crate::modulation::is_static_function_of_the_command(&term.parameters)
+                    && crate::modulation::COMMAND_PATH.contains(&term.location)
+                {
+                    term.tied_locations = crate::modulation::tied_along_the_command_path(term.location);
+                    undecided = Some(
+                        "a static curve of the command acts alike at the command, in the current driver and at the torque motor, which a command slower than the driver does not tell apart".to_string(),
+                    );
+                }
                 term.reading = with_undecided(std::mem::take(&mut term.reading), undecided);
                 Some(Addition::Discovered(term, trial, s))
             }
