@@ -278,6 +278,24 @@ pub fn set_parameter(p: &mut Parameters, name: &str, value: f64) -> Result<(), S
     p.set(value_reference(name), value)
 }
 
+/// `params` with each parameter of `set` back at its value in `start`: the model without the
+/// addition that set them. `Err` (the model's reason) when the model refuses that, because a
+/// later term leans on the value (a dead volume varying in time, added beside a named dead
+/// volume, takes the volume below 0 once the named one is removed); no rival can then stand
+/// in the addition's place, and the caller keeps it rather than stopping the diagnosis.
+pub fn without_addition(
+    params: &Parameters,
+    start: &Parameters,
+    set: &[(&'static str, f64)],
+) -> Result<Parameters, String> {
+    let mut without = params.clone();
+    for (name, _) in set {
+        set_parameter(&mut without, name, parameter_value(start, name))?;
+    }
+    without.validate()?;
+    Ok(without)
+}
+
 /// A name built at run time (a generated candidate's parameter or label) as the `&'static str`
 /// the candidates carry: each distinct text is leaked once and shared afterwards, so the
 /// memory held is bounded by the number of distinct generated names.
@@ -356,6 +374,37 @@ mod tests {
             .unwrap();
         let start = &corner.terms[0];
         assert_eq!(start.mechanism.model_value(start.neutral), base.omega_cd);
+    }
+
+    #[test]
+    fn an_addition_a_later_term_leans_on_cannot_be_removed_and_says_why_while_one_alone_can() {
+        use jetpipe_model::physics::modulation::ModulationSignal;
+        let start = Parameters::default();
+        let mut named = start.clone();
+        set_parameter(&mut named, "dead_volume_1", 1e-6).unwrap();
+        let dead_volume = [("dead_volume_1", 1e-6)];
+        let alone = without_addition(&named, &start, &dead_volume).unwrap();
+        assert_eq!(alone, start);
+        // A term added later lets the volume wander in time down to 0.1 cm3 (valid with the
+        // named 1 cm3, below 0 without it).
+        let mut leaning = named.clone();
+        for (name, value) in [
+            (
+                "modulation_1_parameter",
+                f64::from(jetpipe_model::variables::vr::DEAD_VOLUME_1),
+            ),
+            ("modulation_1_signal", f64::from(ModulationSignal::Time.code())),
+            ("modulation_1_knots", 2.0),
+            ("modulation_1_x_1", 0.0),
+            ("modulation_1_x_2", 10.0),
+            ("modulation_1_y_1", -0.9e-6),
+            ("modulation_1_y_2", 0.5e-6),
+        ] {
+            set_parameter(&mut leaning, name, value).unwrap();
+        }
+        leaning.validate().unwrap();
+        let why = without_addition(&leaning, &start, &dead_volume).unwrap_err();
+        assert!(why.contains("dead_volume_1"), "{why}");
     }
 
     #[test]

@@ -15,6 +15,7 @@
 //! the term may be standing in for part of it, and a name would claim what it cannot show.
 
 use super::*;
+use crate::corrections::without_addition;
 use crate::localize::terms_used;
 use crate::rounds::Findings;
 
@@ -85,10 +86,16 @@ fn named_in_place_of(
     if named.is_empty() {
         return Ok(None);
     }
-    let mut without = f.params.clone();
-    for (name, _) in &term.parameters {
-        set_parameter(&mut without, name, parameter_value(&f.start, name))?;
-    }
+    let without = match without_addition(&f.params, &f.start, &term.parameters) {
+        Ok(without) => without,
+        Err(why) => {
+            progress(&format!(
+                "named effects in place of the {} not tried: the model without it is refused ({why})",
+                term.candidate
+            ));
+            return Ok(None);
+        }
+    };
     let count = heldout_count(&cx.blocks) as f64;
     let penalty = discovery_penalty_per_term(count);
     let (term_misfit, term_force) = alternatives::judge(

@@ -10,6 +10,7 @@
 //! within a penalty either way leaves the two tied, which the report says.
 
 use super::*;
+use crate::corrections::without_addition;
 use crate::named_instead::{best_named_fit, refitted_beside};
 use crate::rounds::Findings;
 
@@ -111,10 +112,16 @@ fn rival_in_place_of(
     if rivals.is_empty() {
         return Ok(Settled::Kept);
     }
-    let mut without = f.params.clone();
-    for (name, _) in &effect.parameters {
-        set_parameter(&mut without, name, parameter_value(&f.start, name))?;
-    }
+    let without = match without_addition(&f.params, &f.start, &effect.parameters) {
+        Ok(without) => without,
+        Err(why) => {
+            progress(&format!(
+                "{}'s rivals not tried: the model without it is refused ({why})",
+                effect.name
+            ));
+            return Ok(Settled::Kept);
+        }
+    };
     let penalty = discovery_penalty_per_term(heldout_count(&cx.blocks) as f64);
     let problem = Problem::new(cx.recording, &without, &cx.blocks, cx.channel_noise);
     let (own_misfit, own_force) = alternatives::judge(cx, &problem, &f.params, replays)?;

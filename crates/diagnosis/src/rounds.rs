@@ -255,8 +255,15 @@ pub(crate) fn run_rounds(
         }
         f.stages.push(Stage::of(&f));
     }
-    let renamed = crate::named_rivals::settle_rivals(cx, &mut f, replays, progress)?;
-    if crate::named_instead::named_instead_of_discovered(cx, &mut f, replays, progress)? || renamed {
+    let renamed = second_opinion(
+        crate::named_rivals::settle_rivals(cx, &mut f, replays, progress),
+        progress,
+    );
+    let instead = second_opinion(
+        crate::named_instead::named_instead_of_discovered(cx, &mut f, replays, progress),
+        progress,
+    );
+    if instead || renamed {
         // The last joint refit was of the additions before the names changed.
         f.joint_refit = None;
         // The last round's findings are these now: going back to it keeps the name.
@@ -268,6 +275,17 @@ pub(crate) fn run_rounds(
     }
     crate::eliminate::attribute_from_joint_fit(cx, &mut f, replays, progress)?;
     Ok(f)
+}
+
+/// Whether a second opinion on the names may have changed any. One the model refuses stops
+/// there, the findings as they stand (each replacement is made whole or not at all), rather
+/// than leave the user without a report; it counts as a change, so the last stage is taken
+/// from the findings again.
+fn second_opinion(outcome: Result<bool, String>, progress: &mut dyn FnMut(&str)) -> bool {
+    outcome.unwrap_or_else(|why| {
+        progress(&format!("the names' second opinion stopped: {why}"));
+        true
+    })
 }
 
 /// Every addition's constants and reading as they now stand in the parameters.
