@@ -14,9 +14,9 @@ const COARSE_GOLDEN_STEPS: usize = 10;
 /// scale, a second-order filter's damping): 0.618^7 = 3 % of the range, as each of its
 /// points costs a whole inner search.
 const FIRST_PASS_OUTER_STEPS: usize = 7;
-/// Points of the grid from which a golden-section search is started again when one of
-/// them does better than where the search over the whole range ended: the first pass's
-/// ranking and the shape searches, then the leaders' refinement.
+/// Points of the grid a search starts from (the golden-section search then runs between
+/// the best point's neighbours): the first pass's ranking and the shape searches, then the
+/// leaders' refinement.
 const COARSE_GRID: usize = 5;
 const FINE_GRID: usize = 9;
 /// Steps along a Gauss–Newton direction tried on the true model, each half the last.
@@ -54,30 +54,43 @@ fn golden(a: f64, b: f64, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, 
     }
 }
 
-/// A golden-section search of a cost on u ∈ [0, 1] that may have more than one valley,
-/// started from several points: the search over the whole range, and the cost on a grid of
-/// `grid` points (the ends included); when a grid point does better than where the search
-/// ended (it followed another valley), the search again between that point's neighbours.
-/// The best u found and its cost: never worse than the single search.
+/// A search of a cost on u ∈ [0, 1] that may have more than one valley: the cost on a grid
+/// of `grid` points (the ends included), then a golden-section search between the best grid
+/// point's neighbours, to the bracket that `steps` golden-section steps leave of the whole
+/// range (0.618^steps). A cost with one valley has its minimum between the best grid point's
+/// neighbours, so the grid does what a first search over the whole range did, and saves its
+/// replays; with several valleys it follows the deepest the grid sees. The best u found and
+/// its cost: never worse than the best grid point.
 pub(crate) fn golden_from_several(grid: usize, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
-    let (mut best_u, mut best) = golden(0.0, 1.0, steps, f);
-    if grid >= 3 {
-        let h = 1.0 / (grid - 1) as f64;
-        let mut start = (best_u, best);
-        for i in 0..grid {
-            let u = i as f64 * h;
-            let cost = f(u);
-            if cost < start.1 {
-                start = (u, cost);
-            }
-        }
-        if start.1 < best {
-            let u0 = start.0;
-            let (u, cost) = golden((u0 - h).max(0.0), (u0 + h).min(1.0), steps, f);
-            (best_u, best) = if cost < start.1 { (u, cost) } else { start };
+    if grid < 3 {
+        return golden(0.0, 1.0, steps, f);
+    }
+    let h = 1.0 / (grid - 1) as f64;
+    let mut best = (0.0, f64::INFINITY);
+    for i in 0..grid {
+        let u = i as f64 * h;
+        let cost = f(u);
+        // (a NaN cost never becomes the best)
+        if cost < best.1 || (i == 0 && !cost.is_nan()) {
+            best = (u, cost);
         }
     }
-    (best_u, best)
+    let (a, b) = ((best.0 - h).max(0.0), (best.0 + h).min(1.0));
+    let local_steps = golden_steps_within(b - a, steps);
+    let (u, cost) = golden(a, b, local_steps, f);
+    if cost < best.1 {
+        (u, cost)
+    } else {
+        best
+    }
+}
+
+/// The golden-section steps that shrink a bracket of `width` (of the whole range 1) at least
+/// as far as `steps` steps shrink the whole range.
+fn golden_steps_within(width: f64, steps: usize) -> usize {
+    let phi = (5f64.sqrt() - 1.0) / 2.0;
+    let saved = (width.ln() / phi.ln()).floor().max(0.0) as usize;
+    steps.saturating_sub(saved)
 }
 
 /// The fixed part of a fitting problem: the recording, the base model, the blocks and
