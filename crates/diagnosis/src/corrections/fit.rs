@@ -25,9 +25,12 @@ const LINE_SEARCH_STEPS: usize = 4;
 /// direction lowers the misfit.
 const MARQUARDT_DAMPINGS: [f64; 4] = [0.01, 0.1, 1.0, 100.0];
 
+/// (√5 − 1)/2: the share of its bracket a golden-section step keeps.
+const GOLDEN_SHARE: f64 = 0.618_033_988_749_894_9;
+
 /// Golden-section search of `steps` steps on [a, b]: the best point and its cost.
 fn golden(a: f64, b: f64, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
-    let phi = (5f64.sqrt() - 1.0) / 2.0;
+    let phi = GOLDEN_SHARE;
     let (mut a, mut b) = (a, b);
     let mut c = b - phi * (b - a);
     let mut d = a + phi * (b - a);
@@ -71,7 +74,7 @@ pub(crate) fn golden_from_several(grid: usize, steps: usize, f: &mut dyn FnMut(f
         let u = i as f64 * h;
         let cost = f(u);
         // (a NaN cost never becomes the best)
-        if cost < best.1 || (i == 0 && !cost.is_nan()) {
+        if cost < best.1 {
             best = (u, cost);
         }
     }
@@ -88,8 +91,7 @@ pub(crate) fn golden_from_several(grid: usize, steps: usize, f: &mut dyn FnMut(f
 /// The golden-section steps that shrink a bracket of `width` (of the whole range 1) at least
 /// as far as `steps` steps shrink the whole range.
 fn golden_steps_within(width: f64, steps: usize) -> usize {
-    let phi = (5f64.sqrt() - 1.0) / 2.0;
-    let saved = (width.ln() / phi.ln()).floor().max(0.0) as usize;
+    let saved = (width.ln() / GOLDEN_SHARE.ln()).floor().max(0.0) as usize;
     steps.saturating_sub(saved)
 }
 
