@@ -185,7 +185,7 @@ mod tests {
             time,
             v_da,
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

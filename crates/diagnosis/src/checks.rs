@@ -198,7 +198,7 @@ mod tests {
             p2: pressures.map(|(_, b)| vec![b; n]),
             time,
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

@@ -93,7 +93,8 @@ pub(crate) fn conclude(
         let ratio = departure / noise;
         if ratio > agreement::AGREEMENT_WITHIN_NOISE {
             let sentence = format!(
-                "The fits' fixed-step replay ({} ms steps) of the final model departs from its error-controlled replay by {departure:.4} N of force ({ratio:.2} noise floors), more than the {} noise floor it was held to on the starting model: the additions were scored on a replay that parts from the accurate one; every error reported is the accurate replay's",
+                "The fits' fixed-step replay ({}{} ms steps) of the final model departs from its error-controlled replay by {departure:.4} N of force ({ratio:.2} noise floors), more than the {} noise floor it was held to on the starting model: the additions were scored on a replay that parts from the accurate one; every error reported is the accurate replay's",
+                if fast_replay.third_order { "third-order, " } else { "" },
                 fast_replay.step * 1e3,
                 agreement::AGREEMENT_WITHIN_NOISE
             );

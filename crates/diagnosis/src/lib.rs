@@ -798,7 +798,7 @@ fn diagnose_unguarded(
     progress("the starting model replayed with the error-controlled integrator");
     let before_accurate = replay(&before_model, &smoothed, 1e-5, smoothed.len())?;
     let fast_replay = agreement::fast_step_that_agrees(&before_model, &smoothed, &before_accurate)?;
-    smoothed.fast_replay_step = fast_replay.step;
+    smoothed.fast_replay = fast_replay.method();
     if let Some(sentence) = fast_replay.sentence() {
         progress(&sentence);
         input_checks.push(sentence);

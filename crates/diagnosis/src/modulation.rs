@@ -964,7 +964,10 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
-            fast_replay_step: 1e-3,
+            fast_replay: crate::replay::FastReplayMethod {
+                step: 1e-3,
+                third_order: false,
+            },
             acceleration_window: 0.0,
         };
         let blocks: Vec<Block> = (0..n)

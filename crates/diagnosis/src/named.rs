@@ -281,7 +281,7 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

@@ -323,7 +323,7 @@ mod tests {
             p2: None,
             time,
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         };
         let base = Parameters::default();

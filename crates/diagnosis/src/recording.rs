@@ -17,10 +17,11 @@ pub struct Recording {
     /// the inputs at every sample of the longer one, which the replays integrate, and which of
     /// its samples the rows are. `None` for a recording as read.
     pub full_rate: Option<std::sync::Arc<FullRateInputs>>,
-    /// The longest step of the fixed-step replays the fits use ([`crate::replay::replay_fast`]):
-    /// [`crate::replay::MAX_FAST_STEP`], or shorter where that replay departs from the
-    /// error-controlled one ([`crate::agreement::fast_step_that_agrees`]).
-    pub fast_replay_step: f64,
+    /// How the fixed-step replays the fits use step ([`crate::replay::replay_fast`]): ROS2 with
+    /// steps of at most [`crate::replay::MAX_FAST_STEP`], or the cheapest shorter or
+    /// third-order stepping that agrees with the error-controlled replay where that one
+    /// departs from it ([`crate::agreement::fast_step_that_agrees`]).
+    pub fast_replay: crate::replay::FastReplayMethod,
     /// The half-width T (s) of the stopper acceleration the replays give the model as its input
     /// a_s ([`crate::acceleration`]); 0 where the model forms it from the positions.
     pub acceleration_window: f64,
@@ -298,7 +299,7 @@ impl Recording {
                     )
                 }),
             })),
-            fast_replay_step: self.fast_replay_step,
+            fast_replay: self.fast_replay,
             acceleration_window: self.acceleration_window,
         }
     }
@@ -454,7 +455,7 @@ impl Recording {
             p1: has_pressures.then_some(p1),
             p2: has_pressures.then_some(p2),
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         })
     }
@@ -481,7 +482,7 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

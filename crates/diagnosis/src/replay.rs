@@ -304,9 +304,28 @@ fn replay_from(
 /// error-controlled replay reproduces within its noise.
 pub const MAX_FAST_STEP: f64 = 1.05e-3;
 
+/// How [`replay_fast`] steps the chamber pressures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FastReplayMethod {
+    /// The longest step, s: each sample interval is stepped in equal parts of at most this.
+    pub step: f64,
+    /// ROS34PW2 (order 3, five right-hand sides a step) instead of ROS2 (order 2, three).
+    pub third_order: bool,
+}
+
+impl Default for FastReplayMethod {
+    fn default() -> Self {
+        Self {
+            step: MAX_FAST_STEP,
+            third_order: false,
+        }
+    }
+}
+
 /// A cheaper replay for fitting: the model's fixed-step simulation ([`FixedStep`]: one ROS2
 /// step of the chamber pressures per sample interval, or per equal part of at most
-/// [`MAX_FAST_STEP`], the current driver and jet pipe still propagated exactly). No error
+/// [`MAX_FAST_STEP`], the current driver and jet pipe still propagated exactly; as the
+/// recording's [`Recording::fast_replay`] says). No error
 /// control: the step (1 ms on the bench) is far below the chambers' time constants, and
 /// the accurate replay checks the final figures. Falls back to [`replay`] when the jet pipe
 /// has no modal form.
@@ -333,7 +352,7 @@ pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, sta
         jetpipe_model::simulation::DEFAULT_RELATIVE_TOLERANCE,
     )?;
     let mut sim = match FixedStep::new(simulation) {
-        Some(sim) => sim,
+        Some(sim) => sim.with_third_order(recording.fast_replay.third_order),
         None => return replay_from(model, recording, 1e-5, end, start),
     };
     let accelerations = drive.accelerations(model, recording);
@@ -351,7 +370,7 @@ pub fn replay_fast_from(model: &Actuator, recording: &Recording, end: usize, sta
         }
         sim.set_command(v_da[k])?;
         // the stopper moves linearly between samples
-        let parts = ((t[k + 1] - t[k]) / recording.fast_replay_step).ceil().max(1.0) as usize;
+        let parts = ((t[k + 1] - t[k]) / recording.fast_replay.step).ceil().max(1.0) as usize;
         if let Some(a) = &accelerations {
             sim.set_stopper_acceleration(a[k + 1])?;
         }
@@ -402,7 +421,7 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

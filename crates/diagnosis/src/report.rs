@@ -221,6 +221,7 @@ impl Diagnosis {
             "replays": self.replays,
             "fast_replay": {
                 "step_s": self.fast_replay.step,
+                "third_order": self.fast_replay.third_order,
                 "force_departure_rms_N": self.fast_replay.force_departure,
                 "force_departure_ratio_to_noise": self.fast_replay.force_ratio,
                 "pressure_departure_rms_Pa": self.fast_replay.pressure_departure.map(|p| p.to_vec()),

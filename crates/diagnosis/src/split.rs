@@ -214,7 +214,7 @@ mod tests {
             p1: Some(read(&p1_model, 1.0)),
             p2: Some(read(&p2_model, -1.0)),
             full_rate: None,
-            fast_replay_step: crate::replay::MAX_FAST_STEP,
+            fast_replay: crate::replay::FastReplayMethod::default(),
             acceleration_window: 0.0,
         };
         let replay = Replay {

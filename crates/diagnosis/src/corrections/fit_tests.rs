@@ -12,7 +12,7 @@ fn a_limit_that_clips_only_the_highest_training_level_is_found_though_held_out_r
     use super::{Block, Problem};
     use crate::corrections::{catalogue, set_parameter};
     use crate::recording::Recording;
-    use crate::replay::{replay_fast, MAX_FAST_STEP};
+    use crate::replay::{replay_fast, FastReplayMethod};
     use jetpipe_model::physics::actuator::Actuator;
     use jetpipe_model::physics::parameters::Parameters;
     let n = 8000;
@@ -27,7 +27,7 @@ fn a_limit_that_clips_only_the_highest_training_level_is_found_though_held_out_r
         p1: None,
         p2: None,
         full_rate: None,
-        fast_replay_step: MAX_FAST_STEP,
+        fast_replay: FastReplayMethod::default(),
         acceleration_window: 0.0,
     };
     let base = Parameters::default();
