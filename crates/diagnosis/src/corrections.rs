@@ -31,6 +31,7 @@ use super::signals::{difference, stopper_acceleration, stopper_velocity, CHANNEL
 
 mod catalogue;
 mod fit;
+mod search;
 
 pub use catalogue::catalogue;
 pub use fit::{Fit, Problem, Sensitivity};

@@ -1,22 +1,24 @@
 //! Fitting a candidate: bounded Gauss–Newton on the training blocks through the model's
-//! sensitivities, golden-section searches for the terms with none, held-out scores.
+//! sensitivities, searches ([`super::search`]) for the terms with none, held-out scores.
 
+use super::search::{golden, search_from_grid};
 use super::*;
 use crate::blocks::Block;
 
-/// Golden-section steps of a searched term: its bracket shrinks to 0.618^16 = 5e-4 of its
-/// range (a thousandth of a decade over three), or, for the first pass's ranking, to
-/// 0.618^10 = 8e-3 (6 % in value over three decades; a limit's range is linear, 0.8 % of
-/// it). The leaders' refinement and a discovered term's trial search to the finer bracket.
+/// The precision of a searched term, in golden-section steps: its bracket shrinks to
+/// 0.618^16 = 5e-4 of its range (a thousandth of a decade over three), or, for the first
+/// pass's ranking, to 0.618^10 = 8e-3 (6 % in value over three decades; a limit's range is
+/// linear, 0.8 % of it). The leaders' refinement and a discovered term's trial search to the
+/// finer bracket.
 const GOLDEN_STEPS: usize = 16;
 const COARSE_GOLDEN_STEPS: usize = 10;
 /// The first pass's steps of the outer search of two nested ones (a friction's second speed
 /// scale, a second-order filter's damping): 0.618^7 = 3 % of the range, as each of its
 /// points costs a whole inner search.
 const FIRST_PASS_OUTER_STEPS: usize = 7;
-/// Points of the grid a search starts from (the golden-section search then runs between
-/// the best point's neighbours): the first pass's ranking and the shape searches, then the
-/// leaders' refinement.
+/// Points of the grid a search starts from (Brent's search then runs between the best
+/// point's neighbours): the first pass's ranking and the shape searches, then the leaders'
+/// refinement.
 const COARSE_GRID: usize = 5;
 const FINE_GRID: usize = 9;
 /// Steps along a Gauss–Newton direction tried on the true model, each half the last.
@@ -24,76 +26,6 @@ const LINE_SEARCH_STEPS: usize = 4;
 /// The dampings λ a damped fit tries, in turn, when no step along the Gauss–Newton
 /// direction lowers the misfit.
 const MARQUARDT_DAMPINGS: [f64; 4] = [0.01, 0.1, 1.0, 100.0];
-
-/// (√5 − 1)/2: the share of its bracket a golden-section step keeps.
-const GOLDEN_SHARE: f64 = 0.618_033_988_749_894_9;
-
-/// Golden-section search of `steps` steps on [a, b]: the best point and its cost.
-fn golden(a: f64, b: f64, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
-    let phi = GOLDEN_SHARE;
-    let (mut a, mut b) = (a, b);
-    let mut c = b - phi * (b - a);
-    let mut d = a + phi * (b - a);
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..steps {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - phi * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + phi * (b - a);
-            fd = f(d);
-        }
-    }
-    if fc < fd {
-        (c, fc)
-    } else {
-        (d, fd)
-    }
-}
-
-/// A search of a cost on u ∈ [0, 1] that may have more than one valley: the cost on a grid
-/// of `grid` points (the ends included), then a golden-section search between the best grid
-/// point's neighbours, to the bracket that `steps` golden-section steps leave of the whole
-/// range (0.618^steps). A cost with one valley has its minimum between the best grid point's
-/// neighbours, so the grid does what a first search over the whole range did, and saves its
-/// replays; with several valleys it follows the deepest the grid sees. The best u found and
-/// its cost: never worse than the best grid point.
-pub(crate) fn golden_from_several(grid: usize, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
-    if grid < 3 {
-        return golden(0.0, 1.0, steps, f);
-    }
-    let h = 1.0 / (grid - 1) as f64;
-    let mut best = (0.0, f64::INFINITY);
-    for i in 0..grid {
-        let u = i as f64 * h;
-        let cost = f(u);
-        // (a NaN cost never becomes the best)
-        if cost < best.1 {
-            best = (u, cost);
-        }
-    }
-    let (a, b) = ((best.0 - h).max(0.0), (best.0 + h).min(1.0));
-    let local_steps = golden_steps_within(b - a, steps);
-    let (u, cost) = golden(a, b, local_steps, f);
-    if cost < best.1 {
-        (u, cost)
-    } else {
-        best
-    }
-}
-
-/// The golden-section steps that shrink a bracket of `width` (of the whole range 1) at least
-/// as far as `steps` steps shrink the whole range.
-fn golden_steps_within(width: f64, steps: usize) -> usize {
-    let saved = (width.ln() / GOLDEN_SHARE.ln()).floor().max(0.0) as usize;
-    steps.saturating_sub(saved)
-}
 
 /// The fixed part of a fitting problem: the recording, the base model, the blocks and
 /// the channels' weights.
@@ -677,10 +609,10 @@ impl Problem<'_> {
 
     /// A transform with one coefficient whose sensitivity vanishes where it is off (a
     /// limit does nothing until it clips, a slew limit until the command jumps) or that
-    /// acts on a measured channel exactly (a delay, a lag, a play): golden-section search
-    /// on the coefficient, on a logarithmic scale where it spans decades.
+    /// acts on a measured channel exactly (a delay, a lag, a play): a search on the
+    /// coefficient ([`search_from_grid`]), on a logarithmic scale where it spans decades.
     /// A candidate whose regressors share one or two shape parameters (a friction's speed
-    /// scales): golden-section search of their logarithms (the second outside the first),
+    /// scales): a search of their logarithms (the second outside the first),
     /// the linear amplitudes solved at each trial point. The first pass, which only ranks
     /// the candidates, searches to a coarser bracket.
     fn fit_shape(&self, candidate: &Candidate, base_replay: &Replay, first_pass: bool) -> Result<Fit, String> {
@@ -712,17 +644,17 @@ impl Problem<'_> {
         let fit_at = |vc: f64, vs: f64| self.fit(&shaped(vc, vs), 1, base_replay, &none).ok();
         let cost = |fit: &Option<Fit>| fit.as_ref().map_or(f64::INFINITY, |f| f.train_total());
         // The best u in [0, 1] of the cost, and its cost.
-        let golden = |iterations: usize, f: &dyn Fn(f64) -> f64| -> (f64, f64) {
-            golden_from_several(COARSE_GRID, iterations, &mut |u| f(u))
+        let search = |iterations: usize, f: &dyn Fn(f64) -> f64| -> (f64, f64) {
+            search_from_grid(COARSE_GRID, iterations, &mut |u| f(u))
         };
         let (inner_steps, outer_steps) = if first_pass {
             (COARSE_GOLDEN_STEPS, FIRST_PASS_OUTER_STEPS)
         } else {
             (14, 10)
         };
-        let inner = |vs: f64| golden(inner_steps, &|u| cost(&fit_at(value_of(0, u), vs)));
+        let inner = |vs: f64| search(inner_steps, &|u| cost(&fit_at(value_of(0, u), vs)));
         let (vc, vs) = if shapes.len() >= 2 {
-            let (u_s, _) = golden(outer_steps, &|u| inner(value_of(1, u)).1);
+            let (u_s, _) = search(outer_steps, &|u| inner(value_of(1, u)).1);
             let vs = value_of(1, u_s);
             (value_of(0, inner(vs).0), vs)
         } else {
@@ -743,7 +675,7 @@ impl Problem<'_> {
 
     /// A second-order filter on a measured channel (its natural frequency, then its damping
     /// ratio as a shape): it acts on the channel exactly, so it is applied to the base
-    /// prediction, with no replay. Golden-section search of the damping's logarithm, and for
+    /// prediction, with no replay. A search of the damping's logarithm, and for
     /// each damping of the frequency's; the filter stays off unless it lowers the misfit.
     fn fit_second_order(
         &self,
@@ -770,8 +702,8 @@ impl Problem<'_> {
         let cost = |y: &[Vec<f64>; CHANNELS]| self.errors(y).0.iter().sum::<f64>();
         let on_scale = |t: &Term, u: f64| t.lower * (t.upper / t.lower).powf(u);
         let best_frequency =
-            |z: f64| golden_from_several(grid, steps, &mut |u| cost(&filtered(on_scale(frequency, u), z)));
-        let (u_damping, _) = golden_from_several(grid, outer_steps, &mut |u| best_frequency(on_scale(damping, u)).1);
+            |z: f64| search_from_grid(grid, steps, &mut |u| cost(&filtered(on_scale(frequency, u), z)));
+        let (u_damping, _) = search_from_grid(grid, outer_steps, &mut |u| best_frequency(on_scale(damping, u)).1);
         let z = on_scale(damping, u_damping);
         let f = on_scale(frequency, best_frequency(z).0);
         let on = filtered(f, z);
@@ -889,7 +821,7 @@ impl Problem<'_> {
         }
         // A limit beyond every command the fits train on changes nothing they see: the search
         // spans the training rows' commands, or a flat stretch of misfit above them takes a
-        // golden section away from a limit that clips only the highest training level.
+        // search away from a limit that clips only the highest training level.
         let commands: Vec<f64> = self
             .recording
             .v_da
@@ -1003,7 +935,7 @@ impl Problem<'_> {
         } else {
             COARSE_GRID
         };
-        let (u, _) = golden_from_several(grid, golden_steps, &mut |u| evaluate(to_value(u)).0);
+        let (u, _) = search_from_grid(grid, golden_steps, &mut |u| evaluate(to_value(u)).0);
         let best = to_value(u);
         let (cost, prediction) = evaluate(best);
         let (values, prediction) = match prediction {

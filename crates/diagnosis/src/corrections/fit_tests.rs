@@ -1,6 +1,6 @@
 //! Tests of the fits' searches and steps.
 
-use super::{bounded_least_squares, golden_from_several};
+use super::bounded_least_squares;
 
 /// A staircase at 1 kHz, a level a second, through a D/A that saturates above 4 V: the
 /// training blocks hold 2 V and 4.2 V, the held-out ones 3 V and, in the last second,
@@ -90,48 +90,4 @@ fn a_step_past_a_bound_stops_at_the_bound_and_the_rest_is_solved_again() {
         (step[0] - 0.5).abs() < 1e-12 && (step[1] - 1.25).abs() < 1e-9,
         "{step:?}"
     );
-}
-
-/// The grid search's evaluations of `cost` and where it ended.
-fn searched(grid: usize, steps: usize, cost: impl Fn(f64) -> f64) -> (f64, f64, usize) {
-    let mut evaluations = 0;
-    let (u, c) = golden_from_several(grid, steps, &mut |u| {
-        evaluations += 1;
-        cost(u)
-    });
-    (u, c, evaluations)
-}
-
-#[test]
-fn a_cost_with_one_valley_is_searched_to_the_bracket_its_steps_give_with_fewer_evaluations_than_two_searches() {
-    let phi: f64 = (5f64.sqrt() - 1.0) / 2.0;
-    for (grid, steps) in [(5, 10), (9, 16)] {
-        for minimum in [0.0, 0.03, 0.31, 0.5, 0.77, 0.999, 1.0] {
-            let (u, _, evaluations) = searched(grid, steps, |u| (u - minimum).powi(2));
-            assert!(
-                (u - minimum).abs() <= phi.powi(steps as i32),
-                "grid {grid}, {steps} steps: the minimum at {minimum} was found at {u}"
-            );
-            // A golden-section search over the whole range takes steps + 2 evaluations; with
-            // the grid after it, steps + 2 + grid at the least.
-            assert!(
-                evaluations < steps + 2 + grid,
-                "grid {grid}, {steps} steps: {evaluations} evaluations"
-            );
-        }
-    }
-}
-
-#[test]
-fn of_two_valleys_the_search_follows_the_deeper_one_the_grid_sees() {
-    // A shallow valley at 0.3 and a deeper one at 0.9: a golden-section search over the whole
-    // range follows the shallow one (its first points cost −0.84 at 0.38 and −0.14 at 0.62);
-    // the grid sees the deeper one at its end (−1.28 at 1 against −0.94 at 0.25).
-    let cost = |u: f64| -(-((u - 0.3) / 0.2).powi(2)).exp() - 2.0 * (-((u - 0.9) / 0.15).powi(2)).exp();
-    let (u, c, _) = searched(5, 10, cost);
-    assert!((u - 0.9).abs() < 0.01 && c < -1.9, "ended at {u} ({c})");
-    // Never worse than the best grid point, and a cost that is infinite everywhere but on one
-    // grid point ends there.
-    let (u, c, _) = searched(5, 10, |u| if (u - 0.75).abs() < 1e-12 { 1.0 } else { f64::INFINITY });
-    assert_eq!((u, c), (0.75, 1.0));
 }
