@@ -32,6 +32,37 @@ pub trait FixedStepMethod<const N: usize> {
     fn jacobians(&self) -> u64;
 }
 
+/// ∂f/∂t at (t, y) by a forward difference of 1e-7 h: well above rounding of the forcing,
+/// well below its variation over the step.
+fn time_derivative<const N: usize, S: OdeSystem<N>>(
+    system: &S,
+    t: f64,
+    y: &SVector<f64, N>,
+    f0: &SVector<f64, N>,
+    h: f64,
+) -> SVector<f64, N> {
+    let eps = 1e-7 * h;
+    (system.rhs(t + eps, y) - f0) / eps
+}
+
+/// The system's Jacobian at (t, y) and (I − γh J)⁻¹, for `gamma_h` = γh.
+fn jacobian_and_inverse<const N: usize, S: OdeSystem<N>>(
+    system: &S,
+    t: f64,
+    y: &SVector<f64, N>,
+    f0: &SVector<f64, N>,
+    gamma_h: f64,
+) -> Result<(SMatrix<f64, N, N>, SMatrix<f64, N, N>), String>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
+    let jacobian = system.jacobian(t, y, f0);
+    let inverse = (SMatrix::<f64, N, N>::identity() - jacobian * gamma_h)
+        .try_inverse()
+        .ok_or("Rosenbrock step: I − γhJ is singular")?;
+    Ok((jacobian, inverse))
+}
+
 /// The integrator's memory: (I − γhJ)⁻¹ and when it was formed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ros2<const N: usize> {
@@ -70,17 +101,11 @@ where
         h: f64,
     ) -> Result<SVector<f64, N>, String> {
         let f0 = system.rhs(t, y);
-        // ∂f/∂t at a step of 1e-7 h: well above rounding of the forcing, well below its
-        // variation over the step.
-        let eps = 1e-7 * h;
-        let f_t = (system.rhs(t + eps, y) - f0) / eps;
+        let f_t = time_derivative(system, t, y, &f0, h);
         // The Jacobian changes slowly: refresh it every few steps. A new h needs a new
         // matrix anyway, and then the Jacobian is formed at the same cost.
         if self.steps % self.jacobian_reuse == 0 || h != self.last_h {
-            let jac = system.jacobian(t, y, &f0);
-            self.inverse = (SMatrix::<f64, N, N>::identity() - jac * (GAMMA * h))
-                .try_inverse()
-                .ok_or("ROS2: I − γhJ is singular")?;
+            (_, self.inverse) = jacobian_and_inverse(system, t, y, &f0, GAMMA * h)?;
             self.last_h = h;
             self.jacobians += 1;
         }
@@ -166,13 +191,9 @@ where
         h: f64,
     ) -> Result<SVector<f64, N>, String> {
         let f0 = system.rhs(t, y);
-        let eps = 1e-7 * h;
-        let f_t = (system.rhs(t + eps, y) - f0) / eps;
+        let f_t = time_derivative(system, t, y, &f0, h);
         if self.steps % self.jacobian_reuse == 0 || h != self.last_h {
-            self.jacobian = system.jacobian(t, y, &f0);
-            self.inverse = (SMatrix::<f64, N, N>::identity() - self.jacobian * (W_GAMMA * h))
-                .try_inverse()
-                .ok_or("ROS34PW2: I − γhA is singular")?;
+            (self.jacobian, self.inverse) = jacobian_and_inverse(system, t, y, &f0, W_GAMMA * h)?;
             self.last_h = h;
             self.jacobians += 1;
         }
