@@ -35,7 +35,8 @@ pub struct FastReplayCheck {
 }
 
 impl FastReplayCheck {
-    /// What the check found, as a sentence for the report; none when the usual step agrees.
+    /// What the check found, as a sentence for the report; none when the usual stepping (ROS2
+    /// at [`MAX_FAST_STEP`]) agrees.
     pub fn sentence(&self) -> Option<String> {
         if self.agrees && self.method() == FastReplayMethod::default() {
             return None;
