@@ -217,20 +217,33 @@ fn divided_difference(moved: &[f64], at: &[f64], step: f64) -> Vec<f32> {
 }
 
 /// Everything needed at one point of a candidate's terms.
-struct Point {
+struct Point<'r> {
     values: Vec<f64>,
-    replay: Replay,
+    /// Shared, not copied, between the points of a fit that differ only in linear terms, and
+    /// the base replay borrowed: every candidate of the first pass starts from it.
+    replay: std::sync::Arc<std::borrow::Cow<'r, Replay>>,
 }
 
 impl Problem<'_> {
     /// Predictions of the measured channels for a candidate at `values`, from a replay at
     /// those values and the sensitivities of modulated parameters.
     fn predict(&self, terms: &[Term], point: &Point, sensitivities: &[Option<Sensitivity>]) -> [Vec<f64>; CHANNELS] {
-        let r = &point.replay;
+        self.predict_at(terms, &point.values, &point.replay, sensitivities)
+    }
+
+    /// [`Problem::predict`] at `values` from `replay`, a replay at the values of the nonlinear
+    /// terms.
+    fn predict_at(
+        &self,
+        terms: &[Term],
+        values: &[f64],
+        r: &Replay,
+        sensitivities: &[Option<Sensitivity>],
+    ) -> [Vec<f64>; CHANNELS] {
         let mut out = [r.force.clone(), r.p1.clone(), r.p2.clone()];
         let n = self.recording.len();
         let mut floor: Option<Vec<bool>> = None;
-        for (j, (term, &value)) in terms.iter().zip(&point.values).enumerate() {
+        for (j, (term, &value)) in terms.iter().zip(values).enumerate() {
             if value == 0.0 {
                 continue;
             }
@@ -401,7 +414,7 @@ impl Problem<'_> {
             .collect();
         let mut point = Point {
             values: terms.iter().map(|t| t.neutral).collect(),
-            replay: base_replay.clone(),
+            replay: std::sync::Arc::new(std::borrow::Cow::Borrowed(base_replay)),
         };
         let mut replays = 0;
         let mut prediction = self.predict(terms, &point, &modulated);
@@ -466,11 +479,7 @@ impl Problem<'_> {
                             }
                         });
                         unit[j] = 1.0;
-                        let only = Point {
-                            values: unit,
-                            replay: point.replay.clone(),
-                        };
-                        let with = self.predict(terms, &only, &modulated);
+                        let with = self.predict_at(terms, &unit, &point.replay, &modulated);
                         Some(std::sync::Arc::new([
                             single(difference(&with[0], &point.replay.force)),
                             single(difference(&with[1], &point.replay.p1)),
@@ -516,7 +525,7 @@ impl Problem<'_> {
                 let replay = if nonlinear_moved {
                     replays += 1;
                     match self.replay(candidate, &values) {
-                        Ok(r) => r,
+                        Ok(r) => std::sync::Arc::new(std::borrow::Cow::Owned(r)),
                         Err(_) => {
                             alpha *= 0.5;
                             continue;
