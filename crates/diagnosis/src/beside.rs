@@ -210,25 +210,7 @@ mod tests {
     use super::*;
 
     fn candidate(terms: Vec<Mechanism>) -> Candidate {
-        Candidate {
-            label: "test",
-            location: "jet_pipe",
-            family: "dynamics",
-            named: None,
-            terms: terms
-                .into_iter()
-                .map(|mechanism| Term {
-                    name: "x",
-                    unit: "1",
-                    mechanism,
-                    neutral: 0.0,
-                    step: 1e-3,
-                    lower: -1.0,
-                    upper: 1.0,
-                })
-                .collect(),
-            settings: vec![],
-        }
+        Candidate::of_mechanisms(terms)
     }
 
     #[test]

@@ -252,6 +252,32 @@ pub struct Candidate {
     pub settings: Vec<(&'static str, f64)>,
 }
 
+#[cfg(test)]
+impl Candidate {
+    /// A candidate at the jet pipe with a term of each mechanism, for tests.
+    pub(crate) fn of_mechanisms(terms: Vec<Mechanism>) -> Candidate {
+        Candidate {
+            label: "test",
+            location: "jet_pipe",
+            family: "dynamics",
+            named: None,
+            terms: terms
+                .into_iter()
+                .map(|mechanism| Term {
+                    name: "x",
+                    unit: "1",
+                    mechanism,
+                    neutral: 0.0,
+                    step: 1e-3,
+                    lower: -1.0,
+                    upper: 1.0,
+                })
+                .collect(),
+            settings: vec![],
+        }
+    }
+}
+
 fn value_reference(name: &str) -> u32 {
     VARIABLES
         .iter()

@@ -385,20 +385,8 @@ pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
 #[cfg(test)]
 mod tests {
     use super::SharedSensitivities;
-    use crate::corrections::{Candidate, Mechanism, Modulation, Term};
+    use crate::corrections::{Candidate, Mechanism, Modulation};
     use crate::Localization;
-
-    fn term(mechanism: Mechanism) -> Term {
-        Term {
-            name: "term",
-            unit: "1",
-            mechanism,
-            neutral: 0.0,
-            step: 1e-3,
-            lower: -1.0,
-            upper: 1.0,
-        }
-    }
 
     #[test]
     fn only_the_sensitivities_the_leaders_read_are_kept_for_their_refinement() {
@@ -408,25 +396,11 @@ mod tests {
             taken: vec![column(), column(), column(), column()],
         };
         let leaders = [
-            Candidate {
-                label: "supply",
-                location: "supply",
-                family: "parameter_offset",
-                named: None,
-                terms: vec![term(Mechanism::Parameter("p_s"))],
-                settings: vec![],
-            },
-            Candidate {
-                label: "driver gain in time",
-                location: "current_driver",
-                family: "drift",
-                named: None,
-                terms: vec![term(Mechanism::Modulated {
-                    parameter: "k_cd",
-                    modulation: Modulation::Ramp,
-                })],
-                settings: vec![],
-            },
+            Candidate::of_mechanisms(vec![Mechanism::Parameter("p_s")]),
+            Candidate::of_mechanisms(vec![Mechanism::Modulated {
+                parameter: "k_cd",
+                modulation: Modulation::Ramp,
+            }]),
         ];
         shared.keep_those_of(&leaders);
         assert!(shared.get("p_s").is_some(), "a leader's constant");
