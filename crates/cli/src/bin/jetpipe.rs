@@ -161,7 +161,8 @@ enum Command {
 /// and at 196–215 MB (two runs) with the threshold fixed at 1 MiB. The fits' series of 100,000
 /// rows (400 KB in single precision, 800 KB in double) fall below 1 MiB: with it, the shared
 /// sensitivities the first pass let go of stayed resident through the final replays, and the
-/// 600 s recording peaked there at 251 MB; at 256 KiB, 219 MB, in the same time (239 and 238 s).
+/// 600 s recording peaked there at 251 MB (239 s); at 256 KiB, at 219 MB in two runs (238 and
+/// 256 s, within the machine's spread; the system time spent on pages roughly doubles).
 fn keep_large_allocations_apart() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: mallopt only sets an allocator parameter; it is called before any thread starts.
