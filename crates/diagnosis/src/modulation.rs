@@ -575,40 +575,6 @@ pub fn is_modulation(c: &Candidate) -> bool {
     c.settings.iter().any(|(name, _)| name.starts_with("modulation_"))
 }
 
-/// The places where a static function of the command acts alike: the command's own curve,
-/// the current driver's gain or offset varying with the command, the torque motor's constant
-/// varying with it. Each makes the torque some function of the command; they differ only by
-/// the driver's lag (its corner is near 300 Hz in the thesis), which a command held or swept
-/// slower does not show.
-pub const COMMAND_PATH: [&str; 3] = ["command", "current_driver", "jet_pipe"];
-
-/// Whether the term `set` puts a constant of the command's path to the torque (`k_cd`,
-/// `i_offset`, `k_m`) in a slot that follows the command or the current: a static function
-/// of the command, which the places of [`COMMAND_PATH`] make alike. (A staircase's 7-bit
-/// command quantiser was found as `k_m` varying with the command, explained at the noise,
-/// while the command's own curve, with its knots where the staircase has no levels, fitted
-/// worse than none.)
-pub fn is_static_function_of_the_command(set: &[(&'static str, f64)]) -> bool {
-    use jetpipe_model::variables::vr;
-    let path = [vr::K_CD, vr::I_OFFSET, vr::K_M].map(f64::from);
-    let follows_the_command = [ModulationSignal::Command, ModulationSignal::Current].map(|s| f64::from(s.code()));
-    (1..=2).any(|slot| {
-        let value = |field: &str| {
-            let name = slot_parameter(slot, field);
-            set.iter().find(|(n, _)| *n == name).map(|&(_, v)| v)
-        };
-        matches!(value("parameter"), Some(p) if path.contains(&p))
-            && matches!(value("signal"), Some(s) if follows_the_command.contains(&s))
-    })
-}
-
-/// The places a static function of the command at `place` is tied with, `place` first.
-pub fn tied_along_the_command_path(place: &'static str) -> Vec<&'static str> {
-    std::iter::once(place)
-        .chain(COMMAND_PATH.iter().copied().filter(|&p| p != place))
-        .collect()
-}
-
 /// How much more held-out misfit than a modulation a written candidate at the same place may
 /// leave and still be tried first: the simpler, named form wins where it is adequate (a
 /// quadratic damping before a viscous friction varying with the velocity, a transducer's
@@ -1093,40 +1059,6 @@ mod tests {
         // The step's corners come next: at 3 (the line through the ends passes 1.125 there) or 4.
         assert!(shapes[2].contains(&3) && shapes[2].contains(&4), "{shapes:?}");
         assert_eq!(shapes.len(), MAX_KNOTS - 1);
-    }
-
-    #[test]
-    fn a_torque_constant_following_the_command_is_a_static_curve_of_the_command_tied_along_its_path_and_others_are_not()
-    {
-        use jetpipe_model::variables::vr;
-        let slot = |parameter: u32, signal: ModulationSignal| {
-            vec![
-                ("modulation_1_parameter", f64::from(parameter)),
-                ("modulation_1_signal", f64::from(signal.code())),
-                ("modulation_1_y_1", 0.01),
-            ]
-        };
-        assert!(is_static_function_of_the_command(&slot(
-            vr::K_M,
-            ModulationSignal::Command
-        )));
-        assert!(is_static_function_of_the_command(&slot(
-            vr::I_OFFSET,
-            ModulationSignal::Current
-        )));
-        assert!(!is_static_function_of_the_command(&slot(
-            vr::K_M,
-            ModulationSignal::StopperPosition
-        )));
-        assert!(!is_static_function_of_the_command(&slot(
-            vr::D_JP,
-            ModulationSignal::Command
-        )));
-        assert!(!is_static_function_of_the_command(&[("k_m", 2.0)]));
-        assert_eq!(
-            tied_along_the_command_path("jet_pipe"),
-            ["jet_pipe", "command", "current_driver"]
-        );
     }
 
     #[test]

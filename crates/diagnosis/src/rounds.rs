@@ -167,15 +167,19 @@ pub(crate) fn run_rounds(
         };
         // A term put in another's place is tied to the places that one was.
         let added = match added {
-            Some(Addition::Discovered(mut term, trial, s)) if term.tied_locations.is_empty() => {
-                term.tied_locations = found.tied_with(term.location);
-                let mut undecided = found.undecided_beside(term.location, cx.pressure_noise.is_some());
-                if crate::modulation::is_static_function_of_the_command(&term.parameters)
-                    && crate::modulation::COMMAND_PATH.contains(&term.location)
-                {
-                    term.tied_locations = crate::modulation::tied_along_the_command_path(term.location);
+            Some(Addition::Discovered(mut term, trial, s))
+                if term.tied_locations.is_empty() || is_along_the_command_path(&term) =>
+            {
+                // Ties already given (by the fit that added it) are in its reading already.
+                let mut undecided = None;
+                if term.tied_locations.is_empty() {
+                    term.tied_locations = found.tied_with(term.location);
+                    undecided = found.undecided_beside(term.location, cx.pressure_noise.is_some());
+                }
+                if is_along_the_command_path(&term) {
+                    term.tied_locations = crate::command_path::tied_along_the_command_path(term.location);
                     undecided = Some(
-                        "a static curve of the command acts alike at the command, in the current driver and at the torque motor, which a command slower than the driver does not tell apart".to_string(),
+                        "a static function of the command (a curve, an offset, a gain or a limit) acts alike at the command, in the current driver and at the torque motor, which a command slower than the driver does not tell apart".to_string(),
                     );
                 }
                 term.reading = with_undecided(std::mem::take(&mut term.reading), undecided);
@@ -784,6 +788,15 @@ const TRAINING_GAIN_IN_NOISE: f64 = 3.0;
 /// A written term that does within this factor of a modulation's held-out force error in the
 /// model (or within the verdict's bar) is added instead of it.
 const WRITTEN_INSTEAD_WITHIN: f64 = 1.1;
+
+/// Whether `term` is a static function of the command at a place of its path, its ties (if
+/// any) among those places: the places the path makes alike replace them.
+fn is_along_the_command_path(term: &DiscoveredTerm) -> bool {
+    use crate::command_path::{acts_alike_along_the_command_path, COMMAND_PATH};
+    COMMAND_PATH.contains(&term.location)
+        && acts_alike_along_the_command_path(&term.parameters)
+        && term.tied_locations.iter().all(|l| COMMAND_PATH.contains(l))
+}
 
 /// A discovered term's `reading` (one sentence) with the places it cannot be told apart from.
 fn with_undecided(reading: String, undecided: Option<String>) -> String {

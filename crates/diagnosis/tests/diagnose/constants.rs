@@ -212,10 +212,12 @@ fn a_jet_pipe_travel_thirty_percent_short_under_ramps_without_pressures_is_its_t
 /// The coil current 5 mA above the driver's (i_offset) under a multisine at 1 kHz without
 /// pressures: a static curve at the command reads it to within the noise as well, with eight
 /// knots; refitted after it, the current driver's gain and offset do as much with two, and
-/// replace it. The offset within 10 %.
+/// replace it. The offset within 10 %. An offset of the current is one of the command as well
+/// (and of the torque motor's force), so the term names the command's path as tied.
 #[test]
 #[ignore = "a broad case (about 20 s of CPU); scripts/bench_cases.sh runs every case"]
-fn a_current_offset_under_a_multisine_without_pressures_is_an_offset_at_the_current_driver_not_a_command_curve() {
+fn a_current_offset_under_a_multisine_without_pressures_is_an_offset_at_the_current_driver_tied_along_the_command_path()
+{
     let d = re_identified(
         "current-offset-multisine",
         &spec(CommandProtocol::Multisine, fixed(), 1000.0, false),
@@ -224,6 +226,10 @@ fn a_current_offset_under_a_multisine_without_pressures_is_an_offset_at_the_curr
     );
     let offset = get(&d, "i_offset");
     assert!((offset / 5e-3 - 1.0).abs() < 0.1, "i_offset {offset}");
+    assert_eq!(
+        d.discovered[0].tied_locations,
+        ["current_driver", "command", "jet_pipe"]
+    );
 }
 
 /// The gas 20 K warmer than the model's 293.15 K under a staircase at 1 kHz with pressures:
