@@ -486,9 +486,14 @@ fn find_addition(
     // over the recording was read as the force sensor's offset and gain, leaving 6.9 noise
     // floors, where the bore varying with time leaves 1.0).
     let downstream_of_elsewhere = !matches!(place, "mechanics" | "force_sensor");
-    if !r.pressures_agree && downstream_of_elsewhere {
+    let downstream = if !r.pressures_agree && downstream_of_elsewhere {
+        crate::named_places::downstream(cx, r, &f.params, replays, progress)
+    } else {
+        None
+    };
+    if let Some(d) = &downstream {
         if let Some((s, sentence)) =
-            crate::named_places::named_downstream(cx, r, &f.params, &f.discovered, replays, progress)?
+            crate::named_places::named_downstream(cx, r, &f.params, &f.discovered, d, replays, progress)?
         {
             return Ok(Some(Addition::Named(s, sentence)));
         }
@@ -537,6 +542,14 @@ fn find_addition(
         progress,
     )? {
         return Ok(Some(Addition::Pair(term.into_iter().collect(), Box::new(trial))));
+    }
+    if let Some(d) = &downstream {
+        if let Some((term, trial)) =
+            crate::named_places::discovered_downstream(cx, r, problem, &f.params, d, replays, progress)?
+        {
+            // Added as a pair's terms are: its ties are its own side's, not the round's.
+            return Ok(Some(Addition::Pair(vec![term], Box::new(trial))));
+        }
     }
     Ok(None)
 }
@@ -656,24 +669,7 @@ fn discover_term(
         if crate::curves::is_command_curve(&s.fit.candidate) {
             set = command_curve_knots_freed(cx, problem, params, set, replays, progress);
         }
-        if crate::curves::is_channel_curve(&s.fit.candidate) {
-            // The curve's coordinates are the quantity the transducer reads: its reading
-            // with the transducer's offset and gain taken off.
-            let p = params;
-            let unread =
-                |reading: &[f64], o: f64, g: f64| -> Vec<f64> { reading.iter().map(|v| (v - o) / g).collect() };
-            let quantities = [
-                unread(&r.current.force, p.force_sensor_offset, p.force_sensor_gain),
-                unread(&r.current.p1, p.p1_sensor_offset, p.p1_sensor_gain),
-                unread(&r.current.p2, p.p2_sensor_offset, p.p2_sensor_gain),
-            ];
-            crate::curves::corners_across_unvisited(
-                &mut set,
-                [&quantities[0], &quantities[1], &quantities[2]],
-                problem.measured,
-                &cx.blocks,
-            );
-        }
+        curve_corners_across_unvisited(cx, r, problem, params, &s.fit.candidate, &mut set);
         let mut trial = params.clone();
         if set
             .iter()
@@ -788,6 +784,36 @@ const TRAINING_GAIN_IN_NOISE: f64 = 3.0;
 /// A written term that does within this factor of a modulation's held-out force error in the
 /// model (or within the verdict's bar) is added instead of it.
 const WRITTEN_INSTEAD_WITHIN: f64 = 1.1;
+
+/// For a transducer's curve, its corners beyond the quantities the recording visits
+/// (`curves::corners_across_unvisited`); other candidates' `set` unchanged.
+pub(crate) fn curve_corners_across_unvisited(
+    cx: &Context,
+    r: &Round,
+    problem: &Problem,
+    params: &Parameters,
+    candidate: &Candidate,
+    set: &mut Vec<(&'static str, f64)>,
+) {
+    if !crate::curves::is_channel_curve(candidate) {
+        return;
+    }
+    // The curve's coordinates are the quantity the transducer reads: its reading with the
+    // transducer's offset and gain taken off.
+    let p = params;
+    let unread = |reading: &[f64], o: f64, g: f64| -> Vec<f64> { reading.iter().map(|v| (v - o) / g).collect() };
+    let quantities = [
+        unread(&r.current.force, p.force_sensor_offset, p.force_sensor_gain),
+        unread(&r.current.p1, p.p1_sensor_offset, p.p1_sensor_gain),
+        unread(&r.current.p2, p.p2_sensor_offset, p.p2_sensor_gain),
+    ];
+    crate::curves::corners_across_unvisited(
+        set,
+        [&quantities[0], &quantities[1], &quantities[2]],
+        problem.measured,
+        &cx.blocks,
+    );
+}
 
 /// Whether `term` is a static function of the command at a place of its path, its ties (if
 /// any) among those places: the places the path makes alike replace them.
