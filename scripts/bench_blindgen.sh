@@ -88,6 +88,7 @@ print(f"Additions withdrawn on {len(withdrawn)} of {len(reports)} draws ({kept} 
       f"force's noise floor on {len(parted)} of the {len(finals)} draws with additions"
       + (f" (largest {max(finals):.2f} noise floors)." if finals else "."))
 PY
+python3 scripts/never_worse.py "$work"/reports/*.json
 echo
 echo "The scorer's account (truth revealed only here):"
 echo

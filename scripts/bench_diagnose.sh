@@ -22,15 +22,17 @@ if [ "${JETPIPE_BENCH_UNDECLARED:-1}" != 0 ]; then
         "$work/benchgen" --out "$work/u_$name.csv" --seed 7 --undeclared "$name" >/dev/null
     done
 fi
+mkdir -p "$work/reports"
 echo "| recording | verdict | named | discovered (location, family: parameters) | held-out before → after (N) | wall (s) on $(nproc) cores |"
 echo "|---|---|---|---|---|---|"
 for rec in "$work"/*.csv ../shared/bench/rec_0*.csv ../shared/bench/undeclared/*.csv; do
     [ -f "$rec" ] || continue
     start=$(date +%s%N)
-    "$work/jetpipe" diagnose "$rec" --report "$work/report.json" >/dev/null 2>&1
+    report="$work/reports/$(basename "$(dirname "$rec")")_$(basename "$rec" .csv).json"
+    "$work/jetpipe" diagnose "$rec" --report "$report" >/dev/null 2>&1
     end=$(date +%s%N)
     ms=$(( (end - start) / 1000000 ))
-    row=$(python3 - "$work/report.json" <<'PY'
+    row=$(python3 - "$report" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
 names = ", ".join(e["name"] for e in d["effects"]) or "—"
@@ -42,6 +44,8 @@ if "unexplained" in d and not d["discovered"]:
     found = f'placed at {u["location"]} ({u["family"]})'
 print(f'{d["verdict"]} | {names} | {found} | {d["heldout"]["before_rms_N"]:.3f} → {d["heldout"]["after_rms_N"]:.3f}')
 PY
-)
+) || row="error | — | — | —"
     echo "| $(basename "$rec" .csv) | $row | $((ms / 1000)).$(( (ms % 1000) / 100 )) |"
 done
+echo
+python3 scripts/never_worse.py "$work"/reports/*.json

@@ -99,6 +99,7 @@ chosen() { # NAME LIST: whether NAME is in the space-separated LIST (or LIST is 
     return 1
 }
 
+mkdir -p "$work/reports"
 echo "| protocol | mechanism | truth | verdict | found (location, family) | right place | held-out after / noise | wall (s) |"
 echo "|---|---|---|---|---|---|---|---|"
 run_table() { # PROTOCOL-ARRAY-NAME MECHANISM-ARRAY-NAME
@@ -115,10 +116,11 @@ for p in "${plist[@]}"; do
         # shellcheck disable=SC2086
         "$work/benchgen" --out "$rec" --seed 5 --duration "$seconds" $popts $mopts >/dev/null 2>&1
         start=$(date +%s%N)
-        "$work/jetpipe" diagnose "$rec" --report "$work/report.json" >/dev/null 2>&1 || true
+        report="$work/reports/${pname}_${mname}.json"
+        "$work/jetpipe" diagnose "$rec" --report "$report" >/dev/null 2>&1 || true
         end=$(date +%s%N)
         ms=$(((end - start) / 1000000))
-        row=$(python3 - "$work/report.json" "$mloc" "$mfam" <<'PY'
+        row=$(python3 - "$report" "$mloc" "$mfam" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
 loc, fam = sys.argv[2], sys.argv[3]
@@ -152,3 +154,5 @@ done
 }
 run_table protocols mechanisms
 run_table balance_protocols balance_mechanisms
+echo
+python3 scripts/never_worse.py "$work"/reports/*.json
