@@ -26,6 +26,7 @@ mod beside;
 pub mod blocks;
 pub mod calibrate;
 pub mod checks;
+pub mod command_gaps;
 pub mod command_path;
 mod conclude;
 pub mod corrections;

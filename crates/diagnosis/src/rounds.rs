@@ -878,11 +878,26 @@ fn command_curve_knots_freed(
     progress(&format!(
         "  command static curve, its knots freed: force on the training blocks {before:.4} -> {after:.4} N"
     ));
-    if after < before {
-        freed
-    } else {
-        set
+    let (chosen, replay) = if after < before { (freed, with) } else { (set, start) };
+    // Stretches of commands no training block holds are joined from their neighbours' lines
+    // where the held-out blocks agree.
+    let mut training: Vec<f64> = (0..cx.recording.v_da.len())
+        .filter(|&k| cx.blocks[k] == Block::Training && cx.recording.v_da[k].is_finite())
+        .map(|k| cx.recording.v_da[k])
+        .collect();
+    training.sort_by(f64::total_cmp);
+    let heldout_rms = |r: &Replay| rms_where(&difference(&cx.recording.force, &r.force), &cx.blocks, Block::HeldOut);
+    let (joined, tried) = crate::command_gaps::joined_where_held_out_agrees(
+        chosen.clone(),
+        &training,
+        heldout_rms(&replay),
+        &mut |values| replayed(values).ok().map(|r| heldout_rms(&r)),
+    );
+    *replays += tried;
+    if joined != chosen {
+        progress("  command static curve: a stretch no training command holds joined from its neighbours' lines");
     }
+    joined
 }
 
 /// A pressure transducer's term leaves the force as it is: it is judged on the pressures,
