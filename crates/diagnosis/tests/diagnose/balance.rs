@@ -6,8 +6,9 @@
 //! mechanics as an extra force of its own kind, with its coefficient near the bench's, and
 //! the force explained (held-out error within 1.5 noise floors).
 
+use super::diagnose;
 use jetpipe_diagnosis::recording::Recording;
-use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{
     generate_protocol, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,

@@ -5,7 +5,8 @@
 //! or more sampling rates, with and without pressures; broader sweeps are rows of
 //! `scripts/bench_protocols.sh`.
 
-use jetpipe_diagnosis::{diagnose, Diagnosis, DiscoveredTerm};
+use super::diagnose;
+use jetpipe_diagnosis::{Diagnosis, DiscoveredTerm};
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{BenchEffects, CommandProtocol, ProtocolSpec, UndeclaredEffects};
 

@@ -5,8 +5,9 @@
 //! proportion to P1 − P2, its coefficient (kg/s per bar) within 5 % of the bench's, and the
 //! force explained.
 
+use super::diagnose;
 use jetpipe_diagnosis::recording::Recording;
-use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{generate_protocol, BenchEffects, CommandProtocol, ProtocolSpec, UndeclaredEffects};
 

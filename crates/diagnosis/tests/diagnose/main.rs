@@ -38,6 +38,35 @@ use jetpipe_diagnosis::recording::Recording;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 
+/// The library's `diagnose`, which also writes the case's report when
+/// `JETPIPE_CASE_REPORTS` names a folder: `scripts/compare_reports.py` holds two such sets
+/// against each other, so that a change meant to move code and not behaviour is shown to
+/// give the same reports. A case's report is named after its test (the harness names each
+/// test's thread after it), with a count when one test diagnoses more than once.
+fn diagnose(
+    recording: &Recording,
+    base: &Parameters,
+    calibrate: bool,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    let diagnosis = jetpipe_diagnosis::diagnose(recording, base, calibrate, progress)?;
+    if let Some(dir) = std::env::var_os("JETPIPE_CASE_REPORTS") {
+        thread_local!(static COUNT: std::cell::Cell<usize> = const { std::cell::Cell::new(0) });
+        let count = COUNT.with(|c| {
+            c.set(c.get() + 1);
+            c.get()
+        });
+        let thread = std::thread::current();
+        let case = thread.name().unwrap_or("main").replace("::", ".");
+        let name = format!("{case}.{count}");
+        let path = std::path::Path::new(&dir).join(format!("{name}.json"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let report = serde_json::to_string_pretty(&diagnosis.to_json(&name)).unwrap();
+        std::fs::write(&path, report).unwrap();
+    }
+    Ok(diagnosis)
+}
+
 /// The names of the named effects a diagnosis added.
 fn names(d: &Diagnosis) -> Vec<&'static str> {
     d.effects.iter().map(|e| e.name).collect()

@@ -5,7 +5,7 @@
 //! piecewise-linear shape can only approach), so nothing of the candidate is copied into the
 //! recording.
 
-use jetpipe_diagnosis::diagnose;
+use super::diagnose;
 use jetpipe_model::physics::modulation::ModulationSignal;
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::variables::vr;

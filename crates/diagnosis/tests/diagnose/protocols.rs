@@ -3,8 +3,9 @@
 //! and at two sampling rates where the rate matters. The truths are the synthetic bench's,
 //! written by its own integrator.
 
+use super::diagnose;
 use jetpipe_diagnosis::recording::Recording;
-use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{
     generate_protocol, BenchEffects, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,

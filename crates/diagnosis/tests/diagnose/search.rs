@@ -4,8 +4,9 @@
 //! with a 1 ms lag and a gas temperature drifting 20 K (explained with T_drift). Short
 //! recordings (20 s at 250 or 500 Hz), two protocols each, with and without pressures.
 
+use super::diagnose;
 use jetpipe_diagnosis::recording::Recording;
-use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{
     generate_protocol_with, BenchEffects, BenchParams, CommandProtocol, ProtocolSpec, StopperMotion, UndeclaredEffects,

@@ -13,8 +13,9 @@
 
 use std::path::PathBuf;
 
+use super::diagnose;
 use jetpipe_diagnosis::recording::Recording;
-use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 
 use super::{names, value_reference};

@@ -8,7 +8,8 @@
 //! The full protocol (80 s) runs for every case; set JETPIPE_DIAGNOSE_CASES to a comma
 //! list of case names to run a subset.
 
-use jetpipe_diagnosis::{diagnose, Diagnosis};
+use super::diagnose;
+use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{generate, BenchEffects};
 

@@ -13,8 +13,9 @@
 //! the current driver and the return under a 20 s staircase at 500 Hz;
 //! `scripts/bench_cases.sh` runs every case.
 
+use super::diagnose;
 use jetpipe_diagnosis::recording::Recording;
-use jetpipe_diagnosis::{diagnose, Diagnosis};
+use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{
     generate, generate_protocol_with, undeclared_mechanism, BenchParams, CommandProtocol, ProtocolSpec, StopperMotion,
