@@ -8,7 +8,26 @@
 //! lower by a further penalty replaces it (a second-order filter at the command, which the
 //! named `transport_delay` followed to within 4.4 noise floors).
 
-use super::*;
+use crate::blocks::Block;
+use crate::corrections::set_parameter;
+use crate::corrections::Candidate;
+use crate::corrections::Fit;
+use crate::corrections::Problem;
+use crate::localize::discovery_penalised;
+use crate::localize::discovery_penalty_per_term;
+use crate::localize::used_terms;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
+use crate::signals::difference;
+use crate::signals::rms_where;
+use crate::Context;
+use crate::DiscoveredTerm;
+use crate::Localization;
+use crate::Scored;
+use crate::DISCOVERY_TRIALS;
+use crate::LOCATED_SHARE;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// What the judgement of a replayed model needs from its round.
 pub(crate) struct Check<'a> {
@@ -38,7 +57,7 @@ impl Check<'_> {
         params: &Parameters,
         replays: &mut usize,
     ) -> Result<Option<(Vec<(&'static str, f64)>, Parameters, f64, f64)>, String> {
-        let Some(set) = discover::model_terms(candidate, values, params, self.problem) else {
+        let Some(set) = crate::discover::model_terms(candidate, values, params, self.problem) else {
             return Ok(None);
         };
         let mut trial = params.clone();

@@ -13,10 +13,25 @@
 //! refused, and all the fits ended where they began (a command lag beside them was left at
 //! zero and 5.1 noise floors stayed; damped, it took 5.1 to 2.8).
 
-use super::*;
+use crate::corrections::parameter_value;
+use crate::corrections::set_parameter;
+use crate::corrections::Candidate;
+use crate::corrections::Fit;
+use crate::corrections::Mechanism;
+use crate::corrections::Problem;
+use crate::joint_candidate;
+use crate::localize::parallel_map;
 use crate::localize::{discovery_penalised, discovery_penalty_per_term, heldout_count, WantedSensitivities};
 use crate::pairs::joined;
+use crate::replay::Replay;
 use crate::rounds::Findings;
+use crate::signals::CHANNELS;
+use crate::Context;
+use crate::DiscoveredTerm;
+use crate::Localization;
+use crate::Scored;
+use crate::EXPLAINED_WITHIN_NOISE;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// Candidates of the round fitted beside the earlier additions.
 const MEMBERS: usize = 4;
@@ -152,7 +167,7 @@ pub(crate) fn best_beside_earlier(
     };
     let candidate = &s.fit.candidate;
     let (own, refitted) = fit.values.split_at(candidate.terms.len());
-    let Some(set) = discover::model_terms(candidate, own, params, problem) else {
+    let Some(set) = crate::discover::model_terms(candidate, own, params, problem) else {
         progress("  the FMU has no parameters for it");
         return Ok(None);
     };

@@ -1,11 +1,31 @@
 //! Step 6: the final accurate replays, the verdict and the tests of the residual.
 
-use super::*;
+use crate::blocks::Block;
+use crate::calibrate::Calibrated;
+use crate::corrections::parameter_value;
+use crate::errors;
+use crate::replay::replay;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
+use crate::signals::difference;
+use crate::signals::rms;
+use crate::signals::ChainSignals;
+use crate::signature::Signature;
+use crate::Context;
+use crate::Diagnosis;
+use crate::Errors;
+use crate::Localization;
+use crate::PressureSplit;
+use crate::Unexplained;
+use crate::EXPLAINED_WITHIN_NOISE;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+use serde_json::json;
 
 /// A discovered term whose constants all stand at the model's defaults (a compliance
 /// refitted to its bound of 0) is not in the model: what the round that added it gained came
 /// from the constants refitted beside it. It is not reported.
-fn drop_terms_at_defaults(found: &mut rounds::Findings, progress: &mut dyn FnMut(&str)) {
+fn drop_terms_at_defaults(found: &mut crate::rounds::Findings, progress: &mut dyn FnMut(&str)) {
     let params = &found.params;
     found.discovered.retain(|d| {
         let off = !d.parameters.is_empty()
@@ -23,8 +43,8 @@ fn drop_terms_at_defaults(found: &mut rounds::Findings, progress: &mut dyn FnMut
 /// the starting model, its accurate replay and the check of the fits' replay against it.
 pub(crate) fn conclude(
     cx: &Context,
-    start: (Actuator, Replay, agreement::FastReplayCheck),
-    mut found: rounds::Findings,
+    start: (Actuator, Replay, crate::agreement::FastReplayCheck),
+    mut found: crate::rounds::Findings,
     mut joint_refit: Option<(f64, f64)>,
     mut input_checks: Vec<String>,
     calibrated: Vec<Calibrated>,
@@ -45,7 +65,7 @@ pub(crate) fn conclude(
     let n = full.len();
     let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
     let full_blocks = match thinned {
-        Some(_) => blocks::blocks(&full.time, &full.x_s, cx.settled_from),
+        Some(_) => crate::blocks::blocks(&full.time, &full.x_s, cx.settled_from),
         None => cx.blocks.clone(),
     };
     let blocks = &full_blocks;
@@ -56,7 +76,7 @@ pub(crate) fn conclude(
     };
     let (mut after, mut after_errors) = replay_accurately(&found.params)?;
     let before_errors = errors(&before, full, blocks);
-    let withdrawn = withdraw::withdraw_if_worse(
+    let withdrawn = crate::withdraw::withdraw_if_worse(
         &mut found,
         &before_model.params,
         &before_errors,
@@ -91,12 +111,12 @@ pub(crate) fn conclude(
         let fast = replay_fast(&final_model, full, n)?;
         let departure = rms(&difference(&fast.force, &after.force));
         let ratio = departure / noise;
-        if ratio > agreement::AGREEMENT_WITHIN_NOISE {
+        if ratio > crate::agreement::AGREEMENT_WITHIN_NOISE {
             let sentence = format!(
                 "The fits' fixed-step replay ({}{} ms steps) of the final model departs from its error-controlled replay by {departure:.4} N of force ({ratio:.2} noise floors), more than the {} noise floor it was held to on the starting model: the additions were scored on a replay that parts from the accurate one; every error reported is the accurate replay's",
                 if fast_replay.third_order { "third-order, " } else { "" },
                 fast_replay.step * 1e3,
-                agreement::AGREEMENT_WITHIN_NOISE
+                crate::agreement::AGREEMENT_WITHIN_NOISE
             );
             progress(&sentence);
             input_checks.push(sentence);
@@ -107,7 +127,7 @@ pub(crate) fn conclude(
     };
     let split = cx
         .pressure_noise
-        .and_then(|pn| split::pressure_split(&final_model, full, &after, noise, pn, blocks));
+        .and_then(|pn| crate::split::pressure_split(&final_model, full, &after, noise, pn, blocks));
     // What the remainder follows, on the fits' rows.
     let after_at_rows = thinned.map(|rows| after.at_rows(rows));
     let after_rows = after_at_rows.as_ref().unwrap_or(&after);
@@ -165,7 +185,7 @@ pub(crate) fn conclude(
         withdrawn,
         fast_replay,
         fast_replay_final,
-        start_pressures: replay::start_pressures(&final_model, full),
+        start_pressures: crate::replay::start_pressures(&final_model, full),
         stopper_smoothing: cx.stopper_smoothing,
         acceleration_window: if final_model.params.stopper_acceleration_input_share > 0.0 {
             full.acceleration_window
@@ -190,7 +210,7 @@ fn what_stays_unexplained(
     let explained = after_errors.heldout_rms <= EXPLAINED_WITHIN_NOISE * noise;
     // Every measured channel counts: pressures that depart while the force does not (a
     // pressure transducer, say) leave a remainder too, with its place and signature.
-    if explained && !split::pressures_off(split, cx.pressure_noise, after_errors.pressure_rms) {
+    if explained && !crate::split::pressures_off(split, cx.pressure_noise, after_errors.pressure_rms) {
         return None;
     }
     let (mut location, mut family, mut alternatives) = match localization {

@@ -18,16 +18,12 @@
 //! Gauss–Newton with bounds on the training blocks of every measured channel at once (each
 //! channel weighted by its noise floor) and scored on the held-out blocks.
 
-use crate::recording::Recording;
-use crate::replay::{replay_fast, Replay};
-use jetpipe_model::physics::actuator::Actuator;
-use jetpipe_model::physics::current_driver;
 use jetpipe_model::physics::extra_force::ProductSignal;
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::sensors::{self, Channel, SensorLaw};
 use jetpipe_model::variables::VARIABLES;
 
-use super::signals::{difference, stopper_acceleration, stopper_velocity, CHANNELS, FORCE, P1, P2};
+use super::signals::{FORCE, P1, P2};
 
 mod catalogue;
 mod fit;

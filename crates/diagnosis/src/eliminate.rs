@@ -10,8 +10,14 @@
 //! errors and share are recomputed from that joint fit: its held-out force error with
 //! everything else and without it.
 
-use super::*;
-use rounds::Findings;
+use crate::corrections::parameter_value;
+use crate::corrections::set_parameter;
+use crate::corrections::Problem;
+use crate::localize::discovery_penalty_per_term;
+use crate::localize::heldout_count;
+use crate::rounds::Findings;
+use crate::Context;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// The held-out force error below which taking an addition out counts as costing nothing,
 /// in noise floors.
@@ -82,7 +88,7 @@ pub(crate) fn drop_redundant(
         let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
         let count = heldout_count(&cx.blocks) as f64;
         let penalty = discovery_penalty_per_term(count);
-        let (misfit, force) = alternatives::judge(cx, &problem, &f.params, replays)?;
+        let (misfit, force) = crate::alternatives::judge(cx, &problem, &f.params, replays)?;
         // The newest addition has just earned its place.
         let newest = f.newest;
         let mut least: Option<(f64, Which)> = None;
@@ -93,7 +99,7 @@ pub(crate) fn drop_redundant(
             if reset == 0 {
                 continue;
             }
-            let (misfit_without, force_without) = alternatives::judge(cx, &problem, &trial, replays)?;
+            let (misfit_without, force_without) = crate::alternatives::judge(cx, &problem, &trial, replays)?;
             let rise = misfit_without - misfit;
             progress(&format!(
                 "  without the {}: held-out misfit {misfit:.0} -> {misfit_without:.0} (noise floors squared, penalty {:.0}), force {force:.4} -> {force_without:.4} N",
@@ -145,13 +151,13 @@ pub(crate) fn attribute_from_joint_fit(
         return Ok(());
     }
     let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
-    let (_, after) = alternatives::judge(cx, &problem, &f.params, replays)?;
+    let (_, after) = crate::alternatives::judge(cx, &problem, &f.params, replays)?;
     progress("each addition's share, from the joint fit");
     for which in all {
         let Some((trial, _)) = without(f, which) else {
             continue;
         };
-        let (_, before) = alternatives::judge(cx, &problem, &trial, replays)?;
+        let (_, before) = crate::alternatives::judge(cx, &problem, &trial, replays)?;
         let share = if before > 0.0 {
             1.0 - (after / before).powi(2)
         } else {

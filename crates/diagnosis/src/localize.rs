@@ -1,7 +1,27 @@
 //! Step 4 of the crate's account: fit every candidate, score it on the held-out blocks
 //! and rank the places of the chain; the penalties by which simpler candidates win.
 
-use super::*;
+use crate::blocks::count;
+use crate::blocks::Block;
+use crate::corrections::Candidate;
+use crate::corrections::Fit;
+use crate::corrections::Mechanism;
+use crate::corrections::Problem;
+use crate::corrections::Sensitivity;
+use crate::corrections::Term;
+use crate::parallel_map_shown;
+use crate::replay::Replay;
+use crate::signals::difference;
+use crate::signals::rms_where;
+use crate::signals::FORCE;
+use crate::Localization;
+use crate::Options;
+use crate::ProgressBars;
+use crate::Scored;
+use crate::LOCATED_SHARE;
+use crate::REFINED;
+use crate::REFINE_ITERATIONS;
+use crate::WORTH_REFINING;
 
 /// How many of a fitted candidate's terms are away from their neutral values.
 pub(crate) fn used_terms(s: &Scored) -> f64 {

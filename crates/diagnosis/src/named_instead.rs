@@ -14,10 +14,27 @@
 //! It does so only where the named effect brings the force to the noise: beside a remainder,
 //! the term may be standing in for part of it, and a name would claim what it cannot show.
 
-use super::*;
+use crate::apply_named;
+use crate::corrections::catalogue;
+use crate::corrections::parameter_value;
 use crate::corrections::without_addition;
+use crate::corrections::Candidate;
+use crate::corrections::Problem;
+use crate::localize::discovery_penalty_per_term;
+use crate::localize::heldout_count;
 use crate::localize::terms_used;
+use crate::named_signature;
+use crate::refittable;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
 use crate::rounds::Findings;
+use crate::AddedEffect;
+use crate::Context;
+use crate::DiscoveredTerm;
+use crate::Scored;
+use crate::EXPLAINED_WITHIN_NOISE;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// Whether a place is on the force side of the piston, where a force the stopper's motion
 /// sets reads the same whether it acts on the piston or is added by the sensor: a smooth
@@ -79,7 +96,7 @@ fn named_in_place_of(
     .filter(|c| c.location == place && c.family == term.family || force_side(place) && force_side(c.location))
     .filter(|c| {
         c.named.map_or(false, |n| {
-            named::has_signature_test(n) && !f.effects.iter().any(|e| e.name == n)
+            crate::named::has_signature_test(n) && !f.effects.iter().any(|e| e.name == n)
         })
     })
     .collect();
@@ -98,7 +115,7 @@ fn named_in_place_of(
     };
     let count = heldout_count(&cx.blocks) as f64;
     let penalty = discovery_penalty_per_term(count);
-    let (term_misfit, term_force) = alternatives::judge(
+    let (term_misfit, term_force) = crate::alternatives::judge(
         cx,
         &Problem::new(cx.recording, &without, &cx.blocks, cx.channel_noise),
         &f.params,
@@ -220,7 +237,7 @@ impl NamedFit {
         &self,
         cx: &Context,
         replays: &mut usize,
-    ) -> Result<(named::SignatureTest, Vec<(&'static str, f64)>), String> {
+    ) -> Result<(crate::named::SignatureTest, Vec<(&'static str, f64)>), String> {
         let name = self.scored.fit.candidate.named.expect("a named candidate");
         let with = replay_fast(&Actuator::new(self.params.clone())?, cx.recording, cx.n)?;
         *replays += 1;
@@ -298,7 +315,7 @@ pub(crate) fn best_named_fit(
             Some((refitted, before, after)) if after < before => refitted,
             _ => trial,
         };
-        let (misfit, force) = alternatives::judge(cx, &problem, &trial, replays)?;
+        let (misfit, force) = crate::alternatives::judge(cx, &problem, &trial, replays)?;
         let score = misfit + used * penalty;
         progress(&format!(
             "  {} ({}) {}",

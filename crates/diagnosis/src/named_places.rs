@@ -1,8 +1,38 @@
 //! Step 5: the named effect that earns its name at the located place, or downstream of a
 //! larger departure upstream, and what each takes of what it could take.
 
-use super::*;
+use crate::apply_named;
+use crate::blocks::Block;
+use crate::corrections::set_parameter;
+use crate::corrections::Candidate;
+use crate::corrections::Fit;
+use crate::corrections::Problem;
+use crate::force_through_mechanics;
+use crate::localize::discovery_penalised;
+use crate::localize::discovery_penalty_per_term;
+use crate::localize::localize;
+use crate::localize::parallel_map;
+use crate::localize::penalised;
+use crate::localize::used_terms;
+use crate::named_signature;
+use crate::replay::replay_fast;
 use crate::rounds::{nameable, pressures_gain, Round};
+use crate::signals::difference;
+use crate::signals::rms_where;
+use crate::signals::CHANNELS;
+use crate::signals::FORCE;
+use crate::worth_adding;
+use crate::Context;
+use crate::DiscoveredTerm;
+use crate::Localization;
+use crate::Scored;
+use crate::DISCOVERY_TRIALS;
+use crate::EXPLAINED_WITHIN_NOISE;
+use crate::LOCATED_SHARE;
+use crate::NAMED_MIN_SHARE;
+use crate::NAMED_SHARE_OF_PLACE;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// The best named effect at the located place that earns its name (step 5), judged on the
 /// fitted prediction.
@@ -209,7 +239,7 @@ pub(crate) fn named_with_term(
     if apply_named(&mut trial, &with_named).is_err() {
         return Ok(None);
     }
-    let Some(set) = discover::model_terms(member, member_values, params, problem) else {
+    let Some(set) = crate::discover::model_terms(member, member_values, params, problem) else {
         return Ok(None);
     };
     if set.iter().any(|(n, v)| set_parameter(&mut trial, n, *v).is_err()) || trial.validate().is_err() {
@@ -237,7 +267,7 @@ pub(crate) fn named_with_term(
     // Each half earns its own penalty against the other alone.
     let mut named_alone = params.clone();
     let mut term_alone = params.clone();
-    let Some(term_set) = discover::model_terms(member, &ranked[m].fit.values, params, problem) else {
+    let Some(term_set) = crate::discover::model_terms(member, &ranked[m].fit.values, params, problem) else {
         return Ok(None);
     };
     if apply_named(&mut named_alone, &half.scored).is_err()
@@ -436,7 +466,7 @@ pub(crate) fn discovered_downstream(
     let penalty_per_term = discovery_penalty_per_term(r.count);
     for s in unnamed {
         let candidate = &s.fit.candidate;
-        let Some(mut set) = discover::model_terms(candidate, &s.fit.values, params, &d.problem) else {
+        let Some(mut set) = crate::discover::model_terms(candidate, &s.fit.values, params, &d.problem) else {
             continue;
         };
         crate::rounds::curve_corners_across_unvisited(cx, r, problem, params, candidate, &mut set);

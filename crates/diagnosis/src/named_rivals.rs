@@ -9,10 +9,19 @@
 //! refitted beside them: a rival better by more than one penalty takes its place; one
 //! within a penalty either way leaves the two tied, which the report says.
 
-use super::*;
+use crate::corrections::catalogue;
+use crate::corrections::parameter_value;
 use crate::corrections::without_addition;
+use crate::corrections::Candidate;
+use crate::corrections::Problem;
+use crate::localize::discovery_penalty_per_term;
+use crate::localize::heldout_count;
 use crate::named_instead::{best_named_fit, refitted_beside};
 use crate::rounds::Findings;
+use crate::AddedEffect;
+use crate::Context;
+use crate::Scored;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// A named effect at the same place whose share of the held-out misfit was at most this much
 /// below the named one's is a rival.
@@ -124,7 +133,7 @@ fn rival_in_place_of(
     };
     let penalty = discovery_penalty_per_term(heldout_count(&cx.blocks) as f64);
     let problem = Problem::new(cx.recording, &without, &cx.blocks, cx.channel_noise);
-    let (own_misfit, own_force) = alternatives::judge(cx, &problem, &f.params, replays)?;
+    let (own_misfit, own_force) = crate::alternatives::judge(cx, &problem, &f.params, replays)?;
     let own_terms = effect
         .parameters
         .iter()
@@ -192,6 +201,8 @@ fn rival_in_place_of(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::corrections::Fit;
+    use crate::signals::CHANNELS;
 
     /// A candidate's score with no fit behind it: its label, place, named effect and share.
     pub(crate) fn scored(

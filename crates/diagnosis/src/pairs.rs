@@ -8,8 +8,32 @@
 //! penalised held-out misfit below the best single candidate's is added as two discovered
 //! terms.
 
-use super::*;
+use crate::blocks::Block;
+use crate::corrections::parameter_value;
+use crate::corrections::set_parameter;
+use crate::corrections::Candidate;
+use crate::corrections::Fit;
+use crate::corrections::Mechanism;
+use crate::corrections::Problem;
+use crate::localize::discovery_penalised;
+use crate::localize::discovery_penalty_per_term;
+use crate::localize::heldout_count;
+use crate::localize::parallel_map;
 use crate::localize::WantedSensitivities;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
+use crate::signals::difference;
+use crate::signals::rms_where;
+use crate::signals::CHANNELS;
+use crate::worth_adding;
+use crate::Context;
+use crate::DiscoveredTerm;
+use crate::Localization;
+use crate::Scored;
+use crate::EXPLAINED_WITHIN_NOISE;
+use crate::LOCATED_SHARE;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// Places whose best candidate enters the pairs.
 const PAIRED_PLACES: usize = 6;
@@ -302,8 +326,8 @@ pub(crate) fn best_pair(
     *replays += fit.replays;
     let (va, vb) = fit.values.split_at(a.terms.len());
     let (Some(set_a), Some(set_b)) = (
-        discover::model_terms(a, va, params, problem),
-        discover::model_terms(b, vb, params, problem),
+        crate::discover::model_terms(a, va, params, problem),
+        crate::discover::model_terms(b, vb, params, problem),
     ) else {
         progress("  the FMU has no parameters for the pair");
         return Ok(None);
@@ -339,14 +363,14 @@ pub(crate) fn best_pair(
         let Some(alone) = found.candidates.iter().find(|s| s.fit.candidate.label == other.label) else {
             return Ok(None);
         };
-        let Some(set) = discover::model_terms(other, &alone.fit.values, params, problem) else {
+        let Some(set) = crate::discover::model_terms(other, &alone.fit.values, params, problem) else {
             return Ok(None);
         };
         let mut single = params.clone();
         if set.iter().any(|(n, v)| set_parameter(&mut single, n, *v).is_err()) || single.validate().is_err() {
             return Ok(None);
         }
-        let (misfit_alone, _) = alternatives::judge(cx, problem, &single, replays)?;
+        let (misfit_alone, _) = crate::alternatives::judge(cx, problem, &single, replays)?;
         let own = (used - other_set.len() as f64).max(1.0);
         progress(&format!(
             "  the {} alone leaves {misfit_alone:.0}: the {} earns {:.0} against its penalty {:.0}",

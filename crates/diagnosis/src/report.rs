@@ -1,6 +1,11 @@
 //! The report: the printed summary and the JSON of `jetpipe diagnose --report`.
 
-use super::*;
+use crate::Diagnosis;
+use crate::Errors;
+use crate::MOST_TIED_LOCATIONS;
+use jetpipe_model::physics::parameters::Parameters;
+use serde_json::json;
+use serde_json::Value;
 
 fn parameters_json(values: &[(&'static str, f64)]) -> Value {
     Value::Object(values.iter().map(|(n, v)| (n.to_string(), json!(v))).collect())
@@ -170,7 +175,7 @@ impl Diagnosis {
                 "family": d.family,
                 "candidate": d.candidate,
                 "parameters": parameters_json(&d.parameters),
-                "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(discover::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
+                "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(crate::discover::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
                 "reading": d.reading,
                 "heldout_before_rms_N": d.heldout_before,
                 "heldout_after_rms_N": d.heldout_after,

@@ -2,7 +2,42 @@
 //! departure, and add the named effect that earns its name there, or else a discovered
 //! term that the replay confirms.
 
-use super::*;
+use crate::apply_named;
+use crate::blocks::Block;
+use crate::corrections::catalogue;
+use crate::corrections::parameter_value;
+use crate::corrections::set_parameter;
+use crate::corrections::Candidate;
+use crate::corrections::Problem;
+use crate::localize::discovery_penalised;
+use crate::localize::discovery_penalty_per_term;
+use crate::localize::heldout_count;
+use crate::localize::localize;
+use crate::localize::used_terms;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
+use crate::signals::difference;
+use crate::signals::rms_where;
+use crate::signals::ChainSignals;
+use crate::signals::CHANNELS;
+use crate::signals::CHANNEL_NAMES;
+use crate::signals::FORCE;
+use crate::signature::Signature;
+use crate::worth_adding;
+use crate::AddedEffect;
+use crate::Context;
+use crate::DiscoveredTerm;
+use crate::Localization;
+use crate::Scored;
+use crate::DISCOVERY_TRIALS;
+use crate::EXPLAINED_WITHIN_NOISE;
+use crate::LOCATED_SHARE;
+use crate::MAX_EFFECTS;
+use crate::MIN_GAIN_IN_NOISE;
+use crate::MIN_RELATIVE_GAIN;
+use crate::REFINE_ITERATIONS;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// What the rounds found: the model's parameters with every effect and term added.
 pub(crate) struct Findings {
@@ -119,7 +154,7 @@ pub(crate) fn run_rounds(
         // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
         // not a line resistance), and so does a richer one that does better than a named
         // effect by its penalty.
-        let check = alternatives::Check {
+        let check = crate::alternatives::Check {
             cx,
             problem: &problem,
             count: r.count,
@@ -129,7 +164,7 @@ pub(crate) fn run_rounds(
             Some(Addition::Named(s, sentence)) => {
                 let mut with = f.params.clone();
                 let simpler = if apply_named(&mut with, &s).is_ok() {
-                    let a = alternatives::Added {
+                    let a = crate::alternatives::Added {
                         scored: &s,
                         with: &with,
                         named: true,
@@ -137,7 +172,7 @@ pub(crate) fn run_rounds(
                             && cx.recording.p1.is_some()
                             && cx.recording.p2.is_some(),
                     };
-                    alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)?
+                    crate::alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)?
                 } else {
                     None
                 };
@@ -147,15 +182,15 @@ pub(crate) fn run_rounds(
                 }
             }
             Some(Addition::Discovered(term, trial, Some(s))) => {
-                let a = alternatives::Added {
+                let a = crate::alternatives::Added {
                     scored: &s,
                     with: &trial,
                     named: false,
                     measured_shape: false,
                 };
-                match alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)? {
+                match crate::alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)? {
                     Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
-                    None => match alternatives::simpler_elsewhere(
+                    None => match crate::alternatives::simpler_elsewhere(
                         &check, &found, &f.params, &a, &r.current, replays, progress,
                     )? {
                         Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
@@ -199,7 +234,7 @@ pub(crate) fn run_rounds(
                         earlier.parameters = term.parameters;
                         earlier.heldout_after = term.heldout_after;
                         earlier.share = 1.0 - (earlier.heldout_after / earlier.heldout_before).powi(2);
-                        earlier.reading = discover::reading(
+                        earlier.reading = crate::discover::reading(
                             earlier.candidate,
                             earlier.location,
                             earlier.family,
@@ -305,7 +340,7 @@ pub(crate) fn sync_earlier(f: &mut Findings) {
             *value = now;
         }
         if moved {
-            d.reading = discover::reading(d.candidate, d.location, d.family, &d.parameters, &f.start);
+            d.reading = crate::discover::reading(d.candidate, d.location, d.family, &d.parameters, &f.start);
         }
     }
 }
@@ -350,7 +385,7 @@ fn replay_round(
         return Ok(None);
     }
     let force_residual = difference(&recording.force, &current.force);
-    let line = signature::spectrum(&recording.time, &force_residual);
+    let line = crate::signature::spectrum(&recording.time, &force_residual);
     // A line on the logarithmic grid of the signature, else a sharp line anywhere up to the
     // Nyquist frequency that the inputs do not carry (`lines.rs`).
     let periodic = (line.peak_over_median > 100.0 && line.low_share < 0.5 && line.peak_hz > 0.2)
@@ -360,8 +395,9 @@ fn replay_round(
             let sample_rate = recording.sample_rate();
             let inputs = [&recording.v_da[..n], &recording.x_s[..n]];
             // Placed again at the samples' own times: the fits' stretches have gaps.
-            lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n])
-                .map(|l| signature::polished_line(&recording.time, &force_residual, l.hz, sample_rate / n as f64))
+            crate::lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n]).map(|l| {
+                crate::signature::polished_line(&recording.time, &force_residual, l.hz, sample_rate / n as f64)
+            })
         });
     // Pressures within their noise: nothing upstream of the piston departs by more
     // than they can show, and only the mechanics and the force sensor are fitted. They can
@@ -444,10 +480,9 @@ fn curve_knots(cx: &Context, problem: &Problem, current: &Replay) -> crate::curv
 /// whose own signature is tested in the residual (friction, the sensor's offset and gain,
 /// hysteresis) are still tried.
 pub(crate) fn nameable(s: &Scored, discovered: &[DiscoveredTerm]) -> bool {
-    s.fit
-        .candidate
-        .named
-        .map_or(false, |name| discovered.is_empty() || named::has_signature_test(name))
+    s.fit.candidate.named.map_or(false, |name| {
+        discovered.is_empty() || crate::named::has_signature_test(name)
+    })
 }
 
 /// Whether a candidate may be added as a discovered term, which claims no name: one outside
@@ -662,7 +697,7 @@ fn discover_term(
             ));
             continue;
         }
-        let Some(mut set) = discover::model_terms(&s.fit.candidate, &s.fit.values, params, problem) else {
+        let Some(mut set) = crate::discover::model_terms(&s.fit.candidate, &s.fit.values, params, problem) else {
             progress(&format!("  {label}: the FMU has no parameters for it"));
             continue;
         };
@@ -707,7 +742,7 @@ fn discover_term(
                 family: crate::curves::family(candidate.family, &set),
                 candidate: candidate.label,
                 reading: with_undecided(
-                    discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+                    crate::discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
                     found.undecided_beside(candidate.location, cx.pressure_noise.is_some()),
                 ),
                 parameters: set,
@@ -786,7 +821,7 @@ const TRAINING_GAIN_IN_NOISE: f64 = 3.0;
 const WRITTEN_INSTEAD_WITHIN: f64 = 1.1;
 
 /// For a transducer's curve, its corners beyond the quantities the recording visits
-/// (`curves::corners_across_unvisited`); other candidates' `set` unchanged.
+/// (`crate::curves::corners_across_unvisited`); other candidates' `set` unchanged.
 pub(crate) fn curve_corners_across_unvisited(
     cx: &Context,
     r: &Round,
@@ -833,7 +868,7 @@ fn with_undecided(reading: String, undecided: Option<String>) -> String {
 }
 
 /// The command's curve `set` refitted with its interior knots free
-/// (`curves::command_curve_with_free_knots`), made non-decreasing again, kept when the
+/// (`crate::curves::command_curve_with_free_knots`), made non-decreasing again, kept when the
 /// model with it fits the training samples better than with `set`.
 fn command_curve_knots_freed(
     cx: &Context,

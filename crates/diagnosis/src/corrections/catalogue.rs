@@ -1,7 +1,17 @@
 //! The candidates: every correction the diagnosis tries, place by place, as instances of the
 //! three general mechanisms of [`super`].
 
-use super::*;
+use crate::corrections::parameter_value;
+use crate::corrections::Candidate;
+use crate::corrections::Filter;
+use crate::corrections::Mechanism;
+use crate::corrections::Modulation;
+use crate::corrections::Regressor;
+use crate::corrections::Term;
+use crate::signals::FORCE;
+use crate::signals::P1;
+use crate::signals::P2;
+use jetpipe_model::physics::parameters::Parameters;
 
 fn parameter(base: &Parameters, name: &'static str, unit: &'static str, relative: f64, lower: f64, upper: f64) -> Term {
     let neutral = parameter_value(base, name);

@@ -2,8 +2,25 @@
 //! sensitivities, searches ([`super::search`]) for the terms with none, held-out scores.
 
 use super::search::{golden, search_from_grid};
-use super::*;
 use crate::blocks::Block;
+use crate::corrections::parameter_value;
+use crate::corrections::set_parameter;
+use crate::corrections::Candidate;
+use crate::corrections::Filter;
+use crate::corrections::Mechanism;
+use crate::corrections::Modulation;
+use crate::corrections::Regressor;
+use crate::corrections::Term;
+use crate::recording::Recording;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
+use crate::signals::difference;
+use crate::signals::stopper_acceleration;
+use crate::signals::stopper_velocity;
+use crate::signals::CHANNELS;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::current_driver;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// The precision of a searched term, in golden-section steps: its bracket shrinks to
 /// 0.618^16 = 5e-4 of its range (a thousandth of a decade over three), or, for the first
@@ -452,7 +469,7 @@ impl Problem<'_> {
                 })
                 .collect();
             let jobs = self.jobs.load(std::sync::atomic::Ordering::Relaxed);
-            let moved_replays = crate::parallel_map(&differenced, jobs, |&(j, step)| {
+            let moved_replays = crate::localize::parallel_map(&differenced, jobs, |&(j, step)| {
                 let mut moved = point.values.clone();
                 moved[j] += step;
                 self.replay(candidate, &moved).ok().map(|r| {

@@ -1,0 +1,235 @@
+//! What every stage of a diagnosis reads: the recording, its blocks, the noise floors and the options.
+
+use crate::blocks::Block;
+use crate::localize::parallel_map;
+use crate::recording::Recording;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
+use crate::signals::difference;
+use crate::signals::CHANNELS;
+use crate::signals::FORCE;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+
+#[allow(unused_imports)]
+use crate::*;
+
+/// Where a diagnosis shows how far its long phases are (the CLI draws progress bars).
+pub trait ProgressBars: Send + Sync {
+    /// A phase of `total` steps begins.
+    fn start(&self, phase: &str, total: usize);
+    /// One step of the phase is done (called from any worker thread).
+    fn advance(&self);
+    fn finish(&self);
+}
+
+/// Options of a diagnosis.
+#[derive(Clone)]
+pub struct Options {
+    /// Re-identify the jet pipe offset, C_d and the leakage first (§3.3.1).
+    pub calibrate: bool,
+    /// Worker threads for the candidates.
+    pub jobs: usize,
+    pub bars: Option<std::sync::Arc<dyn ProgressBars>>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            calibrate: false,
+            jobs: std::thread::available_parallelism().map_or(2, |n| n.get()),
+            bars: None,
+        }
+    }
+}
+
+/// [`parallel_map`] with a progress bar over the items.
+pub(crate) fn parallel_map_shown<T: Sync, R: Send>(
+    phase: &str,
+    bars: &Option<std::sync::Arc<dyn ProgressBars>>,
+    items: &[T],
+    jobs: usize,
+    f: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    match bars {
+        None => parallel_map(items, jobs, f),
+        Some(bars) => {
+            bars.start(phase, items.len());
+            let out = parallel_map(items, jobs, |item| {
+                let r = f(item);
+                bars.advance();
+                r
+            });
+            bars.finish();
+            out
+        }
+    }
+}
+
+/// What every stage of a diagnosis reads: the recording, its training blocks and the
+/// channels' noise floors.
+pub(crate) struct Context<'a> {
+    /// The rows the fits work on: the whole recording, or stretches of a long one
+    /// ([`Recording::rows_for_fits`]).
+    pub(crate) recording: &'a Recording,
+    /// Every sample: the noise floors and the errors reported are its.
+    pub(crate) full: &'a Recording,
+    pub(crate) options: &'a Options,
+    /// What each of the fits' rows is for.
+    pub(crate) blocks: Vec<Block>,
+    /// From when (s) the model's starting state no longer shows.
+    pub(crate) settled_from: f64,
+    pub(crate) n: usize,
+    pub(crate) noise: f64,
+    pub(crate) pressure_noise: Option<[f64; 2]>,
+    pub(crate) channel_noise: [f64; CHANNELS],
+    /// The noise of the force against the pressures.
+    pub(crate) mechanical_noise: f64,
+    /// The piston's area, m², once known ([`Self::with_piston_area`]; 0 before).
+    pub(crate) piston_area: f64,
+    /// Where the replays drive the stopper with smoothed positions, the residual limit of
+    /// the smoothing ([`crate::recording::smoothed_stopper_positions`]), m².
+    pub(crate) stopper_smoothing: Option<f64>,
+}
+
+impl<'a> Context<'a> {
+    /// Estimate the channels' noise floors (step 1), and how long `model`'s starting state
+    /// shows; a force channel rounded coarser than its noise gets a line in `input_checks`.
+    pub(crate) fn measure(
+        full: &'a Recording,
+        recording: &'a Recording,
+        model: &Actuator,
+        options: &'a Options,
+        input_checks: &mut Vec<String>,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<Self, String> {
+        let n = recording.len();
+        // The noise floors from every sample. A sharp line (a pick-up) is a departure to
+        // find, not noise.
+        let sample_rate = full.sample_rate();
+        let floor = |x: &[f64]| crate::noise::noise_floor(&crate::lines::without_lines(x, sample_rate, 3));
+        // A signal that curves within a few samples (a 20 Hz multisine or a shaken stopper
+        // sampled at 250 Hz) lifts the floor of the recorded channel; the model follows most
+        // of it, so the channel's departure from the model keeps the noise alone. A model far
+        // off in fast motion lifts the departure's instead: each floor is the lower of the two.
+        let modelled = replay_fast(model, full, full.len()).ok();
+        let floor_of = |x: &[f64], channel: fn(&Replay) -> &Vec<f64>| {
+            let recorded = floor(x);
+            match &modelled {
+                Some(m) if channel(m).len() == x.len() => recorded.min(floor(&difference(x, channel(m)))),
+                _ => recorded,
+            }
+        };
+        let noise = floor_of(&full.force, |m| &m.force);
+        let pressure_noise = match (&full.p1, &full.p2) {
+            (Some(a), Some(b)) => Some([floor_of(a, |m| &m.p1), floor_of(b, |m| &m.p2)]),
+            _ => None,
+        };
+        drop(modelled);
+        if n < full.len() {
+            let message = format!(
+                "The fits use {n} of the {} samples: stretches of {} s spread over the whole recording. The errors reported are of every sample, and so are the noise floors but for one taken again on the stretches after an addition.",
+                full.len(),
+                crate::recording::FIT_STRETCH_SECONDS
+            );
+            progress(&message);
+            input_checks.push(message);
+        }
+        if let Some(q) = crate::noise::quantisation_step(&full.force) {
+            if q > noise {
+                input_checks.push(format!(
+                    "The force channel is quantised in steps of {q:.4} N, coarser than its noise {noise:.4} N: errors below a step cannot be told from rounding."
+                ));
+            }
+        }
+        progress(&format!(
+            "{n} samples, force noise floor {noise:.4} N{}",
+            pressure_noise
+                .map(|p| format!(", pressure noise floors {:.0} and {:.0} Pa", p[0], p[1]))
+                .unwrap_or_default()
+        ));
+        let mut channel_noise = [noise, 0.0, 0.0];
+        if let Some(p) = pressure_noise {
+            channel_noise[1] = p[0];
+            channel_noise[2] = p[1];
+        }
+        let settled_from = crate::blocks::settling_time(model, recording, channel_noise)?;
+        let t0 = recording.time[0];
+        if settled_from > t0 {
+            progress(&format!(
+                "the model's starting state shows until {:.2} s: the samples before are neither fitted nor scored",
+                settled_from - t0
+            ));
+        }
+        Ok(Self {
+            recording,
+            full,
+            options,
+            blocks: crate::blocks::blocks(&recording.time, &recording.x_s, settled_from),
+            settled_from,
+            n,
+            noise,
+            pressure_noise,
+            channel_noise,
+            mechanical_noise: noise,
+            piston_area: 0.0,
+            stopper_smoothing: None,
+        })
+    }
+
+    /// The force against the pressures carries the pressures' noise through the piston area.
+    pub(crate) fn with_piston_area(mut self, area: f64) -> Self {
+        self.piston_area = area;
+        self.set_mechanical_noise();
+        self
+    }
+
+    pub(crate) fn set_mechanical_noise(&mut self) {
+        let (noise, area) = (self.noise, self.piston_area);
+        self.mechanical_noise = self
+            .pressure_noise
+            .map(|p| (noise * noise + area * area * (p[0] * p[0] + p[1] * p[1])).sqrt())
+            .unwrap_or(noise);
+    }
+
+    /// After an addition, each channel's floor taken again from its departure from the model
+    /// with `params`, where that is lower: a departure the model before could not follow (a
+    /// friction's sharp turns at the reversals) lifted the first estimate as a fast signal
+    /// lifts the recording's, and a floor too high reads an error left as noise. On a
+    /// recording thinned for the fits, from the departure on its stretches: the floor is a
+    /// median over windows of 64 samples, which the few windows across a gap do not move.
+    pub(crate) fn lower_noise_to_departure(
+        &mut self,
+        params: &Parameters,
+        replays: &mut usize,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<(), String> {
+        let with = replay_fast(&Actuator::new(params.clone())?, self.recording, self.n)?;
+        *replays += 1;
+        let sample_rate = self.recording.sample_rate();
+        let floor = |x: &[f64], m: &[f64]| {
+            crate::noise::noise_floor(&crate::lines::without_lines(&difference(x, m), sample_rate, 3))
+        };
+        // Lower by a hundredth at least: the same floor again is no news.
+        let force = floor(&self.recording.force, &with.force);
+        if force < 0.99 * self.noise {
+            progress(&format!(
+                "force noise floor {force:.4} N from the departure after the additions (was {:.4} N)",
+                self.noise
+            ));
+            self.noise = force;
+            self.channel_noise[FORCE] = force;
+        }
+        if let (Some(p), Some(p1), Some(p2)) = (self.pressure_noise.as_mut(), &self.recording.p1, &self.recording.p2) {
+            for (c, (x, m)) in [(p1, &with.p1), (p2, &with.p2)].into_iter().enumerate() {
+                let lower = floor(x, m);
+                if lower < 0.99 * p[c] {
+                    p[c] = lower;
+                    self.channel_noise[c + 1] = lower;
+                }
+            }
+        }
+        self.set_mechanical_noise();
+        Ok(())
+    }
+}

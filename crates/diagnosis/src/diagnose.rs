@@ -1,0 +1,156 @@
+//! The diagnosis from end to end: the steps of the crate's account, in order.
+
+use crate::calibrate::Calibrated;
+use crate::recording::Recording;
+use crate::replay::replay;
+use crate::replay::replay_fast;
+use crate::replay::Replay;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+
+#[allow(unused_imports)]
+use crate::*;
+
+/// Diagnose a recording (see the module's account). `progress` receives one line per stage.
+pub fn diagnose(
+    recording: &Recording,
+    base: &Parameters,
+    calibrate_static: bool,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    let options = Options {
+        calibrate: calibrate_static,
+        ..Options::default()
+    };
+    diagnose_with(recording, base, &options, progress)
+}
+
+/// Diagnose a recording with the given options: the steps of the module's account, in order.
+/// A fault of the diagnosis itself (a panic) comes back as an error that says so, not as the
+/// end of the caller's process: a batch goes on with its other recordings.
+pub fn diagnose_with(
+    recording: &Recording,
+    base: &Parameters,
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    diagnose_owned(recording.clone(), base, options, progress)
+}
+
+/// [`diagnose_with`] on a recording the diagnosis may keep and change (its stopper
+/// positions smoothed in place): a long recording is held once, not twice (a 600 s
+/// recording at 1 kHz is 29 MB).
+pub fn diagnose_owned(
+    recording: Recording,
+    base: &Parameters,
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        diagnose_unguarded(recording, base, options, progress)
+    }));
+    run.unwrap_or_else(|fault| {
+        let message = fault
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| fault.downcast_ref::<&str>().copied())
+            .unwrap_or("no message");
+        Err(format!(
+            "the diagnosis failed on a fault of its own, not of the recording ({message}); please report it with the recording"
+        ))
+    })
+}
+
+pub(crate) fn diagnose_unguarded(
+    recording: Recording,
+    base: &Parameters,
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    // 1. The file's checks and the noise floors.
+    let mut input_checks = crate::checks::check_file(&recording, base)?;
+    let stopper_smoothing = recording.stopper_smoothing();
+    let mut smoothed = recording.into_stopper_smoothed();
+    let before_model = Actuator::new(base.clone())?;
+    // The fits' fixed-step replay, checked against the error-controlled one of the starting
+    // model, which the verdict compares the final model with.
+    progress("the starting model replayed with the error-controlled integrator");
+    let before_accurate = replay(&before_model, &smoothed, 1e-5, smoothed.len())?;
+    let fast_replay = crate::agreement::fast_step_that_agrees(&before_model, &smoothed, &before_accurate)?;
+    smoothed.fast_replay = fast_replay.method();
+    if let Some(sentence) = fast_replay.sentence() {
+        progress(&sentence);
+        input_checks.push(sentence);
+    }
+    smoothed.acceleration_window = crate::acceleration::choose_window(
+        &smoothed,
+        &crate::signals::difference(&smoothed.force, &before_accurate.force),
+    );
+    let departures = before_departures(&smoothed, &before_accurate);
+    let departures: Vec<&[f64]> = departures.iter().map(Vec::as_slice).collect();
+    let fitted = smoothed.rows_for_fits_where_departing(crate::recording::MAX_FIT_ROWS, &departures);
+    let cx = Context::measure(&smoothed, &fitted, &before_model, options, &mut input_checks, progress)?;
+    let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
+    input_checks.extend(crate::checks::check_against_model(
+        cx.recording,
+        &before_fast.force,
+        Some((&before_fast.p1, &before_fast.p2)),
+        base,
+    )?);
+    // 2. The static identification, when asked for.
+    let (mut params, calibrated) = if options.calibrate {
+        calibrate_static(&cx, base, progress)
+    } else {
+        (base.clone(), vec![])
+    };
+    // The forces on the stopper's motion read the acceleration smoothed from the recording
+    // (a model without such a force reads none: the share goes back to 0 at the end).
+    params.stopper_acceleration_input_share = 1.0;
+    let mut cx = cx.with_piston_area(before_model.piston_area);
+    cx.stopper_smoothing = stopper_smoothing;
+    // 3–5. Replay, localize, add what earns its place; then refit the additions together.
+    let mut replays = 1;
+    let found = crate::rounds::run_rounds(&mut cx, params, &mut replays, progress)?;
+    let joint_refit = found.joint_refit;
+    // 6. The verdict, from the accurate replays.
+    crate::conclude::conclude(
+        &cx,
+        (before_model, before_accurate, fast_replay),
+        found,
+        joint_refit,
+        input_checks,
+        calibrated,
+        replays,
+        progress,
+    )
+}
+
+/// The starting model's error on each measured channel at every sample.
+pub(crate) fn before_departures(recording: &Recording, before: &Replay) -> Vec<Vec<f64>> {
+    let mut departures = vec![crate::signals::difference(&recording.force, &before.force)];
+    if let (Some(p1), Some(p2)) = (&recording.p1, &recording.p2) {
+        departures.push(crate::signals::difference(p1, &before.p1));
+        departures.push(crate::signals::difference(p2, &before.p2));
+    }
+    departures
+}
+
+/// Re-identify what the thesis identified from static loops (§3.3.1).
+pub(crate) fn calibrate_static(
+    cx: &Context,
+    base: &Parameters,
+    progress: &mut dyn FnMut(&str),
+) -> (Parameters, Vec<Calibrated>) {
+    progress("calibration: x_jp_offset, C_d and the leakage (§3.3.1), on the whole and on halves");
+    let (params, calibrated) = crate::calibrate::calibrate(cx.recording, base, &cx.blocks);
+    for c in &calibrated {
+        progress(&format!(
+            "  {} = {:.4e} (thesis {:.4e}){}",
+            c.name,
+            c.value,
+            c.thesis,
+            if c.flags.is_empty() { "" } else { "  FLAGGED" }
+        ));
+    }
+    (params, calibrated)
+}
