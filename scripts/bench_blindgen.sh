@@ -8,21 +8,29 @@
 #
 #   JETPIPE_BLINDGEN=DIR bash scripts/bench_blindgen.sh SEED COUNT
 #
-# DIR is blindgen's folder (blindgen.py). Use a seed never used before for every measurement:
-# a seed whose truth has been read is spent. The simulator runs in target/blindgen-venv (numpy
-# and numba from PyPI, made on first use).
+# DIR is blindgen's folder (blindgen.py). blindgen is kept with the project's development data
+# and is not shipped with the repository: without it this benchmark cannot run (the other
+# benchmarks, scripts/bench_diagnose.sh and scripts/bench_protocols.sh, need only the
+# repository). Use a seed never used before for every measurement: a seed whose truth has been
+# read is spent. The simulator runs in target/blindgen-venv (numpy and numba from PyPI, made on
+# first use). The last line, `TOTALS: ...` (honest / located / explained of the draws, the
+# median wall time per recorded sample and the batch's wall time), goes into the results
+# file's history table.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/results.sh
 record_results blindgen "Diagnosis of recordings drawn by an independent simulator (blindgen)" "$@"
 if [ $# -ne 2 ] || [ -z "${JETPIPE_BLINDGEN:-}" ]; then
     echo "usage: JETPIPE_BLINDGEN=DIR bash scripts/bench_blindgen.sh SEED COUNT" >&2
+    echo "DIR is the folder of blindgen.py, the project's independent simulator, which is not" >&2
+    echo "shipped with the repository: this benchmark needs it." >&2
     exit 2
 fi
 seed="$1"
 count="$2"
+[ -d "$JETPIPE_BLINDGEN" ] || { echo "bench_blindgen.sh: $JETPIPE_BLINDGEN is not a folder (blindgen is not shipped with the repository)" >&2; exit 2; }
 blindgen="$(cd "$JETPIPE_BLINDGEN" && pwd)/blindgen.py"
-[ -f "$blindgen" ] || { echo "bench_blindgen.sh: no blindgen.py in $JETPIPE_BLINDGEN" >&2; exit 2; }
+[ -f "$blindgen" ] || { echo "bench_blindgen.sh: no blindgen.py in $JETPIPE_BLINDGEN (blindgen is not shipped with the repository)" >&2; exit 2; }
 venv=target/blindgen-venv
 if ! "$venv/bin/python" -c 'import numpy, numba' >/dev/null 2>&1; then
     python3 -m venv "$venv" >&2
@@ -73,7 +81,7 @@ ratio = d["heldout"]["after_rms_N"] / d["noise_floor_N"]
 print(f'| {name} | {rate} | {times[-1]:.0f} | {pressures} | {d["verdict"]} | {"; ".join(places) or "nothing"} '
       f'| {ratio:.2f} | {ms / 1000:.1f} | {ms / samples:.2f} |')
 PY
-done
+done | tee "$work/rows.md"
 echo
 python3 - "$work/reports" <<'PY'
 import glob, json, sys
@@ -93,5 +101,21 @@ echo
 echo "The scorer's account (truth revealed only here):"
 echo
 echo '```'
-"$venv/bin/python" "$blindgen" score "$draws" --reports "$work/reports"
+"$venv/bin/python" "$blindgen" score "$draws" --reports "$work/reports" | tee "$work/score.txt"
 echo '```'
+# The totals, for the history table of docs/results/blindgen.md: the scorer's line for all
+# draws, and the median of the table's wall time per recorded sample.
+python3 - "$work/rows.md" "$work/score.txt" <<'PY'
+import re, statistics, sys
+rows = [line.strip().strip("|").split("|") for line in open(sys.argv[1]) if line.startswith("| bg_")]
+per_sample = [float(r[8]) for r in rows if r[8].strip() not in ("", "—")]
+wall = [float(r[7]) for r in rows if r[7].strip() not in ("", "—")]
+score = re.search(r"^\s*all\s+honest (\d+)/(\d+), located (\d+)/\d+, explained (\d+)/\d+",
+                  open(sys.argv[2]).read(), re.M)
+parts = [f"honest {score[1]} / located {score[3]} / explained {score[4]} of {score[2]}" if score
+         else "the scorer gave no totals"]
+if per_sample:
+    parts.append(f"median {statistics.median(per_sample):.2f} ms a sample")
+parts.append(f"{len(rows)} draws in {sum(wall) / 60:.0f} min")
+print("TOTALS: " + "; ".join(parts))
+PY

@@ -7,7 +7,9 @@
 #   bash scripts/bench_protocols.sh [SECONDS]     (default 40 s recordings)
 #
 # JETPIPE_BENCH_PROTOCOLS and JETPIPE_BENCH_MECHANISMS (space-separated names of the lists
-# below) choose a subset.
+# below) choose a subset. The recordings are all written by benchgen: the benchmark needs
+# nothing beside the repository. The last line, `TOTALS: ...`, goes into the results file's
+# history table.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/results.sh
@@ -152,7 +154,25 @@ PY
     done
 done
 }
-run_table protocols mechanisms
-run_table balance_protocols balance_mechanisms
+{
+    run_table protocols mechanisms
+    run_table balance_protocols balance_mechanisms
+} | tee "$work/rows.md"
 echo
 python3 scripts/never_worse.py "$work"/reports/*.json
+# The totals, for the history table of docs/results/diagnosis_protocols.md.
+python3 - "$work/rows.md" "$work"/reports/*.json <<'PY'
+import json, os, sys
+sys.path.insert(0, "scripts")
+from never_worse import ALLOWANCE_SHARE_OF_NOISE, excesses
+rows = [line.strip().strip("|").split("|") for line in open(sys.argv[1]) if line.startswith("| ")]
+rows = [[c.strip() for c in r] for r in rows if len(r) == 8]
+explained = sum(1 for r in rows if r[3] == "explained")
+right = sum(1 for r in rows if r[5] == "yes")
+place = sum(1 for r in rows if r[5] == "place")
+reports = [json.load(open(p)) for p in sys.argv[2:] if os.path.exists(p)]
+worse = sum(1 for d in reports if max(excesses(d)) > ALLOWANCE_SHARE_OF_NOISE)
+minutes = sum(float(r[7]) for r in rows if r[7] not in ("", "—")) / 60
+print(f"TOTALS: explained {explained} of {len(rows)}; the truth's place and family {right}, its place only {place}; "
+      f"worse than the start {worse}; {minutes:.0f} min of diagnosis")
+PY

@@ -4,7 +4,9 @@
 # pressure channels (a random staircase, the stopper fixed, an exhaust back pressure), at each
 # length of JETPIPE_SCALE_DURATIONS (s; default "80 600 3600") and with `--jobs 2`. Prints one
 # Markdown table row per length, and writes them into docs/results/diagnosis_scale.md.
-# JETPIPE_SCALE_JETPIPE=PATH times another build of the CLI (e.g. an older commit's).
+# JETPIPE_SCALE_JETPIPE=PATH times another build of the CLI (e.g. an older commit's). The last
+# line, `TOTALS: ...` (per length: wall time, CPU time, peak memory, verdict), goes into the
+# results file's history table.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/results.sh
@@ -39,6 +41,12 @@ rows = thinned.group(1) if thinned else str(samples)
 after = report["heldout"]["after_rms_N"] / report["noise_floor_N"]
 print(f"| {sys.argv[3]} | {samples} | {rows} | {seconds:.0f} | {cpu:.0f} | {peak:.0f} | {report['verdict']} | {after:.2f} |")
 PY
-done
+done | tee "$work/rows.md"
 echo
 echo "load average at the end: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores"
+# The totals, for the history table of docs/results/diagnosis_scale.md.
+python3 - "$work/rows.md" <<'PY'
+import sys
+rows = [[c.strip() for c in line.strip().strip("|").split("|")] for line in open(sys.argv[1]) if line.startswith("| ")]
+print("TOTALS: " + "; ".join(f"{r[0]} s: {r[3]} s wall, {r[4]} s CPU, {r[5]} MB, {r[6]}" for r in rows))
+PY

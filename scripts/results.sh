@@ -5,6 +5,35 @@
 # JETPIPE_RESULTS=0 prints the table without writing the file (e.g. for a quick subset).
 # The header says when the tree had uncommitted changes in the code: such a table is not
 # reproducible from its commit alone.
+#
+# The file holds the latest run only, and ends with a "## History" table that this function
+# keeps: one row per run, newest first (date, commit, settings and arguments, totals), at most
+# RESULTS_HISTORY_ROWS of them; older runs are in the file's git history. The totals come from
+# the benchmark itself: the last line of its output that starts with `TOTALS: ` is taken out of
+# the body and its text goes into the run's row. A file without a history (or no file) starts one.
+
+RESULTS_HISTORY_ROWS=20
+
+# The rows of the "## History" table of a results file (the last such section), newest first,
+# without its header; nothing when the file or the section is missing.
+results_history_rows() {
+    [ -f "$1" ] || return 0
+    awk '
+        /^## History[[:space:]]*$/ { inside = 1; n = 0; delete rows; next }
+        inside && /^## / { inside = 0; next }
+        inside && /^\|/ {
+            if ($0 ~ /^\|[-|: ]+\|[[:space:]]*$/) next      # the separator
+            if ($0 ~ /^\| *date/) next                        # the header
+            rows[++n] = $0
+        }
+        END { for (i = 1; i <= n; i++) print rows[i] }
+    ' "$1"
+}
+
+# A table cell: pipes escaped, newlines joined.
+results_cell() {
+    printf '%s' "$1" | tr '\n' ' ' | sed 's/|/\\|/g'
+}
 
 record_results() {
     local name="$1" title="$2"
@@ -39,6 +68,19 @@ record_results() {
     JETPIPE_RECORDING_RESULTS=1 bash "$script" "$@" | tee "$table"
     local status="${PIPESTATUS[0]}"
     set -e
+    # The run's row of the history, then the earlier runs' rows (read before the file is
+    # rewritten).
+    local totals invocation commit_cell row
+    totals="$(grep '^TOTALS: ' "$table" | tail -n 1 | sed 's/^TOTALS: *//')"
+    if [ "$status" != 0 ]; then
+        totals="${totals:+$totals; }exited with status $status"
+    fi
+    invocation="${settings}$*"
+    invocation="${invocation% }"
+    commit_cell="\`$commit\`${changes:+ (uncommitted changes)}"
+    row="| ${started% UTC} | $commit_cell | $(results_cell "${invocation:+\`$invocation\`}") | $(results_cell "$totals") |"
+    local written
+    written="$(mktemp)"
     {
         echo "# $title"
         echo
@@ -47,13 +89,24 @@ record_results() {
         echo "Running the same command at that commit writes the same table; wall and CPU times vary with"
         echo "the machine and its load."
         echo
-        cat "$table"
+        grep -v '^TOTALS: ' "$table"
         if [ "$status" != 0 ]; then
             echo
             echo "The command exited with status $status."
         fi
-    } >"$file"
-    rm -f "$table"
+        echo
+        echo "## History"
+        echo
+        echo "The runs of \`bash $script\`, newest first (at most $RESULTS_HISTORY_ROWS; the tables of earlier"
+        echo "runs are in this file's git history)."
+        echo
+        echo "| date (UTC) | commit | settings and arguments | totals |"
+        echo "|---|---|---|---|"
+        echo "$row"
+        results_history_rows "$file" | head -n $((RESULTS_HISTORY_ROWS - 1))
+    } >"$written"
+    cat "$written" >"$file"
+    rm -f "$table" "$written"
     echo "wrote $file" >&2
     exit "$status"
 }
