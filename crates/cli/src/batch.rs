@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_model::physics::parameters::Parameters;
 
 use crate::html_report::{self, SummaryRow};

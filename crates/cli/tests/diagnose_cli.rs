@@ -105,7 +105,7 @@ fn fuzzed_csv_text_never_crashes_the_reader() {
             }
         }
         let text: String = text.into_iter().collect();
-        match std::panic::catch_unwind(|| jetpipe_diagnosis::recording::Recording::parse(&text, &params)) {
+        match std::panic::catch_unwind(|| jetpipe_diagnosis::input::recording::Recording::parse(&text, &params)) {
             Ok(Ok(recording)) => assert!(recording.len() >= 2),
             Ok(Err(message)) => assert!(
                 message.contains("row")

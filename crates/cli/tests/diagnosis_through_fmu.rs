@@ -12,7 +12,7 @@ use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 use jetpipe_diagnosis::diagnose;
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::variable::VarType;
 use jetpipe_model::variables::VARIABLES;

@@ -5,7 +5,7 @@
 //!
 //! `cargo run --release -p jetpipe-diagnosis --example replay_fast_timing -- FILE [RUNS]`
 
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::replay::{replay_fast, Replay};
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;

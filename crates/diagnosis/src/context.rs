@@ -1,13 +1,13 @@
 //! What every stage of a diagnosis reads: the recording, its blocks, the noise floors and the options.
 
-use crate::blocks::Block;
-use crate::localize::parallel_map;
-use crate::recording::Recording;
+use crate::fit::localize::parallel_map;
+use crate::input::blocks::Block;
+use crate::input::recording::Recording;
 use crate::replay::replay_fast;
+use crate::replay::signals::difference;
+use crate::replay::signals::CHANNELS;
+use crate::replay::signals::FORCE;
 use crate::replay::Replay;
-use crate::signals::difference;
-use crate::signals::CHANNELS;
-use crate::signals::FORCE;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -88,7 +88,7 @@ pub(crate) struct Context<'a> {
     /// The piston's area, m², once known ([`Self::with_piston_area`]; 0 before).
     pub(crate) piston_area: f64,
     /// Where the replays drive the stopper with smoothed positions, the residual limit of
-    /// the smoothing ([`crate::recording::smoothed_stopper_positions`]), m².
+    /// the smoothing ([`crate::input::recording::smoothed_stopper_positions`]), m².
     pub(crate) stopper_smoothing: Option<f64>,
 }
 
@@ -107,7 +107,8 @@ impl<'a> Context<'a> {
         // The noise floors from every sample. A sharp line (a pick-up) is a departure to
         // find, not noise.
         let sample_rate = full.sample_rate();
-        let floor = |x: &[f64]| crate::noise::noise_floor(&crate::lines::without_lines(x, sample_rate, 3));
+        let floor =
+            |x: &[f64]| crate::input::noise::noise_floor(&crate::input::lines::without_lines(x, sample_rate, 3));
         // A signal that curves within a few samples (a 20 Hz multisine or a shaken stopper
         // sampled at 250 Hz) lifts the floor of the recorded channel; the model follows most
         // of it, so the channel's departure from the model keeps the noise alone. A model far
@@ -130,12 +131,12 @@ impl<'a> Context<'a> {
             let message = format!(
                 "The fits use {n} of the {} samples: stretches of {} s spread over the whole recording. The errors reported are of every sample, and so are the noise floors but for one taken again on the stretches after an addition.",
                 full.len(),
-                crate::recording::FIT_STRETCH_SECONDS
+                crate::input::recording::FIT_STRETCH_SECONDS
             );
             progress(&message);
             input_checks.push(message);
         }
-        if let Some(q) = crate::noise::quantisation_step(&full.force) {
+        if let Some(q) = crate::input::noise::quantisation_step(&full.force) {
             if q > noise {
                 input_checks.push(format!(
                     "The force channel is quantised in steps of {q:.4} N, coarser than its noise {noise:.4} N: errors below a step cannot be told from rounding."
@@ -153,7 +154,7 @@ impl<'a> Context<'a> {
             channel_noise[1] = p[0];
             channel_noise[2] = p[1];
         }
-        let settled_from = crate::blocks::settling_time(model, recording, channel_noise)?;
+        let settled_from = crate::input::blocks::settling_time(model, recording, channel_noise)?;
         let t0 = recording.time[0];
         if settled_from > t0 {
             progress(&format!(
@@ -165,7 +166,7 @@ impl<'a> Context<'a> {
             recording,
             full,
             options,
-            blocks: crate::blocks::blocks(&recording.time, &recording.x_s, settled_from),
+            blocks: crate::input::blocks::blocks(&recording.time, &recording.x_s, settled_from),
             settled_from,
             n,
             noise,
@@ -208,7 +209,7 @@ impl<'a> Context<'a> {
         *replays += 1;
         let sample_rate = self.recording.sample_rate();
         let floor = |x: &[f64], m: &[f64]| {
-            crate::noise::noise_floor(&crate::lines::without_lines(&difference(x, m), sample_rate, 3))
+            crate::input::noise::noise_floor(&crate::input::lines::without_lines(&difference(x, m), sample_rate, 3))
         };
         // Lower by a hundredth at least: the same floor again is no news.
         let force = floor(&self.recording.force, &with.force);

@@ -1,7 +1,7 @@
 //! The diagnosis from end to end: the steps of the crate's account, in order.
 
-use crate::calibrate::Calibrated;
-use crate::recording::Recording;
+use crate::fit::calibrate::Calibrated;
+use crate::input::recording::Recording;
 use crate::replay::replay;
 use crate::replay::replay_fast;
 use crate::replay::Replay;
@@ -68,7 +68,7 @@ pub(crate) fn diagnose_unguarded(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
     // 1. The file's checks and the noise floors.
-    let mut input_checks = crate::checks::check_file(&recording, base)?;
+    let mut input_checks = crate::input::checks::check_file(&recording, base)?;
     let stopper_smoothing = recording.stopper_smoothing();
     let mut smoothed = recording.into_stopper_smoothed();
     let before_model = Actuator::new(base.clone())?;
@@ -76,22 +76,22 @@ pub(crate) fn diagnose_unguarded(
     // model, which the verdict compares the final model with.
     progress("the starting model replayed with the error-controlled integrator");
     let before_accurate = replay(&before_model, &smoothed, 1e-5, smoothed.len())?;
-    let fast_replay = crate::agreement::fast_step_that_agrees(&before_model, &smoothed, &before_accurate)?;
+    let fast_replay = crate::replay::agreement::fast_step_that_agrees(&before_model, &smoothed, &before_accurate)?;
     smoothed.fast_replay = fast_replay.method();
     if let Some(sentence) = fast_replay.sentence() {
         progress(&sentence);
         input_checks.push(sentence);
     }
-    smoothed.acceleration_window = crate::acceleration::choose_window(
+    smoothed.acceleration_window = crate::input::acceleration::choose_window(
         &smoothed,
-        &crate::signals::difference(&smoothed.force, &before_accurate.force),
+        &crate::replay::signals::difference(&smoothed.force, &before_accurate.force),
     );
     let departures = before_departures(&smoothed, &before_accurate);
     let departures: Vec<&[f64]> = departures.iter().map(Vec::as_slice).collect();
-    let fitted = smoothed.rows_for_fits_where_departing(crate::recording::MAX_FIT_ROWS, &departures);
+    let fitted = smoothed.rows_for_fits_where_departing(crate::input::recording::MAX_FIT_ROWS, &departures);
     let cx = Context::measure(&smoothed, &fitted, &before_model, options, &mut input_checks, progress)?;
     let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
-    input_checks.extend(crate::checks::check_against_model(
+    input_checks.extend(crate::input::checks::check_against_model(
         cx.recording,
         &before_fast.force,
         Some((&before_fast.p1, &before_fast.p2)),
@@ -110,10 +110,10 @@ pub(crate) fn diagnose_unguarded(
     cx.stopper_smoothing = stopper_smoothing;
     // 3–5. Replay, localize, add what earns its place; then refit the additions together.
     let mut replays = 1;
-    let found = crate::rounds::run_rounds(&mut cx, params, &mut replays, progress)?;
+    let found = crate::decide::rounds::run_rounds(&mut cx, params, &mut replays, progress)?;
     let joint_refit = found.joint_refit;
     // 6. The verdict, from the accurate replays.
-    crate::conclude::conclude(
+    crate::verdict::conclude::conclude(
         &cx,
         (before_model, before_accurate, fast_replay),
         found,
@@ -127,10 +127,10 @@ pub(crate) fn diagnose_unguarded(
 
 /// The starting model's error on each measured channel at every sample.
 pub(crate) fn before_departures(recording: &Recording, before: &Replay) -> Vec<Vec<f64>> {
-    let mut departures = vec![crate::signals::difference(&recording.force, &before.force)];
+    let mut departures = vec![crate::replay::signals::difference(&recording.force, &before.force)];
     if let (Some(p1), Some(p2)) = (&recording.p1, &recording.p2) {
-        departures.push(crate::signals::difference(p1, &before.p1));
-        departures.push(crate::signals::difference(p2, &before.p2));
+        departures.push(crate::replay::signals::difference(p1, &before.p1));
+        departures.push(crate::replay::signals::difference(p2, &before.p2));
     }
     departures
 }
@@ -142,7 +142,7 @@ pub(crate) fn calibrate_static(
     progress: &mut dyn FnMut(&str),
 ) -> (Parameters, Vec<Calibrated>) {
     progress("calibration: x_jp_offset, C_d and the leakage (§3.3.1), on the whole and on halves");
-    let (params, calibrated) = crate::calibrate::calibrate(cx.recording, base, &cx.blocks);
+    let (params, calibrated) = crate::fit::calibrate::calibrate(cx.recording, base, &cx.blocks);
     for c in &calibrated {
         progress(&format!(
             "  {} = {:.4e} (thesis {:.4e}){}",

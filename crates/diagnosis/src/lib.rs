@@ -1,71 +1,41 @@
-//! Diagnosis of a bench recording: where does the thesis model depart from it, and is
-//! the departure one of the named effects?
+//! Diagnosis of a bench recording: where does the thesis model depart from it, what kind
+//! of departure is it, and is it one of the named effects? The folders are the method's
+//! stages, in the order a recording goes through them ([`diagnose`] runs them):
 //!
-//! 1. Check the file (units, length, sampling) and estimate each channel's noise floor.
-//! 2. Optionally re-identify what the thesis identified from static loops (`--calibrate`).
-//! 3. Replay the recording's inputs through the model. With pressure channels, split the
-//!    residual: the force against A_p (p1 − p2) speaks of the mechanics and the force
-//!    sensor, the pressures against the model's of everything upstream.
-//! 4. Fit every candidate correction ([`corrections`]) on the training blocks of all
-//!    channels and score it on the held-out blocks; the place in the chain whose best
-//!    candidate explains most of the held-out misfit is where the model departs.
-//! 5. A named effect is added only when it is a candidate at that place, explains most of
-//!    what that place can explain, lowers the force error by more than the noise
-//!    ([`worth_adding`]), makes no
-//!    channel worse, and the residual carries its own signature (`named.rs`). Repeat.
-//! 6. Verdict: explained when the held-out force error after is within 1.5 noise floors;
-//!    otherwise the remainder, where it sits in the chain and its signature.
+//! 1. [`input`]: read and check the recording, measure each channel's noise floor and
+//!    spectral lines, and cut it into training and held-out blocks.
+//! 2. [`replay`]: run the recording's inputs through the model (crate `jetpipe-model`), check
+//!    the fits' fixed-step replay against the error-controlled one, and form the signals
+//!    along the chain that a residual may follow.
+//! 3. [`candidates`]: every correction the diagnosis may add, place by place: the written
+//!    catalogue and the generated classes (static curves, a constant varying with a signal,
+//!    products of the mechanics' signals, extra flows, quantisers).
+//! 4. [`fit`]: fit each candidate through the model on the training blocks, score it on the
+//!    held-out blocks with its penalty, and rank the places of the chain (optionally after
+//!    the static calibration of `--calibrate`).
+//! 5. [`decide`]: rounds of localization and addition: a named effect where the residual
+//!    carries its signature, a discovered term otherwise; alternatives, compounds,
+//!    elimination, and withdrawal of anything that leaves a worse model.
+//! 6. [`verdict`]: the final accurate replays, the verdict and the remainder's signature,
+//!    and the report.
 //!
-//! The recordings themselves are [`recording`]; [`replay`](mod@replay) runs their inputs
-//! through the model (crate `jetpipe-model`).
+//! Beside the stages: [`policy`] states every threshold and precedence rule once,
+//! `context.rs` (its `Context`) is what every stage reads, and [`results`] holds what a diagnosis
+//! finds.
 
-pub mod acceleration;
-pub mod agreement;
-mod alternatives;
-mod beside;
-pub mod blocks;
-pub mod calibrate;
-pub mod checks;
-pub mod command_gaps;
-pub mod command_path;
-mod conclude;
-pub mod corrections;
-pub mod curves;
-pub mod discharge;
-mod discover;
-mod eliminate;
-pub mod extra_flows;
-pub mod lines;
-mod localize;
-pub mod modulation;
-mod named;
-mod named_instead;
-mod named_places;
-mod named_rivals;
-pub mod noise;
-mod oscillation;
-mod pairs;
-pub mod products;
-mod quantiser;
-pub mod recording;
+pub mod candidates;
+pub mod decide;
+pub mod fit;
+pub mod input;
 pub mod replay;
-mod report;
-mod rounds;
-pub mod signals;
-pub mod signature;
-mod split;
-mod withdraw;
+pub mod verdict;
 
 mod context;
 mod diagnose;
-mod named_effect;
 pub mod policy;
-mod refit;
 pub mod results;
 
 pub use context::*;
 pub use diagnose::*;
-pub(crate) use named_effect::*;
 pub use policy::*;
-pub(crate) use refit::*;
 pub use results::*;

@@ -1,15 +1,15 @@
 //! What a diagnosis finds: its errors, scores, localization, additions and the whole report.
 
-use crate::blocks::Block;
-use crate::calibrate::Calibrated;
-use crate::corrections::Candidate;
-use crate::corrections::Fit;
-use crate::recording::Recording;
+use crate::candidates::Candidate;
+use crate::fit::calibrate::Calibrated;
+use crate::fit::Fit;
+use crate::input::blocks::Block;
+use crate::input::recording::Recording;
+use crate::replay::signals::difference;
+use crate::replay::signals::rms;
+use crate::replay::signals::rms_where;
 use crate::replay::Replay;
-use crate::signals::difference;
-use crate::signals::rms;
-use crate::signals::rms_where;
-use crate::signature::Signature;
+use crate::verdict::signature::Signature;
 use jetpipe_model::physics::parameters::Parameters;
 use serde_json::Value;
 
@@ -200,9 +200,15 @@ impl DiscoveredTerm {
     ) -> Self {
         DiscoveredTerm {
             location: candidate.location,
-            family: crate::curves::family(candidate.family, &set),
+            family: crate::candidates::curves::family(candidate.family, &set),
             candidate: candidate.label,
-            reading: crate::discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+            reading: crate::decide::discover::reading(
+                candidate.label,
+                candidate.location,
+                candidate.family,
+                &set,
+                params,
+            ),
             parameters: set,
             heldout_before: before,
             heldout_after: after,
@@ -235,7 +241,7 @@ pub struct Diagnosis {
     pub before: Errors,
     pub after: Errors,
     /// The seconds at the start in which the model's starting state still shows: neither
-    /// fitted nor scored ([`blocks`]).
+    /// fitted nor scored ([`crate::input::blocks`]).
     pub settling: f64,
     pub calibrated: Vec<Calibrated>,
     pub effects: Vec<AddedEffect>,
@@ -259,7 +265,7 @@ pub struct Diagnosis {
     /// model than it was given.
     pub withdrawn: Option<Withdrawn>,
     /// The fits' fixed-step replay against the error-controlled one, and the step they used.
-    pub fast_replay: crate::agreement::FastReplayCheck,
+    pub fast_replay: crate::replay::agreement::FastReplayCheck,
     /// The final model's fixed-step replay against its error-controlled one: the force's RMS
     /// departure, N, and in noise floors; none when nothing was added.
     pub fast_replay_final: Option<(f64, f64)>,
@@ -267,16 +273,16 @@ pub struct Diagnosis {
     /// pressure channels ([`crate::replay::start_pressures`]); at the equilibrium otherwise.
     pub start_pressures: Option<[f64; 2]>,
     /// Where the replays drove the stopper with the smoothed positions
-    /// ([`crate::recording::Recording::with_stopper_smoothed`]), the smoothing's residual limit, m²;
+    /// ([`crate::input::recording::Recording::with_stopper_smoothed`]), the smoothing's residual limit, m²;
     /// `None` where they drove it with the recorded ones.
     pub stopper_smoothing: Option<f64>,
     /// The half-width (s) of the stopper acceleration the final model reads as its input a_s
-    /// ([`acceleration`]); 0 where it reads none (no force on the stopper's motion).
+    /// ([`crate::input::acceleration`]); 0 where it reads none (no force on the stopper's motion).
     pub acceleration_window: f64,
 }
 
-pub use crate::split::PressureSplit;
-pub use crate::withdraw::Withdrawn;
+pub use crate::decide::withdraw::Withdrawn;
+pub use crate::verdict::split::PressureSplit;
 
 impl Diagnosis {
     /// Whether the force is within its noise on the held-out blocks.
@@ -288,7 +294,7 @@ impl Diagnosis {
     /// recording.
     pub fn explained(&self) -> bool {
         self.force_explained()
-            && !crate::split::pressures_off(
+            && !crate::verdict::split::pressures_off(
                 self.pressure_split.as_ref(),
                 self.pressure_noise,
                 self.after.pressure_rms,

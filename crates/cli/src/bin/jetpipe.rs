@@ -507,7 +507,7 @@ fn diagnose(
     }
     let started = Instant::now();
     let base = read_parameters(params)?;
-    let recording = jetpipe_diagnosis::recording::Recording::read(recording_path, &base)?;
+    let recording = jetpipe_diagnosis::input::recording::Recording::read(recording_path, &base)?;
     let bars = std::sync::Arc::new(TerminalBars::default());
     let mut progress = |line: &str| {
         let line = format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
@@ -531,7 +531,8 @@ fn diagnose(
     // that should they fail, the diagnosis is not lost with them.
     jetpipe_cli::output::write_atomically(report, &text)?;
     let figures_failed = |e: String| format!("{e} (the report {} was written)", report.display());
-    let recording = jetpipe_diagnosis::recording::Recording::read(recording_path, &base).map_err(figures_failed)?;
+    let recording =
+        jetpipe_diagnosis::input::recording::Recording::read(recording_path, &base).map_err(figures_failed)?;
     let inputs = jetpipe_cli::plots::FigureInputs {
         recording: &recording,
         diagnosis: &diagnosis,

@@ -7,7 +7,7 @@
 //! the force explained (held-out error within 1.5 noise floors).
 
 use super::diagnose;
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{
@@ -304,7 +304,7 @@ fn a_seal_friction_growing_with_the_pressure_under_a_slow_sine_at_250_hertz_with
     );
 }
 
-// The generated products of the mechanics' signals ([`jetpipe_diagnosis::products`]): forces
+// The generated products of the mechanics' signals ([`jetpipe_diagnosis::candidates::products`]): forces
 // written by the bench's own plant, each found as its own product in the model's slots.
 
 /// A friction growing along the bore and turning with the motion: 75 N/m × (x_s − 54 mm) ×

@@ -1,4 +1,4 @@
-//! The static-curve class (`jetpipe_diagnosis::curves`) on recordings of the synthetic
+//! The static-curve class (`jetpipe_diagnosis::candidates::curves`) on recordings of the synthetic
 //! bench's own mechanisms, which it writes with its own code: a force sensor that
 //! saturates, a pressure transducer that saturates or reads a quadratic curve, and a dead
 //! zone in the command. Short recordings (20 s at 250–1000 Hz) under several protocols, two

@@ -1,12 +1,12 @@
 //! An extra mass flow into one chamber alone, picked from the generated class of the model's
-//! extra flow slots ([`jetpipe_diagnosis::extra_flows`]): a flow written by the synthetic
+//! extra flow slots ([`jetpipe_diagnosis::candidates::extra_flows`]): a flow written by the synthetic
 //! bench's own plant (`difference_inflow_2`, chamber 2 gains g (P1 − P2) that chamber 1 does
 //! not lose), which must be discovered at the chambers as an extra flow into chamber 2 in
 //! proportion to P1 − P2, its coefficient (kg/s per bar) within 5 % of the bench's, and the
 //! force explained.
 
 use super::diagnose;
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{generate_protocol, BenchEffects, CommandProtocol, ProtocolSpec, UndeclaredEffects};

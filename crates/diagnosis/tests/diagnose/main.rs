@@ -34,7 +34,7 @@ mod shared;
 mod synthetic;
 mod undeclared;
 
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 

@@ -5,7 +5,7 @@
 //! recordings (20 s at 250 or 500 Hz), two protocols each, with and without pressures.
 
 use super::diagnose;
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{

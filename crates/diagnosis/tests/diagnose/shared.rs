@@ -14,7 +14,7 @@
 use std::path::PathBuf;
 
 use super::diagnose;
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 

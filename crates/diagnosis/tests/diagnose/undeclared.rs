@@ -14,7 +14,7 @@
 //! `scripts/bench_cases.sh` runs every case.
 
 use super::diagnose;
-use jetpipe_diagnosis::recording::Recording;
+use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use synthetic_bench::{

@@ -1,0 +1,15 @@
+//! Stage 5, the decision: rounds of localization and addition, named effects and the signatures
+//! that earn their names, discovered terms, alternatives, compounds, elimination and withdrawal.
+
+pub(crate) mod alternatives;
+pub(crate) mod beside;
+pub(crate) mod discover;
+pub(crate) mod eliminate;
+pub(crate) mod named;
+pub(crate) mod named_effect;
+pub(crate) mod named_instead;
+pub(crate) mod named_places;
+pub(crate) mod named_rivals;
+pub(crate) mod pairs;
+pub(crate) mod rounds;
+pub(crate) mod withdraw;

@@ -1,0 +1,170 @@
+//! Refits of what was added: together after the rounds, or a few constants at a time.
+
+use crate::candidates::parameter_value;
+use crate::candidates::set_parameter;
+use crate::candidates::Candidate;
+use crate::candidates::Mechanism;
+use crate::candidates::Term;
+use crate::fit::Problem;
+use crate::input::blocks::Block;
+use crate::replay::replay_fast;
+use crate::replay::signals::difference;
+use crate::replay::signals::rms_where;
+use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
+
+#[allow(unused_imports)]
+use crate::*;
+
+/// Whether an added parameter is an amount a refit may move: a curve's knot count and
+/// abscissae are its grid, and a modulation slot's constant, signal, frequency and knot
+/// count say what varies with what (its knots' abscissae move: a band of friction 60–66 mm
+/// wide, first placed at the signal's quantiles, was refitted from 2.5 noise floors to 1.2).
+pub(crate) fn refittable(name: &str) -> bool {
+    if name.starts_with("modulation_") {
+        return name.contains("_y_") || name.contains("_x_");
+    }
+    !name.ends_with("_curve_knots") && !name.contains("_curve_x_")
+}
+
+/// The added parameters as one candidate, starting from their current values.
+pub(crate) fn joint_candidate(params: &Parameters, names: &[&'static str]) -> Candidate {
+    let terms: Vec<Term> = names
+        .iter()
+        .map(|&name| {
+            let value = parameter_value(params, name);
+            let (lower, upper) = crate::candidates::declared_bounds(name);
+            Term {
+                name,
+                unit: crate::decide::discover::unit_of(name),
+                mechanism: Mechanism::Parameter(name),
+                neutral: value,
+                step: 1e-3 * value.abs(),
+                lower,
+                upper,
+            }
+        })
+        .collect();
+    Candidate {
+        label: "joint refit",
+        location: "",
+        family: "",
+        named: None,
+        terms,
+        settings: vec![],
+    }
+}
+
+/// Each effect and term was fitted with those before it held: refit them together, and
+/// keep the refit when the held-out force error falls. The error before and after.
+pub(crate) fn refit_jointly(
+    cx: &Context,
+    found: &mut crate::decide::rounds::Findings,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<(f64, f64)>, String> {
+    if found.effects.len() + found.discovered.len() < 2 {
+        return Ok(None);
+    }
+    let params = &found.params;
+    let names: Vec<&'static str> = found
+        .effects
+        .iter()
+        .flat_map(|e| e.parameters.iter())
+        .chain(found.discovered.iter().flat_map(|d| d.parameters.iter()))
+        .map(|(name, _)| *name)
+        .filter(|name| parameter_value(params, name) != 0.0)
+        .filter(|name| refittable(name))
+        .collect();
+    progress(&format!("joint refit of the {} parameters added", names.len()));
+    let Some((trial, before_joint, after_joint)) = refit_constants(cx, params, &names, replays)? else {
+        return Ok(None);
+    };
+    progress(&format!(
+        "  held-out force error {before_joint:.4} -> {after_joint:.4} N"
+    ));
+    if after_joint >= before_joint {
+        return Ok(None);
+    }
+    found.params = trial;
+    retire_switched_off(found, progress);
+    Ok(Some((before_joint, after_joint)))
+}
+
+/// The constants `names` of `params` refitted together (three Gauss–Newton iterations from
+/// where they stand): the parameters with them, and the held-out force error before and
+/// after, N. `None` when the fit fails or its values are not a valid model.
+pub(crate) fn refit_constants(
+    cx: &Context,
+    params: &Parameters,
+    names: &[&'static str],
+    replays: &mut usize,
+) -> Result<Option<(Parameters, f64, f64)>, String> {
+    let (recording, n) = (cx.recording, cx.n);
+    let problem = Problem::new(recording, params, &cx.blocks, cx.channel_noise);
+    problem.set_jobs(cx.options.jobs);
+    let candidate = joint_candidate(params, names);
+    let current = replay_fast(&Actuator::new(params.clone())?, recording, n)?;
+    let before_joint = rms_where(
+        &difference(&recording.force, &current.force),
+        &cx.blocks,
+        Block::HeldOut,
+    );
+    let step_of = |name: &'static str| candidate.terms.iter().find(|t| t.name == name).map_or(0.0, |t| t.step);
+    let sensitivities = |name: &'static str| problem.sensitivity(name, step_of(name), &current);
+    let Ok(fit) = problem.fit(&candidate, 3, &current, &sensitivities) else {
+        return Ok(None);
+    };
+    *replays += fit.replays + names.len();
+    let mut trial = params.clone();
+    // The command the driver sees does not fall as the logged one rises, after the refit as
+    // when the curve was first fitted.
+    let mut refitted: Vec<(&'static str, f64)> = names.iter().copied().zip(fit.values.iter().copied()).collect();
+    crate::candidates::curves::monotone_command(&mut refitted);
+    let valid = refitted
+        .iter()
+        .all(|(name, value)| set_parameter(&mut trial, name, *value).is_ok())
+        && trial.validate().is_ok();
+    if !valid {
+        return Ok(None);
+    }
+    let with = replay_fast(&Actuator::new(trial.clone())?, recording, n)?;
+    *replays += 1;
+    let after_joint = rms_where(&difference(&recording.force, &with.force), &cx.blocks, Block::HeldOut);
+    Ok(Some((trial, before_joint, after_joint)))
+}
+
+/// After the joint refit: a named effect the refit turned off (its amplitude at zero:
+/// another term took over what it explained) is no longer there, and the others report
+/// their refitted values.
+pub(crate) fn retire_switched_off(found: &mut crate::decide::rounds::Findings, progress: &mut dyn FnMut(&str)) {
+    let params = &mut found.params;
+    let count = found.effects.len();
+    found.effects.retain(|e| {
+        let off = match e.name {
+            "piston_friction" => params.friction_coulomb == 0.0,
+            _ => e
+                .parameters
+                .iter()
+                .all(|(name, _)| parameter_value(params, name) == parameter_value(&Parameters::default(), name)),
+        };
+        if off {
+            progress(&format!("  {} is off after the refit: removed", e.name));
+        }
+        !off
+    });
+    if found.effects.len() != count && matches!(found.newest, Some((true, _))) {
+        found.newest = None;
+    }
+    if params.friction_coulomb == 0.0 {
+        params.friction_velocity = 0.0;
+    }
+    for (name, value) in found
+        .effects
+        .iter_mut()
+        .flat_map(|e| e.parameters.iter_mut())
+        .chain(found.discovered.iter_mut().flat_map(|d| d.parameters.iter_mut()))
+    {
+        *value = parameter_value(params, name);
+    }
+}

@@ -1,0 +1,273 @@
+//! Which samples the fits train on and which score them: alternate blocks of
+//! [`BLOCK_SECONDS`], after a first stretch in which the model's
+//! unknown starting state still shows.
+//!
+//! A replay starts from the equilibrium of the first recorded command, as if the bench had
+//! held it before the recording began. A bench that was already running (a controller
+//! acting, a command changing) was not there: until the chambers have forgotten where they
+//! started, the model and the recording differ by a transient that no correction of the
+//! model explains, and a fit that trains on it bends every term towards it. How long the
+//! starting state matters is the model's to say: it is replayed from the equilibria of the
+//! lowest and the highest command of the first block (a bench running before the recording
+//! began was most likely doing what it does in its first seconds), and the samples until
+//! every channel of those replays agrees with the first one within 0.3 of its noise are
+//! neither fitted nor scored.
+
+use crate::input::recording::Recording;
+use crate::replay::{replay_fast_from, Start};
+use crate::BLOCK_SECONDS;
+use jetpipe_model::physics::actuator::Actuator;
+
+/// What a sample is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Block {
+    /// Fitted on.
+    Training,
+    /// Scored on, never fitted.
+    HeldOut,
+    /// Before the model's starting state has faded: neither.
+    Settling,
+}
+
+/// Training samples are those in even-numbered blocks counted from the first sample,
+/// held-out ones those in odd-numbered blocks; those before `settled_from` (s) are settling.
+/// A short move of the stopper (`x_s`, m) is cut finer: see [`short_stopper_moves`].
+pub fn blocks(time: &[f64], x_s: &[f64], settled_from: f64) -> Vec<Block> {
+    let t0 = time.first().copied().unwrap_or(0.0);
+    let mut blocks: Vec<Block> = time
+        .iter()
+        .map(|&t| {
+            if t < settled_from {
+                Block::Settling
+            } else if ((t - t0) / BLOCK_SECONDS).floor() as i64 % 2 == 0 {
+                Block::Training
+            } else {
+                Block::HeldOut
+            }
+        })
+        .collect();
+    for (start, end) in short_stopper_moves(time, x_s) {
+        let from = start - MOVE_MARGIN_SECONDS;
+        for k in time.partition_point(|&t| t < from)..time.partition_point(|&t| t <= end + MOVE_MARGIN_SECONDS) {
+            if blocks[k] != Block::Settling {
+                blocks[k] = if ((time[k] - from) / MOVE_PIECE_SECONDS).floor() as i64 % 2 == 0 {
+                    Block::Training
+                } else {
+                    Block::HeldOut
+                };
+            }
+        }
+    }
+    blocks
+}
+
+/// A stopper that rests and moves a few times shows whatever follows its motion (a force
+/// with its acceleration or velocity) in those moves alone, mostly where it starts and stops.
+/// Left in the blocks of [`BLOCK_SECONDS`], a recording with one move has it all in a
+/// training block or all in a held-out one: the fits never see it, or the score never does.
+/// So a move shorter than [`SHORT_MOVE_SECONDS`] and the [`MOVE_MARGIN_SECONDS`] either side
+/// of it are cut in pieces of [`MOVE_PIECE_SECONDS`], fitted and scored in turn.
+pub const SHORT_MOVE_SECONDS: f64 = 1.0;
+/// What follows a stop (the force's response, a smoothed acceleration) lasts tens of ms.
+pub const MOVE_MARGIN_SECONDS: f64 = 0.05;
+/// Four pieces to a start or a stop that lasts 40 ms.
+pub const MOVE_PIECE_SECONDS: f64 = 0.01;
+/// A move is one when the stopper goes further than this (m): a position that only toggles
+/// by its last logged digit is at rest.
+pub const SMALLEST_MOVE: f64 = 1e-4;
+
+/// The stopper's short moves, (first, last) time (s) at which it moves: runs of samples at
+/// which the position changes, joined across gaps under [`MOVE_MARGIN_SECONDS`], shorter
+/// than [`SHORT_MOVE_SECONDS`] and spanning more than [`SMALLEST_MOVE`]. A stopper moving
+/// all along (shaken, or a noisy position) has none.
+pub fn short_stopper_moves(time: &[f64], x_s: &[f64]) -> Vec<(f64, f64)> {
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for k in 1..time.len().min(x_s.len()) {
+        if x_s[k] == x_s[k - 1] {
+            continue;
+        }
+        match runs.last_mut() {
+            Some(run) if time[k - 1] - time[run.1] < MOVE_MARGIN_SECONDS => run.1 = k,
+            _ => runs.push((k - 1, k)),
+        }
+    }
+    runs.into_iter()
+        .filter(|&(a, b)| time[b] - time[a] < SHORT_MOVE_SECONDS)
+        .filter(|&(a, b)| {
+            let (low, high) = x_s[a..=b]
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| (l.min(x), h.max(x)));
+            high - low > SMALLEST_MOVE
+        })
+        .map(|(a, b)| (time[a], time[b]))
+        .collect()
+}
+
+/// How many samples are `which`.
+pub fn count(blocks: &[Block], which: Block) -> usize {
+    blocks.iter().filter(|&&b| b == which).count()
+}
+
+/// Replays from another starting state must agree with the first replay within this
+/// fraction of each channel's noise floor: what is left adds at most a tenth to the noise's
+/// mean square, 5 % to its RMS. (A tenth of the floor would cost a 20 s recording under
+/// force tracking a quarter of its samples: the chambers' common pressure forgets its start
+/// slowly, 0.3 of the floor about 3.7 s after the start and 0.1 of it after 5 s.)
+pub const SETTLED_WITHIN_NOISE: f64 = 0.3;
+/// The settling stretch is looked for in at most this share of the recording…
+pub const MOST_OF_THE_SPAN: f64 = 0.25;
+/// …and in at most this many seconds.
+pub const LONGEST_SETTLING: f64 = 10.0;
+
+/// The time (s) from which `model`'s starting state no longer shows in its outputs on
+/// `recording`, to within [`SETTLED_WITHIN_NOISE`] of each channel's floor in `noise`
+/// (force, p1, p2; 0 for a channel not weighed), the start taken to lie among the
+/// equilibria of the first block's commands. At most a quarter of the recording or
+/// [`LONGEST_SETTLING`] in. The replays start at those equilibria even where the recording's
+/// pressures give the chambers' start: what the transducers do not read (the jet pipe's
+/// hysteresis memory, say) stays unknown for as long as such a start shows.
+pub fn settling_time(model: &Actuator, recording: &Recording, noise: [f64; 3]) -> Result<f64, String> {
+    let time = &recording.time;
+    let t0 = time[0];
+    let span = time[time.len() - 1] - t0;
+    let horizon = t0 + (MOST_OF_THE_SPAN * span).min(LONGEST_SETTLING);
+    let end = time.partition_point(|&t| t <= horizon).max(1);
+    let first_block = time.partition_point(|&t| t < t0 + BLOCK_SECONDS);
+    let (lowest, highest) = recording.v_da[..first_block.max(1)]
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let first = replay_fast_from(model, recording, end, Start::AtEquilibrium(recording.v_da[0]))?;
+    let mut last_apart: Option<usize> = None;
+    for held in [lowest, highest] {
+        if held == recording.v_da[0] {
+            continue;
+        }
+        let other = replay_fast_from(model, recording, end, Start::AtEquilibrium(held))?;
+        let channels = [
+            (&first.force, &other.force),
+            (&first.p1, &other.p1),
+            (&first.p2, &other.p2),
+        ];
+        for (c, (a, b)) in channels.into_iter().enumerate() {
+            if noise[c] <= 0.0 {
+                continue;
+            }
+            let limit = SETTLED_WITHIN_NOISE * noise[c];
+            if let Some(k) = (0..end)
+                .rev()
+                .find(|&k| (a[k] - b[k]).abs() > limit || !(a[k] - b[k]).is_finite())
+            {
+                last_apart = Some(last_apart.map_or(k, |l: usize| l.max(k)));
+            }
+        }
+    }
+    Ok(match last_apart {
+        None => t0,
+        Some(k) if k + 1 >= end => horizon,
+        Some(k) => time[k + 1],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use jetpipe_model::physics::parameters::Parameters;
+
+    fn recording_of(commands: impl Fn(f64) -> f64, seconds: f64) -> Recording {
+        let n = (seconds * 1000.0) as usize;
+        let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let v_da: Vec<f64> = time.iter().map(|&t| commands(t)).collect();
+        Recording {
+            x_s: vec![0.054; n],
+            force: vec![0.0; n],
+            p1: None,
+            p2: None,
+            time,
+            v_da,
+            full_rate: None,
+            fast_replay: crate::replay::FastReplayMethod::default(),
+            acceleration_window: 0.0,
+        }
+    }
+
+    #[test]
+    fn samples_before_the_settling_time_are_neither_fitted_nor_scored() {
+        let time: Vec<f64> = (0..1000).map(|k| k as f64 * 0.01).collect();
+        let b = blocks(&time, &vec![0.05; time.len()], 0.5);
+        assert!(b[..50].iter().all(|&x| x == Block::Settling));
+        assert!(b[50..200].iter().all(|&x| x == Block::Training));
+        assert!(b[200..400].iter().all(|&x| x == Block::HeldOut));
+        assert!(b[400..600].iter().all(|&x| x == Block::Training));
+        assert_eq!(count(&b, Block::HeldOut), 400);
+    }
+
+    #[test]
+    fn a_short_stopper_move_inside_one_block_is_both_fitted_and_scored() {
+        // 1 kHz, 10 s; the stopper rests at 67 mm, ramps to 76 mm over 2.4–2.7 s (inside the
+        // held-out block 2–4 s) and rests again.
+        let time: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-3).collect();
+        let x_s: Vec<f64> = time
+            .iter()
+            .map(|&t| 0.067 + 0.009 * ((t - 2.4) / 0.3).clamp(0.0, 1.0))
+            .collect();
+        assert_eq!(short_stopper_moves(&time, &x_s).len(), 1);
+        let b = blocks(&time, &x_s, 0.0);
+        let within = |from: f64, to: f64, which: Block| {
+            (0..time.len())
+                .filter(|&k| time[k] >= from && time[k] <= to && b[k] == which)
+                .count()
+        };
+        // The stop at 2.7 s and the start at 2.4 s each have pieces of both kinds.
+        for at in [2.4, 2.7] {
+            assert!(
+                within(at - 0.02, at + 0.02, Block::Training) >= 10,
+                "training near {at} s"
+            );
+            assert!(
+                within(at - 0.02, at + 0.02, Block::HeldOut) >= 10,
+                "held out near {at} s"
+            );
+        }
+        // Away from the move the blocks of 2 s stay.
+        assert!(within(2.0, 2.3, Block::Training) == 0 && within(2.8, 3.99, Block::Training) == 0);
+        assert!(within(0.0, 1.99, Block::HeldOut) == 0);
+    }
+
+    #[test]
+    fn a_stopper_at_rest_moving_all_along_or_toggling_its_last_digit_keeps_the_plain_blocks() {
+        let time: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-3).collect();
+        let plain = blocks(&time, &vec![0.05; time.len()], 0.0);
+        let shaken: Vec<f64> = time.iter().map(|&t| 0.05 + 0.005 * (6.0 * t).sin()).collect();
+        let toggling: Vec<f64> = (0..time.len()).map(|k| 0.05 + 1e-6 * (k / 7 % 2) as f64).collect();
+        // A single long move (3 s) is already split by the blocks.
+        let long_move: Vec<f64> = time
+            .iter()
+            .map(|&t| 0.05 + 0.01 * ((t - 3.0) / 3.0).clamp(0.0, 1.0))
+            .collect();
+        for x_s in [shaken, toggling, long_move] {
+            assert!(short_stopper_moves(&time, &x_s).is_empty());
+            assert_eq!(blocks(&time, &x_s, 0.0), plain);
+        }
+    }
+
+    #[test]
+    fn the_starting_state_fades_within_the_chambers_time_constants_and_not_at_once() {
+        let model = Actuator::new(Parameters::default()).unwrap();
+        let recording = recording_of(|t| if (1.0..1.5).contains(&t) { 6.0 } else { 1.0 }, 20.0);
+        let settled = settling_time(&model, &recording, [0.05, 0.0, 0.0]).unwrap();
+        // The first block's commands span 1–6 V; a start from the equilibrium of 6 V while
+        // 1 V is held relaxes through the chambers (tens of ms), not in one sample, and
+        // within a few seconds.
+        assert!(settled > 0.02 && settled < 4.0, "settled from {settled} s");
+        // A coarser noise floor forgives more of the transient.
+        let coarse = settling_time(&model, &recording, [5.0, 0.0, 0.0]).unwrap();
+        assert!(coarse < settled, "{coarse} against {settled}");
+    }
+
+    #[test]
+    fn a_recording_whose_command_never_changes_has_nothing_to_settle() {
+        let model = Actuator::new(Parameters::default()).unwrap();
+        let recording = recording_of(|_| 2.0, 10.0);
+        assert_eq!(settling_time(&model, &recording, [0.05, 0.0, 0.0]).unwrap(), 0.0);
+    }
+}

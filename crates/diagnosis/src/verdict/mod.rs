@@ -1,0 +1,7 @@
+//! Stage 6, the verdict: the final accurate replays, the pressure split, the residual's
+//! signature, and the report.
+
+pub(crate) mod conclude;
+pub(crate) mod report;
+pub mod signature;
+pub(crate) mod split;
