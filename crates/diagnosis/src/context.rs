@@ -1,6 +1,5 @@
 //! What every stage of a diagnosis reads: the recording, its blocks, the noise floors and the options.
 
-use crate::fit::localize::parallel_map;
 use crate::input::blocks::Block;
 use crate::input::recording::Recording;
 use crate::replay::replay_fast;
@@ -39,29 +38,6 @@ impl Default for Options {
             calibrate: false,
             jobs: std::thread::available_parallelism().map_or(2, |n| n.get()),
             bars: None,
-        }
-    }
-}
-
-/// [`parallel_map`] with a progress bar over the items.
-pub(crate) fn parallel_map_shown<T: Sync, R: Send>(
-    phase: &str,
-    bars: &Option<std::sync::Arc<dyn ProgressBars>>,
-    items: &[T],
-    jobs: usize,
-    f: impl Fn(&T) -> R + Sync,
-) -> Vec<R> {
-    match bars {
-        None => parallel_map(items, jobs, f),
-        Some(bars) => {
-            bars.start(phase, items.len());
-            let out = parallel_map(items, jobs, |item| {
-                let r = f(item);
-                bars.advance();
-                r
-            });
-            bars.finish();
-            out
         }
     }
 }
@@ -154,7 +130,7 @@ impl<'a> Context<'a> {
             channel_noise[1] = p[0];
             channel_noise[2] = p[1];
         }
-        let settled_from = crate::input::blocks::settling_time(model, recording, channel_noise)?;
+        let settled_from = crate::replay::settling::settling_time(model, recording, channel_noise)?;
         let t0 = recording.time[0];
         if settled_from > t0 {
             progress(&format!(

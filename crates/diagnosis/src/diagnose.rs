@@ -82,7 +82,7 @@ pub(crate) fn diagnose_unguarded(
         progress(&sentence);
         input_checks.push(sentence);
     }
-    smoothed.acceleration_window = crate::input::acceleration::choose_window(
+    smoothed.acceleration_window = crate::input::stopper_motion::choose_window(
         &smoothed,
         &crate::replay::signals::difference(&smoothed.force, &before_accurate.force),
     );

@@ -32,6 +32,7 @@ pub mod verdict;
 
 mod context;
 mod diagnose;
+mod parallel;
 pub mod policy;
 pub mod results;
 

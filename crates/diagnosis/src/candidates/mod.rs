@@ -32,7 +32,6 @@ pub mod curves;
 pub mod discharge;
 pub mod extra_flows;
 pub mod modulation;
-pub(crate) mod oscillation;
 pub mod products;
 pub(crate) mod quantiser;
 

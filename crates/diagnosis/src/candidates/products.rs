@@ -324,7 +324,7 @@ mod tests {
             p2: None,
             time,
             full_rate: None,
-            fast_replay: crate::replay::FastReplayMethod::default(),
+            fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
         };
         let base = Parameters::default();

@@ -286,7 +286,7 @@ pub(crate) fn simpler_elsewhere(
     ));
     let (added_misfit, added_force) = check.judge(added.with, replays)?;
     let added_score = added_misfit + added_terms * penalty;
-    let refits: Vec<Option<Fit>> = crate::fit::localize::parallel_map(&others, check.cx.options.jobs, |s| {
+    let refits: Vec<Option<Fit>> = crate::parallel::parallel_map(&others, check.cx.options.jobs, |s| {
         check
             .problem
             .fit(&s.fit.candidate, ELSEWHERE_ITERATIONS, current, &|_| None)

@@ -12,7 +12,7 @@
 
 use crate::candidates::parameter_value;
 use crate::candidates::set_parameter;
-use crate::decide::rounds::Findings;
+use crate::decide::findings::Findings;
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
 use crate::fit::Problem;

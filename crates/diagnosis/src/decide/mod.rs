@@ -5,6 +5,8 @@ pub(crate) mod alternatives;
 pub(crate) mod beside;
 pub(crate) mod discover;
 pub(crate) mod eliminate;
+pub(crate) mod findings;
+pub(crate) mod joint_refit;
 pub(crate) mod named;
 pub(crate) mod named_effect;
 pub(crate) mod named_instead;

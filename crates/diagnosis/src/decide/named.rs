@@ -4,7 +4,8 @@
 
 use crate::input::blocks::Block;
 use crate::input::recording::Recording;
-use crate::replay::signals::{command_direction, stopper_velocity};
+use crate::input::stopper_motion::stopper_velocity;
+use crate::replay::signals::command_direction;
 use crate::verdict::signature::BINS;
 
 /// What a signature test found.
@@ -281,7 +282,7 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
-            fast_replay: crate::replay::FastReplayMethod::default(),
+            fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

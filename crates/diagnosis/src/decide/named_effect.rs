@@ -17,7 +17,7 @@ use crate::*;
 /// mechanics and the force sensor are in question.
 pub(crate) fn force_through_mechanics(model: &Actuator, recording: &Recording) -> Option<Replay> {
     let (p1, p2) = crate::replay::signals::chamber_pressures(model, recording)?;
-    let velocity = crate::replay::signals::stopper_velocity(recording);
+    let velocity = crate::input::stopper_motion::stopper_velocity(recording);
     let force = (0..recording.len())
         .map(|k| {
             let state = jetpipe_model::physics::actuator::State::from([0.0, 0.0, 0.0, 0.0, p1[k], p2[k]]);

@@ -18,9 +18,9 @@ use crate::candidates::catalogue;
 use crate::candidates::parameter_value;
 use crate::candidates::without_addition;
 use crate::candidates::Candidate;
+use crate::decide::findings::Findings;
 use crate::decide::named_effect::apply_named;
 use crate::decide::named_effect::named_signature;
-use crate::decide::rounds::Findings;
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
 use crate::fit::localize::terms_used;
@@ -66,7 +66,7 @@ pub(crate) fn named_instead_of_discovered(
             f.params = params;
             f.effects.push(effect);
             f.newest = Some((true, f.effects.len() - 1));
-            crate::decide::rounds::sync_earlier(f);
+            crate::decide::findings::sync_earlier(f);
             replaced = true;
         } else {
             k += 1;

@@ -3,19 +3,19 @@
 
 use crate::candidates::set_parameter;
 use crate::candidates::Candidate;
+use crate::decide::findings::{nameable, pressures_gain, Round};
 use crate::decide::named_effect::apply_named;
 use crate::decide::named_effect::force_through_mechanics;
 use crate::decide::named_effect::named_signature;
-use crate::decide::rounds::{nameable, pressures_gain, Round};
 use crate::fit::localize::discovery_penalised;
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::localize;
-use crate::fit::localize::parallel_map;
 use crate::fit::localize::penalised;
 use crate::fit::localize::used_terms;
 use crate::fit::Fit;
 use crate::fit::Problem;
 use crate::input::blocks::Block;
+use crate::parallel::parallel_map;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
@@ -470,7 +470,7 @@ pub(crate) fn discovered_downstream(
         let Some(mut set) = crate::decide::discover::model_terms(candidate, &s.fit.values, params, &d.problem) else {
             continue;
         };
-        crate::decide::rounds::curve_corners_across_unvisited(cx, r, problem, params, candidate, &mut set);
+        crate::decide::findings::curve_corners_across_unvisited(cx, r, problem, params, candidate, &mut set);
         let mut trial = params.clone();
         if set.iter().any(|(n, v)| set_parameter(&mut trial, n, *v).is_err()) || trial.validate().is_err() {
             continue;

@@ -13,8 +13,8 @@ use crate::candidates::catalogue;
 use crate::candidates::parameter_value;
 use crate::candidates::without_addition;
 use crate::candidates::Candidate;
+use crate::decide::findings::Findings;
 use crate::decide::named_instead::{best_named_fit, refitted_beside};
-use crate::decide::rounds::Findings;
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
 use crate::fit::Problem;
@@ -74,7 +74,7 @@ pub(crate) fn settle_rivals(
                 progress(&format!("{} instead of the {}", effect.name, f.effects[k].name));
                 f.params = *params;
                 f.effects[k] = effect;
-                crate::decide::rounds::sync_earlier(f);
+                crate::decide::findings::sync_earlier(f);
                 replaced = true;
             }
             Settled::Tied(rival, sentence) => {

@@ -3,9 +3,16 @@
 //! term that the replay confirms.
 
 use crate::candidates::catalogue;
-use crate::candidates::parameter_value;
 use crate::candidates::set_parameter;
 use crate::candidates::Candidate;
+use crate::decide::findings::curve_corners_across_unvisited;
+use crate::decide::findings::nameable;
+use crate::decide::findings::pressures_gain;
+use crate::decide::findings::sync_earlier;
+use crate::decide::findings::Findings;
+use crate::decide::findings::Round;
+use crate::decide::findings::Stage;
+use crate::decide::findings::{carried_alike, same_term};
 use crate::decide::named_effect::apply_named;
 use crate::fit::localize::discovery_penalised;
 use crate::fit::localize::discovery_penalty_per_term;
@@ -33,65 +40,9 @@ use crate::DISCOVERY_TRIALS;
 use crate::EXPLAINED_WITHIN_NOISE;
 use crate::LOCATED_SHARE;
 use crate::MAX_EFFECTS;
-use crate::MIN_GAIN_IN_NOISE;
-use crate::MIN_RELATIVE_GAIN;
 use crate::REFINE_ITERATIONS;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
-
-/// What the rounds found: the model's parameters with every effect and term added.
-pub(crate) struct Findings {
-    pub params: Parameters,
-    pub effects: Vec<AddedEffect>,
-    pub discovered: Vec<DiscoveredTerm>,
-    /// The first round's scored candidates, for the report.
-    pub first_candidates: Vec<Scored>,
-    /// Where the departure left unexplained sits (none when every channel is within its noise).
-    pub localization: Option<Localization>,
-    /// The held-out force error before and after the last joint refit that was kept.
-    pub joint_refit: Option<(f64, f64)>,
-    /// The parameters before the rounds, to which a removed addition's go back.
-    pub start: Parameters,
-    /// The latest addition: a named effect (`true`) or a discovered term, by index.
-    pub newest: Option<(bool, usize)>,
-    /// The findings as each round with an addition left them, earliest first, to which the
-    /// final check can go back (`withdraw.rs`).
-    pub stages: Vec<Stage>,
-}
-
-/// The findings as one round left them.
-#[derive(Clone)]
-pub(crate) struct Stage {
-    pub params: Parameters,
-    pub effects: Vec<AddedEffect>,
-    pub discovered: Vec<DiscoveredTerm>,
-    pub joint_refit: Option<(f64, f64)>,
-}
-
-impl Stage {
-    fn of(f: &Findings) -> Stage {
-        Stage {
-            params: f.params.clone(),
-            effects: f.effects.clone(),
-            discovered: f.discovered.clone(),
-            joint_refit: f.joint_refit,
-        }
-    }
-}
-
-/// One round's replay of the current model and how far it is from the recording.
-pub(crate) struct Round {
-    pub(crate) model: Actuator,
-    pub(crate) current: Replay,
-    pub(crate) heldout: [f64; CHANNELS],
-    /// Held-out samples.
-    pub(crate) count: f64,
-    pub(crate) force_before: f64,
-    pub(crate) pressures_agree: bool,
-    pub(crate) candidates: Vec<Candidate>,
-    /// The force residual's spectral line, if it has one.
-    pub(crate) periodic: Option<f64>,
-}
 
 /// What a round adds to the model.
 enum Addition {
@@ -137,7 +88,7 @@ pub(crate) fn run_rounds(
         // piston leaves the pressures as they were but not the force, and scores kept from
         // the round before judged a command delay beside a friction on the force the
         // friction had left (68 % where it explained all).
-        let screen = crate::candidates::modulation::Screen {
+        let screen = crate::fit::screen::Screen {
             periodic_hz: r.periodic,
         };
         let (found, used) = localize(&problem, &r.current, &r.candidates, cx.options, Some(screen), progress);
@@ -285,12 +236,12 @@ pub(crate) fn run_rounds(
         // discovered restriction fitted while friction was still missing leaves the pressures
         // a few noise floors off, and the next round would fit every upstream candidate again
         // for that.
-        if let Some(refit) = crate::fit::refit::refit_jointly(cx, &mut f, replays, progress)? {
+        if let Some(refit) = crate::decide::joint_refit::refit_jointly(cx, &mut f, replays, progress)? {
             f.joint_refit = Some(refit);
         }
         // What a later addition has made redundant goes (`eliminate.rs`).
         if crate::decide::eliminate::drop_redundant(cx, &mut f, replays, progress)? {
-            if let Some(refit) = crate::fit::refit::refit_jointly(cx, &mut f, replays, progress)? {
+            if let Some(refit) = crate::decide::joint_refit::refit_jointly(cx, &mut f, replays, progress)? {
                 f.joint_refit = Some(refit);
             }
         }
@@ -327,36 +278,6 @@ fn second_opinion(outcome: Result<bool, String>, progress: &mut dyn FnMut(&str))
         progress(&format!("the names' second opinion stopped: {why}"));
         true
     })
-}
-
-/// Every addition's constants and reading as they now stand in the parameters.
-pub(crate) fn sync_earlier(f: &mut Findings) {
-    for (name, value) in f.effects.iter_mut().flat_map(|e| e.parameters.iter_mut()) {
-        *value = parameter_value(&f.params, name);
-    }
-    for d in f.discovered.iter_mut() {
-        let mut moved = false;
-        for (name, value) in d.parameters.iter_mut() {
-            let now = parameter_value(&f.params, name);
-            moved |= now != *value;
-            *value = now;
-        }
-        if moved {
-            d.reading = crate::decide::discover::reading(d.candidate, d.location, d.family, &d.parameters, &f.start);
-        }
-    }
-}
-
-/// Whether two discovered terms are the same candidate carried by the same parameters.
-fn same_term(a: &DiscoveredTerm, b: &DiscoveredTerm) -> bool {
-    carried_alike(a, b.candidate, &b.parameters)
-}
-
-/// Whether `term` is `candidate` carried by the parameters named in `parameters`.
-fn carried_alike(term: &DiscoveredTerm, candidate: &str, parameters: &[(&'static str, f64)]) -> bool {
-    term.candidate == candidate
-        && term.parameters.len() == parameters.len()
-        && term.parameters.iter().zip(parameters).all(|(x, y)| x.0 == y.0)
 }
 
 /// A departure of this many noise floors of a channel lifts the channel's held-out misfit,
@@ -478,16 +399,6 @@ fn curve_knots(cx: &Context, problem: &Problem, current: &Replay) -> crate::cand
         );
     }
     knots
-}
-
-/// Named effects are the hypotheses tried first: once a term outside them has been added,
-/// a named effect found later may be absorbing what that term's form misses, and only those
-/// whose own signature is tested in the residual (friction, the sensor's offset and gain,
-/// hysteresis) are still tried.
-pub(crate) fn nameable(s: &Scored, discovered: &[DiscoveredTerm]) -> bool {
-    s.fit.candidate.named.map_or(false, |name| {
-        discovered.is_empty() || crate::decide::named::has_signature_test(name)
-    })
 }
 
 /// Whether a candidate may be added as a discovered term, which claims no name: one outside
@@ -835,36 +746,6 @@ const TRAINING_GAIN_IN_NOISE: f64 = 3.0;
 /// model (or within the verdict's bar) is added instead of it.
 const WRITTEN_INSTEAD_WITHIN: f64 = 1.1;
 
-/// For a transducer's curve, its corners beyond the quantities the recording visits
-/// (`crate::candidates::curves::corners_across_unvisited`); other candidates' `set` unchanged.
-pub(crate) fn curve_corners_across_unvisited(
-    cx: &Context,
-    r: &Round,
-    problem: &Problem,
-    params: &Parameters,
-    candidate: &Candidate,
-    set: &mut Vec<(&'static str, f64)>,
-) {
-    if !crate::candidates::curves::is_channel_curve(candidate) {
-        return;
-    }
-    // The curve's coordinates are the quantity the transducer reads: its reading with the
-    // transducer's offset and gain taken off.
-    let p = params;
-    let unread = |reading: &[f64], o: f64, g: f64| -> Vec<f64> { reading.iter().map(|v| (v - o) / g).collect() };
-    let quantities = [
-        unread(&r.current.force, p.force_sensor_offset, p.force_sensor_gain),
-        unread(&r.current.p1, p.p1_sensor_offset, p.p1_sensor_gain),
-        unread(&r.current.p2, p.p2_sensor_offset, p.p2_sensor_gain),
-    ];
-    crate::candidates::curves::corners_across_unvisited(
-        set,
-        [&quantities[0], &quantities[1], &quantities[2]],
-        problem.measured,
-        &cx.blocks,
-    );
-}
-
 /// Whether `term` is a static function of the command at a place of its path, its ties (if
 /// any) among those places: the places the path makes alike replace them.
 fn is_along_the_command_path(term: &DiscoveredTerm) -> bool {
@@ -980,17 +861,6 @@ fn pressures_judgement(
     };
     let better = pressures_gain(&r.heldout, &replayed, r.count) && after <= r.force_before + 0.05 * cx.noise;
     better.then(|| (rms_pa([&r.current.p1, &r.current.p2]), rms_pa([&with.p1, &with.p2])))
-}
-
-/// Whether the pressures' held-out misfit (noise floors squared, summed over `count`
-/// samples) falls from `was` to `now` by enough to earn an addition: the force's rule in
-/// their noise, in mean square. Two channels at their noise read √2 floors together, so a
-/// term that takes them from 2.0 to their noise gains 0.6 floor of the RMS but 2 of the mean
-/// square (a chamber 1 transducer saturating over its top 5 kPa: 1.98 -> 1.42).
-pub(crate) fn pressures_gain(was: &[f64; CHANNELS], now: &[f64; CHANNELS], count: f64) -> bool {
-    let in_noise = |h: &[f64; CHANNELS]| ((h[1] + h[2]) / count).sqrt();
-    let (was, now) = (in_noise(was), in_noise(now));
-    was - now >= MIN_RELATIVE_GAIN * was && was * was - now * now >= MIN_GAIN_IN_NOISE
 }
 
 /// Add the named effect to the model and write down its evidence.

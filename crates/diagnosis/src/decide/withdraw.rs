@@ -1,9 +1,10 @@
 //! Never a worse model: additions the accurate replay finds worse than the starting model
 //! are taken out again, the latest first.
 
+use crate::decide::findings;
 use jetpipe_model::physics::parameters::Parameters;
 
-use crate::{decide::rounds, Errors};
+use crate::Errors;
 
 /// Additions taken out because, replayed accurately, they made the force error larger than
 /// the starting model's, held out or over the whole recording.
@@ -52,7 +53,7 @@ fn names(effects: &[crate::AddedEffect], discovered: &[crate::DiscoveredTerm]) -
 /// `replay_accurately`, and the latest that is not worse than the start is kept, with its
 /// replay; when none is, `found` is the starting model again.
 pub(crate) fn withdraw_if_worse<R>(
-    found: &mut rounds::Findings,
+    found: &mut findings::Findings,
     start: &Parameters,
     before: &Errors,
     after: &Errors,
@@ -65,7 +66,7 @@ pub(crate) fn withdraw_if_worse<R>(
         return Ok(None);
     }
     let every = names(&found.effects, &found.discovered);
-    let earlier: Vec<rounds::Stage> = found
+    let earlier: Vec<findings::Stage> = found
         .stages
         .iter()
         .rev()
@@ -128,7 +129,7 @@ mod tests {
 
     /// Findings with one named effect, added in a first round at an offset of 0.7 N, and one
     /// discovered term added in a second, beside which the offset was refitted to 0.72 N.
-    fn findings(start: &Parameters) -> rounds::Findings {
+    fn findings(start: &Parameters) -> findings::Findings {
         let mut params = start.clone();
         params.force_sensor_offset = 0.72;
         let mut first = start.clone();
@@ -145,9 +146,9 @@ mod tests {
             rivals: vec![],
             tied_effects: vec![],
         }];
-        rounds::Findings {
+        findings::Findings {
             params,
-            stages: vec![rounds::Stage {
+            stages: vec![findings::Stage {
                 params: first,
                 effects: effects.clone(),
                 discovered: vec![],
@@ -190,7 +191,7 @@ mod tests {
     /// The diagnosis started at 0.3 N held out and 0.4 N whole; its final model is at
     /// `after`, its first round's model at `first_round`. Returns what was withdrawn, how many
     /// accurate replays ran and the findings left.
-    fn withdrawn_when(first_round: Errors, after: Errors) -> (Option<Withdrawal<()>>, usize, rounds::Findings) {
+    fn withdrawn_when(first_round: Errors, after: Errors) -> (Option<Withdrawal<()>>, usize, findings::Findings) {
         let start = Parameters::default();
         let mut found = findings(&start);
         let calls = Cell::new(0);

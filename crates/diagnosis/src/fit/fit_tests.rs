@@ -12,8 +12,9 @@ fn a_limit_that_clips_only_the_highest_training_level_is_found_though_held_out_r
     use crate::candidates::{catalogue, set_parameter};
     use crate::fit::Problem;
     use crate::input::blocks::Block;
+    use crate::input::recording::FastReplayMethod;
     use crate::input::recording::Recording;
-    use crate::replay::{replay_fast, FastReplayMethod};
+    use crate::replay::replay_fast;
     use jetpipe_model::physics::actuator::Actuator;
     use jetpipe_model::physics::parameters::Parameters;
     let n = 8000;

@@ -9,7 +9,7 @@ use crate::fit::Problem;
 use crate::fit::Sensitivity;
 use crate::input::blocks::count;
 use crate::input::blocks::Block;
-use crate::parallel_map_shown;
+use crate::parallel::parallel_map_shown;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::signals::FORCE;
@@ -61,38 +61,6 @@ pub(crate) const MIN_MEAN_SQUARE_GAIN_PER_TERM: f64 = 0.01;
 
 pub(crate) fn discovery_penalised(s: &Scored, heldout_samples: f64) -> f64 {
     s.fit.heldout_total() + used_terms(s) * discovery_penalty_per_term(heldout_samples)
-}
-
-/// Runs `f` on every item over `jobs` threads, results in the items' order.
-pub(crate) fn parallel_map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let jobs = jobs.clamp(1, items.len().max(1));
-    if jobs == 1 {
-        return items.iter().map(f).collect();
-    }
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut out: Vec<(usize, R)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..jobs)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = vec![];
-                    loop {
-                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        if k >= items.len() {
-                            break;
-                        }
-                        mine.push((k, f(&items[k])));
-                    }
-                    mine
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("a diagnosis worker panicked"))
-            .collect()
-    });
-    out.sort_by_key(|(k, _)| *k);
-    out.into_iter().map(|(_, r)| r).collect()
 }
 
 /// The model constants whose sensitivities several fits share at one point, each once, with
@@ -181,7 +149,7 @@ pub(crate) fn localize(
     base_replay: &Replay,
     candidates: &[Candidate],
     options: &Options,
-    screen: Option<crate::candidates::modulation::Screen>,
+    screen: Option<crate::fit::screen::Screen>,
     progress: &mut dyn FnMut(&str),
 ) -> (Localization, usize) {
     let jobs = options.jobs;
@@ -258,7 +226,7 @@ pub(crate) fn localize(
     if let Some(screen) = screen {
         let penalty = discovery_penalty_per_term(heldout_count(problem.blocks) as f64);
         let started = std::time::Instant::now();
-        let (found, answered) = crate::candidates::modulation::screen(
+        let (found, answered) = crate::fit::screen::screen(
             problem,
             base_replay,
             &shared,
@@ -283,10 +251,10 @@ pub(crate) fn localize(
         ));
         for s in &found {
             if let (Some(c), Some(sensitivity)) = (
-                crate::candidates::modulation::candidate(s, problem.base, candidates),
+                crate::fit::screen::candidate(s, problem.base, candidates),
                 shared(s.constant),
             ) {
-                let fit = crate::candidates::modulation::first_order_fit(problem, base_replay, s, c, &sensitivity);
+                let fit = crate::fit::screen::first_order_fit(problem, base_replay, s, c, &sensitivity);
                 replays += fit.replays;
                 scored.push(score(fit));
             }

@@ -3,7 +3,10 @@
 
 pub mod calibrate;
 pub(crate) mod localize;
+pub(crate) mod normal;
+pub(crate) mod oscillation;
 pub(crate) mod refit;
+pub(crate) mod screen;
 pub(crate) mod search;
 
 use crate::candidates::parameter_value;
@@ -17,10 +20,10 @@ use crate::candidates::Term;
 use crate::fit::search::{golden, search_from_grid};
 use crate::input::blocks::Block;
 use crate::input::recording::Recording;
+use crate::input::stopper_motion::stopper_acceleration;
+use crate::input::stopper_motion::stopper_velocity;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
-use crate::replay::signals::stopper_acceleration;
-use crate::replay::signals::stopper_velocity;
 use crate::replay::signals::CHANNELS;
 use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
@@ -477,7 +480,7 @@ impl Problem<'_> {
                 })
                 .collect();
             let jobs = self.jobs.load(std::sync::atomic::Ordering::Relaxed);
-            let moved_replays = crate::fit::localize::parallel_map(&differenced, jobs, |&(j, step)| {
+            let moved_replays = crate::parallel::parallel_map(&differenced, jobs, |&(j, step)| {
                 let mut moved = point.values.clone();
                 moved[j] += step;
                 self.replay(candidate, &moved).ok().map(|r| {

@@ -198,7 +198,7 @@ mod tests {
             p2: pressures.map(|(_, b)| vec![b; n]),
             time,
             full_rate: None,
-            fast_replay: crate::replay::FastReplayMethod::default(),
+            fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

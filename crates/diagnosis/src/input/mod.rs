@@ -7,3 +7,4 @@ pub mod checks;
 pub mod lines;
 pub mod noise;
 pub mod recording;
+pub mod stopper_motion;

@@ -2,6 +2,7 @@
 //! columns `time_s, v_da_V, x_s_m, force_N`, optionally `p1_Pa, p2_Pa`, in SI units.
 //! Every problem is reported with its row (1-based, the header is row 1) and column.
 
+use crate::MAX_FAST_STEP;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// A checked recording.
@@ -18,10 +19,10 @@ pub struct Recording {
     /// its samples the rows are. `None` for a recording as read.
     pub full_rate: Option<std::sync::Arc<FullRateInputs>>,
     /// How the fixed-step replays the fits use step ([`crate::replay::replay_fast`]): ROS2 with
-    /// steps of at most [`crate::replay::MAX_FAST_STEP`], or the cheapest shorter or
+    /// steps of at most [`crate::policy::MAX_FAST_STEP`], or the cheapest shorter or
     /// third-order stepping that agrees with the error-controlled replay where that one
     /// departs from it ([`crate::replay::agreement::fast_step_that_agrees`]).
-    pub fast_replay: crate::replay::FastReplayMethod,
+    pub fast_replay: crate::input::recording::FastReplayMethod,
     /// The half-width T (s) of the stopper acceleration the replays give the model as its input
     /// a_s ([`crate::input::acceleration`]); 0 where the model forms it from the positions.
     pub acceleration_window: f64,
@@ -105,7 +106,7 @@ pub const STOPPER_SMOOTHING_LONGEST_INTERVAL: f64 = 1.5e-3;
 /// Whether the stopper positions of a recording sampled at `time` are smoothed: its
 /// sampling interval (from its median) is at most [`STOPPER_SMOOTHING_LONGEST_INTERVAL`].
 pub fn stopper_smoothing_applies(time: &[f64]) -> bool {
-    time.len() > 1 && 1.0 / crate::replay::signals::sample_rate(time) <= STOPPER_SMOOTHING_LONGEST_INTERVAL
+    time.len() > 1 && 1.0 / crate::input::recording::sample_rate(time) <= STOPPER_SMOOTHING_LONGEST_INTERVAL
 }
 
 /// The largest sum of squares (m²) the least-squares quadratic through seven stopper
@@ -459,9 +460,47 @@ impl Recording {
             p1: has_pressures.then_some(p1),
             p2: has_pressures.then_some(p2),
             full_rate: None,
-            fast_replay: crate::replay::FastReplayMethod::default(),
+            fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
         })
+    }
+}
+
+/// Samples per second of a series sampled at `time`: from its span, or, when it has gaps
+/// (the stretches of a recording thinned for the fits), from its median interval.
+pub fn sample_rate(time: &[f64]) -> f64 {
+    let n = time.len();
+    if n < 2 {
+        return 1.0;
+    }
+    let span = (time[n - 1] - time[0]).max(1e-12);
+    let mean = span / (n - 1) as f64;
+    if time.windows(2).all(|w| w[1] - w[0] <= 2.0 * mean) {
+        return (n - 1) as f64 / span;
+    }
+    let mut intervals: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = intervals.len() / 2;
+    1.0 / intervals
+        .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
+        .1
+        .max(1e-12)
+}
+
+/// How [`replay_fast`] steps the chamber pressures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FastReplayMethod {
+    /// The longest step, s: each sample interval is stepped in equal parts of at most this.
+    pub step: f64,
+    /// ROS34PW2 (order 3, five right-hand sides a step) instead of ROS2 (order 2, three).
+    pub third_order: bool,
+}
+
+impl Default for FastReplayMethod {
+    fn default() -> Self {
+        Self {
+            step: MAX_FAST_STEP,
+            third_order: false,
+        }
     }
 }
 
@@ -486,7 +525,7 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
-            fast_replay: crate::replay::FastReplayMethod::default(),
+            fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }

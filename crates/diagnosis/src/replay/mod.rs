@@ -8,6 +8,7 @@
 //! another command, starts where it was, not at an equilibrium it had not reached.
 
 pub mod agreement;
+pub mod settling;
 pub mod signals;
 
 use crate::input::recording::Recording;
@@ -88,7 +89,7 @@ const FLAT_SLOPE: f64 = 1e-3;
 /// Where a replay starts: at rest at the command held before the recording, with the
 /// chamber pressures where the transducers read them when the recording has them
 /// (`AsRead`), or at that command's equilibrium (`AtEquilibrium`: what
-/// [`crate::input::blocks::settling_time`] compares, since states the transducers do not read, a
+/// [`crate::replay::settling::settling_time`] compares, since states the transducers do not read, a
 /// hysteresis loop's memory say, stay unknown for as long as a start at another equilibrium
 /// shows).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -301,30 +302,6 @@ fn replay_from(
     Ok(out)
 }
 
-/// The longest fixed step of [`replay_fast`] (s): a recording sampled more coarsely than
-/// the bench's 1 ms is stepped in equal parts of at most this. One 4 ms ROS2 step per
-/// sample at 250 Hz left the pressures 3–8 noise floors off a clean recording that the
-/// error-controlled replay reproduces within its noise.
-pub const MAX_FAST_STEP: f64 = 1.05e-3;
-
-/// How [`replay_fast`] steps the chamber pressures.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FastReplayMethod {
-    /// The longest step, s: each sample interval is stepped in equal parts of at most this.
-    pub step: f64,
-    /// ROS34PW2 (order 3, five right-hand sides a step) instead of ROS2 (order 2, three).
-    pub third_order: bool,
-}
-
-impl Default for FastReplayMethod {
-    fn default() -> Self {
-        Self {
-            step: MAX_FAST_STEP,
-            third_order: false,
-        }
-    }
-}
-
 /// A cheaper replay for fitting: the model's fixed-step simulation ([`FixedStep`]: one ROS2
 /// step of the chamber pressures per sample interval, or per equal part of at most
 /// [`MAX_FAST_STEP`], the current driver and jet pipe still propagated exactly; as the
@@ -424,7 +401,7 @@ mod tests {
             p1: None,
             p2: None,
             full_rate: None,
-            fast_replay: crate::replay::FastReplayMethod::default(),
+            fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
         }
     }
@@ -535,11 +512,11 @@ mod tests {
         let thin = replay(&model, &thinned, 1e-6, thinned.len()).unwrap();
         assert_eq!(thin.force, full.at_rows(&rows).force);
         // The stopper's velocity is the full-rate one at each row.
-        let velocity = crate::replay::signals::stopper_velocity(&recording);
+        let velocity = crate::input::stopper_motion::stopper_velocity(&recording);
         let at_rows: Vec<f64> = rows.iter().map(|&k| velocity[k]).collect();
-        assert_eq!(crate::replay::signals::stopper_velocity(&thinned), at_rows);
+        assert_eq!(crate::input::stopper_motion::stopper_velocity(&thinned), at_rows);
         assert!((thinned.sample_rate() - 1000.0).abs() < 1e-6);
-        assert!((crate::replay::signals::sample_rate(&thinned.time) - 1000.0).abs() < 1e-6);
+        assert!((crate::input::recording::sample_rate(&thinned.time) - 1000.0).abs() < 1e-6);
         // A recording within the limit is kept whole; one just over it nearly whole: five of
         // the six stretches for at most 22,000 rows (the second one is left out).
         assert_eq!(recording.rows_for_fits(24_000), recording);
@@ -599,7 +576,7 @@ mod tests {
         })
         .unwrap();
         let a = crate::input::acceleration::smoothed_accelerations(&recording.time, &recording.x_s, 0.02);
-        assert_eq!(crate::replay::signals::stopper_acceleration(&recording), a);
+        assert_eq!(crate::input::stopper_motion::stopper_acceleration(&recording), a);
         let largest = a.iter().fold(0.0f64, |m, a| m.max(a.abs()));
         assert!(largest > 0.03, "the shake's acceleration: {largest} m/s²");
         let n = recording.len();

@@ -1,12 +1,11 @@
 //! The recording's channels and the model's, sample by sample: the residuals the
 //! diagnosis works on and the signals along the chain that a residual may follow.
 
-use crate::input::acceleration;
 use crate::input::blocks::Block;
 use crate::input::recording::Recording;
+use crate::input::stopper_motion::stopper_velocity;
 use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
-use jetpipe_model::physics::extra_force;
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 
 /// Channels compared with the model: the force always, the two chamber pressures when the
@@ -16,63 +15,6 @@ pub const P1: usize = 1;
 pub const P2: usize = 2;
 pub const CHANNELS: usize = 3;
 pub const CHANNEL_NAMES: [&str; CHANNELS] = ["force", "p1", "p2"];
-
-/// Stopper velocity as the replays' forces read it at sample k: the slope of the interval
-/// that ends there carried to the sample with the acceleration the positions form
-/// ([`jetpipe_model::physics::extra_force::stopper_velocities`]; zero at the first sample),
-/// whatever acceleration input the replays are given. For a recording thinned for the fits,
-/// the full-rate recording's at the row.
-pub fn stopper_velocity(recording: &Recording) -> Vec<f64> {
-    at_rows(recording, &extra_force::stopper_velocities)
-}
-
-/// The stopper acceleration the model reads at each sample: formed from the positions
-/// (`jetpipe_model::physics::extra_force::stopper_accelerations`), or, with an
-/// acceleration window, the input the replays give it ([`crate::input::acceleration`]); of the
-/// full-rate recording at the rows of a thinned one.
-pub fn stopper_acceleration(recording: &Recording) -> Vec<f64> {
-    let window = recording.acceleration_window;
-    if window <= 0.0 {
-        return at_rows(recording, &extra_force::stopper_accelerations);
-    }
-    at_rows(recording, &|time: &[f64], x_s: &[f64]| {
-        acceleration::smoothed_accelerations(time, x_s, window)
-    })
-}
-
-/// A series formed from a motion's sample times and positions.
-type StopperMotionOf<'a> = dyn Fn(&[f64], &[f64]) -> Vec<f64> + 'a;
-
-/// `motion` of the recording's stopper positions at its rows.
-fn at_rows(recording: &Recording, motion: &StopperMotionOf<'_>) -> Vec<f64> {
-    match &recording.full_rate {
-        Some(full) => {
-            let all = motion(&full.time, &full.x_s);
-            full.rows.iter().map(|&k| all[k]).collect()
-        }
-        None => motion(&recording.time, &recording.x_s),
-    }
-}
-
-/// Samples per second of a series sampled at `time`: from its span, or, when it has gaps
-/// (the stretches of a recording thinned for the fits), from its median interval.
-pub fn sample_rate(time: &[f64]) -> f64 {
-    let n = time.len();
-    if n < 2 {
-        return 1.0;
-    }
-    let span = (time[n - 1] - time[0]).max(1e-12);
-    let mean = span / (n - 1) as f64;
-    if time.windows(2).all(|w| w[1] - w[0] <= 2.0 * mean) {
-        return (n - 1) as f64 / span;
-    }
-    let mut intervals: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
-    let mid = intervals.len() / 2;
-    1.0 / intervals
-        .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
-        .1
-        .max(1e-12)
-}
 
 /// Centred difference quotient over ±`half` samples.
 pub fn rate(time: &[f64], x: &[f64], half: usize) -> Vec<f64> {

@@ -25,7 +25,7 @@ use serde_json::json;
 /// A discovered term whose constants all stand at the model's defaults (a compliance
 /// refitted to its bound of 0) is not in the model: what the round that added it gained came
 /// from the constants refitted beside it. It is not reported.
-fn drop_terms_at_defaults(found: &mut crate::decide::rounds::Findings, progress: &mut dyn FnMut(&str)) {
+fn drop_terms_at_defaults(found: &mut crate::decide::findings::Findings, progress: &mut dyn FnMut(&str)) {
     let params = &found.params;
     found.discovered.retain(|d| {
         let off = !d.parameters.is_empty()
@@ -44,7 +44,7 @@ fn drop_terms_at_defaults(found: &mut crate::decide::rounds::Findings, progress:
 pub(crate) fn conclude(
     cx: &Context,
     start: (Actuator, Replay, crate::replay::agreement::FastReplayCheck),
-    mut found: crate::decide::rounds::Findings,
+    mut found: crate::decide::findings::Findings,
     mut joint_refit: Option<(f64, f64)>,
     mut input_checks: Vec<String>,
     calibrated: Vec<Calibrated>,

@@ -113,7 +113,7 @@ pub struct Spectrum {
 pub fn spectrum(time: &[f64], residual: &[f64]) -> Spectrum {
     let n = residual.len();
     let time = &time[..n];
-    let sample_rate = crate::replay::signals::sample_rate(time);
+    let sample_rate = crate::input::recording::sample_rate(time);
     // The stretches of a recording thinned for the fits are read at their own times: joined
     // end to end they would break a line's phase at every gap and move its peak.
     let span = time[n - 1] - time[0];

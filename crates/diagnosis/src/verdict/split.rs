@@ -214,7 +214,7 @@ mod tests {
             p1: Some(read(&p1_model, 1.0)),
             p2: Some(read(&p2_model, -1.0)),
             full_rate: None,
-            fast_replay: crate::replay::FastReplayMethod::default(),
+            fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
         };
         let replay = Replay {

@@ -7,7 +7,8 @@
 //! the constant oscillating in a modulation slot, once in sine and once in cosine; the two
 //! answers are exact to first order, lags and clipping included.
 
-use crate::candidates::modulation::{free_slots, slot_parameter, value_reference, Normal};
+use crate::candidates::modulation::{free_slots, slot_parameter, value_reference};
+use crate::fit::normal::Normal;
 use crate::fit::{Problem, Sensitivity};
 use crate::input::blocks::Block;
 use crate::replay::signals::CHANNELS;
@@ -83,7 +84,7 @@ pub fn screen_periodic(
 pub fn traced_line(problem: &Problem, residual: &[Vec<f64>; CHANNELS], sensitivity: &Sensitivity) -> Option<f64> {
     let time = &problem.recording.time;
     let n = time.len();
-    let rate = crate::replay::signals::sample_rate(time);
+    let rate = crate::input::recording::sample_rate(time);
     let window = ((TRACE_WINDOW_S * rate).round() as usize).max(MIN_TRACE_SAMPLES);
     let mut centres = vec![];
     let mut sums = vec![];
@@ -128,7 +129,7 @@ pub fn traced_line(problem: &Problem, residual: &[Vec<f64>; CHANNELS], sensitivi
 /// plant's answer to that input, not a disturbance (a shaken stopper's 2.5 Hz).
 pub fn carried_by_inputs(problem: &Problem, hz: f64) -> bool {
     let recording = problem.recording;
-    let rate = crate::replay::signals::sample_rate(&recording.time);
+    let rate = crate::input::recording::sample_rate(&recording.time);
     [&recording.v_da, &recording.x_s].iter().any(|x| {
         let mean = x.iter().sum::<f64>() / x.len() as f64;
         let centred: Vec<f64> = x.iter().map(|v| v - mean).collect();
