@@ -38,7 +38,7 @@ import tolerance_sweep as ts  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 ARCHIVES = {"fmi2": ROOT / "dist" / "JetPipeActuator.fmu", "fmi3": ROOT / "dist" / "JetPipeActuator-fmi3.fmu"}
-HELD_ONLY = {"moving_stopper", "full_steps"}
+HELD_ONLY = {"moving_stopper", "moving_stopper_volumes", "full_steps"}
 
 
 def main():
@@ -54,7 +54,7 @@ def main():
     load = os.getloadavg()
     print(f"{os.cpu_count()} cores, load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; "
           f"{t_end:g} s simulated per run, inputs every 0.1 ms")
-    print(f"{'archive':7s} {'input':17s} {'inputs':12s} {'rtol':>6s} {'result':>8s} {'F RMS (N)':>10s} "
+    print(f"{'archive':7s} {'input':22s} {'inputs':12s} {'rtol':>6s} {'result':>8s} {'F RMS (N)':>10s} "
           f"{'steps/s':>9s} {'RHS/s':>9s} {'restarts':>8s} {'wall (s)':>8s}")
     failures = 0
     for archive in args.archives.split(","):
@@ -82,7 +82,7 @@ def main():
                         result, rms = f"FAILED ({reason})", float("nan")
                     else:
                         result, rms = "ok", ts.force_rms(reference, me)
-                    print(f"{archive:7s} {name:17s} {mode:12s} {rtol:6.0e} {result:>8s} {rms:10.2e} "
+                    print(f"{archive:7s} {name:22s} {mode:12s} {rtol:6.0e} {result:>8s} {rms:10.2e} "
                           f"{work.steps / t_end:9.0f} {work.rhs / t_end:9.0f} {work.restarts:8d} {wall:8.1f}",
                           flush=True)
     print(f"{failures} failed runs with held or smooth inputs")

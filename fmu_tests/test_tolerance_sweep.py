@@ -82,6 +82,7 @@ CASES = [
     ("fmi2", "full_steps", "held", 1e-10),
     ("fmi2", "moving_stopper", "held", 1e-8),
     ("fmi2", "volumes_and_mount", "held", 1e-6),
+    ("fmi2", "moving_stopper_volumes", "held", 1e-8),
     ("fmi2", "slow_sine", "smooth", 1e-10),
     ("fmi2", "fast_sine", "smooth", 1e-10),
     ("fmi2", "chirp", "smooth", 1e-10),
@@ -127,6 +128,7 @@ def test_the_inputs_reach_every_regime():
     assert seen["full_steps"]["spring floor"], seen
     assert seen["moving_stopper"]["supply reverses"] and seen["moving_stopper"]["spring floor"], seen
     assert seen["moving_stopper"]["leakage reverses"], seen
+    assert seen["moving_stopper_volumes"]["spring floor"], seen
 
 
 def test_fmpy_interpolating_the_inputs_reaches_the_end_at_1e_6():

@@ -92,6 +92,9 @@ SIGNALS = {
     "full_steps": _v_full_steps,
     "moving_stopper": _v_moving_stopper,
     "volumes_and_mount": _v_slow_sine,
+    # the compliant stopper's law switches in the right-hand side where the force meets the
+    # spring floor (event indicator z0): the moving stopper with the volumes and the mount
+    "moving_stopper_volumes": _v_moving_stopper,
 }
 
 
@@ -102,7 +105,7 @@ def delayed(law, delay: float = HOLD / 2):
 
 
 def start_values(name: str) -> dict:
-    return dict(VOLUMES_AND_MOUNT) if name == "volumes_and_mount" else {}
+    return dict(VOLUMES_AND_MOUNT) if name in ("volumes_and_mount", "moving_stopper_volumes") else {}
 
 
 def signal(name: str, t_end: float, sample: float = HOLD, hold: bool = True) -> np.ndarray:
