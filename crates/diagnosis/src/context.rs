@@ -10,9 +10,6 @@ use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
-#[allow(unused_imports)]
-use crate::*;
-
 /// Where a diagnosis shows how far its long phases are (the CLI draws progress bars).
 pub trait ProgressBars: Send + Sync {
     /// A phase of `total` steps begins.

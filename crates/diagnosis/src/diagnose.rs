@@ -1,15 +1,15 @@
 //! The diagnosis from end to end: the steps of the crate's account, in order.
 
+use crate::context::Context;
+use crate::context::Options;
 use crate::fit::calibrate::Calibrated;
 use crate::input::recording::Recording;
 use crate::replay::replay;
 use crate::replay::replay_fast;
 use crate::replay::Replay;
+use crate::verdict::diagnosis::Diagnosis;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
-
-#[allow(unused_imports)]
-use crate::*;
 
 /// Diagnose a recording (see the module's account). `progress` receives one line per stage.
 pub fn diagnose(

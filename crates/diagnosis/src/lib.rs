@@ -20,8 +20,8 @@
 //!    and the report.
 //!
 //! Beside the stages: [`policy`] states every threshold and precedence rule once,
-//! `context.rs` (its `Context`) is what every stage reads, and [`results`] holds what a diagnosis
-//! finds.
+//! `context.rs` (its `Context`) is what every stage reads, and the result types live in the stage that
+//! produces them and are re-exported here.
 
 pub mod candidates;
 pub mod decide;
@@ -34,9 +34,12 @@ mod context;
 mod diagnose;
 mod parallel;
 pub mod policy;
-pub mod results;
 
-pub use context::*;
-pub use diagnose::*;
-pub use policy::*;
-pub use results::*;
+pub use context::{Options, ProgressBars};
+pub use decide::additions::{AddedEffect, DiscoveredTerm};
+pub use decide::withdraw::Withdrawn;
+pub use diagnose::{diagnose, diagnose_owned, diagnose_with};
+pub use fit::scored::{Localization, Scored};
+pub use replay::errors::Errors;
+pub use verdict::diagnosis::{Diagnosis, Unexplained};
+pub use verdict::split::PressureSplit;

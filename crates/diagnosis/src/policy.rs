@@ -1,8 +1,5 @@
 //! Every threshold and precedence rule of the diagnosis, each stated once with its reason.
 
-#[allow(unused_imports)]
-use crate::*;
-
 /// Length of the alternating training / held-out blocks.
 pub const BLOCK_SECONDS: f64 = 2.0;
 /// The verdict is "explained" when the held-out force error is within this many noise floors.
@@ -43,7 +40,7 @@ pub fn worth_adding(before: f64, after: f64, noise: f64, refines: bool) -> bool 
     gain >= MIN_RELATIVE_GAIN * before && in_noise
 }
 /// A place is an alternative to the located one when the held-out misfit it leaves is at
-/// most this many times the located one's ([`Localization::alternatives`]).
+/// most this many times the located one's (`Localization::alternatives`).
 pub const ALTERNATIVE_REMAINDER: f64 = 1.25;
 /// A place in the chain is named when its best candidate explains at least this share of
 /// the held-out misfit (sum over channels, each in its own noise floors).
@@ -65,7 +62,7 @@ pub(crate) const REFINED: usize = 3;
 pub(crate) const WORTH_REFINING: f64 = 0.1;
 pub(crate) const REFINE_ITERATIONS: usize = 10;
 
-/// The longest fixed step of [`replay_fast`] (s): a recording sampled more coarsely than
+/// The longest fixed step of `replay_fast` (s): a recording sampled more coarsely than
 /// the bench's 1 ms is stepped in equal parts of at most this. One 4 ms ROS2 step per
 /// sample at 250 Hz left the pressures 3–8 noise floors off a clean recording that the
 /// error-controlled replay reproduces within its noise.

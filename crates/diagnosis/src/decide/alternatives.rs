@@ -10,22 +10,22 @@
 
 use crate::candidates::set_parameter;
 use crate::candidates::Candidate;
+use crate::context::Context;
+use crate::decide::additions::DiscoveredTerm;
 use crate::fit::localize::discovery_penalised;
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::used_terms;
+use crate::fit::scored::Localization;
+use crate::fit::scored::Scored;
 use crate::fit::Fit;
 use crate::fit::Problem;
 use crate::input::blocks::Block;
+use crate::policy::DISCOVERY_TRIALS;
+use crate::policy::LOCATED_SHARE;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::Replay;
-use crate::Context;
-use crate::DiscoveredTerm;
-use crate::Localization;
-use crate::Scored;
-use crate::DISCOVERY_TRIALS;
-use crate::LOCATED_SHARE;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 

@@ -17,20 +17,20 @@ use crate::candidates::parameter_value;
 use crate::candidates::set_parameter;
 use crate::candidates::Candidate;
 use crate::candidates::Mechanism;
+use crate::context::Context;
+use crate::decide::additions::DiscoveredTerm;
 use crate::decide::findings::Findings;
 use crate::decide::pairs::joined;
 use crate::fit::localize::{discovery_penalised, discovery_penalty_per_term, heldout_count, WantedSensitivities};
 use crate::fit::refit::joint_candidate;
+use crate::fit::scored::Localization;
+use crate::fit::scored::Scored;
 use crate::fit::Fit;
 use crate::fit::Problem;
 use crate::parallel::parallel_map;
+use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::replay::signals::CHANNELS;
 use crate::replay::Replay;
-use crate::Context;
-use crate::DiscoveredTerm;
-use crate::Localization;
-use crate::Scored;
-use crate::EXPLAINED_WITHIN_NOISE;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// Candidates of the round fitted beside the earlier additions.

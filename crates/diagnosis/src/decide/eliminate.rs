@@ -12,11 +12,11 @@
 
 use crate::candidates::parameter_value;
 use crate::candidates::set_parameter;
+use crate::context::Context;
 use crate::decide::findings::Findings;
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
 use crate::fit::Problem;
-use crate::Context;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// The held-out force error below which taking an addition out counts as costing nothing,

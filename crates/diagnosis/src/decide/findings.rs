@@ -3,16 +3,16 @@
 
 use crate::candidates::parameter_value;
 use crate::candidates::Candidate;
+use crate::context::Context;
+use crate::decide::additions::AddedEffect;
+use crate::decide::additions::DiscoveredTerm;
+use crate::fit::scored::Localization;
+use crate::fit::scored::Scored;
 use crate::fit::Problem;
+use crate::policy::MIN_GAIN_IN_NOISE;
+use crate::policy::MIN_RELATIVE_GAIN;
 use crate::replay::signals::CHANNELS;
 use crate::replay::Replay;
-use crate::AddedEffect;
-use crate::Context;
-use crate::DiscoveredTerm;
-use crate::Localization;
-use crate::Scored;
-use crate::MIN_GAIN_IN_NOISE;
-use crate::MIN_RELATIVE_GAIN;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 

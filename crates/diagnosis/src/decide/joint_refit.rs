@@ -2,9 +2,9 @@
 //! refitted together ([`crate::fit::refit`]), and what the refit turns off is retired.
 
 use crate::candidates::parameter_value;
+use crate::context::Context;
 use crate::fit::refit::refit_constants;
 use crate::fit::refit::refittable;
-use crate::Context;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// Each effect and term was fitted with those before it held: refit them together, and

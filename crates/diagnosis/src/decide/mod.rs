@@ -1,6 +1,7 @@
 //! Stage 5, the decision: rounds of localization and addition, named effects and the signatures
 //! that earn their names, discovered terms, alternatives, compounds, elimination and withdrawal.
 
+pub mod additions;
 pub(crate) mod alternatives;
 pub(crate) mod beside;
 pub(crate) mod discover;

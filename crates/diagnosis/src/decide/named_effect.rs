@@ -1,6 +1,7 @@
 //! A named effect applied to the model, and its signature in the residual.
 
 use crate::candidates::set_parameter;
+use crate::fit::scored::Scored;
 use crate::input::blocks::Block;
 use crate::input::recording::Recording;
 use crate::replay::signals::difference;
@@ -8,9 +9,6 @@ use crate::replay::signals::force_from_pressures;
 use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
-
-#[allow(unused_imports)]
-use crate::*;
 
 /// The force sensor's reading if the measured pressures drove the model's mechanics
 /// (friction, spring floor) and sensor: what the force should be when only the

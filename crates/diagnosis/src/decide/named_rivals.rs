@@ -13,14 +13,14 @@ use crate::candidates::catalogue;
 use crate::candidates::parameter_value;
 use crate::candidates::without_addition;
 use crate::candidates::Candidate;
+use crate::context::Context;
+use crate::decide::additions::AddedEffect;
 use crate::decide::findings::Findings;
 use crate::decide::named_instead::{best_named_fit, refitted_beside};
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
+use crate::fit::scored::Scored;
 use crate::fit::Problem;
-use crate::AddedEffect;
-use crate::Context;
-use crate::Scored;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// A named effect at the same place whose share of the held-out misfit was at most this much

@@ -4,7 +4,7 @@
 use crate::decide::findings;
 use jetpipe_model::physics::parameters::Parameters;
 
-use crate::Errors;
+use crate::replay::errors::Errors;
 
 /// Additions taken out because, replayed accurately, they made the force error larger than
 /// the starting model's, held out or over the whole recording.
@@ -37,7 +37,10 @@ pub(crate) type Replayed<R> = (R, Errors);
 /// What was withdrawn and, when an earlier round's model stays, its replay.
 pub(crate) type Withdrawal<R> = (Withdrawn, Option<Replayed<R>>);
 
-fn names(effects: &[crate::AddedEffect], discovered: &[crate::DiscoveredTerm]) -> Vec<&'static str> {
+fn names(
+    effects: &[crate::decide::additions::AddedEffect],
+    discovered: &[crate::decide::additions::DiscoveredTerm],
+) -> Vec<&'static str> {
     effects
         .iter()
         .map(|e| e.name)
@@ -114,7 +117,8 @@ pub(crate) fn withdraw_if_worse<R>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{AddedEffect, DiscoveredTerm};
+    use crate::decide::additions::AddedEffect;
+    use crate::decide::additions::DiscoveredTerm;
     use std::cell::Cell;
 
     fn errors(heldout_rms: f64, rms: f64) -> Errors {

@@ -4,24 +4,24 @@
 use crate::candidates::Candidate;
 use crate::candidates::Mechanism;
 use crate::candidates::Term;
+use crate::context::Options;
+use crate::context::ProgressBars;
+use crate::fit::scored::Localization;
+use crate::fit::scored::Scored;
 use crate::fit::Fit;
 use crate::fit::Problem;
 use crate::fit::Sensitivity;
 use crate::input::blocks::count;
 use crate::input::blocks::Block;
 use crate::parallel::parallel_map_shown;
+use crate::policy::LOCATED_SHARE;
+use crate::policy::REFINED;
+use crate::policy::REFINE_ITERATIONS;
+use crate::policy::WORTH_REFINING;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::signals::FORCE;
 use crate::replay::Replay;
-use crate::Localization;
-use crate::Options;
-use crate::ProgressBars;
-use crate::Scored;
-use crate::LOCATED_SHARE;
-use crate::REFINED;
-use crate::REFINE_ITERATIONS;
-use crate::WORTH_REFINING;
 
 /// How many of a fitted candidate's terms are away from their neutral values.
 pub(crate) fn used_terms(s: &Scored) -> f64 {
@@ -381,7 +381,7 @@ pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
 mod tests {
     use super::SharedSensitivities;
     use crate::candidates::{Candidate, Mechanism, Modulation};
-    use crate::Localization;
+    use crate::fit::scored::Localization;
 
     #[test]
     fn only_the_sensitivities_the_leaders_read_are_kept_for_their_refinement() {

@@ -6,6 +6,7 @@ pub(crate) mod localize;
 pub(crate) mod normal;
 pub(crate) mod oscillation;
 pub(crate) mod refit;
+pub mod scored;
 pub(crate) mod screen;
 pub(crate) mod search;
 

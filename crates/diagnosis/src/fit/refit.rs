@@ -5,6 +5,7 @@ use crate::candidates::set_parameter;
 use crate::candidates::Candidate;
 use crate::candidates::Mechanism;
 use crate::candidates::Term;
+use crate::context::Context;
 use crate::fit::Problem;
 use crate::input::blocks::Block;
 use crate::replay::replay_fast;
@@ -12,9 +13,6 @@ use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
-
-#[allow(unused_imports)]
-use crate::*;
 
 /// Whether an added parameter is an amount a refit may move: a curve's knot count and
 /// abscissae are its grid, and a modulation slot's constant, signal, frequency and knot

@@ -15,7 +15,7 @@
 //! half-width T, centred (no lag), its rounding 1 µm / T² (0.0025 m/s² at 20 ms). Near the
 //! recording's ends T shrinks to the time there is; at the first and last samples a = 0.
 //! T is chosen among [`WINDOWS`] by which best carries the starting model's force residual
-//! ([`choose_window`]); the report gives it, so the FMU can be fed the same.
+//! ([`crate::input::stopper_motion::choose_window`]); the report gives it, so the FMU can be fed the same.
 
 /// The half-widths (s) the diagnosis chooses among: a doubling grid from a few samples at
 /// 1 kHz to the length of a slow stopper's ramp.

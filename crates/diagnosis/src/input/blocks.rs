@@ -13,7 +13,7 @@
 //! every channel of those replays agrees with the first one within 0.3 of its noise are
 //! neither fitted nor scored.
 
-use crate::BLOCK_SECONDS;
+use crate::policy::BLOCK_SECONDS;
 
 /// What a sample is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,7 +6,7 @@
 use crate::input::recording::Recording;
 use jetpipe_model::physics::parameters::Parameters;
 
-use crate::BLOCK_SECONDS;
+use crate::policy::BLOCK_SECONDS;
 
 /// Fewer held-out blocks than this, and no held-out score means anything.
 pub const MIN_BLOCKS: f64 = 4.0;

@@ -2,7 +2,7 @@
 //! columns `time_s, v_da_V, x_s_m, force_N`, optionally `p1_Pa, p2_Pa`, in SI units.
 //! Every problem is reported with its row (1-based, the header is row 1) and column.
 
-use crate::MAX_FAST_STEP;
+use crate::policy::MAX_FAST_STEP;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// A checked recording.
@@ -46,7 +46,7 @@ pub struct FullRateInputs {
 /// ([`Recording::rows_for_fits`]). 100,000 rows keep an 80 s recording at 1 kHz whole.
 pub const MAX_FIT_ROWS: usize = 100_000;
 /// The stretches a long recording's fits keep: one training and one held-out block.
-pub const FIT_STRETCH_SECONDS: f64 = 2.0 * crate::BLOCK_SECONDS;
+pub const FIT_STRETCH_SECONDS: f64 = 2.0 * crate::policy::BLOCK_SECONDS;
 
 const REQUIRED: [&str; 4] = ["time_s", "v_da_V", "x_s_m", "force_N"];
 const OPTIONAL: [&str; 2] = ["p1_Pa", "p2_Pa"];
@@ -486,7 +486,7 @@ pub fn sample_rate(time: &[f64]) -> f64 {
         .max(1e-12)
 }
 
-/// How [`replay_fast`] steps the chamber pressures.
+/// How `replay_fast` steps the chamber pressures.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FastReplayMethod {
     /// The longest step, s: each sample interval is stepped in equal parts of at most this.

@@ -3,12 +3,13 @@
 //! a slow recording, say), the fits would chase the fixed step's error, so they use the
 //! cheapest shorter or third-order stepping that agrees.
 
+use crate::input::lines;
+use crate::input::noise;
 use crate::input::recording::FastReplayMethod;
 use crate::input::recording::Recording;
 use crate::policy::MAX_FAST_STEP;
 use crate::replay::signals::{difference, rms};
 use crate::replay::{replay_fast, Replay};
-use crate::{input::lines, input::noise};
 use jetpipe_model::physics::actuator::Actuator;
 
 /// The largest RMS departure of the fixed-step replay from the error-controlled one, in

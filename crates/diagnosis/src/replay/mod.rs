@@ -8,6 +8,7 @@
 //! another command, starts where it was, not at an equilibrium it had not reached.
 
 pub mod agreement;
+pub mod errors;
 pub mod settling;
 pub mod signals;
 
@@ -304,7 +305,7 @@ fn replay_from(
 
 /// A cheaper replay for fitting: the model's fixed-step simulation ([`FixedStep`]: one ROS2
 /// step of the chamber pressures per sample interval, or per equal part of at most
-/// [`MAX_FAST_STEP`], the current driver and jet pipe still propagated exactly; as the
+/// [`crate::policy::MAX_FAST_STEP`], the current driver and jet pipe still propagated exactly; as the
 /// recording's [`Recording::fast_replay`] says). No error
 /// control: the step (1 ms on the bench) is far below the chambers' time constants, and
 /// the accurate replay checks the final figures. Falls back to [`replay`] when the jet pipe

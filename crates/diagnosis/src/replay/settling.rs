@@ -2,8 +2,8 @@
 //! start that is neither fitted nor scored ([`crate::input::blocks`]).
 
 use crate::input::recording::Recording;
+use crate::policy::BLOCK_SECONDS;
 use crate::replay::{replay_fast_from, Start};
-use crate::BLOCK_SECONDS;
 use jetpipe_model::physics::actuator::Actuator;
 
 /// Replays from another starting state must agree with the first replay within this

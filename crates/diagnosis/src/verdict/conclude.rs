@@ -1,23 +1,23 @@
 //! Step 6: the final accurate replays, the verdict and the tests of the residual.
 
 use crate::candidates::parameter_value;
-use crate::errors;
+use crate::context::Context;
 use crate::fit::calibrate::Calibrated;
+use crate::fit::scored::Localization;
 use crate::input::blocks::Block;
+use crate::policy::EXPLAINED_WITHIN_NOISE;
+use crate::replay::errors::errors;
+use crate::replay::errors::Errors;
 use crate::replay::replay;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms;
 use crate::replay::signals::ChainSignals;
 use crate::replay::Replay;
+use crate::verdict::diagnosis::Diagnosis;
+use crate::verdict::diagnosis::Unexplained;
 use crate::verdict::signature::Signature;
-use crate::Context;
-use crate::Diagnosis;
-use crate::Errors;
-use crate::Localization;
-use crate::PressureSplit;
-use crate::Unexplained;
-use crate::EXPLAINED_WITHIN_NOISE;
+use crate::verdict::split::PressureSplit;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 use serde_json::json;

@@ -2,6 +2,7 @@
 //! signature, and the report.
 
 pub(crate) mod conclude;
+pub mod diagnosis;
 pub(crate) mod report;
 pub mod signature;
 pub(crate) mod split;

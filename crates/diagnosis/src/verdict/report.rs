@@ -1,8 +1,8 @@
 //! The report: the printed summary and the JSON of `jetpipe diagnose --report`.
 
-use crate::Diagnosis;
-use crate::Errors;
-use crate::MOST_TIED_LOCATIONS;
+use crate::policy::MOST_TIED_LOCATIONS;
+use crate::replay::errors::Errors;
+use crate::verdict::diagnosis::Diagnosis;
 use jetpipe_model::physics::parameters::Parameters;
 use serde_json::json;
 use serde_json::Value;

@@ -5,9 +5,9 @@
 use crate::input::blocks::Block;
 use crate::input::noise::noise_floor;
 use crate::input::recording::Recording;
+use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::replay::signals::{chamber_pressures, difference, rms};
 use crate::replay::Replay;
-use crate::EXPLAINED_WITHIN_NOISE;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 
@@ -342,7 +342,7 @@ mod tests {
         let split = pressure_split(&model, &recording, &replay, 0.05, [300.0, 300.0], &blocks).unwrap();
         assert!(split.pressures_within_noise(), "{:?}", split.pressure_ratio);
         assert!(
-            split.force_vs_pressures_ratio <= crate::EXPLAINED_WITHIN_NOISE,
+            split.force_vs_pressures_ratio <= crate::policy::EXPLAINED_WITHIN_NOISE,
             "{} in units of the noise the pressures taken back carry",
             split.force_vs_pressures_ratio
         );
@@ -365,7 +365,7 @@ mod tests {
         let split = pressure_split(&model, &recording, &replay, 0.05, [300.0, 300.0], &blocks).unwrap();
         // The pressures' alternating noise, opposite in the two, is all that is left.
         assert!(
-            split.force_vs_pressures_ratio <= crate::EXPLAINED_WITHIN_NOISE,
+            split.force_vs_pressures_ratio <= crate::policy::EXPLAINED_WITHIN_NOISE,
             "{}",
             split.force_vs_pressures_ratio
         );

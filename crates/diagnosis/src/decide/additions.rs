@@ -1,0 +1,79 @@
+//! What the decision adds to the model: named effects and discovered terms, each with the
+//! error it removed and the places it cannot be told from.
+
+use crate::candidates::Candidate;
+use jetpipe_model::physics::parameters::Parameters;
+
+/// A named effect that was added.
+#[derive(Clone, Debug)]
+pub struct AddedEffect {
+    pub name: &'static str,
+    pub location: &'static str,
+    pub parameters: Vec<(&'static str, f64)>,
+    pub evidence: String,
+    pub heldout_before: f64,
+    pub heldout_after: f64,
+    /// Share of the held-out force mean square it removes.
+    pub share: f64,
+    pub remainder_follows: String,
+    /// Other named effects at its place that explained nearly as much when it was named
+    /// (name, share of the held-out misfit), tried in its place once every round is done
+    /// (`named_rivals.rs`).
+    pub rivals: Vec<(&'static str, f64)>,
+    /// The named effects this recording cannot tell it from, its own name first; empty when
+    /// it tells them apart.
+    pub tied_effects: Vec<&'static str>,
+}
+
+/// A term outside the named effects that was added (see `discover.rs`).
+#[derive(Clone, Debug)]
+pub struct DiscoveredTerm {
+    pub location: &'static str,
+    pub family: &'static str,
+    pub candidate: &'static str,
+    /// The FMU parameters that carry it, in SI units.
+    pub parameters: Vec<(&'static str, f64)>,
+    pub reading: String,
+    pub heldout_before: f64,
+    pub heldout_after: f64,
+    /// Share of the held-out force mean square it removes.
+    pub share: f64,
+    /// For a term on the pressure transducers, which the force does not see: the held-out
+    /// RMS of each pressure, Pa, before and after.
+    pub pressures_heldout: Option<([f64; 2], [f64; 2])>,
+    /// The places this recording cannot tell the term's from, its own first (at most
+    /// [`crate::policy::MOST_TIED_LOCATIONS`]); empty when it tells the place.
+    pub tied_locations: Vec<&'static str>,
+}
+
+impl DiscoveredTerm {
+    /// The fitted `candidate`, carried by the model parameters `set` (read against their
+    /// values in `params`), as a term that takes the held-out force error from `before` to
+    /// `after`; its family as the fitted shape reads (a curve that flattens is a limit).
+    pub(crate) fn fitted(
+        candidate: &Candidate,
+        set: Vec<(&'static str, f64)>,
+        params: &Parameters,
+        before: f64,
+        after: f64,
+    ) -> Self {
+        DiscoveredTerm {
+            location: candidate.location,
+            family: crate::candidates::curves::family(candidate.family, &set),
+            candidate: candidate.label,
+            reading: crate::decide::discover::reading(
+                candidate.label,
+                candidate.location,
+                candidate.family,
+                &set,
+                params,
+            ),
+            parameters: set,
+            heldout_before: before,
+            heldout_after: after,
+            share: 1.0 - (after / before).powi(2),
+            pressures_heldout: None,
+            tied_locations: vec![],
+        }
+    }
+}

@@ -1,0 +1,105 @@
+//! A candidate's score in one round, and the places of the chain ranked by the candidates
+//! scored there (where the model departs).
+
+use crate::fit::Fit;
+use crate::policy::ALTERNATIVE_REMAINDER;
+use crate::policy::LOCATED_SHARE;
+use crate::policy::MOST_TIED_LOCATIONS;
+
+/// A candidate's score in one round.
+#[derive(Clone, Debug)]
+pub struct Scored {
+    pub fit: Fit,
+    /// Share of the held-out misfit (all channels, each in its noise floors) it removes.
+    pub explained: f64,
+    /// Held-out force RMS error with it, N.
+    pub force_heldout_rms: f64,
+}
+
+impl Scored {
+    pub fn parameters(&self) -> Vec<(&'static str, f64)> {
+        self.fit
+            .candidate
+            .terms
+            .iter()
+            .zip(&self.fit.values)
+            .map(|(t, v)| (t.name, *v))
+            .collect()
+    }
+}
+
+/// Where the model departs, from one round of candidates.
+#[derive(Clone, Debug)]
+pub struct Localization {
+    /// The place whose best candidate explains most, or "unknown" when none explains
+    /// [`LOCATED_SHARE`] of the misfit.
+    pub location: &'static str,
+    pub family: &'static str,
+    /// Best share explained at each place, best first, with the candidate that did it.
+    pub by_location: Vec<(&'static str, f64, &'static str)>,
+    pub candidates: Vec<Scored>,
+}
+
+impl Localization {
+    pub(crate) fn best_at(&self, location: &str) -> Option<&Scored> {
+        self.candidates
+            .iter()
+            .filter(|s| s.fit.candidate.location == location)
+            .max_by(|a, b| a.explained.total_cmp(&b.explained))
+    }
+
+    /// A clause naming the places that explain nearly as much as the located one
+    /// ([`Localization::alternatives`]), with their shares, for a term added at `added` (the
+    /// located place or one of those); `None` when there are none. What the recording cannot
+    /// tell apart is said beside what was added.
+    pub fn undecided_beside(&self, added: &str, has_pressures: bool) -> Option<String> {
+        let others: Vec<String> = std::iter::once(self.location)
+            .chain(self.alternatives())
+            .filter(|l| *l != added)
+            .filter_map(|l| self.by_location.iter().find(|(at, _, _)| *at == l))
+            .map(|(l, e, _)| format!("the {l} ({:.1} %)", 100.0 * e))
+            .collect();
+        if others.is_empty() {
+            return None;
+        }
+        Some(format!(
+            "a correction at {} explains nearly as much, which this recording does not tell apart{}",
+            others.join(" or at "),
+            if has_pressures {
+                ""
+            } else {
+                " (pressure channels would split the chain at the piston)"
+            }
+        ))
+    }
+
+    /// The places a term added at `added` cannot be told apart from on this recording
+    /// ([`Self::alternatives`] and the located place), `added` first and at most three in
+    /// all; empty when the recording tells the place.
+    pub fn tied_with(&self, added: &'static str) -> Vec<&'static str> {
+        let others: Vec<&'static str> = std::iter::once(self.location)
+            .chain(self.alternatives())
+            .filter(|l| *l != added)
+            .collect();
+        if others.is_empty() {
+            return vec![];
+        }
+        std::iter::once(added).chain(others).take(MOST_TIED_LOCATIONS).collect()
+    }
+
+    /// Places that explain nearly as much as the best: they leave at most a quarter more
+    /// of the held-out misfit than it does. Measured on what is left, not on the share
+    /// explained: where the model is far off, 99 % explained can leave seven noise floors
+    /// beside one.
+    pub fn alternatives(&self) -> Vec<&'static str> {
+        let Some(&(_, top, _)) = self.by_location.first() else {
+            return vec![];
+        };
+        self.by_location
+            .iter()
+            .skip(1)
+            .filter(|(_, e, _)| 1.0 - *e <= ALTERNATIVE_REMAINDER * (1.0 - top) && *e >= LOCATED_SHARE)
+            .map(|(l, _, _)| *l)
+            .collect()
+    }
+}
