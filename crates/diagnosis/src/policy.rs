@@ -67,3 +67,30 @@ pub(crate) const REFINE_ITERATIONS: usize = 10;
 /// sample at 250 Hz left the pressures 3–8 noise floors off a clean recording that the
 /// error-controlled replay reproduces within its noise.
 pub const MAX_FAST_STEP: f64 = 1.05e-3;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refit_that_takes_two_noise_floors_to_one_and_a_half_is_worth_adding_and_a_new_term_must_take_a_whole_floor_unless_it_closes_the_last_mile(
+    ) {
+        // In noise floors. A refit of a term already added: 2.0 → 1.4 removes 2.0 of the mean square's 4.0.
+        assert!(worth_adding(2.0, 1.4, 1.0, true));
+        // A new term must take a whole noise floor of the RMS…
+        assert!(!worth_adding(3.0, 2.2, 1.0, false));
+        assert!(!worth_adding(2.0, 1.6, 1.0, false));
+        assert!(worth_adding(2.0, 0.9, 1.0, false));
+        // …but below 2.5 floors, one that brings the force within 1.5 needs a floor squared
+        // of the mean square.
+        assert!(worth_adding(2.0, 1.4, 1.0, false));
+        assert!(worth_adding(1.72, 1.18, 1.0, false));
+        assert!(!worth_adding(1.6, 1.4, 1.0, false));
+        assert!(!worth_adding(2.6, 1.7, 1.0, false));
+        // 1.2 → 1.0: a fifth of the RMS but under half a noise floor squared.
+        assert!(!worth_adding(1.2, 1.0, 1.0, true));
+        // 10 → 9.5: 19 noise floors squared of mean square, but 5 % of the error.
+        assert!(!worth_adding(10.0, 9.5, 1.0, true));
+        assert!(!worth_adding(2.0, 2.1, 1.0, true));
+    }
+}

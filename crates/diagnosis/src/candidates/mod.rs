@@ -28,6 +28,7 @@ use crate::replay::signals::{FORCE, P1, P2};
 pub(crate) mod catalogue;
 pub mod command_gaps;
 pub mod command_path;
+pub(crate) mod curve_reading;
 pub mod curves;
 pub mod discharge;
 pub mod extra_flows;

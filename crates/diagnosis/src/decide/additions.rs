@@ -59,7 +59,7 @@ impl DiscoveredTerm {
     ) -> Self {
         DiscoveredTerm {
             location: candidate.location,
-            family: crate::candidates::curves::family(candidate.family, &set),
+            family: crate::candidates::curve_reading::family(candidate.family, &set),
             candidate: candidate.label,
             reading: crate::decide::discover::reading(
                 candidate.label,

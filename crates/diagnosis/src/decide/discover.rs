@@ -306,10 +306,10 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
     if let Some(quantiser) = crate::candidates::quantiser::reading(set) {
         return format!("At the {location} ({family}): {quantiser}");
     }
-    if let Some(curve) = crate::candidates::curves::reading(set) {
+    if let Some(curve) = crate::candidates::curve_reading::reading(set) {
         return format!(
             "At the {location} ({}): {curve}",
-            crate::candidates::curves::family("nonlinearity", set)
+            crate::candidates::curve_reading::family("nonlinearity", set)
         );
     }
     let parts: Vec<String> = set

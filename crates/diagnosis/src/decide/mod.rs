@@ -13,6 +13,7 @@ pub(crate) mod named_effect;
 pub(crate) mod named_instead;
 pub(crate) mod named_places;
 pub(crate) mod named_rivals;
+pub(crate) mod new_term;
 pub(crate) mod pairs;
 pub(crate) mod rounds;
 pub(crate) mod withdraw;
