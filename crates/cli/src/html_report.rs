@@ -31,6 +31,7 @@ const STYLE: &str = "body{font-family:system-ui,sans-serif;max-width:960px;margi
 h1{font-size:1.5em;margin-bottom:.2em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:.25em .6em;text-align:left;vertical-align:top}
 th{background:#f3f3f3}td.n{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+summary{cursor:pointer;color:#444}details{margin:.5em 0}
 .verdict{display:inline-block;padding:.2em .7em;border-radius:.3em;font-weight:bold;color:#fff}
 .explained{background:#2b7a2b}.unexplained_remainder{background:#b3541e}.error{background:#a11}
 pre{background:#f6f6f6;padding:.7em;overflow-x:auto}figure{margin:1.2em 0}figure svg{max-width:100%;height:auto}
@@ -253,6 +254,9 @@ fn slot_code_name(name: &str, value: f64) -> Option<&'static str> {
     }
 }
 
+/// Tables of more rows than this fold under the sentence that states them.
+const FOLD_ROWS: usize = 8;
+
 fn parameters_table(parameters: &Value, units: Option<&Value>) -> String {
     let Some(object) = parameters.as_object() else {
         return String::new();
@@ -273,7 +277,15 @@ fn parameters_table(parameters: &Value, units: Option<&Value>) -> String {
         };
         rows.push_str(&format!("<tr><td><code>{}</code></td>{cell}</tr>", escape(name)));
     }
-    format!("<table><tr><th>parameter</th><th>value</th></tr>{rows}</table>")
+    let table = format!("<table><tr><th>parameter</th><th>value</th></tr>{rows}</table>");
+    if object.len() > FOLD_ROWS {
+        format!(
+            "<details><summary>the {} parameters that carry it</summary>{table}</details>",
+            object.len()
+        )
+    } else {
+        table
+    }
 }
 
 fn errors_section(report: &Value) -> String {
@@ -815,6 +827,44 @@ mod tests {
         assert!(table.contains("title=\"-0.0235 N\">−23.50 mN</td>"), "{table}");
         assert!(table.contains(&format!(">{constant} (F_jp_sat)</td>")), "{table}");
         assert!(table.contains(">5 (x_s)</td>"), "{table}");
+    }
+
+    #[test]
+    fn a_long_knot_table_folds_under_its_reading_and_a_short_table_stays_open() {
+        let mut knots = serde_json::Map::new();
+        knots.insert("command_curve_knots".into(), 20.into());
+        for k in 1..=20 {
+            knots.insert(format!("command_curve_x_{k}"), (-10.0 + f64::from(k)).into());
+            knots.insert(format!("command_curve_y_{k}"), (-9.5 + f64::from(k)).into());
+        }
+        let report = serde_json::json!({
+            "verdict": "explained", "samples": 1000, "noise_floor_N": 0.05,
+            "summary": ["The model explains the recording."],
+            "heldout": {"before_rms_N": 3.4, "after_rms_N": 0.05},
+            "before": {"force_rms_N": 3.5}, "after": {"force_rms_N": 0.051},
+            "effects": [{"name": "sensor_offset_gain", "location": "force_sensor",
+                         "evidence": "The force sensor reads 1.5 N high.",
+                         "parameters": {"force_sensor_offset": 1.5, "force_sensor_gain": 1.04}}],
+            "discovered": [{"location": "command", "family": "nonlinearity", "candidate": "command static curve",
+                            "reading": "At the command (nonlinearity): the curve bends.",
+                            "parameters": knots, "units": {}}],
+        });
+        let html = page("curve", &report, &[], "curve.json", None);
+        let (open, close) = (html.find("<details>").unwrap(), html.find("</details>").unwrap());
+        assert_eq!(html.matches("<details>").count(), 1, "only the knot table folds");
+        let folded = &html[open..close];
+        assert!(
+            folded.contains("<summary>the 41 parameters that carry it</summary>"),
+            "{folded}"
+        );
+        assert!(
+            folded.contains("<code>command_curve_x_20</code>") && folded.contains("−9.000 V"),
+            "{folded}"
+        );
+        let reading = html.find("the curve bends.").unwrap();
+        assert!(reading < open, "the reading comes before its folded table");
+        let effect = html.find("<code>force_sensor_offset</code>").unwrap();
+        assert!(effect < open && html.find("<code>force_sensor_gain</code>").unwrap() < open);
     }
 
     #[test]
