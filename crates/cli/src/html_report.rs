@@ -7,6 +7,8 @@
 
 use serde_json::Value;
 
+use jetpipe_model::physics::modulation::ModulationSignal;
+
 use crate::plots::Figure;
 
 /// `text` with the characters HTML gives a meaning escaped.
@@ -28,7 +30,8 @@ pub fn escape(text: &str) -> String {
 const STYLE: &str = "body{font-family:system-ui,sans-serif;max-width:960px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
 h1{font-size:1.5em;margin-bottom:.2em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:.25em .6em;text-align:left;vertical-align:top}
-th{background:#f3f3f3}td.n{text-align:right;font-variant-numeric:tabular-nums}
+th{background:#f3f3f3}td.n{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+summary{cursor:pointer;color:#444}details{margin:.5em 0}
 .verdict{display:inline-block;padding:.2em .7em;border-radius:.3em;font-weight:bold;color:#fff}
 .explained{background:#2b7a2b}.unexplained_remainder{background:#b3541e}.error{background:#a11}
 pre{background:#f6f6f6;padding:.7em;overflow-x:auto}figure{margin:1.2em 0}figure svg{max-width:100%;height:auto}
@@ -38,9 +41,172 @@ fn number(v: &Value) -> Option<f64> {
     v.as_f64()
 }
 
-/// A value in N with four decimals, or a dash.
+/// The prefixed forms of an SI unit a person reads, largest first, each with its factor; the
+/// unit itself (factor 1) is among them. Units without a sensible prefix have none.
+fn prefixes(unit: &str) -> &'static [(f64, &'static str)] {
+    match unit {
+        "Pa" => &[(1e6, "MPa"), (1e3, "kPa"), (1.0, "Pa")],
+        "Pa/s" => &[(1e6, "MPa/s"), (1e3, "kPa/s"), (1.0, "Pa/s")],
+        "m" => &[(1.0, "m"), (1e-3, "mm"), (1e-6, "µm"), (1e-9, "nm")],
+        "m/s" => &[(1.0, "m/s"), (1e-3, "mm/s"), (1e-6, "µm/s")],
+        "m2" => &[(1.0, "m²"), (1e-6, "mm²")],
+        "m3" => &[(1.0, "m³"), (1e-6, "cm³"), (1e-9, "mm³")],
+        "s" => &[(1.0, "s"), (1e-3, "ms"), (1e-6, "µs"), (1e-9, "ns")],
+        "N" => &[(1.0, "N"), (1e-3, "mN")],
+        "N/m" => &[(1e3, "kN/m"), (1.0, "N/m")],
+        "m/N" => &[(1.0, "m/N"), (1e-3, "mm/N"), (1e-6, "µm/N")],
+        "A" => &[(1.0, "A"), (1e-3, "mA"), (1e-6, "µA")],
+        "V" => &[(1.0, "V"), (1e-3, "mV"), (1e-6, "µV")],
+        "kg" => &[(1.0, "kg"), (1e-3, "g"), (1e-6, "mg")],
+        "kg/s" => &[(1.0, "kg/s"), (1e-3, "g/s"), (1e-6, "mg/s")],
+        "Hz" => &[(1e3, "kHz"), (1.0, "Hz")],
+        _ => &[],
+    }
+}
+
+/// A unit as the model writes it (`m3`, `N.s2/m2`, `kg/(s.Pa)`) as it is printed: powers as
+/// superscripts, products with a middle dot (`m³`, `N·s²/m²`, `kg/(s·Pa)`).
+fn unit_for_people(unit: &str) -> String {
+    let mut out = String::with_capacity(unit.len());
+    let mut after_letter = false;
+    for c in unit.chars() {
+        match c {
+            '0'..='9' if after_letter => out.push(superscript(c)),
+            '.' => out.push('·'),
+            c => {
+                out.push(c);
+                after_letter = c.is_alphabetic();
+            }
+        }
+    }
+    out
+}
+
+fn superscript(c: char) -> char {
+    match c {
+        '0' => '⁰',
+        '1' => '¹',
+        '2' => '²',
+        '3' => '³',
+        '4' => '⁴',
+        '5' => '⁵',
+        '6' => '⁶',
+        '7' => '⁷',
+        '8' => '⁸',
+        '9' => '⁹',
+        '-' => '⁻',
+        c => c,
+    }
+}
+
+/// `x` (≥ 0) rounded to `digits` significant figures, and the decimal exponent of the result.
+fn rounded(x: f64, digits: usize) -> (f64, i32) {
+    let text = format!("{:.*e}", digits.saturating_sub(1), x);
+    let (_, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+    (text.parse().unwrap_or(x), exponent.parse().unwrap_or(0))
+}
+
+/// A non-negative number in fixed notation with `decimals`, its whole part grouped by
+/// thousands with a narrow no-break space (`652 925`).
+fn grouped(x: f64, decimals: usize) -> String {
+    let text = format!("{x:.decimals$}");
+    let (whole, fraction) = text
+        .split_once('.')
+        .map_or((text.as_str(), None), |(w, f)| (w, Some(f)));
+    let mut out = String::new();
+    for (k, c) in whole.chars().enumerate() {
+        if k > 0 && (whole.len() - k) % 3 == 0 {
+            out.push('\u{202f}');
+        }
+        out.push(c);
+    }
+    if let Some(fraction) = fraction {
+        out.push('.');
+        out.push_str(fraction);
+    }
+    out
+}
+
+/// An amount with its unit (the model's SI unit: `"Pa"`, `"m3"`, `"1"` or `""` for a number),
+/// as a person reads it, with `digits` significant figures: a true minus sign, an SI prefix
+/// where the unit takes one (`652.9 kPa`, `44.00 mm`, `25.00 µs`, `1.500 cm³`), fixed notation
+/// grouped by thousands from 0.001 to a million of the unit printed, and beyond that only,
+/// `3.200 × 10⁻⁹ kg/(s·Pa)`. Zero is `0`; a whole number without a unit (a count, a code) is
+/// written whole.
+pub fn amount_to(value: f64, unit: &str, digits: usize) -> String {
+    let digits = digits.max(1);
+    let dimensionless = unit.is_empty() || unit == "1";
+    let printed_unit = unit_for_people(unit);
+    let with_unit = |number: String, unit: &str| {
+        if dimensionless {
+            number
+        } else {
+            format!("{number} {unit}")
+        }
+    };
+    let sign = if value < 0.0 { "−" } else { "" };
+    if value.is_nan() {
+        return with_unit("NaN".into(), &printed_unit);
+    }
+    if value.is_infinite() {
+        return with_unit(format!("{sign}∞"), &printed_unit);
+    }
+    if value == 0.0 {
+        return with_unit("0".into(), &printed_unit);
+    }
+    let magnitude = value.abs();
+    if dimensionless && magnitude.fract() == 0.0 && magnitude < 1e6 {
+        return format!("{sign}{}", grouped(magnitude, 0));
+    }
+    let (rounded_magnitude, _) = rounded(magnitude, digits);
+    let scales = prefixes(unit);
+    // The largest prefix under which the rounded amount is at least one.
+    let (factor, prefixed) = scales
+        .iter()
+        .find(|(factor, _)| rounded_magnitude >= factor * (1.0 - 1e-12))
+        .or(scales.last())
+        .map_or((1.0, printed_unit.as_str()), |&(factor, name)| (factor, name));
+    let mantissa = magnitude / factor;
+    let (rounded_mantissa, exponent) = rounded(mantissa, digits);
+    if (1e-3..1e6).contains(&rounded_mantissa) {
+        let decimals = (digits as i32 - 1 - exponent).max(0) as usize;
+        // Above a thousand, the whole number: rounding 652 925 to 653 000 would only hide digits.
+        let shown = if decimals == 0 { mantissa } else { rounded_mantissa };
+        return with_unit(format!("{sign}{}", grouped(shown, decimals)), prefixed);
+    }
+    let (rounded_magnitude, exponent) = rounded(magnitude, digits);
+    let significand = rounded_magnitude / 10f64.powi(exponent);
+    let power: String = exponent.to_string().chars().map(superscript).collect();
+    with_unit(format!("{sign}{significand:.*} × 10{power}", digits - 1), &printed_unit)
+}
+
+/// [`amount_to`] with four significant figures: `−10.00 V`, `652.9 kPa`, `0.8500`.
+pub fn amount(value: f64, unit: &str) -> String {
+    amount_to(value, unit, 4)
+}
+
+/// The exact value of an amount, as the JSON report holds it, in its SI unit: a cell's title.
+fn exact(value: f64, unit: &str) -> String {
+    if unit.is_empty() || unit == "1" {
+        format!("{value:?}")
+    } else {
+        format!("{value:?} {unit}")
+    }
+}
+
+/// A value in N with four decimals, or a dash; below 0.01 N or from 10 000 N on, as
+/// [`amount`] writes it (`4.900 mN` rather than `0.0049 N`).
 fn newtons(v: &Value) -> String {
-    number(v).map_or_else(|| "—".into(), |x| format!("{x:.4} N"))
+    number(v).map_or_else(
+        || "—".into(),
+        |x| {
+            if x == 0.0 || (0.01..1e4).contains(&x.abs()) {
+                format!("{x:.4} N").replace('-', "−")
+            } else {
+                amount(x, "N")
+            }
+        },
+    )
 }
 
 fn percent(v: &Value) -> String {
@@ -56,25 +222,70 @@ fn unit_of(name: &str) -> &'static str {
         .unwrap_or("")
 }
 
+/// The variable of the table with value reference `code` (a modulation slot's constant).
+fn variable_of_code(code: f64) -> Option<&'static jetpipe_model::variable::Variable> {
+    jetpipe_model::variables::VARIABLES
+        .iter()
+        .find(|v| code.fract() == 0.0 && f64::from(v.value_reference) == code)
+}
+
+/// What a modulation slot's setting `name` is in, from the slot's other settings in
+/// `parameters`: a knot's abscissa in the unit of the slot's signal, its increment in the unit
+/// of the constant it modulates (the variable table writes "1" for both).
+fn slot_unit(name: &str, parameters: &serde_json::Map<String, Value>) -> Option<&'static str> {
+    let (slot, setting) = name.strip_prefix("modulation_")?.split_once('_')?;
+    let code = |what: &str| number(parameters.get(&format!("modulation_{slot}_{what}"))?);
+    if setting.starts_with("x_") {
+        ModulationSignal::from_code(code("signal")?).map(ModulationSignal::unit)
+    } else if setting.starts_with("y_") {
+        variable_of_code(code("parameter")?)?.unit
+    } else {
+        None
+    }
+}
+
+/// What a modulation slot's code names: its signal, or the constant it modulates.
+fn slot_code_name(name: &str, value: f64) -> Option<&'static str> {
+    let (_, setting) = name.strip_prefix("modulation_")?.split_once('_')?;
+    match setting {
+        "signal" => ModulationSignal::from_code(value).map(ModulationSignal::name),
+        "parameter" => variable_of_code(value).map(|v| v.name),
+        _ => None,
+    }
+}
+
+/// Tables of more rows than this fold under the sentence that states them.
+const FOLD_ROWS: usize = 8;
+
 fn parameters_table(parameters: &Value, units: Option<&Value>) -> String {
     let Some(object) = parameters.as_object() else {
         return String::new();
     };
     let mut rows = String::new();
     for (name, value) in object {
-        let unit = units
-            .and_then(|u| u.get(name))
-            .and_then(Value::as_str)
-            .map(str::to_string)
-            .unwrap_or_else(|| unit_of(name).to_string());
-        rows.push_str(&format!(
-            "<tr><td><code>{}</code></td><td class=n>{}</td><td>{}</td></tr>",
-            escape(name),
-            number(value).map_or_else(|| escape(&value.to_string()), |x| format!("{x:.6e}")),
-            escape(&unit)
-        ));
+        let unit = slot_unit(name, object)
+            .or_else(|| units.and_then(|u| u.get(name)).and_then(Value::as_str))
+            .unwrap_or_else(|| unit_of(name));
+        let cell = match number(value) {
+            Some(x) => format!(
+                "<td class=n title=\"{}\">{}{}</td>",
+                escape(&exact(x, unit)),
+                escape(&amount(x, unit)),
+                slot_code_name(name, x).map_or_else(String::new, |n| format!(" ({})", escape(n)))
+            ),
+            None => format!("<td class=n>{}</td>", escape(&value.to_string())),
+        };
+        rows.push_str(&format!("<tr><td><code>{}</code></td>{cell}</tr>", escape(name)));
     }
-    format!("<table><tr><th>parameter</th><th>value</th><th>unit</th></tr>{rows}</table>")
+    let table = format!("<table><tr><th>parameter</th><th>value</th></tr>{rows}</table>");
+    if object.len() > FOLD_ROWS {
+        format!(
+            "<details><summary>the {} parameters that carry it</summary>{table}</details>",
+            object.len()
+        )
+    } else {
+        table
+    }
 }
 
 fn errors_section(report: &Value) -> String {
@@ -99,16 +310,18 @@ fn errors_section(report: &Value) -> String {
         number(&report["noise_floor_Pa"]["p2"]),
     ) {
         html.push_str(&format!(
-            " Noise floors of the pressures: P1 {p1:.0} Pa, P2 {p2:.0} Pa."
+            " Noise floors of the pressures: P1 {}, P2 {}.",
+            amount(p1, "Pa"),
+            amount(p2, "Pa")
         ));
     }
     html.push_str("</p>");
     let pressures = |v: &Value| -> Option<String> {
         let a = v.as_array()?;
         Some(format!(
-            "P1 {:.0} Pa, P2 {:.0} Pa",
-            a.first()?.as_f64()?,
-            a.get(1)?.as_f64()?
+            "P1 {}, P2 {}",
+            amount(a.first()?.as_f64()?, "Pa"),
+            amount(a.get(1)?.as_f64()?, "Pa")
         ))
     };
     if let (Some(b), Some(a)) = (
@@ -186,13 +399,16 @@ fn additions_section(report: &Value) -> String {
             percent(&d["share_of_heldout_explained"]),
         ));
     }
-    if let (Some(a), Some(b)) = (
-        number(&report["joint_refit"]["heldout_before_rms_N"]),
-        number(&report["joint_refit"]["heldout_after_rms_N"]),
+    let joint = &report["joint_refit"];
+    if let (Some(_), Some(_)) = (
+        number(&joint["heldout_before_rms_N"]),
+        number(&joint["heldout_after_rms_N"]),
     ) {
         html.push_str(&format!(
-            "<p>Refitted together, the added parameters lower the held-out force error from {a:.4} N to {b:.4} N \
-             (the values above are the refitted ones).</p>"
+            "<p>Refitted together, the added parameters lower the held-out force error from {} to {} \
+             (the values above are the refitted ones).</p>",
+            newtons(&joint["heldout_before_rms_N"]),
+            newtons(&joint["heldout_after_rms_N"]),
         ));
     }
     html
@@ -250,22 +466,27 @@ fn split_and_checks_section(report: &Value) -> String {
         escape(split["sentence"].as_str().unwrap_or(""))
     );
     if split["available"].as_bool() == Some(true) {
-        let pair = |v: &Value, k: usize, digits: usize| {
+        let ratio = |v: &Value, k: usize| {
             v.get(k)
                 .and_then(Value::as_f64)
-                .map_or_else(|| "—".into(), |x| format!("{x:.digits$}"))
+                .map_or_else(|| "—".into(), |x| format!("{x:.2}"))
+        };
+        let pascals = |v: &Value, k: usize| {
+            v.get(k)
+                .and_then(Value::as_f64)
+                .map_or_else(|| "—".into(), |x| amount(x, "Pa"))
         };
         html.push_str(&format!(
             "<table><tr><th></th><th>RMS</th><th>in noise floors</th></tr>\
              <tr><td>measured force − force of the measured pressures</td><td class=n>{}</td><td class=n>{}</td></tr>\
-             <tr><td>measured − modelled P1</td><td class=n>{} Pa</td><td class=n>{}</td></tr>\
-             <tr><td>measured − modelled P2</td><td class=n>{} Pa</td><td class=n>{}</td></tr></table>",
+             <tr><td>measured − modelled P1</td><td class=n>{}</td><td class=n>{}</td></tr>\
+             <tr><td>measured − modelled P2</td><td class=n>{}</td><td class=n>{}</td></tr></table>",
             newtons(&split["force_vs_pressures_rms_N"]),
             number(&split["force_vs_pressures_ratio_to_noise"]).map_or_else(|| "—".into(), |x| format!("{x:.2}")),
-            pair(&split["pressures_vs_model_rms_Pa"], 0, 0),
-            pair(&split["pressures_vs_model_ratio_to_noise"], 0, 2),
-            pair(&split["pressures_vs_model_rms_Pa"], 1, 0),
-            pair(&split["pressures_vs_model_ratio_to_noise"], 1, 2),
+            pascals(&split["pressures_vs_model_rms_Pa"], 0),
+            ratio(&split["pressures_vs_model_ratio_to_noise"], 0),
+            pascals(&split["pressures_vs_model_rms_Pa"], 1),
+            ratio(&split["pressures_vs_model_ratio_to_noise"], 1),
         ));
     }
     html.push_str("<h2>Input checks</h2>");
@@ -528,6 +749,122 @@ mod tests {
         );
         assert_eq!(row.heldout_after_n, Some(0.05));
         assert!(row.remainder_location.is_empty());
+    }
+
+    #[test]
+    fn amounts_read_with_a_true_minus_an_si_prefix_and_four_significant_figures() {
+        assert_eq!(amount(-10.0, "V"), "−10.00 V");
+        assert_eq!(amount(652_925.0, "Pa"), "652.9 kPa");
+        assert_eq!(amount(-1.2e7, "Pa"), "−12.00 MPa");
+        assert_eq!(
+            amount(999.96, "Pa"),
+            "1.000 kPa",
+            "the rounding carries into the prefix"
+        );
+        assert_eq!(amount(2.5e-5, "s"), "25.00 µs");
+        assert_eq!(amount(0.044, "m"), "44.00 mm");
+        assert_eq!(amount(1.5e-6, "m3"), "1.500 cm³");
+        assert_eq!(amount(3.2e-8, "m3"), "32.00 mm³");
+        assert_eq!(amount(3.14e-4, "m2"), "314.0 mm²");
+        assert_eq!(amount(0.0123, "N"), "12.30 mN");
+        assert_eq!(amount(-0.0042, "A"), "−4.200 mA");
+        assert_eq!(amount(2.1e-3, "kg/s"), "2.100 g/s");
+        assert_eq!(amount(2.1e-4, "kg/s"), "210.0 mg/s");
+        assert_eq!(amount(5.0e4, "N/m"), "50.00 kN/m");
+        assert_eq!(amount(4.998e-5, "m/N"), "49.98 µm/N");
+    }
+
+    #[test]
+    fn zero_and_plain_numbers_and_whole_counts_read_plainly() {
+        assert_eq!(amount(0.0, "Pa"), "0 Pa");
+        assert_eq!(amount(-0.0, "V"), "0 V");
+        assert_eq!(amount(0.0, "1"), "0");
+        assert_eq!(amount(0.85, "1"), "0.8500");
+        assert_eq!(amount(1.234, ""), "1.234");
+        assert_eq!(amount(-0.001234, "1"), "−0.001234");
+        assert_eq!(amount(125.0, "1"), "125", "a code is written whole");
+        assert_eq!(amount(12_345.6, "1"), "12\u{202f}346");
+        assert_eq!(amount(1500.0, "N"), "1\u{202f}500 N", "newtons take no kilo");
+        assert_eq!(amount(293.15, "K"), "293.1 K");
+    }
+
+    #[test]
+    fn compound_units_and_amounts_beyond_every_prefix_fall_back_to_powers_of_ten() {
+        assert_eq!(amount(3.2e-9, "kg/(s.Pa)"), "3.200 × 10⁻⁹ kg/(s·Pa)");
+        assert_eq!(amount(-4.5e-7, "1/N2"), "−4.500 × 10⁻⁷ 1/N²");
+        assert_eq!(amount(120.5, "N.s/m"), "120.5 N·s/m");
+        assert_eq!(amount(1e-15, "m"), "1.000 × 10⁻¹⁵ m");
+        assert_eq!(amount(1.5e12, "Pa"), "1.500 × 10¹² Pa");
+        assert_eq!(amount(6.02214e23, "1"), "6.022 × 10²³");
+        assert_eq!(amount(9.0e-4, ""), "9.000 × 10⁻⁴");
+        assert_eq!(amount_to(-10.0, "V", 2), "−10 V");
+        assert_eq!(amount(f64::NAN, "N"), "NaN N");
+    }
+
+    #[test]
+    fn a_parameters_cell_shows_the_amount_and_keeps_the_exact_value_in_its_title() {
+        let table = parameters_table(&serde_json::json!({"P_s": 652_925.123_456_789, "C_d": 0.85}), None);
+        assert!(
+            table.contains("<td class=n title=\"652925.123456789 Pa\">652.9 kPa</td>"),
+            "{table}"
+        );
+        assert!(table.contains("<td class=n title=\"0.85\">0.8500</td>"), "{table}");
+        assert!(!table.contains("e5"), "{table}");
+    }
+
+    #[test]
+    fn a_modulation_slots_knots_read_in_the_units_of_its_signal_and_of_its_constant() {
+        let constant = jetpipe_model::variables::vr::F_JP_SAT;
+        let table = parameters_table(
+            &serde_json::json!({
+                "modulation_1_parameter": constant, "modulation_1_signal": 5, "modulation_1_knots": 2,
+                "modulation_1_x_1": 0.044, "modulation_1_y_1": -0.0235,
+            }),
+            Some(&serde_json::json!({"modulation_1_x_1": "1", "modulation_1_y_1": "1"})),
+        );
+        assert_eq!(unit_of("F_jp_sat"), "N");
+        assert!(table.contains("title=\"0.044 m\">44.00 mm</td>"), "{table}");
+        assert!(table.contains("title=\"-0.0235 N\">−23.50 mN</td>"), "{table}");
+        assert!(table.contains(&format!(">{constant} (F_jp_sat)</td>")), "{table}");
+        assert!(table.contains(">5 (x_s)</td>"), "{table}");
+    }
+
+    #[test]
+    fn a_long_knot_table_folds_under_its_reading_and_a_short_table_stays_open() {
+        let mut knots = serde_json::Map::new();
+        knots.insert("command_curve_knots".into(), 20.into());
+        for k in 1..=20 {
+            knots.insert(format!("command_curve_x_{k}"), (-10.0 + f64::from(k)).into());
+            knots.insert(format!("command_curve_y_{k}"), (-9.5 + f64::from(k)).into());
+        }
+        let report = serde_json::json!({
+            "verdict": "explained", "samples": 1000, "noise_floor_N": 0.05,
+            "summary": ["The model explains the recording."],
+            "heldout": {"before_rms_N": 3.4, "after_rms_N": 0.05},
+            "before": {"force_rms_N": 3.5}, "after": {"force_rms_N": 0.051},
+            "effects": [{"name": "sensor_offset_gain", "location": "force_sensor",
+                         "evidence": "The force sensor reads 1.5 N high.",
+                         "parameters": {"force_sensor_offset": 1.5, "force_sensor_gain": 1.04}}],
+            "discovered": [{"location": "command", "family": "nonlinearity", "candidate": "command static curve",
+                            "reading": "At the command (nonlinearity): the curve bends.",
+                            "parameters": knots, "units": {}}],
+        });
+        let html = page("curve", &report, &[], "curve.json", None);
+        let (open, close) = (html.find("<details>").unwrap(), html.find("</details>").unwrap());
+        assert_eq!(html.matches("<details>").count(), 1, "only the knot table folds");
+        let folded = &html[open..close];
+        assert!(
+            folded.contains("<summary>the 41 parameters that carry it</summary>"),
+            "{folded}"
+        );
+        assert!(
+            folded.contains("<code>command_curve_x_20</code>") && folded.contains("−9.000 V"),
+            "{folded}"
+        );
+        let reading = html.find("the curve bends.").unwrap();
+        assert!(reading < open, "the reading comes before its folded table");
+        let effect = html.find("<code>force_sensor_offset</code>").unwrap();
+        assert!(effect < open && html.find("<code>force_sensor_gain</code>").unwrap() < open);
     }
 
     #[test]
