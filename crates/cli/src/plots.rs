@@ -17,8 +17,8 @@ use plotters::prelude::*;
 
 use jetpipe_diagnosis::input::recording::Recording;
 use jetpipe_diagnosis::replay::signals::ChainSignals;
+use jetpipe_diagnosis::replay::signature::conditional_means;
 use jetpipe_diagnosis::replay::{replay, Replay};
-use jetpipe_diagnosis::verdict::signature::conditional_means;
 use jetpipe_diagnosis::Diagnosis;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::command_stage;

@@ -254,6 +254,15 @@ pub struct Candidate {
     pub settings: Vec<(&'static str, f64)>,
 }
 
+/// The unit of an FMU parameter, from the variable table.
+pub fn unit_of(name: &str) -> &'static str {
+    jetpipe_model::variables::VARIABLES
+        .iter()
+        .find(|v| v.name == name)
+        .and_then(|v| v.unit)
+        .unwrap_or("")
+}
+
 #[cfg(test)]
 impl Candidate {
     /// A candidate at the jet pipe with a term of each mechanism, for tests.

@@ -316,14 +316,6 @@ fn shown_signed(value: f64, unit: &str) -> String {
     }
 }
 
-pub(crate) fn unit_of(name: &str) -> &'static str {
-    VARIABLES
-        .iter()
-        .find(|v| v.name == name)
-        .and_then(|v| v.unit)
-        .unwrap_or("")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,6 +8,7 @@
 //! jet pipe null's and the gas temperature's) and compositions that would not be exact give
 //! `None`, and the candidate stays a located departure.
 
+use crate::candidates::unit_of;
 use crate::candidates::{parameter_value, Candidate, Mechanism, Modulation, Regressor};
 use crate::fit::Problem;
 use crate::replay::signals::{FORCE, P1, P2};
@@ -281,15 +282,6 @@ pub fn model_terms(
     }
     crate::candidates::curves::monotone_command(&mut unique);
     Some(unique)
-}
-
-/// The unit of an FMU parameter, from the variable table.
-pub fn unit_of(name: &str) -> &'static str {
-    jetpipe_model::variables::VARIABLES
-        .iter()
-        .find(|v| v.name == name)
-        .and_then(|v| v.unit)
-        .unwrap_or("")
 }
 
 /// One sentence on what was added: each parameter against its value in the model before.

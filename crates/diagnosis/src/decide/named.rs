@@ -6,7 +6,7 @@ use crate::input::blocks::Block;
 use crate::input::recording::Recording;
 use crate::input::stopper_motion::stopper_velocity;
 use crate::replay::signals::command_direction;
-use crate::verdict::signature::BINS;
+use crate::replay::signature::BINS;
 
 /// What a signature test found.
 pub struct SignatureTest {

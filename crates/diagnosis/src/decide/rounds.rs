@@ -29,8 +29,8 @@ use crate::replay::signals::ChainSignals;
 use crate::replay::signals::CHANNELS;
 use crate::replay::signals::CHANNEL_NAMES;
 use crate::replay::signals::FORCE;
+use crate::replay::signature::Signature;
 use crate::replay::Replay;
-use crate::verdict::signature::Signature;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -298,7 +298,7 @@ fn replay_round(
         return Ok(None);
     }
     let force_residual = difference(&recording.force, &current.force);
-    let line = crate::verdict::signature::spectrum(&recording.time, &force_residual);
+    let line = crate::replay::signature::spectrum(&recording.time, &force_residual);
     // A line on the logarithmic grid of the signature, else a sharp line anywhere up to the
     // Nyquist frequency that the inputs do not carry (`lines.rs`).
     let periodic = (line.peak_over_median > 100.0 && line.low_share < 0.5 && line.peak_hz > 0.2)
@@ -309,7 +309,7 @@ fn replay_round(
             let inputs = [&recording.v_da[..n], &recording.x_s[..n]];
             // Placed again at the samples' own times: the fits' stretches have gaps.
             crate::input::lines::strongest_line(&force_residual, sample_rate, &inputs, &current.force[..n]).map(|l| {
-                crate::verdict::signature::polished_line(&recording.time, &force_residual, l.hz, sample_rate / n as f64)
+                crate::replay::signature::polished_line(&recording.time, &force_residual, l.hz, sample_rate / n as f64)
             })
         });
     // Pressures within their noise: nothing upstream of the piston departs by more

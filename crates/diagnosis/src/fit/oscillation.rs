@@ -117,7 +117,7 @@ pub fn traced_line(problem: &Problem, residual: &[Vec<f64>; CHANNELS], sensitivi
     information.sort_by(|a, b| a.total_cmp(b));
     let shrink = 0.1 * information[information.len() / 2];
     let trace: Vec<f64> = sums.iter().map(|(rs, ss)| rs / (ss + shrink)).collect();
-    let line = crate::verdict::signature::spectrum(&centres, &trace);
+    let line = crate::replay::signature::spectrum(&centres, &trace);
     (line.peak_over_median > TRACE_LINE_OVER_MEDIAN
         && line.peak_hz > TRACE_LOWEST_HZ
         && !carried_by_inputs(problem, line.peak_hz))

@@ -34,7 +34,7 @@ pub(crate) fn joint_candidate(params: &Parameters, names: &[&'static str]) -> Ca
             let (lower, upper) = crate::candidates::declared_bounds(name);
             Term {
                 name,
-                unit: crate::decide::discover::unit_of(name),
+                unit: crate::candidates::unit_of(name),
                 mechanism: Mechanism::Parameter(name),
                 neutral: value,
                 step: 1e-3 * value.abs(),

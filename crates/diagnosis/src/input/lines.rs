@@ -1,5 +1,5 @@
 //! Sharp spectral lines anywhere up to the Nyquist frequency: a mains pick-up on a sensor, a
-//! compressor's ripple. The residual's spectrum on a logarithmic grid ([`crate::verdict::signature`])
+//! compressor's ripple. The residual's spectrum on a logarithmic grid ([`crate::replay::signature`])
 //! steps over a line narrower than its 6 % spacing; here the whole spectrum is read from a
 //! Hann-windowed FFT, a line is a bin that stands far above its neighbourhood, and its
 //! frequency is interpolated between bins (Gaussian interpolation, exact for a Gaussian

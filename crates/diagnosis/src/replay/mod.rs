@@ -11,6 +11,7 @@ pub mod agreement;
 pub mod errors;
 pub mod settling;
 pub mod signals;
+pub mod signature;
 
 use crate::input::recording::Recording;
 use jetpipe_model::physics::actuator::{Actuator, Outputs};

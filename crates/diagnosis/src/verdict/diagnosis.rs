@@ -8,7 +8,7 @@ use crate::fit::scored::Localization;
 use crate::fit::scored::Scored;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::replay::errors::Errors;
-use crate::verdict::signature::Signature;
+use crate::replay::signature::Signature;
 use crate::verdict::split::PressureSplit;
 use jetpipe_model::physics::parameters::Parameters;
 use serde_json::Value;

@@ -4,5 +4,4 @@
 pub(crate) mod conclude;
 pub mod diagnosis;
 pub(crate) mod report;
-pub mod signature;
 pub(crate) mod split;

@@ -175,7 +175,7 @@ impl Diagnosis {
                 "family": d.family,
                 "candidate": d.candidate,
                 "parameters": parameters_json(&d.parameters),
-                "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(crate::decide::discover::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
+                "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(crate::candidates::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
                 "reading": d.reading,
                 "heldout_before_rms_N": d.heldout_before,
                 "heldout_after_rms_N": d.heldout_after,
