@@ -10,6 +10,7 @@
 //! for traces in time, every k-th sample for curves in a plane, at most `MAX_SCATTER` points
 //! for a scatter), so a figure of an 80 000-sample recording stays under about 100 kB.
 
+use jetpipe_diagnosis::vocabulary::{Family, Place};
 use std::path::Path;
 
 use plotters::coord::Shift;
@@ -550,8 +551,9 @@ fn pressures_over_time(recording: &Recording, before: &Replay, after: &Replay) -
 }
 
 /// Whether an added term is a static curve of the command path (command → jet pipe position).
-fn bends_command_path(location: &str, family: &str) -> bool {
-    matches!(location, "command" | "current_driver" | "jet_pipe") && matches!(family, "nonlinearity" | "limit")
+fn bends_command_path(location: Place, family: Family) -> bool {
+    matches!(location, Place::Command | Place::CurrentDriver | Place::JetPipe)
+        && matches!(family, Family::Nonlinearity | Family::Limit)
 }
 
 /// The drawn static curves of the terms that are static curves: the force sensor's map, and
@@ -560,11 +562,9 @@ fn bends_command_path(location: &str, family: &str) -> bool {
 fn static_curves(recording: &Recording, diagnosis: &Diagnosis, base: &Parameters) -> Result<Vec<Figure>, String> {
     let after = &diagnosis.parameters;
     let mut figures = vec![];
-    let sensor_term = diagnosis
-        .discovered
-        .iter()
-        .any(|d| d.location == "force_sensor" && matches!(d.family, "nonlinearity" | "parameter_offset"))
-        || diagnosis.effects.iter().any(|e| e.location == "force_sensor");
+    let sensor_term = diagnosis.discovered.iter().any(|d| {
+        d.location == Place::ForceSensor && matches!(d.family, Family::Nonlinearity | Family::ParameterOffset)
+    }) || diagnosis.effects.iter().any(|e| e.location == Place::ForceSensor);
     if sensor_term {
         figures.push(force_sensor_curve(recording, diagnosis, base, after)?);
     }

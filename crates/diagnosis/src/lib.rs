@@ -34,6 +34,7 @@ mod context;
 mod diagnose;
 mod parallel;
 pub mod policy;
+pub mod vocabulary;
 
 pub use context::{Options, ProgressBars};
 pub use decide::additions::{AddedEffect, DiscoveredTerm};

@@ -10,11 +10,12 @@
 //! so it cannot tell these places apart, and a report says so (`tied_locations`).
 
 use crate::candidates::modulation::slot_parameter;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::modulation::ModulationSignal;
 use jetpipe_model::variables::vr;
 
 /// The command, the current driver and the torque motor (the jet pipe's place).
-pub const COMMAND_PATH: [&str; 3] = ["command", "current_driver", "jet_pipe"];
+pub const COMMAND_PATH: [Place; 3] = [Place::Command, Place::CurrentDriver, Place::JetPipe];
 
 /// The constants before f3 whose change is a static function of the command: the driver's
 /// gain and offset, the torque motor's constant and f3's input scale (u = k_m i / F_jp_sat).
@@ -81,7 +82,7 @@ pub fn acts_alike_along_the_command_path(set: &[(&'static str, f64)]) -> bool {
 }
 
 /// The places a static function of the command at `place` is tied with, `place` first.
-pub fn tied_along_the_command_path(place: &'static str) -> Vec<&'static str> {
+pub fn tied_along_the_command_path(place: Place) -> Vec<Place> {
     std::iter::once(place)
         .chain(COMMAND_PATH.iter().copied().filter(|&p| p != place))
         .collect()
@@ -143,8 +144,8 @@ mod tests {
             ModulationSignal::Command
         )));
         assert_eq!(
-            tied_along_the_command_path("jet_pipe"),
-            ["jet_pipe", "command", "current_driver"]
+            tied_along_the_command_path(Place::JetPipe),
+            [Place::JetPipe, Place::Command, Place::CurrentDriver]
         );
     }
 }

@@ -2,6 +2,7 @@
 //! one sentence that states its largest departure from the straight line.
 
 use crate::candidates::curves::FLAT;
+use crate::vocabulary::Family;
 use jetpipe_model::physics::static_curve::{StaticCurve, MAX_KNOTS};
 
 /// The curves that `set` turns on: (prefix, curve).
@@ -27,15 +28,15 @@ fn curves_in(set: &[(&'static str, f64)]) -> Vec<(&'static str, StaticCurve)> {
 
 /// The family of a discovered term: `limit` when a curve in `set` is flat at an end (a
 /// saturation), else the candidate's.
-pub fn family(candidate_family: &'static str, set: &[(&'static str, f64)]) -> &'static str {
+pub fn family(candidate_family: Family, set: &[(&'static str, f64)]) -> Family {
     let curves = curves_in(set);
     if curves.is_empty() {
         return candidate_family;
     }
     if curves.iter().any(|(_, c)| flat_end(c).is_some()) {
-        "limit"
+        Family::Limit
     } else {
-        "nonlinearity"
+        Family::Nonlinearity
     }
 }
 
@@ -222,7 +223,7 @@ mod tests {
             ("force_sensor_curve_x_3", 100.0),
             ("force_sensor_curve_y_3", 85.1),
         ];
-        assert_eq!(family("nonlinearity", &s), "limit");
+        assert_eq!(family(Family::Nonlinearity, &s), Family::Limit);
         let r = reading(&s).unwrap();
         assert!(r.contains("the force sensor saturates at 85.00 N"), "{r}");
         let d = [
@@ -236,7 +237,7 @@ mod tests {
             ("command_curve_x_4", 8.0),
             ("command_curve_y_4", 7.6),
         ];
-        assert_eq!(family("nonlinearity", &d), "nonlinearity");
+        assert_eq!(family(Family::Nonlinearity, &d), Family::Nonlinearity);
         let r = reading(&d).unwrap();
         assert!(r.contains("the command has a dead zone of ±0.40 V"), "{r}");
     }

@@ -38,6 +38,7 @@
 use crate::candidates::{Candidate, Mechanism, Regressor, Term};
 use crate::input::blocks::Block;
 use crate::replay::signals::{CHANNELS, FORCE, P1, P2};
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::static_curve::{StaticCurve, MAX_KNOTS};
 use jetpipe_model::variables::VARIABLES;
@@ -423,18 +424,18 @@ pub fn candidates(base: &Parameters, knots: &CurveKnots, has_pressures: bool) ->
     let c = |label, location, terms, settings| Candidate {
         label,
         location,
-        family: "nonlinearity",
+        family: Family::Nonlinearity,
         named: None,
         terms,
         settings,
     };
     if knots.command.len() >= 3 && !base.command_curve.is_on() {
         let (terms, settings) = command_terms(&knots.command);
-        list.push(c("command static curve", "command", terms, settings));
+        list.push(c("command static curve", Place::Command, terms, settings));
     }
     if knots.channels[FORCE].len() >= 3 && free[FORCE] {
         let terms = channel_terms(FORCE, &knots.channels[FORCE], "N");
-        list.push(c("force sensor static curve", "force_sensor", terms, vec![]));
+        list.push(c("force sensor static curve", Place::ForceSensor, terms, vec![]));
     }
     if has_pressures {
         let one = |ch: usize| {
@@ -443,7 +444,7 @@ pub fn candidates(base: &Parameters, knots: &CurveKnots, has_pressures: bool) ->
         if let Some(t) = one(P1) {
             list.push(c(
                 "chamber 1 pressure sensor static curve",
-                "pressure_sensors",
+                Place::PressureSensors,
                 t,
                 vec![],
             ));
@@ -451,14 +452,14 @@ pub fn candidates(base: &Parameters, knots: &CurveKnots, has_pressures: bool) ->
         if let Some(t) = one(P2) {
             list.push(c(
                 "chamber 2 pressure sensor static curve",
-                "pressure_sensors",
+                Place::PressureSensors,
                 t,
                 vec![],
             ));
         }
         if let (Some(mut a), Some(b)) = (one(P1), one(P2)) {
             a.extend(b);
-            list.push(c("pressure sensor static curves", "pressure_sensors", a, vec![]));
+            list.push(c("pressure sensor static curves", Place::PressureSensors, a, vec![]));
         }
     }
     list
@@ -780,8 +781,8 @@ pub fn command_curve_with_free_knots(set: &[(&'static str, f64)]) -> Option<Cand
     }
     Some(Candidate {
         label: "command static curve",
-        location: "command",
-        family: "nonlinearity",
+        location: Place::Command,
+        family: Family::Nonlinearity,
         named: None,
         terms,
         settings: set.to_vec(),

@@ -8,6 +8,7 @@
 //! depends on the ratio alone, so the curve is a place of its own at the valve.
 
 use crate::candidates::{Candidate, Mechanism, Term};
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 
 /// The pressure ratios of the knots: evenly over 0–1 (four knots left P2 1.6 noise floors
@@ -52,8 +53,8 @@ pub fn candidate(base: &Parameters) -> Option<Candidate> {
         .collect();
     Some(Candidate {
         label: "discharge coefficient against the pressure ratio",
-        location: "valve",
-        family: "nonlinearity",
+        location: Place::Valve,
+        family: Family::Nonlinearity,
         named: None,
         terms,
         settings,

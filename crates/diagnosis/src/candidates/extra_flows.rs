@@ -9,6 +9,7 @@
 //! `chamber_laminar_vent_i`. Ten candidates: five signals into each of two chambers.
 
 use crate::candidates::{interned, parameter_value, Candidate, Mechanism, Term};
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::extra_flow::{FlowSignal, FLOW_SLOTS};
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -75,8 +76,8 @@ pub fn candidates(params: &Parameters) -> Vec<Candidate> {
         .into_iter()
         .map(|(signal, chamber)| Candidate {
             label: label(signal, chamber),
-            location: "chambers",
-            family: "extra_flow",
+            location: Place::Chambers,
+            family: Family::ExtraFlow,
             named: None,
             terms: vec![Term {
                 name: coefficient,
@@ -173,7 +174,7 @@ mod tests {
         assert!(labels.contains(&"extra flow into chamber 2 ∝ (P1 − P2)"), "{labels:?}");
         assert!(list
             .iter()
-            .all(|c| c.location == "chambers" && c.family == "extra_flow" && c.terms.len() == 1));
+            .all(|c| c.location == Place::Chambers && c.family == Family::ExtraFlow && c.terms.len() == 1));
     }
 
     #[test]

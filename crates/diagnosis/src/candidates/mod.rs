@@ -18,6 +18,7 @@
 //! Gauss–Newton with bounds on the training blocks of every measured channel at once (each
 //! channel weighted by its noise floor) and scored on the held-out blocks.
 
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::extra_force::ProductSignal;
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::sensors::{self, Channel, SensorLaw};
@@ -245,8 +246,8 @@ pub struct Term {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Candidate {
     pub label: &'static str,
-    pub location: &'static str,
-    pub family: &'static str,
+    pub location: Place,
+    pub family: Family,
     /// The named effect this candidate is, if it is one.
     pub named: Option<&'static str>,
     pub terms: Vec<Term>,
@@ -269,8 +270,8 @@ impl Candidate {
     pub(crate) fn of_mechanisms(terms: Vec<Mechanism>) -> Candidate {
         Candidate {
             label: "test",
-            location: "jet_pipe",
-            family: "dynamics",
+            location: Place::JetPipe,
+            family: Family::Dynamics,
             named: None,
             terms: terms
                 .into_iter()

@@ -18,6 +18,7 @@
 //! and cos: faster than the chambers, the product has the phase wrong.
 
 use crate::candidates::{interned, parameter_value, Candidate, Mechanism};
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::modulation::{ModulationSignal, MODULATABLE};
 use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::variables::VARIABLES;
@@ -51,7 +52,7 @@ impl std::fmt::Display for Follows {
 
 /// The place of the chain a constant belongs to: the place of a catalogue candidate that
 /// fits it as a constant, else the place its name says.
-pub fn place_of(constant: &'static str, catalogue: &[Candidate]) -> &'static str {
+pub fn place_of(constant: &'static str, catalogue: &[Candidate]) -> Place {
     if let Some(c) = catalogue
         .iter()
         .find(|c| c.terms.iter().any(|t| t.mechanism == Mechanism::Parameter(constant)))
@@ -59,30 +60,30 @@ pub fn place_of(constant: &'static str, catalogue: &[Candidate]) -> &'static str
         return c.location;
     }
     match constant {
-        n if n.starts_with("force_sensor") => "force_sensor",
-        n if n.starts_with("p1_sensor") || n.starts_with("p2_sensor") => "pressure_sensors",
-        "k_cd" | "i_offset" | "omega_cd" => "current_driver",
-        "k_m" | "omega_1" | "omega_2" | "zeta_2" | "x_jp_offset" | "x_jp_sat" | "F_jp_sat" => "jet_pipe",
-        "P_s" => "supply",
-        "P_r" => "return",
-        "T" | "dead_volume_1" | "dead_volume_2" | "C_dm_A_lpp" | "C_db_A_lpp" => "chambers",
-        "D_cyl" | "k_spring" | "friction_coulomb" | "viscous_friction" => "mechanics",
-        n if n.starts_with("extra_force") => "mechanics",
-        _ => "valve",
+        n if n.starts_with("force_sensor") => Place::ForceSensor,
+        n if n.starts_with("p1_sensor") || n.starts_with("p2_sensor") => Place::PressureSensors,
+        "k_cd" | "i_offset" | "omega_cd" => Place::CurrentDriver,
+        "k_m" | "omega_1" | "omega_2" | "zeta_2" | "x_jp_offset" | "x_jp_sat" | "F_jp_sat" => Place::JetPipe,
+        "P_s" => Place::Supply,
+        "P_r" => Place::Return,
+        "T" | "dead_volume_1" | "dead_volume_2" | "C_dm_A_lpp" | "C_db_A_lpp" => Place::Chambers,
+        "D_cyl" | "k_spring" | "friction_coulomb" | "viscous_friction" => Place::Mechanics,
+        n if n.starts_with("extra_force") => Place::Mechanics,
+        _ => Place::Valve,
     }
 }
 
 /// The family of a departure where `constant` at `place` follows `follows`.
-pub fn family_of(constant: &str, place: &str, follows: Follows) -> &'static str {
+pub fn family_of(constant: &str, place: Place, follows: Follows) -> Family {
     match follows {
-        Follows::Periodic(_) => "periodic",
-        Follows::Signal(ModulationSignal::Time) => "drift",
-        Follows::Signal(ModulationSignal::StopperVelocitySign) => "asymmetry",
-        Follows::Signal(_) if constant.contains("area_scale") => "asymmetry",
+        Follows::Periodic(_) => Family::Periodic,
+        Follows::Signal(ModulationSignal::Time) => Family::Drift,
+        Follows::Signal(ModulationSignal::StopperVelocitySign) => Family::Asymmetry,
+        Follows::Signal(_) if constant.contains("area_scale") => Family::Asymmetry,
         Follows::Signal(_) => match place {
-            "mechanics" => "extra_force",
-            "chambers" => "extra_flow",
-            _ => "nonlinearity",
+            Place::Mechanics => Family::ExtraForce,
+            Place::Chambers => Family::ExtraFlow,
+            _ => Family::Nonlinearity,
         },
     }
 }

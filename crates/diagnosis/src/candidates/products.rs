@@ -16,6 +16,7 @@
 
 use crate::candidates::{interned, parameter_value, Candidate, Mechanism, Regressor, Term};
 use crate::replay::signals::FORCE;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::extra_force::{ProductSignal, PRODUCT_SLOTS};
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -163,8 +164,8 @@ pub fn candidates(params: &Parameters, mean_position: f64) -> Vec<Candidate> {
         }
         out.push(Candidate {
             label: label(first, second),
-            location: "mechanics",
-            family: "extra_force",
+            location: Place::Mechanics,
+            family: Family::ExtraForce,
             named: None,
             terms,
             settings,

@@ -2,13 +2,14 @@
 //! error it removed and the places it cannot be told from.
 
 use crate::candidates::Candidate;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 
 /// A named effect that was added.
 #[derive(Clone, Debug)]
 pub struct AddedEffect {
     pub name: &'static str,
-    pub location: &'static str,
+    pub location: Place,
     pub parameters: Vec<(&'static str, f64)>,
     pub evidence: String,
     pub heldout_before: f64,
@@ -28,8 +29,8 @@ pub struct AddedEffect {
 /// A term outside the named effects that was added (see `discover.rs`).
 #[derive(Clone, Debug)]
 pub struct DiscoveredTerm {
-    pub location: &'static str,
-    pub family: &'static str,
+    pub location: Place,
+    pub family: Family,
     pub candidate: &'static str,
     /// The FMU parameters that carry it, in SI units.
     pub parameters: Vec<(&'static str, f64)>,
@@ -43,7 +44,7 @@ pub struct DiscoveredTerm {
     pub pressures_heldout: Option<([f64; 2], [f64; 2])>,
     /// The places this recording cannot tell the term's from, its own first (at most
     /// [`crate::policy::MOST_TIED_LOCATIONS`]); empty when it tells the place.
-    pub tied_locations: Vec<&'static str>,
+    pub tied_locations: Vec<Place>,
 }
 
 impl DiscoveredTerm {

@@ -26,6 +26,7 @@ use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::Replay;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -270,7 +271,7 @@ pub(crate) fn simpler_elsewhere(
     // One step from neutral ranks the constants by how far a linearisation reaches, not by
     // where the departure is (a large one lets any gain along the chain take most of it):
     // the best of each place is refitted, not the best few of one place.
-    let mut places: Vec<&'static str> = vec![];
+    let mut places: Vec<Place> = vec![];
     others.retain(|s| {
         let new_place = !places.contains(&s.fit.candidate.location);
         if new_place {

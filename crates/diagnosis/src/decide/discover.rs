@@ -12,6 +12,7 @@ use crate::candidates::unit_of;
 use crate::candidates::{parameter_value, Candidate, Mechanism, Modulation, Regressor};
 use crate::fit::Problem;
 use crate::replay::signals::{FORCE, P1, P2};
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 
 /// The FMU parameters (name, value) that put the fitted `values` of `terms` into the
@@ -285,7 +286,13 @@ pub fn model_terms(
 }
 
 /// One sentence on what was added: each parameter against its value in the model before.
-pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, f64)], before: &Parameters) -> String {
+pub fn reading(
+    label: &str,
+    location: Place,
+    family: Family,
+    set: &[(&'static str, f64)],
+    before: &Parameters,
+) -> String {
     if let Some(discharge) = crate::candidates::discharge::reading(set, before) {
         return discharge;
     }
@@ -301,7 +308,7 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
     if let Some(curve) = crate::candidates::curve_reading::reading(set) {
         return format!(
             "At the {location} ({}): {curve}",
-            crate::candidates::curve_reading::family("nonlinearity", set)
+            crate::candidates::curve_reading::family(Family::Nonlinearity, set)
         );
     }
     let parts: Vec<String> = set
@@ -349,7 +356,7 @@ pub fn reading(label: &str, location: &str, family: &str, set: &[(&'static str, 
 
 /// A transducer's or the command's second-order filter in physical words: its natural
 /// frequency, damping and −3 dB corner, f_n √(1 − 2ζ² + √((1 − 2ζ²)² + 1)).
-fn second_order_reading(location: &str, family: &str, set: &[(&'static str, f64)]) -> Option<String> {
+fn second_order_reading(location: Place, family: Family, set: &[(&'static str, f64)]) -> Option<String> {
     let &(name, f_n) = set.iter().find(|(n, v)| n.ends_with("_filter_frequency") && *v > 0.0)?;
     let prefix = &name[..name.len() - "_filter_frequency".len()];
     let zeta = set

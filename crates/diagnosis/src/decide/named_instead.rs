@@ -33,14 +33,15 @@ use crate::fit::Problem;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::replay::replay_fast;
 use crate::replay::Replay;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// Whether a place is on the force side of the piston, where a force the stopper's motion
 /// sets reads the same whether it acts on the piston or is added by the sensor: a smooth
 /// friction was found as the force sensor's offset varying with the stopper velocity.
-fn force_side(place: &str) -> bool {
-    matches!(place, "mechanics" | "force_sensor")
+fn force_side(place: Place) -> bool {
+    matches!(place, Place::Mechanics | Place::ForceSensor)
 }
 
 /// Gauss–Newton iterations of the named effect's fit in the term's place.

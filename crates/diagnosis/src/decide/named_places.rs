@@ -31,6 +31,7 @@ use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::signals::CHANNELS;
 use crate::replay::signals::FORCE;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -174,7 +175,7 @@ pub(crate) fn named_with_term(
         .filter(|s| s.fit.candidate.named.is_none() && crate::decide::pairs::pairable(&s.fit.candidate))
         .collect();
     written.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
-    let places: Vec<&'static str> = halves.iter().map(|h| h.scored.fit.candidate.location).collect();
+    let places: Vec<Place> = halves.iter().map(|h| h.scored.fit.candidate.location).collect();
     let mut elsewhere = 0;
     let ranked: Vec<&Scored> = written
         .into_iter()
@@ -367,7 +368,7 @@ pub(crate) fn downstream<'a>(
     let near: Vec<Candidate> = r
         .candidates
         .iter()
-        .filter(|c| matches!(c.location, "mechanics" | "force_sensor"))
+        .filter(|c| matches!(c.location, Place::Mechanics | Place::ForceSensor))
         .cloned()
         .collect();
     progress("the force departs from the pressures too: the mechanics and the force sensor on their own");
@@ -453,7 +454,7 @@ pub(crate) fn discovered_downstream(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Option<(DiscoveredTerm, Parameters)>, String> {
     let side = &d.side;
-    if side.location == "unknown" {
+    if side.location == Place::Unknown {
         return Ok(None);
     }
     let mut unnamed: Vec<&Scored> = side

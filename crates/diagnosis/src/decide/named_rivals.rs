@@ -21,6 +21,7 @@ use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
 use crate::fit::scored::Scored;
 use crate::fit::Problem;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// A named effect at the same place whose share of the held-out misfit was at most this much
@@ -34,7 +35,7 @@ const MOST_RIVALS: usize = 2;
 /// is within [`RIVAL_SHARE_GAP`] of `explained`, most first.
 pub(crate) fn rivals_of(
     name: &'static str,
-    place: &str,
+    place: Place,
     explained: f64,
     candidates: &[Scored],
 ) -> Vec<(&'static str, f64)> {
@@ -203,20 +204,16 @@ pub(crate) mod tests {
     use super::*;
     use crate::fit::Fit;
     use crate::replay::signals::CHANNELS;
+    use crate::vocabulary::Family;
 
     /// A candidate's score with no fit behind it: its label, place, named effect and share.
-    pub(crate) fn scored(
-        label: &'static str,
-        location: &'static str,
-        named: Option<&'static str>,
-        explained: f64,
-    ) -> Scored {
+    pub(crate) fn scored(label: &'static str, location: Place, named: Option<&'static str>, explained: f64) -> Scored {
         Scored {
             fit: Fit {
                 candidate: Candidate {
                     label,
                     location,
-                    family: "parameter_offset",
+                    family: Family::ParameterOffset,
                     named,
                     terms: vec![],
                     settings: vec![],
@@ -235,19 +232,19 @@ pub(crate) mod tests {
     #[test]
     fn a_rival_is_a_named_effect_at_the_same_place_within_five_points_of_the_share_and_each_is_listed_once() {
         let candidates = vec![
-            scored("heat exchange", "chambers", Some("heat_transfer"), 0.969),
-            scored("dead volumes", "chambers", Some("dead_volume"), 0.966),
-            scored("dead volumes, one chamber", "chambers", Some("dead_volume"), 0.930),
-            scored("gas temperature drift", "chambers", None, 0.975),
-            scored("chamber 1 leak", "chambers", Some("leak_at_the_place"), 0.910),
-            scored("supply restriction", "supply", Some("supply_pressure_drop"), 0.968),
+            scored("heat exchange", Place::Chambers, Some("heat_transfer"), 0.969),
+            scored("dead volumes", Place::Chambers, Some("dead_volume"), 0.966),
+            scored("dead volumes, one chamber", Place::Chambers, Some("dead_volume"), 0.930),
+            scored("gas temperature drift", Place::Chambers, None, 0.975),
+            scored("chamber 1 leak", Place::Chambers, Some("leak_at_the_place"), 0.910),
+            scored("supply restriction", Place::Supply, Some("supply_pressure_drop"), 0.968),
         ];
-        let rivals = rivals_of("heat_transfer", "chambers", 0.969, &candidates);
+        let rivals = rivals_of("heat_transfer", Place::Chambers, 0.969, &candidates);
         assert_eq!(rivals, vec![("dead_volume", 0.966)]);
         // Named the other way round, the heat exchange is the rival.
-        let rivals = rivals_of("dead_volume", "chambers", 0.966, &candidates);
+        let rivals = rivals_of("dead_volume", Place::Chambers, 0.966, &candidates);
         assert_eq!(rivals, vec![("heat_transfer", 0.969)]);
         // A named effect far ahead has none.
-        assert!(rivals_of("heat_transfer", "chambers", 1.02, &candidates).is_empty());
+        assert!(rivals_of("heat_transfer", Place::Chambers, 1.02, &candidates).is_empty());
     }
 }

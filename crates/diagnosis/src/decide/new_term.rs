@@ -27,6 +27,7 @@ use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::signals::CHANNELS;
 use crate::replay::Replay;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -50,7 +51,7 @@ pub(crate) fn discover_term(
     // pipe reads as a delay under a slow sine) and the located place has no term to keep, the
     // best of the others is tried. Up to DISCOVERY_TRIALS of each.
     let tied = found.alternatives();
-    let unnamed_at = |place: &str| -> Vec<&Scored> {
+    let unnamed_at = |place: Place| -> Vec<&Scored> {
         let mut at: Vec<&Scored> = found
             .candidates
             .iter()
@@ -83,7 +84,7 @@ pub(crate) fn discover_term(
         at.truncate(DISCOVERY_TRIALS);
         at
     };
-    let mut others: Vec<&Scored> = tied.iter().flat_map(|place| unnamed_at(place)).collect();
+    let mut others: Vec<&Scored> = tied.iter().flat_map(|&place| unnamed_at(place)).collect();
     others.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
     others.truncate(DISCOVERY_TRIALS);
     let mut at_place: Vec<&Scored> = unnamed_at(found.location).into_iter().chain(others).collect();
@@ -173,12 +174,12 @@ pub(crate) fn discover_term(
         // A term on the pressure transducers is judged on the pressures; so is one upstream
         // of the piston whose departure shows in the pressures more than in the force (a
         // stopper position 1 mm off leaves 2 noise floors in the force, 9 in the pressures).
-        let pressures = if s.fit.candidate.location == "pressure_sensors" || (!force_ok && cx.pressure_noise.is_some())
-        {
-            pressures_judgement(cx, r, problem, &with, after, progress, label)
-        } else {
-            None
-        };
+        let pressures =
+            if s.fit.candidate.location == Place::PressureSensors || (!force_ok && cx.pressure_noise.is_some()) {
+                pressures_judgement(cx, r, problem, &with, after, progress, label)
+            } else {
+                None
+            };
         if pressures.is_some() || force_ok {
             let candidate = &s.fit.candidate;
             progress(&format!("adding a {} at the {}", candidate.label, candidate.location));

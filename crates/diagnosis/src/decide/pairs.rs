@@ -32,6 +32,7 @@ use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::signals::CHANNELS;
 use crate::replay::Replay;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -165,7 +166,7 @@ pub(crate) fn best_pair(
     // Per place the best two: a pair's members need not be what fits best alone (a softer
     // static curve alone, the receivers' null in a pair).
     let mut members: Vec<&Scored> = vec![];
-    let mut places: Vec<&'static str> = vec![];
+    let mut places: Vec<Place> = vec![];
     for s in ranked {
         let c = &s.fit.candidate;
         if c.named.is_some() || !pairable(c) {

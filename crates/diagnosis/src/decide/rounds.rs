@@ -31,6 +31,7 @@ use crate::replay::signals::CHANNEL_NAMES;
 use crate::replay::signals::FORCE;
 use crate::replay::signature::Signature;
 use crate::replay::Replay;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -334,7 +335,7 @@ fn replay_round(
             problem.mean_position,
         ))
         .filter(|c| !f.effects.iter().any(|e| Some(e.name) == c.named))
-        .filter(|c| !pressures_agree || matches!(c.location, "mechanics" | "force_sensor"))
+        .filter(|c| !pressures_agree || matches!(c.location, Place::Mechanics | Place::ForceSensor))
         .collect();
     progress(&format!(
         "round {}: held-out misfit {} noise floors",
@@ -404,7 +405,7 @@ fn find_addition(
 ) -> Result<Option<Addition>, String> {
     let place = found.location;
     let mut halves = vec![];
-    if place != "unknown" {
+    if place != Place::Unknown {
         if let Some((s, sentence)) =
             crate::decide::named_places::named_at_place(cx, r, problem, found, &f.discovered, &mut halves, progress)
         {
@@ -417,7 +418,7 @@ fn find_addition(
     // them would stand in for a term there that also moves the pressures (a bore narrowing
     // over the recording was read as the force sensor's offset and gain, leaving 6.9 noise
     // floors, where the bore varying with time leaves 1.0).
-    let downstream_of_elsewhere = !matches!(place, "mechanics" | "force_sensor");
+    let downstream_of_elsewhere = !matches!(place, Place::Mechanics | Place::ForceSensor);
     let downstream = if !r.pressures_agree && downstream_of_elsewhere {
         crate::decide::named_places::downstream(cx, r, &f.params, replays, progress)
     } else {
@@ -455,7 +456,7 @@ fn find_addition(
     )? {
         return Ok(Some(Addition::Pair(terms, Box::new(trial))));
     }
-    if place != "unknown" {
+    if place != Place::Unknown {
         if let Some((term, trial, s)) =
             discover_term(cx, r, problem, found, &f.params, &f.discovered, replays, progress)?
         {
@@ -555,11 +556,12 @@ fn add_effect(
 mod tests {
     use super::*;
     use crate::decide::findings::{nameable, unclaimed};
+    use crate::vocabulary::Family;
 
     fn term(candidate: &'static str, parameters: Vec<(&'static str, f64)>) -> DiscoveredTerm {
         DiscoveredTerm {
-            location: "mechanics",
-            family: "extra_force",
+            location: Place::Mechanics,
+            family: Family::ExtraForce,
             candidate,
             parameters,
             reading: String::new(),
@@ -574,9 +576,9 @@ mod tests {
     #[test]
     fn a_named_effect_without_a_signature_test_is_tried_as_a_term_once_a_term_is_in_and_one_with_a_test_never() {
         use crate::decide::named_rivals::tests::scored;
-        let dead_volumes = scored("dead volumes", "chambers", Some("dead_volume"), 0.98);
-        let friction = scored("piston friction", "mechanics", Some("piston_friction"), 0.9);
-        let leak = scored("chamber leaks to the return", "chambers", None, 0.8);
+        let dead_volumes = scored("dead volumes", Place::Chambers, Some("dead_volume"), 0.98);
+        let friction = scored("piston friction", Place::Mechanics, Some("piston_friction"), 0.9);
+        let leak = scored("chamber leaks to the return", Place::Chambers, None, 0.8);
         let earlier = vec![term("chamber leaks to the return", vec![("chamber_vent_1", 4.5e-9)])];
         // Before any term: the dead volumes are a name to try, not a term.
         assert!(nameable(&dead_volumes, &[]) && !unclaimed(&dead_volumes, &[]));

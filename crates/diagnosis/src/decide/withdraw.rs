@@ -119,6 +119,7 @@ mod tests {
     use super::*;
     use crate::decide::additions::AddedEffect;
     use crate::decide::additions::DiscoveredTerm;
+    use crate::vocabulary::{Family, Place};
     use std::cell::Cell;
 
     fn errors(heldout_rms: f64, rms: f64) -> Errors {
@@ -140,7 +141,7 @@ mod tests {
         first.force_sensor_offset = 0.7;
         let effects = vec![AddedEffect {
             name: "sensor_offset_gain",
-            location: "force_sensor",
+            location: Place::ForceSensor,
             parameters: vec![("force_sensor_offset", 0.7)],
             evidence: String::new(),
             heldout_before: 0.3,
@@ -160,8 +161,8 @@ mod tests {
             }],
             effects,
             discovered: vec![DiscoveredTerm {
-                location: "jet_pipe",
-                family: "dynamics",
+                location: Place::JetPipe,
+                family: Family::Dynamics,
                 candidate: "jet pipe extra lag",
                 parameters: vec![],
                 reading: String::new(),

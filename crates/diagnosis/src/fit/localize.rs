@@ -22,6 +22,7 @@ use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
 use crate::replay::signals::FORCE;
 use crate::replay::Replay;
+use crate::vocabulary::{Family, Place};
 
 /// How many of a fitted candidate's terms are away from their neutral values.
 pub(crate) fn used_terms(s: &Scored) -> f64 {
@@ -350,7 +351,7 @@ fn is_lag(candidate: &Candidate) -> bool {
 /// Rank the places of the chain by their best candidate.
 pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
     scored.sort_by(|a, b| b.explained.total_cmp(&a.explained));
-    let mut by_location: Vec<(&'static str, f64, &'static str)> = vec![];
+    let mut by_location: Vec<(Place, f64, &'static str)> = vec![];
     for s in scored.iter() {
         if !by_location.iter().any(|(l, _, _)| *l == s.fit.candidate.location) {
             by_location.push((s.fit.candidate.location, s.explained, s.fit.candidate.label));
@@ -367,7 +368,7 @@ pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
                 .unwrap_or(best);
             (place, simplest.fit.candidate.family)
         }
-        _ => ("unknown", "unknown"),
+        _ => (Place::Unknown, Family::Unknown),
     };
     Localization {
         location,
@@ -382,6 +383,7 @@ mod tests {
     use super::SharedSensitivities;
     use crate::candidates::{Candidate, Mechanism, Modulation};
     use crate::fit::scored::Localization;
+    use crate::vocabulary::{Family, Place};
 
     #[test]
     fn only_the_sensitivities_the_leaders_read_are_kept_for_their_refinement() {
@@ -404,10 +406,10 @@ mod tests {
         assert!(shared.get("A_0").is_none());
     }
 
-    fn located(by_location: Vec<(&'static str, f64, &'static str)>) -> Localization {
+    fn located(by_location: Vec<(Place, f64, &'static str)>) -> Localization {
         Localization {
             location: by_location[0].0,
-            family: "parameter_offset",
+            family: Family::ParameterOffset,
             by_location,
             candidates: vec![],
         }
@@ -416,9 +418,9 @@ mod tests {
     #[test]
     fn places_that_explain_nearly_as_much_are_named_beside_the_term_added() {
         let l = located(vec![
-            ("force_sensor", 0.998, "force sensor offset and gain"),
-            ("supply", 0.9977, "supply pressure"),
-            ("mechanics", 0.5, "viscous friction"),
+            (Place::ForceSensor, 0.998, "force sensor offset and gain"),
+            (Place::Supply, 0.9977, "supply pressure"),
+            (Place::Mechanics, 0.5, "viscous friction"),
         ]);
         let clause = l
             .undecided_beside(l.location, false)
@@ -431,7 +433,7 @@ mod tests {
             .unwrap()
             .contains("pressure channels"));
         // A term added at the tied place names the located one beside it, not itself.
-        let beside_supply = l.undecided_beside("supply", true).unwrap();
+        let beside_supply = l.undecided_beside(Place::Supply, true).unwrap();
         assert!(beside_supply.contains("the force_sensor (99.8 %)"), "{beside_supply}");
         assert!(!beside_supply.contains("the supply"), "{beside_supply}");
     }
@@ -439,8 +441,8 @@ mod tests {
     #[test]
     fn a_place_well_ahead_of_the_others_is_added_without_a_doubt() {
         let l = located(vec![
-            ("force_sensor", 0.998, "force sensor lag"),
-            ("jet_pipe", 0.8, "jet pipe lag"),
+            (Place::ForceSensor, 0.998, "force sensor lag"),
+            (Place::JetPipe, 0.8, "jet pipe lag"),
         ]);
         assert_eq!(l.undecided_beside(l.location, true), None);
     }
@@ -449,8 +451,8 @@ mod tests {
     fn a_place_that_leaves_several_times_the_misfit_is_no_alternative_however_much_it_explains() {
         // 76 noise floors before: 99.98 % explained leaves about one, 99.1 % about seven.
         let l = located(vec![
-            ("valve", 0.9998, "discharge coefficient against the pressure ratio"),
-            ("command", 0.991, "command static curve"),
+            (Place::Valve, 0.9998, "discharge coefficient against the pressure ratio"),
+            (Place::Command, 0.991, "command static curve"),
         ]);
         assert_eq!(l.undecided_beside(l.location, false), None);
         assert!(l.alternatives().is_empty());

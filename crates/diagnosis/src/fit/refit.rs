@@ -11,6 +11,7 @@ use crate::input::blocks::Block;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -45,8 +46,8 @@ pub(crate) fn joint_candidate(params: &Parameters, names: &[&'static str]) -> Ca
         .collect();
     Candidate {
         label: "joint refit",
-        location: "",
-        family: "",
+        location: Place::Unplaced,
+        family: Family::Unclassified,
         named: None,
         terms,
         settings: vec![],

@@ -5,6 +5,7 @@ use crate::fit::Fit;
 use crate::policy::ALTERNATIVE_REMAINDER;
 use crate::policy::LOCATED_SHARE;
 use crate::policy::MOST_TIED_LOCATIONS;
+use crate::vocabulary::{Family, Place};
 
 /// A candidate's score in one round.
 #[derive(Clone, Debug)]
@@ -33,15 +34,15 @@ impl Scored {
 pub struct Localization {
     /// The place whose best candidate explains most, or "unknown" when none explains
     /// [`LOCATED_SHARE`] of the misfit.
-    pub location: &'static str,
-    pub family: &'static str,
+    pub location: Place,
+    pub family: Family,
     /// Best share explained at each place, best first, with the candidate that did it.
-    pub by_location: Vec<(&'static str, f64, &'static str)>,
+    pub by_location: Vec<(Place, f64, &'static str)>,
     pub candidates: Vec<Scored>,
 }
 
 impl Localization {
-    pub(crate) fn best_at(&self, location: &str) -> Option<&Scored> {
+    pub(crate) fn best_at(&self, location: Place) -> Option<&Scored> {
         self.candidates
             .iter()
             .filter(|s| s.fit.candidate.location == location)
@@ -52,7 +53,7 @@ impl Localization {
     /// ([`Localization::alternatives`]), with their shares, for a term added at `added` (the
     /// located place or one of those); `None` when there are none. What the recording cannot
     /// tell apart is said beside what was added.
-    pub fn undecided_beside(&self, added: &str, has_pressures: bool) -> Option<String> {
+    pub fn undecided_beside(&self, added: Place, has_pressures: bool) -> Option<String> {
         let others: Vec<String> = std::iter::once(self.location)
             .chain(self.alternatives())
             .filter(|l| *l != added)
@@ -76,8 +77,8 @@ impl Localization {
     /// The places a term added at `added` cannot be told apart from on this recording
     /// ([`Self::alternatives`] and the located place), `added` first and at most three in
     /// all; empty when the recording tells the place.
-    pub fn tied_with(&self, added: &'static str) -> Vec<&'static str> {
-        let others: Vec<&'static str> = std::iter::once(self.location)
+    pub fn tied_with(&self, added: Place) -> Vec<Place> {
+        let others: Vec<Place> = std::iter::once(self.location)
             .chain(self.alternatives())
             .filter(|l| *l != added)
             .collect();
@@ -91,7 +92,7 @@ impl Localization {
     /// of the held-out misfit than it does. Measured on what is left, not on the share
     /// explained: where the model is far off, 99 % explained can leave seven noise floors
     /// beside one.
-    pub fn alternatives(&self) -> Vec<&'static str> {
+    pub fn alternatives(&self) -> Vec<Place> {
         let Some(&(_, top, _)) = self.by_location.first() else {
             return vec![];
         };

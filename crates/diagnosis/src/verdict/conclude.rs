@@ -18,6 +18,7 @@ use crate::replay::Replay;
 use crate::verdict::diagnosis::Diagnosis;
 use crate::verdict::diagnosis::Unexplained;
 use crate::verdict::split::PressureSplit;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 use serde_json::json;
@@ -215,9 +216,9 @@ fn what_stays_unexplained(
     }
     let (mut location, mut family, mut alternatives) = match localization {
         Some(l) => (l.location, l.family, l.alternatives()),
-        None => ("unknown", "unknown", vec![]),
+        None => (Place::Unknown, Family::Unknown, vec![]),
     };
-    let share_at = |place: &str| {
+    let share_at = |place: Place| {
         localization
             .as_ref()
             .and_then(|l| l.by_location.iter().find(|(p, _, _)| *p == place))
@@ -227,17 +228,17 @@ fn what_stays_unexplained(
     // after the pressures, in the mechanics or the force sensor, though no candidate there
     // explains a good part of it: both are named, the better candidates' place first.
     let after_the_pressures =
-        location == "unknown" && split.map_or(false, PressureSplit::departure_after_the_pressures);
+        location == Place::Unknown && split.map_or(false, PressureSplit::departure_after_the_pressures);
     if after_the_pressures {
-        let (first, second) = if share_at("force_sensor") > share_at("mechanics") {
-            ("force_sensor", "mechanics")
+        let (first, second) = if share_at(Place::ForceSensor) > share_at(Place::Mechanics) {
+            (Place::ForceSensor, Place::Mechanics)
         } else {
-            ("mechanics", "force_sensor")
+            (Place::Mechanics, Place::ForceSensor)
         };
-        (location, family, alternatives) = (first, "unknown", vec![second]);
+        (location, family, alternatives) = (first, Family::Unknown, vec![second]);
     }
     let ratio = after_errors.heldout_rms / noise.max(1e-12);
-    let place = if location == "unknown" {
+    let place = if location == Place::Unknown {
         "no candidate place in the chain explains a good part of it".to_string()
     } else if after_the_pressures {
         format!(
@@ -257,7 +258,7 @@ fn what_stays_unexplained(
             if alternatives.is_empty() {
                 String::new()
             } else {
-                format!(", though the {} explain nearly as much", alternatives.join(" and the "))
+                format!(", though the {} explain nearly as much", alternatives.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(" and the "))
             }
         )
     };

@@ -10,6 +10,7 @@ use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::replay::errors::Errors;
 use crate::replay::signature::Signature;
 use crate::verdict::split::PressureSplit;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 use serde_json::Value;
 
@@ -18,9 +19,9 @@ use serde_json::Value;
 pub struct Unexplained {
     pub rms: f64,
     pub ratio_to_noise: f64,
-    pub location: &'static str,
-    pub family: &'static str,
-    pub alternatives: Vec<&'static str>,
+    pub location: Place,
+    pub family: Family,
+    pub alternatives: Vec<Place>,
     pub signature: Signature,
     pub sentence: String,
 }

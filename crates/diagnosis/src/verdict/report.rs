@@ -3,6 +3,7 @@
 use crate::policy::MOST_TIED_LOCATIONS;
 use crate::replay::errors::Errors;
 use crate::verdict::diagnosis::Diagnosis;
+use crate::vocabulary::Place;
 use jetpipe_model::physics::parameters::Parameters;
 use serde_json::json;
 use serde_json::Value;
@@ -248,7 +249,7 @@ impl Diagnosis {
                     "location": u.location,
                     "family": u.family,
                     "alternatives": u.alternatives,
-                    "tied_locations": if u.alternatives.is_empty() || u.location == "unknown" {
+                    "tied_locations": if u.alternatives.is_empty() || u.location == Place::Unknown {
                         vec![]
                     } else {
                         std::iter::once(u.location).chain(u.alternatives.iter().copied()).take(MOST_TIED_LOCATIONS).collect::<Vec<_>>()

@@ -64,7 +64,7 @@ fn discovered_as(d: &Diagnosis, label: &str, candidate: &str, parameter: &str, t
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
     assert_eq!(
-        (found.location, found.family, found.candidate),
+        (found.location.as_str(), found.family.as_str(), found.candidate),
         ("mechanics", "extra_force", candidate),
         "{label}: {}",
         found.reading

@@ -52,7 +52,7 @@ fn only_term<'a>(label: &str, d: &'a Diagnosis, location: &str, family: &str) ->
     assert_eq!(d.discovered.len(), 1, "{label}: {}", d.summary().join(" | "));
     let term = &d.discovered[0];
     assert_eq!(
-        (term.location, term.family),
+        (term.location.as_str(), term.family.as_str()),
         (location, family),
         "{label}: {}",
         term.reading
@@ -370,7 +370,7 @@ fn a_force_sensor_saturating_beside_dead_volumes_is_found_on_the_force_against_t
     let limit = d
         .discovered
         .iter()
-        .find(|t| (t.location, t.family) == ("force_sensor", "limit"))
+        .find(|t| (t.location.as_str(), t.family.as_str()) == ("force_sensor", "limit"))
         .unwrap_or_else(|| panic!("{label}: no limit at the force sensor: {}", d.summary().join(" | ")));
     let level = reading_number(&limit.reading, "the force sensor saturates at ");
     assert!((level - 89.5).abs() < 0.2, "{label}: {}", limit.reading);

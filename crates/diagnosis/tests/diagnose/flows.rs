@@ -47,7 +47,7 @@ fn found_into_chamber_2(d: &Diagnosis, label: &str, g: f64) {
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
     assert_eq!(
-        (found.location, found.family, found.candidate),
+        (found.location.as_str(), found.family.as_str(), found.candidate),
         ("chambers", "extra_flow", "extra flow into chamber 2 ∝ (P1 − P2)"),
         "{label}: {}",
         found.reading

@@ -44,7 +44,7 @@ fn a_friction_over_a_band_of_the_bore_is_the_coulomb_friction_varying_with_the_s
     assert_eq!(d.discovered.len(), 1, "{}", d.summary().join(" | "));
     let found = &d.discovered[0];
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         ("mechanics", "extra_force"),
         "{}",
         found.reading
@@ -108,7 +108,7 @@ fn a_current_offset_that_turns_with_the_stoppers_direction_is_the_offset_varying
     let found = d
         .discovered
         .iter()
-        .find(|f| (f.location, f.family) == ("current_driver", "asymmetry"))
+        .find(|f| (f.location.as_str(), f.family.as_str()) == ("current_driver", "asymmetry"))
         .unwrap_or_else(|| panic!("{}", d.summary().join(" | ")));
     let slot = d
         .parameters
@@ -167,7 +167,7 @@ fn a_current_offset_rippling_at_16_hz_is_found_as_a_periodic_modulation_of_the_j
     let found = d
         .discovered
         .iter()
-        .find(|f| f.family == "periodic" && ["current_driver", "jet_pipe"].contains(&f.location))
+        .find(|f| f.family.as_str() == "periodic" && ["current_driver", "jet_pipe"].contains(&f.location.as_str()))
         .unwrap_or_else(|| panic!("{}", d.summary().join(" | ")));
     let slot = d
         .parameters
@@ -217,7 +217,7 @@ fn a_current_offset_rippling_while_the_jet_pipe_hits_its_stops_is_found_at_the_c
     let found = d
         .discovered
         .iter()
-        .find(|f| (f.location, f.family) == ("current_driver", "periodic"))
+        .find(|f| (f.location.as_str(), f.family.as_str()) == ("current_driver", "periodic"))
         .unwrap_or_else(|| panic!("{}", d.summary().join(" | ")));
     let sine = d
         .parameters
@@ -279,7 +279,7 @@ fn a_bore_narrowing_over_the_recording_is_the_bore_varying_with_time() {
     assert_eq!(d.discovered.len(), 1, "{}", d.summary().join(" | "));
     let found = &d.discovered[0];
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         ("mechanics", "drift"),
         "{}",
         found.reading

@@ -61,7 +61,7 @@ fn pickup_found(label: &str, spec: &ProtocolSpec, amplitude: f64, frequency: f64
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         ("force_sensor", "periodic"),
         "{}",
         found.reading
@@ -160,7 +160,7 @@ fn supply_set_low_found(label: &str, spec: &ProtocolSpec) {
     assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
     let found = d.discovered.first().expect("a discovered term");
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         ("supply", "parameter_offset"),
         "{}",
         found.reading
@@ -356,7 +356,12 @@ fn explained_at(label: &str, spec: &ProtocolSpec, undeclared: UndeclaredEffects,
         .discovered
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered: {}", d.summary()[0]));
-    assert_eq!((found.location, found.family), place, "{label}: {}", found.reading);
+    assert_eq!(
+        (found.location.as_str(), found.family.as_str()),
+        place,
+        "{label}: {}",
+        found.reading
+    );
     assert_eq!(d.verdict(), "explained", "{label}: {}", d.summary()[0]);
     d.parameters
 }

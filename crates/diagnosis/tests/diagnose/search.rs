@@ -96,7 +96,11 @@ fn compound_found(label: &str, spec: &ProtocolSpec) {
         },
     );
     assert!(names(&d).is_empty(), "{label}: named {:?}", names(&d));
-    let places: Vec<(&str, &str)> = d.discovered.iter().map(|t| (t.location, t.family)).collect();
+    let places: Vec<(&str, &str)> = d
+        .discovered
+        .iter()
+        .map(|t| (t.location.as_str(), t.family.as_str()))
+        .collect();
     assert!(
         places.contains(&("supply", "parameter_offset")) && places.contains(&("jet_pipe", "parameter_offset")),
         "{label}: {places:?}"
@@ -139,7 +143,7 @@ fn stopper_offset_found(label: &str, spec: &ProtocolSpec) {
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
     assert_eq!(
-        (first.location, first.family),
+        (first.location.as_str(), first.family.as_str()),
         ("chambers", "parameter_offset"),
         "{}",
         first.reading
@@ -185,7 +189,7 @@ fn compliant_mount_found(label: &str, spec: &ProtocolSpec, lag_shows: bool) {
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
     assert_eq!(
-        (first.location, first.family),
+        (first.location.as_str(), first.family.as_str()),
         ("mechanics", "compliance"),
         "{}",
         first.reading
@@ -251,7 +255,7 @@ fn temperature_drift_found(label: &str, spec: &ProtocolSpec) {
         .first()
         .unwrap_or_else(|| panic!("{label}: nothing discovered ({})", d.summary()[0]));
     assert_eq!(
-        (first.location, first.family),
+        (first.location.as_str(), first.family.as_str()),
         ("chambers", "drift"),
         "{}",
         first.reading
@@ -343,7 +347,7 @@ fn a_sensor_offset_and_gain_beside_a_command_delay_stays_the_named_effect_not_a_
     println!("offset and gain beside a delay: {}", d.summary().join(" | "));
     assert!(names(&d).contains(&"sensor_offset_gain"), "{}", d.summary().join(" | "));
     assert!(
-        d.discovered.iter().all(|t| t.location != "force_sensor"),
+        d.discovered.iter().all(|t| t.location.as_str() != "force_sensor"),
         "{}",
         d.summary().join(" | ")
     );

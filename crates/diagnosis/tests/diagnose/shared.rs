@@ -73,7 +73,7 @@ fn undeclared(file: &str, location: &str, family: &str, truth: &[(&str, f64)]) {
         .first()
         .unwrap_or_else(|| panic!("{file}: nothing discovered"));
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         (location, family),
         "{file}: {}",
         found.reading

@@ -65,7 +65,7 @@ fn placed(name: &str, seed: u64) {
             .first()
             .unwrap_or_else(|| panic!("{name}: nothing discovered ({})", d.summary()[0]));
         assert_eq!(
-            (found.location, found.family),
+            (found.location.as_str(), found.family.as_str()),
             (location, family),
             "{name}: {}",
             found.reading
@@ -92,14 +92,19 @@ fn placed(name: &str, seed: u64) {
     match (d.discovered.first(), &d.unexplained) {
         (Some(found), _) => {
             assert_eq!(
-                (found.location, found.family),
+                (found.location.as_str(), found.family.as_str()),
                 (location, family),
                 "{name}: {}",
                 found.reading
             )
         }
         (None, Some(u)) => {
-            assert_eq!((u.location, u.family), (location, family), "{name}: {}", u.sentence);
+            assert_eq!(
+                (u.location.as_str(), u.family.as_str()),
+                (location, family),
+                "{name}: {}",
+                u.sentence
+            );
             if !force_reached {
                 assert_eq!(d.verdict(), "explained", "{name}");
                 assert!(u.sentence.contains("pressures depart"), "{}", u.sentence);
@@ -268,7 +273,7 @@ fn explained_under_a_short_staircase(name: &str) {
         .first()
         .unwrap_or_else(|| panic!("{name}: nothing discovered ({})", d.summary()[0]));
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         (mechanism.location, mechanism.family),
         "{name}: {}",
         found.reading
@@ -425,7 +430,7 @@ fn an_undeclared_back_pressure_and_named_friction_are_both_found() {
     assert_eq!(names(&d), ["piston_friction"]);
     let found = d.discovered.first().expect("the back pressure discovered");
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         ("return", "parameter_offset"),
         "{}",
         found.reading
@@ -454,7 +459,7 @@ fn a_wider_port_restriction_with_named_friction_is_found_at_its_own_size() {
     assert_eq!(names(&d), ["piston_friction"]);
     let found = d.discovered.first().expect("the port restriction discovered");
     assert_eq!(
-        (found.location, found.family),
+        (found.location.as_str(), found.family.as_str()),
         ("valve", "restriction"),
         "{}",
         found.reading

@@ -11,6 +11,7 @@ use crate::candidates::Term;
 use crate::replay::signals::FORCE;
 use crate::replay::signals::P1;
 use crate::replay::signals::P2;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 
 /// The written candidates from the chambers to the transducers, in the chain's order;
@@ -29,8 +30,8 @@ pub(super) fn chambers_to_transducers(
     let mut list = vec![
         c(
             "dead volumes",
-            "chambers",
-            "parameter_offset",
+            Place::Chambers,
+            Family::ParameterOffset,
             Some("dead_volume"),
             vec![
                 term_off("dead_volume_1", "m3", 5e-7, 1e-4),
@@ -39,15 +40,15 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "heat exchange",
-            "chambers",
-            "parameter_offset",
+            Place::Chambers,
+            Family::ParameterOffset,
             Some("heat_transfer"),
             vec![term_off("heat_transfer_fraction", "1", 0.05, 1.0)],
         ),
         c(
             "leakage past the piston",
-            "chambers",
-            "parameter_offset",
+            Place::Chambers,
+            Family::ParameterOffset,
             None,
             vec![
                 offset("C_dm_A_lpp", "m2", 2e-9, -1e-6, 1e-6),
@@ -59,8 +60,8 @@ pub(super) fn chambers_to_transducers(
         // it, which is the support length L_sup changed by as much (§2.6, (2.31)–(2.32)).
         c(
             "stopper position offset",
-            "chambers",
-            "parameter_offset",
+            Place::Chambers,
+            Family::ParameterOffset,
             None,
             vec![offset(
                 "L_sup",
@@ -74,8 +75,8 @@ pub(super) fn chambers_to_transducers(
         // (2.29) together (heat exchange changes the chambers' exponent alone).
         c(
             "gas isentropic exponent",
-            "chambers",
-            "parameter_offset",
+            Place::Chambers,
+            Family::ParameterOffset,
             None,
             vec![p("gamma", "1", 0.005, 1.0 + 1e-6, 5.0 / 3.0)],
         ),
@@ -84,15 +85,15 @@ pub(super) fn chambers_to_transducers(
         // air warming up): the FMU carries the ramp as T_drift.
         c(
             "gas temperature",
-            "chambers",
-            "parameter_offset",
+            Place::Chambers,
+            Family::ParameterOffset,
             None,
             vec![p("T", "K", 0.005, 200.0, 400.0)],
         ),
         c(
             "gas temperature drift",
-            "chambers",
-            "drift",
+            Place::Chambers,
+            Family::Drift,
             None,
             vec![
                 p("T", "K", 0.005, 200.0, 400.0),
@@ -101,8 +102,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "chamber leaks to the return",
-            "chambers",
-            "extra_flow",
+            Place::Chambers,
+            Family::ExtraFlow,
             None,
             vec![
                 term_off("chamber_vent_1", "m2", 5e-9, 1e-6),
@@ -114,8 +115,8 @@ pub(super) fn chambers_to_transducers(
         // chambers the orifice is the piston's leakage); the pairs combine two of them.
         c(
             "laminar chamber leaks to the return",
-            "chambers",
-            "extra_flow",
+            Place::Chambers,
+            Family::ExtraFlow,
             None,
             vec![
                 term_off("chamber_laminar_vent_1", "kg/(s.Pa)", 1e-11, 1e-6),
@@ -124,8 +125,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "chamber leaks from the supply",
-            "chambers",
-            "extra_flow",
+            Place::Chambers,
+            Family::ExtraFlow,
             None,
             vec![
                 term_off("chamber_supply_leak_1", "m2", 5e-9, 1e-6),
@@ -134,8 +135,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "laminar chamber leaks from the supply",
-            "chambers",
-            "extra_flow",
+            Place::Chambers,
+            Family::ExtraFlow,
             None,
             vec![
                 term_off("chamber_laminar_supply_leak_1", "kg/(s.Pa)", 1e-11, 1e-6),
@@ -145,15 +146,15 @@ pub(super) fn chambers_to_transducers(
         // Beside the leakage past the piston (2.23), which keeps its orifice law (its own candidate).
         c(
             "laminar leak between the chambers",
-            "chambers",
-            "extra_flow",
+            Place::Chambers,
+            Family::ExtraFlow,
             None,
             vec![term_off("chamber_laminar_cross_leak", "kg/(s.Pa)", 1e-11, 1e-6)],
         ),
         c(
             "Coulomb friction",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             Some("piston_friction"),
             vec![Term {
                 lower: 0.0,
@@ -164,8 +165,8 @@ pub(super) fn chambers_to_transducers(
         // law rising with speed beyond it stays viscous friction, an undeclared term.
         c(
             "smooth Coulomb friction",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             Some("piston_friction"),
             vec![
                 Term {
@@ -185,8 +186,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "Stribeck friction",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             Some("piston_friction"),
             vec![
                 Term {
@@ -219,8 +220,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "viscous friction",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             None,
             vec![output("viscous_friction", "N.s/m", FORCE, Regressor::Viscous, 1.0)],
         ),
@@ -229,8 +230,8 @@ pub(super) fn chambers_to_transducers(
         // floor's force shows, and either gives it; where it moves, the held-out blocks choose.
         c(
             "piston bore",
-            "mechanics",
-            "parameter_offset",
+            Place::Mechanics,
+            Family::ParameterOffset,
             None,
             // D_cyl sets the piston's area, (2.30)–(2.34): the force per pressure difference and
             // the chambers' volumes together.
@@ -238,29 +239,29 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "return spring rate",
-            "mechanics",
-            "parameter_offset",
+            Place::Mechanics,
+            Family::ParameterOffset,
             None,
             vec![p("k_spring", "N/m", 0.01, 0.0, 1e5)],
         ),
         c(
             "return spring free length",
-            "mechanics",
-            "parameter_offset",
+            Place::Mechanics,
+            Family::ParameterOffset,
             None,
             vec![offset("L_spring0", "m", 1e-4, 0.0, 1.0)],
         ),
         c(
             "stopper compliance",
-            "mechanics",
-            "compliance",
+            Place::Mechanics,
+            Family::Compliance,
             None,
             vec![term_off("stopper_compliance", "m/N", 1e-6, 1e-3)],
         ),
         c(
             "stopper mount with a lag",
-            "mechanics",
-            "compliance",
+            Place::Mechanics,
+            Family::Compliance,
             None,
             // The lag acts only with a compliance: started at 0.5 ms, it moves from the
             // second Gauss–Newton step on, once the compliance has.
@@ -271,8 +272,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "force on the stopper position",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             None,
             vec![output("position_stiffness", "N/m", FORCE, Regressor::Position, 10.0)],
         ),
@@ -282,8 +283,8 @@ pub(super) fn chambers_to_transducers(
         // not tried: it reads as the force sensor's gain wherever the pressures set the force.
         c(
             "moving mass",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             None,
             vec![output(
                 "extra_force_acceleration",
@@ -295,8 +296,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "quadratic damping",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             None,
             vec![output(
                 "extra_force_velocity_squared",
@@ -308,8 +309,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "seal friction growing with the pressure",
-            "mechanics",
-            "extra_force",
+            Place::Mechanics,
+            Family::ExtraForce,
             None,
             vec![
                 output(
@@ -333,8 +334,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "force sensor offset and gain",
-            "force_sensor",
-            "parameter_offset",
+            Place::ForceSensor,
+            Family::ParameterOffset,
             Some("sensor_offset_gain"),
             vec![
                 output("force_sensor_offset", "N", FORCE, Regressor::One, 0.1),
@@ -343,8 +344,8 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "force sensor curve",
-            "force_sensor",
-            "nonlinearity",
+            Place::ForceSensor,
+            Family::Nonlinearity,
             None,
             vec![
                 output("force_sensor_offset", "N", FORCE, Regressor::One, 0.1),
@@ -355,36 +356,36 @@ pub(super) fn chambers_to_transducers(
         ),
         c(
             "force sensor lag",
-            "force_sensor",
-            "dynamics",
+            Place::ForceSensor,
+            Family::Dynamics,
             None,
             vec![filter("force_sensor_lag", "s", FORCE, Filter::Lag, 1e-4, 0.2)],
         ),
         c(
             "force sensor second-order filter",
-            "force_sensor",
-            "dynamics",
+            Place::ForceSensor,
+            Family::Dynamics,
             None,
             second_order("force_sensor_filter_frequency", "force_sensor_filter_damping", FORCE),
         ),
         c(
             "force sensor delay",
-            "force_sensor",
-            "delay",
+            Place::ForceSensor,
+            Family::Delay,
             None,
             vec![filter("force_sensor_delay", "s", FORCE, Filter::Delay, 1e-4, 0.2)],
         ),
         c(
             "force sensor play",
-            "force_sensor",
-            "hysteresis",
+            Place::ForceSensor,
+            Family::Hysteresis,
             None,
             vec![filter("force_sensor_play", "N", FORCE, Filter::Play, 1e-3, 20.0)],
         ),
         c(
             "force sensor drift",
-            "force_sensor",
-            "drift",
+            Place::ForceSensor,
+            Family::Drift,
             None,
             vec![
                 output("force_sensor_offset", "N", FORCE, Regressor::One, 0.1),
@@ -397,8 +398,8 @@ pub(super) fn chambers_to_transducers(
         // model at the spectral line's frequency, not as a modulated static sensitivity.
         let mut ripple = c(
             "supply pressure ripple",
-            "supply",
-            "periodic",
+            Place::Supply,
+            Family::Periodic,
             None,
             vec![
                 Term {
@@ -427,8 +428,8 @@ pub(super) fn chambers_to_transducers(
         list.push(ripple);
         list.push(c(
             "force sensor pick-up",
-            "force_sensor",
-            "periodic",
+            Place::ForceSensor,
+            Family::Periodic,
             None,
             vec![
                 output("force_sensor_ripple_sin", "N", FORCE, Regressor::Sine(f), 0.1),
@@ -439,22 +440,22 @@ pub(super) fn chambers_to_transducers(
     if has_pressures {
         list.push(c(
             "chamber 1 pressure sensor offset",
-            "pressure_sensors",
-            "parameter_offset",
+            Place::PressureSensors,
+            Family::ParameterOffset,
             None,
             vec![output("p1_sensor_offset", "Pa", P1, Regressor::One, 100.0)],
         ));
         list.push(c(
             "chamber 2 pressure sensor offset",
-            "pressure_sensors",
-            "parameter_offset",
+            Place::PressureSensors,
+            Family::ParameterOffset,
             None,
             vec![output("p2_sensor_offset", "Pa", P2, Regressor::One, 100.0)],
         ));
         list.push(c(
             "pressure sensor offsets and gains",
-            "pressure_sensors",
-            "parameter_offset",
+            Place::PressureSensors,
+            Family::ParameterOffset,
             None,
             vec![
                 output("p1_sensor_offset", "Pa", P1, Regressor::One, 100.0),
@@ -479,30 +480,30 @@ pub(super) fn chambers_to_transducers(
         ] {
             list.push(c(
                 "pressure sensor lag",
-                "pressure_sensors",
-                "dynamics",
+                Place::PressureSensors,
+                Family::Dynamics,
                 None,
                 vec![filter(lag, "s", channel, Filter::Lag, 1e-4, 0.2)],
             ));
             list.push(c(
                 "pressure sensor second-order filter",
-                "pressure_sensors",
-                "dynamics",
+                Place::PressureSensors,
+                Family::Dynamics,
                 None,
                 second_order(frequency, damping, channel),
             ));
             list.push(c(
                 "pressure sensor delay",
-                "pressure_sensors",
-                "delay",
+                Place::PressureSensors,
+                Family::Delay,
                 None,
                 vec![filter(delay, "s", channel, Filter::Delay, 1e-4, 0.2)],
             ));
         }
         list.push(c(
             "pressure sensor drift",
-            "pressure_sensors",
-            "drift",
+            Place::PressureSensors,
+            Family::Drift,
             None,
             vec![
                 output("p1_sensor_offset", "Pa", P1, Regressor::One, 100.0),

@@ -9,6 +9,7 @@ use crate::candidates::Candidate;
 use crate::candidates::Mechanism;
 use crate::candidates::Modulation;
 use crate::candidates::Term;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 
 /// The written candidates from the command to the return line, in the chain's order.
@@ -22,15 +23,15 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
     vec![
         c(
             "command delay",
-            "command",
-            "delay",
+            Place::Command,
+            Family::Delay,
             Some("transport_delay"),
             vec![term_off("command_delay", "s", 1e-3, 0.05)],
         ),
         c(
             "command lag",
-            "command",
-            "dynamics",
+            Place::Command,
+            Family::Dynamics,
             None,
             vec![Term {
                 name: "command_lag",
@@ -44,8 +45,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "command second-order filter",
-            "command",
-            "dynamics",
+            Place::Command,
+            Family::Dynamics,
             None,
             // The natural frequency searched on a logarithmic scale (a corner far above the
             // signals barely moves the outputs), then refined with the damping.
@@ -71,8 +72,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "command limit",
-            "command",
-            "limit",
+            Place::Command,
+            Family::Limit,
             None,
             vec![searched("command_limit", "V", Mechanism::CommandLimit, 0.0, inf)],
         ),
@@ -82,8 +83,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         // A D/A of fewer bits than the logger's: the command the driver sees takes its levels.
         c(
             "command quantiser",
-            "command",
-            "nonlinearity",
+            Place::Command,
+            Family::Nonlinearity,
             None,
             vec![Term {
                 neutral: 0.0,
@@ -98,8 +99,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "command upper limit",
-            "command",
-            "limit",
+            Place::Command,
+            Family::Limit,
             None,
             vec![Term {
                 neutral: 100.0,
@@ -114,8 +115,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "command lower limit",
-            "command",
-            "limit",
+            Place::Command,
+            Family::Limit,
             None,
             vec![Term {
                 neutral: -100.0,
@@ -130,8 +131,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "current driver gain and offset",
-            "current_driver",
-            "parameter_offset",
+            Place::CurrentDriver,
+            Family::ParameterOffset,
             None,
             vec![
                 p("k_cd", "A/V", 0.01, 0.0, inf),
@@ -140,8 +141,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "current driver corner",
-            "current_driver",
-            "dynamics",
+            Place::CurrentDriver,
+            Family::Dynamics,
             None,
             vec![Term {
                 name: "current_driver_time_constant",
@@ -155,15 +156,15 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "current limit",
-            "current_driver",
-            "limit",
+            Place::CurrentDriver,
+            Family::Limit,
             None,
             vec![searched("current_limit", "A", Mechanism::CurrentLimit, 0.0, inf)],
         ),
         c(
             "current slew limit",
-            "current_driver",
-            "limit",
+            Place::CurrentDriver,
+            Family::Limit,
             None,
             vec![searched(
                 "current_slew_limit",
@@ -175,15 +176,15 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "jet pipe null",
-            "jet_pipe",
-            "parameter_offset",
+            Place::JetPipe,
+            Family::ParameterOffset,
             None,
             vec![offset("x_jp_offset", "m", 2e-6, -1e-3, 1e-3)],
         ),
         c(
             "jet pipe null and travel",
-            "jet_pipe",
-            "parameter_offset",
+            Place::JetPipe,
+            Family::ParameterOffset,
             None,
             vec![
                 offset("x_jp_offset", "m", 2e-6, -1e-3, 1e-3),
@@ -192,8 +193,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "jet pipe static curve",
-            "jet_pipe",
-            "nonlinearity",
+            Place::JetPipe,
+            Family::Nonlinearity,
             None,
             vec![
                 Term {
@@ -210,15 +211,15 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "jet pipe static curve with a softer knee",
-            "jet_pipe",
-            "nonlinearity",
+            Place::JetPipe,
+            Family::Nonlinearity,
             None,
             vec![term_off("f3_algebraic_share", "1", 0.05, 1.0)],
         ),
         c(
             "jet and receiver diameter",
-            "valve",
-            "parameter_offset",
+            Place::Valve,
+            Family::ParameterOffset,
             None,
             // D_jp sets the receiver's geometry, (2.8)–(2.17): the areas' shape along the jet's
             // travel, not only their size.
@@ -226,15 +227,15 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "jet pipe lag",
-            "jet_pipe",
-            "dynamics",
+            Place::JetPipe,
+            Family::Dynamics,
             None,
             vec![corner(base, "omega_1", 10.0, 1e4)],
         ),
         c(
             "jet pipe resonance",
-            "jet_pipe",
-            "dynamics",
+            Place::JetPipe,
+            Family::Dynamics,
             None,
             // ω2 and ζ2 of (2.6): the modal form the model steps with needs ζ2 below 1.
             vec![
@@ -244,8 +245,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "jet pipe hysteresis",
-            "jet_pipe",
-            "hysteresis",
+            Place::JetPipe,
+            Family::Hysteresis,
             Some("jet_pipe_hysteresis"),
             vec![
                 term_off("hysteresis_width", "m", 2e-5, 1e-3),
@@ -260,8 +261,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
             ],
             ..c(
                 "jet pipe hysteresis, smooth law",
-                "jet_pipe",
-                "hysteresis",
+                Place::JetPipe,
+                Family::Hysteresis,
                 Some("jet_pipe_hysteresis"),
                 vec![
                     started("hysteresis_width", "m", BOUC_WEN_START_WIDTH, 2e-6, 0.0, 1e-3),
@@ -274,8 +275,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         },
         c(
             "jet pipe null drift",
-            "jet_pipe",
-            "drift",
+            Place::JetPipe,
+            Family::Drift,
             None,
             vec![
                 offset("x_jp_offset", "m", 2e-6, -1e-3, 1e-3),
@@ -284,15 +285,15 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "discharge coefficient",
-            "valve",
-            "parameter_offset",
+            Place::Valve,
+            Family::ParameterOffset,
             None,
             vec![p("C_d", "1", 0.01, 1e-3, 1.0)],
         ),
         c(
             "orifice areas port by port",
-            "valve",
-            "asymmetry",
+            Place::Valve,
+            Family::Asymmetry,
             None,
             vec![
                 p("supply_area_scale_1", "1", 0.01, 0.0, 3.0),
@@ -303,8 +304,8 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "port restrictions",
-            "valve",
-            "restriction",
+            Place::Valve,
+            Family::Restriction,
             None,
             vec![
                 term_off("port_resistance_1", "Pa.s/kg", 1e8, 1e11),
@@ -313,43 +314,43 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "port 1 orifice with a line volume",
-            "valve",
-            "restriction",
+            Place::Valve,
+            Family::Restriction,
             None,
             volume_behind("port_restriction_area_1", "port_line_volume_1"),
         ),
         c(
             "port 2 orifice with a line volume",
-            "valve",
-            "restriction",
+            Place::Valve,
+            Family::Restriction,
             None,
             volume_behind("port_restriction_area_2", "port_line_volume_2"),
         ),
         c(
             "supply pressure",
-            "supply",
-            "parameter_offset",
+            Place::Supply,
+            Family::ParameterOffset,
             None,
             vec![p("P_s", "Pa", 0.005, 1.2e5, 2e6)],
         ),
         c(
             "supply line resistance",
-            "supply",
-            "restriction",
+            Place::Supply,
+            Family::Restriction,
             Some("supply_pressure_drop"),
             vec![term_off("supply_resistance", "Pa.s/kg", 1e8, 1e11)],
         ),
         c(
             "supply orifice with a plenum",
-            "supply",
-            "restriction",
+            Place::Supply,
+            Family::Restriction,
             Some("supply_pressure_drop"),
             volume_behind("supply_restriction_area", "supply_plenum_volume"),
         ),
         c(
             "supply pressure drift",
-            "supply",
-            "drift",
+            Place::Supply,
+            Family::Drift,
             None,
             vec![
                 p("P_s", "Pa", 0.005, 1.2e5, 2e6),
@@ -358,22 +359,22 @@ pub(super) fn command_to_return(base: &Parameters) -> Vec<Candidate> {
         ),
         c(
             "return pressure",
-            "return",
-            "parameter_offset",
+            Place::Return,
+            Family::ParameterOffset,
             None,
             vec![p("P_r", "Pa", 0.01, 1e4, 6e5)],
         ),
         c(
             "return line resistance",
-            "return",
-            "restriction",
+            Place::Return,
+            Family::Restriction,
             None,
             vec![term_off("return_resistance", "Pa.s/kg", 1e8, 1e11)],
         ),
         c(
             "return vent orifice with a plenum",
-            "return",
-            "restriction",
+            Place::Return,
+            Family::Restriction,
             None,
             volume_behind("return_vent_area", "return_plenum_volume"),
         ),

@@ -8,6 +8,7 @@ use crate::candidates::Mechanism;
 use crate::candidates::Modulation;
 use crate::candidates::Regressor;
 use crate::candidates::Term;
+use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 
 pub(super) fn parameter(
@@ -181,8 +182,8 @@ pub(super) fn modulated(
 /// any) and its terms.
 pub(super) fn c(
     label: &'static str,
-    location: &'static str,
-    family: &'static str,
+    location: Place,
+    family: Family,
     named: Option<&'static str>,
     terms: Vec<Term>,
 ) -> Candidate {
