@@ -1,4 +1,7 @@
-//! Every threshold and precedence rule of the diagnosis, each stated once with its reason.
+//! The thresholds and precedence rules by which the diagnosis decides, each stated once with its
+//! reason: what is explained, what earns a place in the model, which of two forms wins, how many
+//! places and rounds are tried. The numerical settings of each method (grids, steps, knots, a
+//! class's own limits) stay with the method.
 
 /// Length of the alternating training / held-out blocks.
 pub const BLOCK_SECONDS: f64 = 2.0;
@@ -53,20 +56,107 @@ pub const NAMED_SHARE_OF_PLACE: f64 = 0.75;
 /// for something else (measured: 0.88–1.00 for the named effects of the synthetic bench,
 /// Bouc–Wen hysteresis lowest; 0.63–0.76 for a supply drift and a port restriction).
 pub const NAMED_MIN_SHARE: f64 = 0.8;
-pub(crate) const MAX_EFFECTS: usize = 3;
+pub const MAX_EFFECTS: usize = 3;
 /// How many of the located place's candidates are tried in the model, best first.
-pub(crate) const DISCOVERY_TRIALS: usize = 3;
+pub const DISCOVERY_TRIALS: usize = 3;
 /// Candidates refitted with more Gauss–Newton iterations after the first pass.
-pub(crate) const REFINED: usize = 3;
+pub const REFINED: usize = 3;
 /// Only candidates whose first step explains at least this share are refined.
-pub(crate) const WORTH_REFINING: f64 = 0.1;
-pub(crate) const REFINE_ITERATIONS: usize = 10;
+pub const WORTH_REFINING: f64 = 0.1;
+pub const REFINE_ITERATIONS: usize = 10;
+
+// The replay's stepping.
 
 /// The longest fixed step of `replay_fast` (s): a recording sampled more coarsely than
 /// the bench's 1 ms is stepped in equal parts of at most this. One 4 ms ROS2 step per
 /// sample at 250 Hz left the pressures 3–8 noise floors off a clean recording that the
 /// error-controlled replay reproduces within its noise.
 pub const MAX_FAST_STEP: f64 = 1.05e-3;
+
+// The decision stage's rules: when a richer or a written term is preferred, how many places and
+// rounds are tried, and when an addition counts as redundant or negligible.
+
+/// A term richer than the named effect it would replace must close at least this share of
+/// the gap between the named effect's held-out force error and the noise floor.
+pub const RICHER_SHARE_OF_GAP: f64 = 0.2;
+
+/// A term as rich as the named effect it would replace must close at least this share of
+/// that gap, or take this share of the named effect's held-out misfit (a departure in the
+/// pressures).
+pub const EQUAL_SHARE_OF_GAP: f64 = 0.05;
+
+/// An addition with at least this many parameters (a static curve through its knots) can
+/// stand in for a simpler term at another place of the chain: those are re-tried after it.
+pub const FLEXIBLE_TERMS: f64 = 4.0;
+
+/// The simpler terms re-tried at other places have at most this many parameters.
+pub const SIMPLE_TERMS: f64 = 2.0;
+
+/// How many of them: the best of each place, best first by their penalised held-out misfit.
+pub const ELSEWHERE_TRIALS: usize = 8;
+
+/// Places whose best candidate enters the pairs.
+pub const PAIRED_PLACES: usize = 6;
+
+/// Pairs fitted again from fresh sensitivities after the first step's ranking.
+pub const LEADING_PAIRS: usize = 3;
+
+/// A departure of this many noise floors of a channel lifts the channel's held-out misfit,
+/// noise and departure together, to [`EXPLAINED_WITHIN_NOISE`]: √(1 + 1.118²) = 1.5.
+pub const PRESSURES_SHOW_FROM: f64 = 1.118;
+
+/// A named effect at the same place whose share of the held-out misfit was at most this much
+/// below the named one's is a rival.
+pub const RIVAL_SHARE_GAP: f64 = 0.05;
+
+/// At most this many rivals are tried for each named effect.
+pub const MOST_RIVALS: usize = 2;
+
+/// A written term that earns its place but leaves more than the verdict's bar ends the
+/// trials only when no later trial's fit promises to leave at most this share of its
+/// held-out force error: a current driver's gain, as good as tied with the jet pipe, is
+/// tried after the jet pipe's curve that leaves 7 noise floors.
+pub const PROMISE_BEYOND_WRITTEN: f64 = 0.5;
+
+/// See `shown_mostly_where_fitted` (`decide/new_term.rs`).
+pub const TRAINING_GAIN_IN_NOISE: f64 = 3.0;
+
+/// A written term that does within this factor of a modulation's held-out force error in the
+/// model (or within the verdict's bar) is added instead of it.
+pub const WRITTEN_INSTEAD_WITHIN: f64 = 1.1;
+
+/// A force error larger than the starting model's by at most this share of the noise floor
+/// is not worse: a thousandth of the noise is beyond any measurement, and a term that leaves
+/// the force alone (a pressure transducer's offset, say) moves it by about that much through
+/// the chambers' start, which the transducers' readings set.
+pub const NEGLIGIBLE_SHARE_OF_NOISE: f64 = 1e-3;
+
+/// At most this many earlier rounds' models are replayed accurately before every addition
+/// goes: each costs an error-controlled replay of the whole recording.
+pub const EARLIER_ROUNDS_TRIED: usize = 3;
+
+/// Candidates of the round fitted beside the earlier additions.
+pub const BESIDE_MEMBERS: usize = 4;
+
+/// Written candidates away from the named effect's place fitted beside it (all at its place are).
+pub const ELSEWHERE_BESIDE_NAMED: usize = 3;
+
+/// The held-out force error below which taking an addition out counts as costing nothing,
+/// in noise floors.
+pub const REDUNDANT_WITHIN_NOISE: f64 = 0.1;
+
+/// See `discovery_penalty_per_term` (`fit/localize.rs`).
+pub const MIN_MEAN_SQUARE_GAIN_PER_TERM: f64 = 0.01;
+
+/// How much more held-out misfit than a modulation a written candidate at the same place may
+/// leave and still be tried first: the simpler, named form wins where it is adequate (a
+/// quadratic damping before a viscous friction varying with the velocity, a transducer's
+/// static curve before its gain varying with its pressure).
+pub const WRITTEN_FIRST_WITHIN: f64 = 1.25;
+
+/// A written candidate whose first-order fit leaves the force within this many noise floors
+/// is tried before a modulation at its place: its refit in the model usually gains the rest.
+pub const WRITTEN_ADEQUATE_WITHIN: f64 = 2.0;
 
 #[cfg(test)]
 mod tests {

@@ -147,16 +147,6 @@ pub fn is_modulation(c: &Candidate) -> bool {
     c.settings.iter().any(|(name, _)| name.starts_with("modulation_"))
 }
 
-/// How much more held-out misfit than a modulation a written candidate at the same place may
-/// leave and still be tried first: the simpler, named form wins where it is adequate (a
-/// quadratic damping before a viscous friction varying with the velocity, a transducer's
-/// static curve before its gain varying with its pressure).
-pub const WRITTEN_FIRST_WITHIN: f64 = 1.25;
-
-/// A written candidate whose first-order fit leaves the force within this many noise floors
-/// is tried before a modulation at its place: its refit in the model usually gains the rest.
-pub const WRITTEN_ADEQUATE_WITHIN: f64 = 2.0;
-
 /// Whether a modulation's knot values are one change of the constant (all within a tenth of
 /// the largest of one another): then it is no modulation.
 pub fn is_flat(values: &[f64]) -> bool {

@@ -21,7 +21,12 @@ use crate::fit::Fit;
 use crate::fit::Problem;
 use crate::input::blocks::Block;
 use crate::policy::DISCOVERY_TRIALS;
+use crate::policy::ELSEWHERE_TRIALS;
+use crate::policy::EQUAL_SHARE_OF_GAP;
+use crate::policy::FLEXIBLE_TERMS;
 use crate::policy::LOCATED_SHARE;
+use crate::policy::RICHER_SHARE_OF_GAP;
+use crate::policy::SIMPLE_TERMS;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
@@ -207,23 +212,8 @@ pub(crate) fn alternative_at_place(
     Ok(simplest(adequate, name, progress))
 }
 
-/// A term richer than the named effect it would replace must close at least this share of
-/// the gap between the named effect's held-out force error and the noise floor.
-const RICHER_SHARE_OF_GAP: f64 = 0.2;
-/// A term as rich as the named effect it would replace must close at least this share of
-/// that gap, or take this share of the named effect's held-out misfit (a departure in the
-/// pressures).
-const EQUAL_SHARE_OF_GAP: f64 = 0.05;
-
-/// An addition with at least this many parameters (a static curve through its knots) can
-/// stand in for a simpler term at another place of the chain: those are re-tried after it.
-const FLEXIBLE_TERMS: f64 = 4.0;
-/// The simpler terms re-tried at other places have at most this many parameters.
-const SIMPLE_TERMS: f64 = 2.0;
 /// Their linearisations: a jet pipe's travel 30 % short comes to within the noise in three.
 const ELSEWHERE_ITERATIONS: usize = 4;
-/// How many of them: the best of each place, best first by their penalised held-out misfit.
-const ELSEWHERE_TRIALS: usize = 8;
 
 /// After a flexible addition (a static curve), the simplest term at another place of the
 /// chain that, refitted and replayed, does as well on the held-out blocks: that term, as

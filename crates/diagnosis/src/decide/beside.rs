@@ -28,13 +28,12 @@ use crate::fit::scored::Scored;
 use crate::fit::Fit;
 use crate::fit::Problem;
 use crate::parallel::parallel_map;
+use crate::policy::BESIDE_MEMBERS;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::replay::signals::CHANNELS;
 use crate::replay::Replay;
 use jetpipe_model::physics::parameters::Parameters;
 
-/// Candidates of the round fitted beside the earlier additions.
-const MEMBERS: usize = 4;
 /// Gauss–Newton iterations of each fit beside the earlier additions.
 const ITERATIONS: usize = 3;
 
@@ -116,7 +115,7 @@ pub(crate) fn best_beside_earlier(
         })
         .collect();
     ranked.sort_by(|a, b| discovery_penalised(a, count).total_cmp(&discovery_penalised(b, count)));
-    ranked.truncate(MEMBERS);
+    ranked.truncate(BESIDE_MEMBERS);
     if ranked.is_empty() {
         return Ok(None);
     }

@@ -17,11 +17,8 @@ use crate::decide::findings::Findings;
 use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
 use crate::fit::Problem;
+use crate::policy::REDUNDANT_WITHIN_NOISE;
 use jetpipe_model::physics::parameters::Parameters;
-
-/// The held-out force error below which taking an addition out counts as costing nothing,
-/// in noise floors.
-const REDUNDANT_WITHIN_NOISE: f64 = 0.1;
 
 /// One addition of the findings: a named effect (`true`) or a discovered term, by index.
 type Which = (bool, usize);

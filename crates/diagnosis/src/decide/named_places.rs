@@ -22,6 +22,7 @@ use crate::input::blocks::Block;
 use crate::parallel::parallel_map;
 use crate::policy::worth_adding;
 use crate::policy::DISCOVERY_TRIALS;
+use crate::policy::ELSEWHERE_BESIDE_NAMED;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::policy::LOCATED_SHARE;
 use crate::policy::NAMED_MIN_SHARE;
@@ -310,8 +311,6 @@ pub(crate) fn named_with_term(
     Ok(Some((with_named, sentence, term, trial)))
 }
 
-/// Written candidates away from the named effect's place fitted beside it (all at its place are).
-const ELSEWHERE_BESIDE_NAMED: usize = 3;
 /// Gauss–Newton iterations of each named effect and term fitted together.
 const PAIR_ITERATIONS: usize = 2;
 

@@ -21,15 +21,10 @@ use crate::fit::localize::discovery_penalty_per_term;
 use crate::fit::localize::heldout_count;
 use crate::fit::scored::Scored;
 use crate::fit::Problem;
+use crate::policy::MOST_RIVALS;
+use crate::policy::RIVAL_SHARE_GAP;
 use crate::vocabulary::Place;
 use jetpipe_model::physics::parameters::Parameters;
-
-/// A named effect at the same place whose share of the held-out misfit was at most this much
-/// below the named one's is a rival.
-pub const RIVAL_SHARE_GAP: f64 = 0.05;
-
-/// At most this many rivals are tried for each named effect.
-const MOST_RIVALS: usize = 2;
 
 /// The named effects at `place` other than `name` whose share of the round's held-out misfit
 /// is within [`RIVAL_SHARE_GAP`] of `explained`, most first.

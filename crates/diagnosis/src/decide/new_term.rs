@@ -21,7 +21,10 @@ use crate::policy::worth_adding;
 use crate::policy::DISCOVERY_TRIALS;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::policy::LOCATED_SHARE;
+use crate::policy::PROMISE_BEYOND_WRITTEN;
 use crate::policy::REFINE_ITERATIONS;
+use crate::policy::TRAINING_GAIN_IN_NOISE;
+use crate::policy::WRITTEN_INSTEAD_WITHIN;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
@@ -70,11 +73,10 @@ pub(crate) fn discover_term(
             .fold(f64::INFINITY, f64::min);
         let written_adequate = written
             .iter()
-            .any(|s| s.force_heldout_rms <= crate::candidates::modulation::WRITTEN_ADEQUATE_WITHIN * noise);
+            .any(|s| s.force_heldout_rms <= crate::policy::WRITTEN_ADEQUATE_WITHIN * noise);
         let behind = |s: &Scored| {
             crate::candidates::modulation::is_modulation(&s.fit.candidate)
-                && (written_adequate
-                    || written_best <= crate::candidates::modulation::WRITTEN_FIRST_WITHIN * s.fit.heldout_total())
+                && (written_adequate || written_best <= crate::policy::WRITTEN_FIRST_WITHIN * s.fit.heldout_total())
         };
         at.sort_by(|a, b| {
             behind(a)
@@ -249,12 +251,6 @@ pub(crate) fn written_instead_bar(modulation_after: f64, noise: f64) -> f64 {
     (EXPLAINED_WITHIN_NOISE * noise).max(WRITTEN_INSTEAD_WITHIN * modulation_after)
 }
 
-/// A written term that earns its place but leaves more than the verdict's bar ends the
-/// trials only when no later trial's fit promises to leave at most this share of its
-/// held-out force error: a current driver's gain, as good as tied with the jet pipe, is
-/// tried after the jet pipe's curve that leaves 7 noise floors.
-pub(crate) const PROMISE_BEYOND_WRITTEN: f64 = 0.5;
-
 /// Whether a term earns its place on a departure that the training blocks hold more of than
 /// the held-out ones (a command saturating near the top of a slow sine whose peaks fell in
 /// training blocks: 16 noise floors there, 3.7 held out). It must lower the training error by
@@ -269,13 +265,6 @@ pub(crate) fn shown_mostly_where_fitted(
 ) -> bool {
     training_gain >= TRAINING_GAIN_IN_NOISE * noise && worth_adding(heldout_before, heldout_after, noise, true)
 }
-
-/// See [`shown_mostly_where_fitted`].
-pub(crate) const TRAINING_GAIN_IN_NOISE: f64 = 3.0;
-
-/// A written term that does within this factor of a modulation's held-out force error in the
-/// model (or within the verdict's bar) is added instead of it.
-pub(crate) const WRITTEN_INSTEAD_WITHIN: f64 = 1.1;
 
 /// Whether `term` is a static function of the command at a place of its path, its ties (if
 /// any) among those places: the places the path makes alike replace them.

@@ -26,7 +26,9 @@ use crate::input::blocks::Block;
 use crate::parallel::parallel_map;
 use crate::policy::worth_adding;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
+use crate::policy::LEADING_PAIRS;
 use crate::policy::LOCATED_SHARE;
+use crate::policy::PAIRED_PLACES;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
@@ -36,14 +38,10 @@ use crate::vocabulary::Place;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
-/// Places whose best candidate enters the pairs.
-const PAIRED_PLACES: usize = 6;
 /// Gauss–Newton iterations of every pair's fit: the first from the shared sensitivities,
 /// the second from fresh ones (one step ranked a current driver's offset above the
 /// receivers' null, which fits a supply set low and the null better).
 const PAIR_ITERATIONS: usize = 2;
-/// Pairs fitted again from fresh sensitivities after the first step's ranking.
-const LEADING_PAIRS: usize = 3;
 /// Gauss–Newton iterations of the best pair's refinement.
 const PAIR_REFINE_ITERATIONS: usize = 4;
 

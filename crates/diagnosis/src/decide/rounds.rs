@@ -22,6 +22,7 @@ use crate::fit::Problem;
 use crate::input::blocks::Block;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
 use crate::policy::MAX_EFFECTS;
+use crate::policy::PRESSURES_SHOW_FROM;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
 use crate::replay::signals::rms_where;
@@ -270,10 +271,6 @@ fn second_opinion(outcome: Result<bool, String>, progress: &mut dyn FnMut(&str))
         true
     })
 }
-
-/// A departure of this many noise floors of a channel lifts the channel's held-out misfit,
-/// noise and departure together, to [`EXPLAINED_WITHIN_NOISE`]: √(1 + 1.118²) = 1.5.
-const PRESSURES_SHOW_FROM: f64 = 1.118;
 
 /// Replay the current model; `None` when every channel is within its noise held out.
 fn replay_round(

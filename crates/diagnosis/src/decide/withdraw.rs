@@ -2,6 +2,8 @@
 //! are taken out again, the latest first.
 
 use crate::decide::findings;
+use crate::policy::EARLIER_ROUNDS_TRIED;
+use crate::policy::NEGLIGIBLE_SHARE_OF_NOISE;
 use jetpipe_model::physics::parameters::Parameters;
 
 use crate::replay::errors::Errors;
@@ -20,16 +22,6 @@ pub struct Withdrawn {
     /// (empty: the model reported is the starting model).
     pub kept: Vec<&'static str>,
 }
-
-/// A force error larger than the starting model's by at most this share of the noise floor
-/// is not worse: a thousandth of the noise is beyond any measurement, and a term that leaves
-/// the force alone (a pressure transducer's offset, say) moves it by about that much through
-/// the chambers' start, which the transducers' readings set.
-pub const NEGLIGIBLE_SHARE_OF_NOISE: f64 = 1e-3;
-
-/// At most this many earlier rounds' models are replayed accurately before every addition
-/// goes: each costs an error-controlled replay of the whole recording.
-pub const EARLIER_ROUNDS_TRIED: usize = 3;
 
 /// A model's replay with its errors.
 pub(crate) type Replayed<R> = (R, Errors);

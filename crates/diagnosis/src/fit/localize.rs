@@ -15,6 +15,7 @@ use crate::input::blocks::count;
 use crate::input::blocks::Block;
 use crate::parallel::parallel_map_shown;
 use crate::policy::LOCATED_SHARE;
+use crate::policy::MIN_MEAN_SQUARE_GAIN_PER_TERM;
 use crate::policy::REFINED;
 use crate::policy::REFINE_ITERATIONS;
 use crate::policy::WORTH_REFINING;
@@ -56,9 +57,6 @@ pub(crate) fn discovery_penalty_per_term(heldout_samples: f64) -> f64 {
         .ln()
         .max(MIN_MEAN_SQUARE_GAIN_PER_TERM * heldout_samples)
 }
-
-/// See [`discovery_penalty_per_term`].
-pub(crate) const MIN_MEAN_SQUARE_GAIN_PER_TERM: f64 = 0.01;
 
 pub(crate) fn discovery_penalised(s: &Scored, heldout_samples: f64) -> f64 {
     s.fit.heldout_total() + used_terms(s) * discovery_penalty_per_term(heldout_samples)
