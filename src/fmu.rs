@@ -193,15 +193,27 @@ pub static MODEL_EXCHANGE: ModelExchangeInfo = ModelExchangeInfo {
     event_indicators: model_exchange::EVENT_INDICATORS,
 };
 
-/// v_DA within the D/A range; the message names the variable, the value and the range.
-fn check_command(v_da: f64) -> Result<(), String> {
+/// How far past an end of the D/A range, in units of the end's last place, a command is still
+/// that end: an importer's linear interpolation between two samples at +10 V gives
+/// 10.000000000000002 V (one place past) at some instants, which is the end, not a wrong value.
+const COMMAND_ROUNDING_PLACES: f64 = 4.0;
+
+/// v_DA within the D/A range, a rounding past an end taken as that end; the message names the
+/// variable, the value and the range.
+fn checked_command(v_da: f64) -> Result<f64, String> {
     let (lo, hi) = V_DA_RANGE;
-    if !(lo..=hi).contains(&v_da) {
-        return Err(format!(
+    let rounding = |end: f64| COMMAND_ROUNDING_PLACES * f64::EPSILON * end.abs();
+    if (lo..=hi).contains(&v_da) {
+        Ok(v_da)
+    } else if v_da > hi && v_da - hi <= rounding(hi) {
+        Ok(hi)
+    } else if v_da < lo && lo - v_da <= rounding(lo) {
+        Ok(lo)
+    } else {
+        Err(format!(
             "v_DA = {v_da} V is invalid: must be finite and within the D/A range [{lo}, {hi}] V"
-        ));
+        ))
     }
-    Ok(())
 }
 
 /// One FMU instance: parameters and inputs until initialisation, then a simulation.
@@ -388,7 +400,7 @@ impl CoSimModel for ActuatorFmu {
     fn set_real(&mut self, value_reference: u32, value: f64) -> Result<(), String> {
         match value_reference {
             vr::V_DA => {
-                check_command(value)?;
+                let value = checked_command(value)?;
                 match &mut self.simulation {
                     Some(s) => s.set_command(value),
                     None => {
@@ -702,6 +714,23 @@ mod tests {
         let e = fmu.deserialize(&malformed).unwrap_err();
         assert!(e.contains("transducer value count is 0.5"), "{e}");
         assert_eq!(fmu.serialize(), before);
+    }
+
+    #[test]
+    fn a_command_one_rounding_past_the_d_a_range_is_its_end_and_a_nanovolt_past_is_refused() {
+        let (lo, hi) = V_DA_RANGE;
+        for (end, past) in [(hi, 10.000000000000002), (lo, -10.000000000000002)] {
+            assert!(past != end, "the rounding is past the end");
+            let mut fmu = ActuatorFmu::instantiate();
+            fmu.set_real(vr::V_DA, past).unwrap();
+            assert_eq!(fmu.get_real(vr::V_DA).unwrap(), end);
+            fmu.exit_initialization().unwrap();
+            fmu.set_real(vr::V_DA, past).unwrap();
+            assert_eq!(fmu.get_real(vr::V_DA).unwrap(), end);
+            let beyond = end + end.signum() * 1e-9;
+            let message = fmu.set_real(vr::V_DA, beyond).unwrap_err();
+            assert!(message.contains("v_DA") && message.contains("D/A range"), "{message}");
+        }
     }
 
     #[test]
