@@ -71,9 +71,9 @@ FULL_COMMAND = 9.99
 
 def _v_full_steps(t, t_end):
     """Full-scale steps, switching every 50 ms: the jet pipe over a port, chamber 1 towards the
-    supply and chamber 2 towards the return, then the other way. ±9.99 V, not ±10 V: FMPy
-    interpolates between two rows of 10 V as w0·10 + w1·10, which rounds to
-    10.000000000000002 V at some instants, and the FMU refuses a v_DA outside the D/A range."""
+    supply and chamber 2 towards the return, then the other way. ±9.99 V, as the figures of
+    docs/importing.md were measured (the FMU now takes FMPy's rounding of ±10 V, 10.000000000000002
+    V at some instants, as the range's end: test_tolerance_sweep.py's last test)."""
     return (FULL_COMMAND if int(t / 0.05) % 2 == 0 else -FULL_COMMAND), 0.054
 
 
