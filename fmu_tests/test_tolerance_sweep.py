@@ -143,18 +143,19 @@ def test_fmpy_interpolating_the_inputs_reaches_the_end_at_1e_6():
 
 @pytest.mark.parametrize("archive", ["fmi2", "fmi3"])
 def test_a_full_scale_command_interpolated_by_fmpy_is_taken_at_the_end_of_the_d_a_range(archive):
-    """Rows of exactly ±10 V, which FMPy interpolates to 10.000000000000002 V at some
-    instants: Co-Simulation runs to the end and the FMU reads the command as the range's end."""
+    """Rows of exactly ±10 V, which FMPy's Model Exchange interpolates to 10.000000000000002 V
+    at some of CVODE's instants: the run reaches the end, the command read as the range's end
+    (before, the FMU refused that value and the run stopped)."""
+    import fmpy
+
     fmu = archive_path(archive)
     times = np.arange(0.0, 0.05 + 1e-12, 1e-3)
     inputs = np.zeros(len(times), dtype=[("time", float), ("v_DA", float), ("x_s", float)])
     inputs["time"] = times
     inputs["v_DA"] = np.where(np.arange(len(times)) % 20 < 10, 10.0, -10.0)
     inputs["x_s"] = 0.054
-    import fmpy
-
-    result = fmpy.simulate_fmu(str(fmu), fmi_type="CoSimulation", stop_time=0.05, input=inputs,
-                               output_interval=1e-4, output=["v_DA", "F_act"])
+    result = fmpy.simulate_fmu(str(fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-6,
+                               stop_time=0.05, input=inputs, output_interval=1e-4, output=["v_DA", "F_act"])
     assert result["time"][-1] == pytest.approx(0.05)
     assert np.max(np.abs(result["v_DA"])) == 10.0
     assert np.all(np.isfinite(result["F_act"]))
