@@ -27,6 +27,7 @@ use jetpipe_model::variables::VARIABLES;
 use crate::replay::signals::{FORCE, P1, P2};
 
 pub(crate) mod catalogue;
+pub mod command_curve;
 pub mod command_gaps;
 pub mod command_path;
 pub(crate) mod curve_reading;

@@ -281,7 +281,7 @@ pub fn model_terms(
     if unique.is_empty() {
         return None;
     }
-    crate::candidates::curves::monotone_command(&mut unique);
+    crate::candidates::command_curve::monotone_command(&mut unique);
     Some(unique)
 }
 

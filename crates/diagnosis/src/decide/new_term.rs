@@ -284,7 +284,7 @@ pub(crate) fn with_undecided(reading: String, undecided: Option<String>) -> Stri
 }
 
 /// The command's curve `set` refitted with its interior knots free
-/// (`crate::candidates::curves::command_curve_with_free_knots`), made non-decreasing again, kept when the
+/// (`crate::candidates::command_curve::command_curve_with_free_knots`), made non-decreasing again, kept when the
 /// model with it fits the training samples better than with `set`.
 pub(crate) fn command_curve_knots_freed(
     cx: &Context,
@@ -294,7 +294,7 @@ pub(crate) fn command_curve_knots_freed(
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
 ) -> Vec<(&'static str, f64)> {
-    let Some(free) = crate::candidates::curves::command_curve_with_free_knots(&set) else {
+    let Some(free) = crate::candidates::command_curve::command_curve_with_free_knots(&set) else {
         return set;
     };
     let replayed = |values: &[(&'static str, f64)]| -> Result<Replay, String> {
@@ -320,7 +320,7 @@ pub(crate) fn command_curve_knots_freed(
             entry.1 = value;
         }
     }
-    crate::candidates::curves::monotone_command(&mut freed);
+    crate::candidates::command_curve::monotone_command(&mut freed);
     let Ok(with) = replayed(&freed) else {
         return set;
     };

@@ -83,7 +83,7 @@ pub(crate) fn refit_constants(
     // The command the driver sees does not fall as the logged one rises, after the refit as
     // when the curve was first fitted.
     let mut refitted: Vec<(&'static str, f64)> = names.iter().copied().zip(fit.values.iter().copied()).collect();
-    crate::candidates::curves::monotone_command(&mut refitted);
+    crate::candidates::command_curve::monotone_command(&mut refitted);
     let valid = refitted
         .iter()
         .all(|(name, value)| set_parameter(&mut trial, name, *value).is_ok())
