@@ -52,6 +52,8 @@ pub(crate) struct Context<'a> {
     pub(crate) blocks: Vec<Block>,
     /// From when (s) the model's starting state no longer shows.
     pub(crate) settled_from: f64,
+    /// The spans (s) of the recording's glitches, whose samples are set aside.
+    pub(crate) set_aside: Vec<(f64, f64)>,
     pub(crate) n: usize,
     pub(crate) noise: f64,
     pub(crate) pressure_noise: Option<[f64; 2]>,
@@ -73,6 +75,7 @@ impl<'a> Context<'a> {
         recording: &'a Recording,
         model: &Actuator,
         options: &'a Options,
+        set_aside: Vec<(f64, f64)>,
         input_checks: &mut Vec<String>,
         progress: &mut dyn FnMut(&str),
     ) -> Result<Self, String> {
@@ -139,8 +142,9 @@ impl<'a> Context<'a> {
             recording,
             full,
             options,
-            blocks: crate::input::blocks::blocks(&recording.time, &recording.x_s, settled_from),
+            blocks: crate::input::blocks::blocks(&recording.time, &recording.x_s, settled_from, &set_aside),
             settled_from,
+            set_aside,
             n,
             noise,
             pressure_noise,

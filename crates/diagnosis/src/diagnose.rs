@@ -67,8 +67,14 @@ pub(crate) fn diagnose_unguarded(
     options: &Options,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
-    // 1. The file's checks and the noise floors.
+    // 1. The glitches set aside, the file's checks and the noise floors.
+    let mut recording = recording;
+    let glitches = crate::input::glitches::find_and_repair(&mut recording);
     let mut input_checks = crate::input::checks::check_file(&recording, base)?;
+    if let Some(sentence) = crate::input::glitches::sentence(&glitches) {
+        progress(&sentence);
+        input_checks.push(sentence);
+    }
     let stopper_smoothing = recording.stopper_smoothing();
     let mut smoothed = recording.into_stopper_smoothed();
     let before_model = Actuator::new(base.clone())?;
@@ -89,7 +95,16 @@ pub(crate) fn diagnose_unguarded(
     let departures = before_departures(&smoothed, &before_accurate);
     let departures: Vec<&[f64]> = departures.iter().map(Vec::as_slice).collect();
     let fitted = smoothed.rows_for_fits_where_departing(crate::input::recording::MAX_FIT_ROWS, &departures);
-    let cx = Context::measure(&smoothed, &fitted, &before_model, options, &mut input_checks, progress)?;
+    let set_aside = crate::input::glitches::set_aside_spans(&glitches);
+    let cx = Context::measure(
+        &smoothed,
+        &fitted,
+        &before_model,
+        options,
+        set_aside,
+        &mut input_checks,
+        progress,
+    )?;
     let before_fast = replay_fast(&before_model, cx.recording, cx.n)?;
     input_checks.extend(crate::input::checks::check_against_model(
         cx.recording,
@@ -120,6 +135,7 @@ pub(crate) fn diagnose_unguarded(
         joint_refit,
         input_checks,
         calibrated,
+        glitches,
         replays,
         progress,
     )

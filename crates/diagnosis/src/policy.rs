@@ -8,6 +8,23 @@ pub const BLOCK_SECONDS: f64 = 2.0;
 /// The verdict is "explained" when the held-out force error is within this many noise floors.
 pub const EXPLAINED_WITHIN_NOISE: f64 = 1.5;
 
+// Glitches in the data ([`crate::input::glitches`]): each bar is one noise cannot reach, so
+// that a clean recording has none.
+
+/// A spike stands this many noise floors off the lines through its neighbours: white noise
+/// reaches it about once in 10^10 samples (the three distances have standard deviations of
+/// 2.4, 2.4 and 1.2 floors).
+pub const SPIKE_NOISE_FLOORS: f64 = 10.0;
+/// …and this many times the median distance of the samples around it from a cubic through
+/// their neighbours, so that a signal curving fast (a chirp sampled a few times a period)
+/// does not read as spikes: in white noise that median is 0.94 floors, so there the first
+/// bar decides.
+pub const SPIKE_LOCAL_SCALES: f64 = 8.0;
+/// A run of equal values this long or longer is a stuck channel; shorter, repeated samples.
+pub const STUCK_SAMPLES: usize = 10;
+/// A step in time longer than this many median steps is a gap (a dropped sample doubles one).
+pub const GAP_STEPS: f64 = 1.5;
+
 /// The most places a report names as not told apart (`tied_locations`).
 pub const MOST_TIED_LOCATIONS: usize = 3;
 /// A named effect must lower the held-out force error by this fraction…

@@ -327,9 +327,10 @@ mod tests {
             full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         };
         let base = Parameters::default();
-        let blocks = crate::input::blocks::blocks(&recording.time, &recording.x_s, 0.1);
+        let blocks = crate::input::blocks::blocks(&recording.time, &recording.x_s, 0.1, &[]);
         let problem = Problem::new(&recording, &base, &blocks, [0.05, 0.0, 0.0]);
         let plain = replay_fast(&Actuator::new(base.clone()).unwrap(), &recording, n).unwrap();
         let c = 0.8;

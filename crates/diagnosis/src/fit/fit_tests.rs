@@ -31,6 +31,7 @@ fn a_limit_that_clips_only_the_highest_training_level_is_found_though_held_out_r
         full_rate: None,
         fast_replay: FastReplayMethod::default(),
         acceleration_window: 0.0,
+        repeated_rows: vec![],
     };
     let base = Parameters::default();
     let mut clipped = base.clone();

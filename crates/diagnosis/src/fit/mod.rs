@@ -343,7 +343,7 @@ impl Problem<'_> {
                 match self.blocks[k] {
                     Block::Training => train[c] += e * e,
                     Block::HeldOut => heldout[c] += e * e,
-                    Block::Settling => {}
+                    Block::Settling | Block::SetAside => {}
                 }
             }
         }

@@ -33,7 +33,7 @@ impl Normal {
                 self.heldout_ss += target * target;
                 (&mut self.heldout, &mut self.heldout_rhs)
             }
-            Block::Settling => return,
+            Block::Settling | Block::SetAside => return,
         };
         for (i, &a) in row.iter().enumerate() {
             if a == 0.0 {

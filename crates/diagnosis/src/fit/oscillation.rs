@@ -10,7 +10,6 @@
 use crate::candidates::modulation::{free_slots, slot_parameter, value_reference};
 use crate::fit::normal::Normal;
 use crate::fit::{Problem, Sensitivity};
-use crate::input::blocks::Block;
 use crate::replay::signals::CHANNELS;
 use crate::replay::Replay;
 use jetpipe_model::physics::modulation::ModulationSignal;
@@ -56,7 +55,7 @@ pub fn screen_periodic(
 ) -> Option<(Vec<f64>, Vec<f64>, f64)> {
     let mut normal = Normal::new(3);
     for (k, &block) in problem.blocks.iter().enumerate() {
-        if block == Block::Settling {
+        if !block.is_used() {
             continue;
         }
         for c in 0..CHANNELS {
@@ -92,7 +91,7 @@ pub fn traced_line(problem: &Problem, residual: &[Vec<f64>; CHANNELS], sensitivi
     while k + window <= n {
         let (mut rs, mut ss) = (0.0, 0.0);
         for j in k..k + window {
-            if problem.blocks[j] == Block::Settling {
+            if !problem.blocks[j].is_used() {
                 continue;
             }
             for c in 0..CHANNELS {

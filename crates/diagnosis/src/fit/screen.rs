@@ -106,7 +106,7 @@ fn knots_of(values: &[f64], blocks: &[Block], signal: ModulationSignal) -> Optio
     }
     if signal == ModulationSignal::Time {
         // Evenly in time: a slow wander has no quantiles to follow.
-        let first = values.iter().zip(blocks).find(|(_, b)| **b != Block::Settling)?.0;
+        let first = values.iter().zip(blocks).find(|(_, b)| b.is_used())?.0;
         let last = values.last()?;
         let knots: Vec<f64> = (0..FINE_KNOTS)
             .map(|j| first + (last - first) * j as f64 / (FINE_KNOTS - 1) as f64)
@@ -116,7 +116,7 @@ fn knots_of(values: &[f64], blocks: &[Block], signal: ModulationSignal) -> Optio
     let mut kept: Vec<f64> = values
         .iter()
         .zip(blocks)
-        .filter(|(v, b)| **b != Block::Settling && v.is_finite())
+        .filter(|(v, b)| b.is_used() && v.is_finite())
         .map(|(v, _)| *v)
         .collect();
     if kept.len() < 10 {
@@ -200,7 +200,7 @@ fn screen_pair(
     let mut phi = vec![0.0; size];
     let mut row = vec![0.0; size];
     for (k, &block) in problem.blocks.iter().enumerate() {
-        if block == Block::Settling {
+        if !block.is_used() {
             continue;
         }
         hats(knots, values[k], &mut phi);
@@ -616,6 +616,7 @@ mod tests {
                 third_order: false,
             },
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         };
         let blocks: Vec<Block> = (0..n)
             .map(|k| {

@@ -24,12 +24,23 @@ pub enum Block {
     HeldOut,
     /// Before the model's starting state has faded: neither.
     Settling,
+    /// A glitch of the recording ([`crate::input::glitches`]): neither, and left out of
+    /// every error reported.
+    SetAside,
+}
+
+impl Block {
+    /// Whether the sample is fitted on or scored on.
+    pub fn is_used(self) -> bool {
+        matches!(self, Block::Training | Block::HeldOut)
+    }
 }
 
 /// Training samples are those in even-numbered blocks counted from the first sample,
 /// held-out ones those in odd-numbered blocks; those before `settled_from` (s) are settling.
-/// A short move of the stopper (`x_s`, m) is cut finer: see [`short_stopper_moves`].
-pub fn blocks(time: &[f64], x_s: &[f64], settled_from: f64) -> Vec<Block> {
+/// A short move of the stopper (`x_s`, m) is cut finer: see [`short_stopper_moves`]. Samples
+/// within the `set_aside` spans (s, inclusive) are set aside.
+pub fn blocks(time: &[f64], x_s: &[f64], settled_from: f64, set_aside: &[(f64, f64)]) -> Vec<Block> {
     let t0 = time.first().copied().unwrap_or(0.0);
     let mut blocks: Vec<Block> = time
         .iter()
@@ -52,6 +63,13 @@ pub fn blocks(time: &[f64], x_s: &[f64], settled_from: f64) -> Vec<Block> {
                 } else {
                     Block::HeldOut
                 };
+            }
+        }
+    }
+    if !set_aside.is_empty() {
+        for (block, &t) in blocks.iter_mut().zip(time) {
+            if crate::input::glitches::is_set_aside(t, set_aside) {
+                *block = Block::SetAside;
             }
         }
     }
@@ -124,13 +142,14 @@ pub(crate) mod tests {
             full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         }
     }
 
     #[test]
     fn samples_before_the_settling_time_are_neither_fitted_nor_scored() {
         let time: Vec<f64> = (0..1000).map(|k| k as f64 * 0.01).collect();
-        let b = blocks(&time, &vec![0.05; time.len()], 0.5);
+        let b = blocks(&time, &vec![0.05; time.len()], 0.5, &[]);
         assert!(b[..50].iter().all(|&x| x == Block::Settling));
         assert!(b[50..200].iter().all(|&x| x == Block::Training));
         assert!(b[200..400].iter().all(|&x| x == Block::HeldOut));
@@ -148,7 +167,7 @@ pub(crate) mod tests {
             .map(|&t| 0.067 + 0.009 * ((t - 2.4) / 0.3).clamp(0.0, 1.0))
             .collect();
         assert_eq!(short_stopper_moves(&time, &x_s).len(), 1);
-        let b = blocks(&time, &x_s, 0.0);
+        let b = blocks(&time, &x_s, 0.0, &[]);
         let within = |from: f64, to: f64, which: Block| {
             (0..time.len())
                 .filter(|&k| time[k] >= from && time[k] <= to && b[k] == which)
@@ -173,7 +192,7 @@ pub(crate) mod tests {
     #[test]
     fn a_stopper_at_rest_moving_all_along_or_toggling_its_last_digit_keeps_the_plain_blocks() {
         let time: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-3).collect();
-        let plain = blocks(&time, &vec![0.05; time.len()], 0.0);
+        let plain = blocks(&time, &vec![0.05; time.len()], 0.0, &[]);
         let shaken: Vec<f64> = time.iter().map(|&t| 0.05 + 0.005 * (6.0 * t).sin()).collect();
         let toggling: Vec<f64> = (0..time.len()).map(|k| 0.05 + 1e-6 * (k / 7 % 2) as f64).collect();
         // A single long move (3 s) is already split by the blocks.
@@ -183,7 +202,7 @@ pub(crate) mod tests {
             .collect();
         for x_s in [shaken, toggling, long_move] {
             assert!(short_stopper_moves(&time, &x_s).is_empty());
-            assert_eq!(blocks(&time, &x_s, 0.0), plain);
+            assert_eq!(blocks(&time, &x_s, 0.0, &[]), plain);
         }
     }
 }

@@ -26,6 +26,9 @@ pub struct Recording {
     /// The half-width T (s) of the stopper acceleration the replays give the model as its input
     /// a_s ([`crate::input::acceleration`]); 0 where the model forms it from the positions.
     pub acceleration_window: f64,
+    /// Rows of the file that repeated the row before them exactly, time included, and were
+    /// dropped: (1-based file row, time in s). Reported as glitches.
+    pub repeated_rows: Vec<(usize, f64)>,
 }
 
 /// The inputs of a recording at every sample, and the samples a thinned view keeps.
@@ -306,6 +309,7 @@ impl Recording {
             })),
             fast_replay: self.fast_replay,
             acceleration_window: self.acceleration_window,
+            repeated_rows: self.repeated_rows.clone(),
         }
     }
 
@@ -407,18 +411,19 @@ impl Recording {
         if time.is_empty() {
             return Err("no samples after the header row".to_string());
         }
+        let (time, v_da, x_s, force, p1, p2, repeated_rows) = without_repeated_rows([time, v_da, x_s, force, p1, p2])?;
         if time.len() < 2 {
-            return Err("only one sample: a recording needs at least two".to_string());
-        }
-        for k in 1..time.len() {
-            if time[k] <= time[k - 1] {
-                return Err(format!(
-                    "row {}, column time_s: time {} s does not increase (previous row: {} s)",
-                    k + 2,
-                    time[k],
-                    time[k - 1]
-                ));
-            }
+            return Err(format!(
+                "only one sample{}: a recording needs at least two",
+                if repeated_rows.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " once {} rows repeating the row before exactly are dropped",
+                        repeated_rows.len()
+                    )
+                }
+            ));
         }
         let (lo, hi) = params.cylinder().stopper_range();
         // A stopper column in millimetres is the commonest unit slip: say so.
@@ -462,8 +467,72 @@ impl Recording {
             full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows,
         })
     }
+}
+
+/// The columns without the rows that repeat the row before them exactly, time included (a
+/// logger that wrote a row twice), and those rows (1-based file row, time). A time that does
+/// not increase otherwise is refused: which of two different rows at one time is right
+/// cannot be told.
+#[allow(clippy::type_complexity)]
+fn without_repeated_rows(
+    mut data: [Vec<f64>; 6],
+) -> Result<
+    (
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<(usize, f64)>,
+    ),
+    String,
+> {
+    let mut repeated = vec![];
+    {
+        let time = &data[0];
+        for k in 1..time.len() {
+            if time[k] > time[k - 1] {
+                continue;
+            }
+            let same = data.iter().all(|c| c.is_empty() || c[k] == c[k - 1]);
+            if time[k] == time[k - 1] && same {
+                repeated.push(k);
+                continue;
+            }
+            return Err(format!(
+                "row {}, column time_s: time {} s does not increase (previous row: {} s){}",
+                k + 2,
+                time[k],
+                time[k - 1],
+                if time[k] == time[k - 1] {
+                    " and the two rows differ: which one is right cannot be told"
+                } else {
+                    ""
+                }
+            ));
+        }
+    }
+    let rows: Vec<(usize, f64)> = repeated.iter().map(|&k| (k + 2, data[0][k])).collect();
+    if !repeated.is_empty() {
+        for column in data.iter_mut().filter(|c| !c.is_empty()) {
+            let mut k = 0;
+            let mut next = repeated.iter().peekable();
+            column.retain(|_| {
+                let drop = next.peek() == Some(&&k);
+                if drop {
+                    next.next();
+                }
+                k += 1;
+                !drop
+            });
+        }
+    }
+    let [time, v_da, x_s, force, p1, p2] = data;
+    Ok((time, v_da, x_s, force, p1, p2, rows))
 }
 
 /// Samples per second of a series sampled at `time`: from its span, or, when it has gaps
@@ -527,6 +596,7 @@ mod tests {
             full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         }
     }
 
@@ -654,8 +724,16 @@ mod tests {
                 "row 3, column force_N",
             ),
             (
+                "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0,1,0.054,2\n",
+                "row 3, column time_s: time 0 s does not increase (previous row: 0 s) and the two rows differ",
+            ),
+            (
+                "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0.1,1,0.054,1\n0.05,1,0.054,1\n",
+                "row 4, column time_s",
+            ),
+            (
                 "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0,1,0.054,1\n",
-                "row 3, column time_s",
+                "only one sample",
             ),
             (
                 "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0.1,1,0.12,1\n",
@@ -672,5 +750,14 @@ mod tests {
             let e = parse(text).unwrap_err();
             assert!(e.contains(expected), "{text:?}: {e}");
         }
+    }
+
+    #[test]
+    fn a_row_written_twice_is_dropped_and_its_row_kept_for_the_report() {
+        let text = "time_s,v_da_V,x_s_m,force_N\n0,1,0.054,1\n0.001,1,0.054,2\n0.001,1,0.054,2\n0.002,1,0.054,3\n";
+        let r = Recording::parse(text, &Parameters::default()).unwrap();
+        assert_eq!(r.time, vec![0.0, 0.001, 0.002]);
+        assert_eq!(r.force, vec![1.0, 2.0, 3.0]);
+        assert_eq!(r.repeated_rows, vec![(4, 0.001)]);
     }
 }

@@ -120,6 +120,7 @@ mod tests {
             full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         };
         for window in [0.01, 0.04] {
             let a = smoothed_accelerations(&time, &x_s, window);

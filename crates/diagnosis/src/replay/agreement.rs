@@ -190,6 +190,7 @@ mod tests {
             full_rate: None,
             fast_replay: FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         };
         let accurate = replay(model, &recording, 1e-7, n).unwrap();
         // Gaussian noise by the sum of twelve uniforms.

@@ -1,9 +1,9 @@
 //! The force errors of a replay against the recording: over the whole, on the training and
-//! on the held-out blocks, and each pressure's.
+//! on the held-out blocks, and each pressure's; the glitches set aside are left out of each.
 
 use crate::input::blocks::Block;
 use crate::replay::signals::difference;
-use crate::replay::signals::rms;
+use crate::replay::signals::rms_kept;
 use crate::replay::signals::rms_where;
 use crate::replay::Recording;
 use crate::replay::Replay;
@@ -26,14 +26,17 @@ pub(crate) fn errors(model: &Replay, recording: &Recording, blocks: &[Block]) ->
         .force
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &f| (a.min(f), b.max(f)));
-    let total = rms(&residual);
+    let total = rms_kept(&residual, blocks);
     Errors {
         rms: total,
         nrmse: if hi > lo { total / (hi - lo) } else { 0.0 },
         train_rms: rms_where(&residual, blocks, Block::Training),
         heldout_rms: rms_where(&residual, blocks, Block::HeldOut),
         pressure_rms: match (&recording.p1, &recording.p2) {
-            (Some(p1), Some(p2)) => Some([rms(&difference(p1, &model.p1)), rms(&difference(p2, &model.p2))]),
+            (Some(p1), Some(p2)) => Some([
+                rms_kept(&difference(p1, &model.p1), blocks),
+                rms_kept(&difference(p2, &model.p2), blocks),
+            ]),
             _ => None,
         },
     }

@@ -405,6 +405,7 @@ mod tests {
             full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         }
     }
 

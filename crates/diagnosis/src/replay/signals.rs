@@ -139,6 +139,22 @@ pub fn rms_where(x: &[f64], blocks: &[Block], which: Block) -> f64 {
     }
 }
 
+/// RMS of `x` over the samples of `blocks` that are not set aside as glitches.
+pub fn rms_kept(x: &[f64], blocks: &[Block]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (v, &b) in x.iter().zip(blocks) {
+        if b != Block::SetAside {
+            sum += v * v;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        (sum / n as f64).sqrt()
+    }
+}
+
 pub fn rms(x: &[f64]) -> f64 {
     if x.is_empty() {
         0.0

@@ -49,6 +49,7 @@ pub(crate) fn conclude(
     mut joint_refit: Option<(f64, f64)>,
     mut input_checks: Vec<String>,
     calibrated: Vec<Calibrated>,
+    glitches: Vec<crate::input::glitches::Glitch>,
     replays: usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
@@ -66,7 +67,7 @@ pub(crate) fn conclude(
     let n = full.len();
     let thinned = cx.recording.full_rate.as_ref().map(|f| f.rows.as_slice());
     let full_blocks = match thinned {
-        Some(_) => crate::input::blocks::blocks(&full.time, &full.x_s, cx.settled_from),
+        Some(_) => crate::input::blocks::blocks(&full.time, &full.x_s, cx.settled_from, &cx.set_aside),
         None => cx.blocks.clone(),
     };
     let blocks = &full_blocks;
@@ -167,6 +168,7 @@ pub(crate) fn conclude(
         noise_floor: noise,
         pressure_noise: cx.pressure_noise,
         input_checks,
+        glitches,
         before: before_errors,
         after: after_errors,
         settling: cx.settled_from - full.time[0],

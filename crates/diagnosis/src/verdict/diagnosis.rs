@@ -33,6 +33,8 @@ pub struct Diagnosis {
     pub noise_floor: f64,
     pub pressure_noise: Option<[f64; 2]>,
     pub input_checks: Vec<String>,
+    /// The recording's glitches ([`crate::input::glitches`]): their samples were set aside.
+    pub glitches: Vec<crate::input::glitches::Glitch>,
     pub before: Errors,
     pub after: Errors,
     /// The seconds at the start in which the model's starting state still shows: neither

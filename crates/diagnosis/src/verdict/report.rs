@@ -153,6 +153,14 @@ impl Diagnosis {
             "verdict": self.verdict(),
             "summary": self.summary(),
             "input_checks": self.input_checks,
+            "glitches": self.glitches.iter().map(|g| json!({
+                "kind": g.kind.as_str(),
+                "column": g.column,
+                "from_s": g.from_s,
+                "to_s": g.to_s,
+                "samples": g.samples,
+                "set_aside": g.sets_aside(),
+            })).collect::<Vec<_>>(),
             "before": err(&self.before),
             "after": err(&self.after),
             "heldout": {

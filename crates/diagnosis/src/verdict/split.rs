@@ -6,7 +6,7 @@ use crate::input::blocks::Block;
 use crate::input::noise::noise_floor;
 use crate::input::recording::Recording;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
-use crate::replay::signals::{chamber_pressures, difference, rms};
+use crate::replay::signals::{chamber_pressures, difference, rms, rms_kept};
 use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
@@ -104,7 +104,7 @@ pub(crate) fn pressure_split(
         let kept: Vec<f64> = x
             .iter()
             .zip(blocks)
-            .filter(|(_, &b)| b != Block::Settling)
+            .filter(|(_, b)| b.is_used())
             .map(|(v, _)| *v)
             .collect();
         rms(&kept)
@@ -135,8 +135,8 @@ pub(crate) fn pressure_split(
         pressure_rms[1] / pressure_noise[1].max(1e-9),
     ];
     let whole_pressure_ratio = [
-        rms(&difference(p1, &replay.p1)) / pressure_noise[0].max(1e-9),
-        rms(&difference(p2, &replay.p2)) / pressure_noise[1].max(1e-9),
+        rms_kept(&difference(p1, &replay.p1), blocks) / pressure_noise[0].max(1e-9),
+        rms_kept(&difference(p2, &replay.p2), blocks) / pressure_noise[1].max(1e-9),
     ];
     let ratio = mechanical / mechanical_noise.max(1e-12);
     let pressures_off = pressure_ratio.iter().any(|r| *r > EXPLAINED_WITHIN_NOISE);
@@ -216,6 +216,7 @@ mod tests {
             full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod::default(),
             acceleration_window: 0.0,
+            repeated_rows: vec![],
         };
         let replay = Replay {
             force,

@@ -27,6 +27,7 @@ mod beside;
 mod constants;
 mod curves;
 mod flows;
+mod glitches;
 mod modulations;
 mod protocols;
 mod search;
