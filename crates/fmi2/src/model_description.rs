@@ -346,7 +346,9 @@ fn write_xml(info: &ModelInfo, guid: &str) -> String {
             w,
             r#"  <ModelExchange modelIdentifier="{}" completedIntegratorStepNotNeeded="{}" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canNotUseMemoryManagementFunctions="true" providesDirectionalDerivative="false"/>"#,
             e(info.model_identifier),
-            !info.model_exchange.map_or(false, |me| me.needs_completed_integrator_step)
+            !info
+                .model_exchange
+                .map_or(false, |me| me.needs_completed_integrator_step)
         );
     }
     let _ = writeln!(

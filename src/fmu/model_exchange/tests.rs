@@ -173,7 +173,10 @@ fn largest_difference(a: &[(f64, f64)], b: &[(f64, f64)]) -> (f64, f64) {
 #[test]
 fn the_memory_advanced_at_the_current_s_reversals_follows_co_simulation_s_through_a_sine_and_a_jump() {
     let preset = preset();
-    assert!(preset.iter().any(|&(r, v)| r == vr::HYSTERESIS_EXPONENT && v > 0.0), "{preset:?}");
+    assert!(
+        preset.iter().any(|&(r, v)| r == vr::HYSTERESIS_EXPONENT && v > 0.0),
+        "{preset:?}"
+    );
     let t_end = 0.06;
     let cs = co_simulation_run(&preset, t_end);
     let me = explicit_run(&preset, t_end, Updates::AsDeclared);
@@ -184,12 +187,15 @@ fn the_memory_advanced_at_the_current_s_reversals_follows_co_simulation_s_throug
         "hysteresis output, ME - CS: {output:.2e} m as declared, {coarse_output:.2e} m advanced every sample; x_jp {position:.2e} m"
     );
     // the loop is 0.16 mm wide: both follow it to a millionth of its width
-    let span = cs.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max)
-        - cs.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+    let span =
+        cs.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max) - cs.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
     assert!(span > 0.16e-3, "the command sweeps the loop: {span} m");
     assert!(output < 1e-10 && position < 1e-10, "{output:e} m, {position:e} m");
     // a memory advanced only every sample misses the reversals within one, by far more
-    assert!(coarse_output > 20.0 * output.max(1e-12), "{coarse_output:e} m against {output:e} m");
+    assert!(
+        coarse_output > 20.0 * output.max(1e-12),
+        "{coarse_output:e} m against {output:e} m"
+    );
 }
 
 #[test]
