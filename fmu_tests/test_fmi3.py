@@ -124,7 +124,8 @@ def test_the_fmi3_description_declares_both_interfaces_the_states_the_event_indi
     assert md3.guid == md2.guid  # the instantiation token is the 2.0 GUID
     assert md3.coSimulation is not None and md3.modelExchange is not None
     assert [d.variable.name for d in md3.derivatives] == [d.variable.name for d in md2.derivatives]
-    assert len(md3.eventIndicators) == md2.numberOfEventIndicators == 7
+    assert len(md3.eventIndicators) == md2.numberOfEventIndicators == 8
+    assert md3.modelExchange.needsCompletedIntegratorStep  # the hysteresis memory is advanced there
     by_name2 = {v.name: v for v in md2.modelVariables}
     for v in md3.modelVariables:
         if v.name in by_name2:
@@ -226,25 +227,26 @@ def test_with_the_measured_preset_fmi3_co_simulation_follows_fmi2_within_1e_9_ne
     assert np.max(np.abs(cs3["F_act"] - plain["F_act"])) > 0.1  # the preset is on
 
 
-def test_with_the_measured_preset_without_hysteresis_fmi3_model_exchange_follows_fmi2_co_simulation(fmu3_path, fmu2_path):
+def test_with_the_measured_preset_and_its_hysteresis_fmi3_model_exchange_follows_fmi2_co_simulation(fmu3_path, fmu2_path):
     signal = scenarios.input_signal()[:401]
-    values = preset(without_hysteresis=True)
+    values = preset()
+    assert values["hysteresis_width"] > 0
     cs2 = simulate(fmu2_path, "CoSimulation", signal, 2.0, 1e-3, values)
     me3 = simulate(fmu3_path, "ModelExchange", signal, 2.0, 1e-3, values)
     rms = force_rms(cs2, me3)
-    print(f"thesis_measured without hysteresis, 2 s: F_act RMS 3.0 ME - 2.0 CS = {rms:.3e} N")
+    print(f"thesis_measured, 2 s: F_act RMS 3.0 ME - 2.0 CS = {rms:.3e} N")
     assert rms < RMS_LIMIT_N
 
 
-def test_the_jet_pipe_hysteresis_is_refused_in_fmi3_model_exchange_by_name(unzip3, md3):
+def test_the_transport_delay_is_refused_in_fmi3_model_exchange_by_name(unzip3, md3):
     vrs = vr3(md3)
-    fmu = make(unzip3, md3, "me", "hysteresis")
+    fmu = make(unzip3, md3, "me", "delay")
     try:
         fmu.enterInitializationMode()
         with pytest.raises(Exception):
-            fmu.setFloat64([vrs["hysteresis_width"]], [20e-6])
+            fmu.setFloat64([vrs["command_delay"]], [2e-3])
         text = fmu.log.last()
-        assert "jet_pipe_hysteresis" in text and "hysteresis_width" in text and "Co-Simulation" in text, text
+        assert "transport_delay" in text and "command_delay" in text and "Co-Simulation" in text, text
         assert text.startswith("fmi3SetFloat64"), text
     finally:
         fmu.freeInstance()
@@ -259,7 +261,7 @@ def test_an_fmi3_instance_runs_model_exchange_calls_and_its_event_indicator_vari
     try:
         nx = fmu.getNumberOfContinuousStates()
         nz = fmu.getNumberOfEventIndicators()
-        assert (nx, nz) == (11, 7)
+        assert (nx, nz) == (11, 8)
         fmu.setFloat64([vrs["v_DA"]], [2.5])
         fmu.enterInitializationMode(startTime=0.0)
         fmu.exitInitializationMode()

@@ -24,6 +24,7 @@ Two ways to give FMPy 0.3.32 an input, and what its Model Exchange loop does wit
 from __future__ import annotations
 
 import io
+import json
 import math
 import time as wall_clock
 from contextlib import contextmanager, redirect_stdout
@@ -33,6 +34,7 @@ import fmpy
 import fmpy.sundials as sundials
 import numpy as np
 from fmpy.sundials.libraries import sundials_cvode
+from pathlib import Path
 
 OUTPUTS = ["F_act", "P1", "P2", "i", "x_jp"]
 HOLD = 1e-4  # s: the inputs' sample period
@@ -77,6 +79,20 @@ def _v_full_steps(t, t_end):
     return (FULL_COMMAND if int(t / 0.05) % 2 == 0 else -FULL_COMMAND), 0.054
 
 
+def _v_preset_sine(t, t_end):
+    """20 Hz, ±1.5 V about 2.5 V: the static tip position sweeps 0.22 mm peak to peak, beyond
+    the measured preset's 0.16 mm loop, and the current reverses twice a period (where the
+    preset's hysteresis memory moves)."""
+    return 2.5 + 1.5 * math.sin(2 * math.pi * 20.0 * t), 0.054
+
+
+def _v_preset_sine_and_steps(t, t_end):
+    """The 20 Hz sine plus ±1 V steps every 30 ms: the current reverses at some of the steps
+    too."""
+    step = 1.0 if int(t / 0.03) % 2 == 0 else -1.0
+    return _v_preset_sine(t, t_end)[0] + step, 0.054
+
+
 def _v_moving_stopper(t, t_end):
     """The stopper from 54 mm to 30 mm, to 78 mm and back at 5 Hz under −0.3 V, where the
     pressure force is near the spring's: the force crosses the spring floor (2.38) both ways,
@@ -95,7 +111,12 @@ SIGNALS = {
     # the compliant stopper's law switches in the right-hand side where the force meets the
     # spring floor (event indicator z0): the moving stopper with the volumes and the mount
     "moving_stopper_volumes": _v_moving_stopper,
+    # presets/thesis_measured.json, its Bouc-Wen hysteresis among its terms
+    "measured_preset": _v_preset_sine_and_steps,
+    "measured_preset_sine": _v_preset_sine,
 }
+
+PRESET = json.loads((Path(__file__).resolve().parent.parent / "presets" / "thesis_measured.json").read_text())
 
 
 def delayed(law, delay: float = HOLD / 2):
@@ -105,6 +126,8 @@ def delayed(law, delay: float = HOLD / 2):
 
 
 def start_values(name: str) -> dict:
+    if name.startswith("measured_preset"):
+        return dict(PRESET)
     return dict(VOLUMES_AND_MOUNT) if name in ("volumes_and_mount", "moving_stopper_volumes") else {}
 
 

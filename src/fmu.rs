@@ -183,14 +183,16 @@ pub static MODEL_INFO: ModelInfo = ModelInfo {
 };
 
 /// Model Exchange: the eleven states (the six of (4.1), the volumes' pressures and the mount's
-/// load) and the event indicators of
-/// the private module `model_exchange`.
+/// load), the event indicators and the hysteresis memory of the private module
+/// `model_exchange`.
 // The state vector of `model_exchange` is the model description's.
 const _: () = assert!(model_exchange::STATES == CONTINUOUS_STATES.len());
 
 pub static MODEL_EXCHANGE: ModelExchangeInfo = ModelExchangeInfo {
     states: &CONTINUOUS_STATES,
     event_indicators: model_exchange::EVENT_INDICATORS,
+    // the hysteresis memory is advanced after each accepted step (model_exchange's text)
+    needs_completed_integrator_step: true,
 };
 
 /// How far past an end of the D/A range, in units of the end's last place, a command is still
@@ -296,6 +298,7 @@ impl ActuatorFmu {
                 &model_exchange::nodes_of(simulation),
                 simulation.v_da(),
                 simulation.x_s(),
+                simulation.hysteresis_memory().as_ref(),
                 value_reference,
             )
             .ok_or_else(|| format!("no Real variable with value reference {value_reference}"));
@@ -639,9 +642,10 @@ impl CoSimModel for ActuatorFmu {
 /// restrictions' parameters and the pressures of the gas volumes behind them; version 5: the
 /// interface and the Model Exchange state; version 6: the modulation slots' parameters;
 /// version 7: the laminar chamber leaks and the extra force's product slots; version 8: the
-/// extra flow slots; version 9: the stopper acceleration input.
+/// extra flow slots; version 9: the stopper acceleration input; version 10: Model Exchange's
+/// hysteresis memory.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 9, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 10, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped

@@ -18,7 +18,7 @@ use jetpipe_model::physics::actuator::{Actuator, Inputs, State as ModelState};
 use jetpipe_model::physics::parameters::Parameters;
 
 const NX: usize = 11;
-const NZ: usize = 7;
+const NZ: usize = 8;
 
 unsafe fn states(c: fmi2Component) -> [f64; NX] {
     let mut x = [f64::NAN; NX];
@@ -188,7 +188,6 @@ fn an_effect_with_a_memory_is_refused_in_model_exchange_by_name_and_stays_in_co_
     unsafe {
         for (parameter, value, effect) in [
             (vr::COMMAND_DELAY, 2e-3, "transport_delay"),
-            (vr::HYSTERESIS_WIDTH, 1e-5, "jet_pipe_hysteresis"),
             (vr::FORCE_SENSOR_LAG, 1e-3, "the transducers' lags"),
             (vr::FRICTION_COULOMB, 1.0, "piston_friction"),
             (vr::MODULATION_1_PARAMETER, vr::P_S as f64, "the modulation slots"),
@@ -282,7 +281,7 @@ fn wrong_lengths_null_arrays_and_non_states_are_errors_that_change_nothing() {
             (
                 "ni",
                 fmi2GetEventIndicators(c, z.as_mut_ptr(), NZ - 1),
-                "ni = 6, but the model description declares 7",
+                "ni = 7, but the model description declares 8",
             ),
             ("NULL", fmi2GetDerivatives(c, null_mut(), NX), "is NULL"),
             ("NULL x", fmi2SetContinuousStates(c, null(), NX), "x[] is NULL"),
@@ -322,6 +321,8 @@ fn wrong_lengths_null_arrays_and_non_states_are_errors_that_change_nothing() {
             z[0] > 0.0 && z[2] > 0.0 && z[3] > 0.0 && z[4] > 0.0 && z[5] > 0.0,
             "{z:?}"
         );
+        // without the hysteresis, z7 (the current's reversal) never changes sign
+        assert_eq!(z[7], 1.0);
         // Co-Simulation calls are illegal here, with the interface in the message
         let from = sink.len();
         assert_eq!(fmi2DoStep(c, 0.0, 1e-3, fmi2True), fmi2Error);

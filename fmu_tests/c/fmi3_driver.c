@@ -34,7 +34,7 @@ typedef void *library_t;
 #include "fmi3Functions.h"
 
 #define NX 11
-#define NZ 7
+#define NZ 8
 #define SUBSTEPS 1000 /* 10 us steps within a 10 ms sample */
 
 static const fmi3ValueReference INPUTS[2] = {1u, 2u};                   /* v_DA, x_s */

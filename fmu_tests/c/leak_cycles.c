@@ -197,7 +197,7 @@ int main(int argc, char **argv) {
             return 1;
         }
         {
-            fmi2Real x[11], dx[11], z[7], nominal[11];
+            fmi2Real x[11], dx[11], z[8], nominal[11];
             fmi2EventInfo info;
             fmi2Boolean enter = fmi2True, stop = fmi2True;
             const fmi2ValueReference vr_delay[1] = {350u}; /* command_delay: refused in Model Exchange */
@@ -217,7 +217,7 @@ int main(int argc, char **argv) {
                 EXPECT(fmi2SetTime(m, j * 1e-6), fmi2OK);
                 EXPECT(fmi2SetContinuousStates(m, x, 11), fmi2OK);
                 EXPECT(fmi2GetDerivatives(m, dx, 11), fmi2OK);
-                EXPECT(fmi2GetEventIndicators(m, z, 7), fmi2OK);
+                EXPECT(fmi2GetEventIndicators(m, z, 8), fmi2OK);
                 EXPECT(fmi2CompletedIntegratorStep(m, fmi2True, &enter, &stop), fmi2OK);
                 for (int i = 0; i < 11; i++) x[i] += 1e-6 * dx[i];
             }

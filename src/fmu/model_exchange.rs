@@ -5,13 +5,27 @@
 //! (the equations the Co-Simulation step integrates), and event indicators where the
 //! right-hand side is not smooth.
 //!
+//! The jet pipe's hysteresis (`jet_pipe_hysteresis`, either law: plays or Bouc–Wen) is a
+//! discrete state, its memory, as in Co-Simulation: the operator is rate-independent, and
+//! its output after the static position x̄ = f3(k_m i) has moved monotonically from the
+//! memory's is `Hysteresis::output_after(memory, x̄)`, the function the Co-Simulation step
+//! evaluates along its closed-form current. x̄ moves monotonically while the current does, so
+//! the memory needs advancing (`Hysteresis::advance`) only where di/dt changes sign: event
+//! indicator z7 = ī − i (ī the static current of the command, (2.3)) stops the solver
+//! there, and `fmi2NewDiscreteStates` advances it. It is advanced also at every
+//! `fmi2CompletedIntegratorStep` (exact while x̄ is monotone; an importer that ignores the
+//! event indicators then errs by a step's reversal at most) and at every other event (an
+//! input's jump reverses the current at once). The right-hand side is the one Co-Simulation
+//! integrates, with the same law and the same memory: what differs is only where the
+//! reversal is put, CVODE's root of z7 in place of the closed form's turning point.
+//!
 //! What Model Exchange does not have, and why:
-//! * effects with a memory of the past, which the Co-Simulation step updates at
-//!   communication points or keeps in a history buffer (the jet pipe's hysteresis, the
-//!   transport delay, the command stage's lag, filter and slew limit, the transducers' lags,
-//!   delays, plays and filters, and the forces that read the stopper's motion over the last
-//!   intervals) are refused, each named, when set and when initialisation ends; they stay
-//!   available in Co-Simulation;
+//! * effects with a memory of the past that is not the hysteresis', which the Co-Simulation
+//!   step updates at communication points or keeps in a history buffer (the transport delay,
+//!   the command stage's lag, filter and slew limit, the transducers' lags, delays, plays
+//!   and filters, and the forces that read the stopper's motion over the last intervals) are
+//!   refused, each named, when set and when initialisation ends; they stay available in
+//!   Co-Simulation;
 //! * the constants that vary in time are refused too (not yet part of Model Exchange).
 //!
 //! The stopper: a new x_s set in event mode moves it at once as in Co-Simulation (the air in
@@ -26,6 +40,8 @@ use fmi2::model::{EventUpdate, ModelExchangeModel};
 use jetpipe_model::physics::actuator::{index, Actuator, Inputs, State};
 use jetpipe_model::physics::chambers::pressure_after_volume_jump;
 use jetpipe_model::physics::command_stage;
+use jetpipe_model::physics::current_driver;
+use jetpipe_model::physics::effects::PLAY_OPERATORS;
 use jetpipe_model::physics::jet_pipe;
 use jetpipe_model::physics::modulation;
 use jetpipe_model::physics::parameters::{table_start, variable_name, Parameters};
@@ -35,7 +51,11 @@ use jetpipe_model::physics::time_varying;
 use jetpipe_model::simulation::Simulation;
 
 /// The number of event indicators (see [`event_indicators`]).
-pub const EVENT_INDICATORS: usize = 7;
+pub const EVENT_INDICATORS: usize = 8;
+
+/// The jet_pipe_hysteresis operator's memory (see `Hysteresis`): its plays, or the Bouc–Wen
+/// law's input and output where it was last advanced.
+pub(super) type Memory = [f64; PLAY_OPERATORS];
 
 /// The number of continuous states: the six of (4.1) and the [`node::STATES`] beyond them.
 pub const STATES: usize = 6 + node::STATES;
@@ -67,6 +87,8 @@ pub(super) struct MeState {
     time: f64,
     x: State,
     nodes: Nodes,
+    /// The hysteresis memory when the effect is on (see the module's text).
+    memory: Option<Memory>,
     /// Where the stopper is: the last x_s set that is inside the cylinder (see
     /// [`ActuatorFmu::exit_initialization_model_exchange`]).
     x_s: f64,
@@ -87,11 +109,6 @@ const MEMORY: &str =
 /// The effects that Model Exchange refuses, each with its parameters (any of them away from
 /// its default switches the effect on).
 const REFUSED: &[Refused] = &[
-    Refused {
-        effect: "jet_pipe_hysteresis",
-        why: "it is not an ODE: a play-operator memory that follows the history of the input",
-        parameters: &[vr::HYSTERESIS_WIDTH],
-    },
     Refused {
         effect: "transport_delay",
         why: "it is not an ODE: a history buffer of the command",
@@ -195,7 +212,6 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
         }
     }
     let flags = [
-        (model.hysteresis.is_active(), "jet_pipe_hysteresis"),
         (p.command_delay != 0.0, "transport_delay"),
         (
             p.command_lag > 0.0 || p.command_filter_frequency > 0.0 || p.current_slew_limit > 0.0,
@@ -227,8 +243,9 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
 }
 
 /// The inputs of the right-hand side: v_DA through the command stage's static part (its
-/// curve, cubic and limits; its memories are refused), the stopper held.
-fn inputs(model: &Actuator, v_da: f64, x_s: f64) -> Inputs {
+/// curve, cubic and limits; its memories are refused), the stopper held, the hysteresis
+/// memory.
+fn inputs(model: &Actuator, v_da: f64, x_s: f64, memory: Option<&Memory>) -> Inputs {
     let p = &model.params;
     let v_da = if command_stage::is_active(p) {
         command_stage::static_map(p, v_da)
@@ -239,7 +256,15 @@ fn inputs(model: &Actuator, v_da: f64, x_s: f64) -> Inputs {
         v_da,
         x_s,
         x_s_rate: 0.0,
-        plays: None,
+        plays: memory.copied(),
+    }
+}
+
+/// The memory advanced to the static position of `current`: exact when the current has moved
+/// monotonically since the memory was last advanced (see the module's text).
+pub(super) fn advance_memory(model: &Actuator, memory: &mut Option<Memory>, current: f64) {
+    if let Some(memory) = memory {
+        model.hysteresis.advance(memory, model.static_jet_position(current));
     }
 }
 
@@ -250,8 +275,10 @@ fn inputs(model: &Actuator, v_da: f64, x_s: f64) -> Inputs {
 /// * z2, z3 = P_s − P1, P_s − P2: a supply flow reverses (2.18);
 /// * z4, z5 = P1 − P_r, P2 − P_r: a return flow reverses;
 /// * z6 = sin(π x_abs/D_jp): the jet pipe crosses a tangency of the orifice geometry, where
-///   the areas (2.8)–(2.17) stop being analytic (every multiple of D_jp).
-fn event_indicators(model: &Actuator, x: &State, x_s: f64, z: &mut [f64]) {
+///   the areas (2.8)–(2.17) stop being analytic (every multiple of D_jp);
+/// * z7 = ī − i, with the hysteresis on (else 1): the current, and so f3's output, reverses
+///   (di/dt = ω_cd (ī − i), (2.1)–(2.3)), where the hysteresis memory is advanced.
+fn event_indicators(model: &Actuator, x: &State, v_da: f64, x_s: f64, memory: Option<&Memory>, z: &mut [f64]) {
     // (the places' pressures with restrictions do not reverse the flows the valve sees
     // between them and the chambers: the same indicators)
     let p = &model.params;
@@ -266,6 +293,13 @@ fn event_indicators(model: &Actuator, x: &State, x_s: f64, z: &mut [f64]) {
         p1 - p.p_r,
         p2 - p.p_r,
         (std::f64::consts::PI * x_abs / p.d_jp).sin(),
+        match memory {
+            Some(_) => {
+                let command = inputs(model, v_da, x_s, None).v_da;
+                current_driver::static_current(p.k_cd, p.i_offset, command) - x[index::CURRENT]
+            }
+            None => 1.0,
+        },
     ];
     z.copy_from_slice(&values);
 }
@@ -273,9 +307,10 @@ fn event_indicators(model: &Actuator, x: &State, x_s: f64, z: &mut [f64]) {
 /// The rates of the [`STATES`] states: (4.1) from `Actuator::derivatives`; with gas volumes
 /// behind restrictions or a lagging mount, the pressures' from
 /// `Actuator::pressure_rates_with_volumes` (the law the Co-Simulation step integrates them
-/// with), else 0 for the states beyond the six.
-fn rates(model: &Actuator, x: &State, nodes: &Nodes, v_da: f64, x_s: f64) -> [f64; STATES] {
-    let d = model.derivatives(x, &inputs(model, v_da, x_s));
+/// with), else 0 for the states beyond the six. The jet pipe's input is f3's output through
+/// the hysteresis from `memory` when that is on.
+fn rates(model: &Actuator, x: &State, nodes: &Nodes, v_da: f64, x_s: f64, memory: Option<&Memory>) -> [f64; STATES] {
+    let d = model.derivatives(x, &inputs(model, v_da, x_s, memory));
     let mut out = [0.0; STATES];
     out[..6].copy_from_slice(d.as_slice());
     if model.has_volume_states() {
@@ -297,6 +332,7 @@ pub(super) fn state_variable(
     nodes: &Nodes,
     v_da: f64,
     x_s: f64,
+    memory: Option<&Memory>,
     value_reference: u32,
 ) -> Option<f64> {
     let states = [
@@ -323,7 +359,7 @@ pub(super) fn state_variable(
         me_vr::DER_STOPPER_MOUNT_LOAD,
     ];
     if let Some(k) = derivatives.iter().position(|&v| v == value_reference) {
-        return Some(rates(model, x, nodes, v_da, x_s)[k]);
+        return Some(rates(model, x, nodes, v_da, x_s, memory)[k]);
     }
     match value_reference {
         me_vr::X_JP_VELOCITY => Some(x[index::JET_VELOCITY]),
@@ -374,6 +410,7 @@ impl ActuatorFmu {
             time: self.start_time,
             x: *simulation.state(),
             nodes: nodes_of(&simulation),
+            memory: simulation.hysteresis_memory(),
             x_s: simulation.x_s(),
             states_changed: false,
         })
@@ -408,7 +445,17 @@ impl ActuatorFmu {
                     _ => y.p2_meas,
                 }
             }
-            _ => return state_variable(&me.model, x, &me.nodes, self.v_da, me.x_s, value_reference),
+            _ => {
+                return state_variable(
+                    &me.model,
+                    x,
+                    &me.nodes,
+                    self.v_da,
+                    me.x_s,
+                    me.memory.as_ref(),
+                    value_reference,
+                )
+            }
         })
     }
 
@@ -449,6 +496,8 @@ impl ActuatorFmu {
                 w.f64s(&me.nodes);
                 w.f64(me.x_s);
                 w.bool(me.states_changed);
+                w.bool(me.memory.is_some());
+                w.f64s(me.memory.as_ref().map_or(&[][..], |m| &m[..]));
             }
         }
     }
@@ -478,11 +527,33 @@ impl ActuatorFmu {
             let x_s = r.f64()?;
             restored.params.check_stopper(x_s)?;
             let states_changed = r.bool("statesChanged")?;
+            let model = Actuator::new(restored.params.clone())?;
+            let has_memory = r.bool("hysteresisMemory")?;
+            let memory_values = r.f64s_at_most(PLAY_OPERATORS, "hysteresis memory")?;
+            let memory = match (has_memory, model.hysteresis.is_active()) {
+                (true, true) if memory_values.len() == PLAY_OPERATORS => {
+                    if let Some(v) = memory_values.iter().find(|v| !v.is_finite()) {
+                        return Err(format!("a hysteresis memory value is {v}"));
+                    }
+                    let mut memory = [0.0; PLAY_OPERATORS];
+                    memory.copy_from_slice(&memory_values);
+                    Some(memory)
+                }
+                (false, false) if memory_values.is_empty() => None,
+                _ => {
+                    return Err(format!(
+                        "a hysteresis memory of {} values for parameters whose hysteresis is {}",
+                        memory_values.len(),
+                        if model.hysteresis.is_active() { "on" } else { "off" }
+                    ))
+                }
+            };
             restored.me = Some(MeState {
-                model: Actuator::new(restored.params.clone())?,
+                model,
                 time,
                 x: State::from_column_slice(&values),
                 nodes,
+                memory,
                 x_s,
                 states_changed,
             });
@@ -531,7 +602,7 @@ impl ModelExchangeModel for ActuatorFmu {
     fn derivatives(&self, dx: &mut [f64]) -> Result<(), String> {
         let me = self.me_view()?;
         self.check_stopper_set(&me)?;
-        let d = rates(&me.model, &me.x, &me.nodes, self.v_da, me.x_s);
+        let d = rates(&me.model, &me.x, &me.nodes, self.v_da, me.x_s, me.memory.as_ref());
         if let Some(k) = d.iter().position(|v| !v.is_finite()) {
             return Err(format!(
                 "the derivative of state {k} is {} at the states {:?}",
@@ -546,7 +617,7 @@ impl ModelExchangeModel for ActuatorFmu {
     fn event_indicators(&self, z: &mut [f64]) -> Result<(), String> {
         let me = self.me_view()?;
         self.check_stopper_set(&me)?;
-        event_indicators(&me.model, &me.x, me.x_s, z);
+        event_indicators(&me.model, &me.x, self.v_da, me.x_s, me.memory.as_ref(), z);
         Ok(())
     }
 
@@ -561,14 +632,26 @@ impl ModelExchangeModel for ActuatorFmu {
         nominals[6..].iter_mut().for_each(|n| *n = scales[index::P1]);
     }
 
+    /// Every event (a reversal of the current, z7, among them) advances the hysteresis memory.
     fn new_discrete_states(&mut self) -> Result<EventUpdate, String> {
-        let changed = self
-            .me
-            .as_mut()
-            .map_or(false, |me| std::mem::replace(&mut me.states_changed, false));
+        let changed = self.me.as_mut().map_or(false, |me| {
+            advance_memory(&me.model, &mut me.memory, me.x[index::CURRENT]);
+            std::mem::replace(&mut me.states_changed, false)
+        });
         Ok(EventUpdate {
             values_of_continuous_states_changed: changed,
             ..EventUpdate::default()
         })
     }
+
+    /// The hysteresis memory advanced to the accepted step's end.
+    fn completed_integrator_step(&mut self) -> Result<bool, String> {
+        if let Some(me) = self.me.as_mut() {
+            advance_memory(&me.model, &mut me.memory, me.x[index::CURRENT]);
+        }
+        Ok(false)
+    }
 }
+
+#[cfg(test)]
+mod tests;

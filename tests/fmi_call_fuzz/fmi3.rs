@@ -29,7 +29,7 @@ use jetpipe::fmu3_exports::*;
 use jetpipe::variables::vr;
 
 const NX: usize = 11;
-const NZ: usize = 7;
+const NZ: usize = 8;
 
 /// One instance's messages: (status, message).
 #[derive(Default)]

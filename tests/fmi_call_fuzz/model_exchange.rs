@@ -26,7 +26,7 @@ use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 
 const NX: usize = 11;
-const NZ: usize = 7;
+const NZ: usize = 8;
 
 /// The states a Model Exchange instance reaches.
 const REACHABLE: [State; 6] = [
@@ -102,7 +102,7 @@ pub unsafe fn call(c: fmi2Component, f: Function, valid: bool) -> (String, fmi2S
         Function::GetEventIndicators => {
             if valid {
                 (
-                    "fmi2GetEventIndicators(ni 7)".into(),
+                    "fmi2GetEventIndicators(ni 8)".into(),
                     fmi2GetEventIndicators(c, z.as_mut_ptr(), NZ),
                 )
             } else {

@@ -231,6 +231,10 @@ pub struct ModelExchangeInfo {
     /// In the order of the state vector of `fmi2GetContinuousStates`.
     pub states: &'static [ContinuousState],
     pub event_indicators: usize,
+    /// Whether the model updates a memory in `fmi2CompletedIntegratorStep` (FMI 2.0's
+    /// `completedIntegratorStepNotNeeded` is its negation, FMI 3.0's
+    /// `needsCompletedIntegratorStep` the same); the call never asks for an event either way.
+    pub needs_completed_integrator_step: bool,
 }
 
 impl ModelInfo {

@@ -344,8 +344,11 @@ fn write_xml(info: &ModelInfo, guid: &str) -> String {
     if info.model_exchange.is_some() {
         let _ = writeln!(
             w,
-            r#"  <ModelExchange modelIdentifier="{}" completedIntegratorStepNotNeeded="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canNotUseMemoryManagementFunctions="true" providesDirectionalDerivative="false"/>"#,
-            e(info.model_identifier)
+            r#"  <ModelExchange modelIdentifier="{}" completedIntegratorStepNotNeeded="{}" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canNotUseMemoryManagementFunctions="true" providesDirectionalDerivative="false"/>"#,
+            e(info.model_identifier),
+            !info
+                .model_exchange
+                .map_or(false, |me| me.needs_completed_integrator_step)
         );
     }
     let _ = writeln!(

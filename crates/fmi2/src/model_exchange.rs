@@ -25,6 +25,7 @@ pub fn me_info<M: CoSimModel>() -> &'static ModelExchangeInfo {
     static NONE: ModelExchangeInfo = ModelExchangeInfo {
         states: &[],
         event_indicators: 0,
+        needs_completed_integrator_step: false,
     };
     M::info().model_exchange.unwrap_or(&NONE)
 }
@@ -228,7 +229,8 @@ pub unsafe fn enter_continuous_time_mode_as<M: ModelExchangeModel, K: Call>(c: f
     })
 }
 
-/// `fmi2CompletedIntegratorStep`: never asks for an event (`completedIntegratorStepNotNeeded`).
+/// `fmi2CompletedIntegratorStep`: the model's update after an accepted step
+/// ([`ModelExchangeModel::completed_integrator_step`]); never asks for an event.
 ///
 /// # Safety
 /// `enter_event_mode` and `terminate_simulation` must be writable.

@@ -180,6 +180,7 @@ static LAG_ME: ModelExchangeInfo = ModelExchangeInfo {
         derivative: 3,
     }],
     event_indicators: 2,
+    needs_completed_integrator_step: false,
 };
 
 #[test]
@@ -214,6 +215,25 @@ fn the_model_description_of_a_model_with_model_exchange_has_its_elements_in_the_
 }
 
 #[test]
+fn a_model_that_updates_a_memory_after_each_step_asks_for_the_completed_integrator_step() {
+    static STEPPED: ModelExchangeInfo = ModelExchangeInfo {
+        needs_completed_integrator_step: true,
+        ..LAG_ME
+    };
+    let with = |me: &'static ModelExchangeInfo| {
+        try_model_description_xml(&ModelInfo {
+            variables: &LAG_VARIABLES,
+            model_exchange: Some(me),
+            units: &[],
+            ..clone_info(M::info())
+        })
+        .unwrap()
+    };
+    assert!(with(&LAG_ME).contains(r#"completedIntegratorStepNotNeeded="true""#));
+    assert!(with(&STEPPED).contains(r#"completedIntegratorStepNotNeeded="false""#));
+}
+
+#[test]
 fn a_state_that_is_not_a_continuous_real_output_or_local_is_a_problem_of_the_table() {
     static BAD: ModelExchangeInfo = ModelExchangeInfo {
         states: &[
@@ -227,6 +247,7 @@ fn a_state_that_is_not_a_continuous_real_output_or_local_is_a_problem_of_the_tab
             },
         ],
         event_indicators: 0,
+        needs_completed_integrator_step: false,
     };
     let info = ModelInfo {
         variables: &LAG_VARIABLES,

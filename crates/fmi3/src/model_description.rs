@@ -76,11 +76,12 @@ fn write_xml(info: &ModelInfo) -> String {
         e(info.version),
         e(info.generation_tool),
     );
-    if me.is_some() {
+    if let Some(me) = me {
         let _ = writeln!(
             w,
-            r#"  <ModelExchange modelIdentifier="{}" canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="false" providesAdjointDerivatives="false" providesPerElementDependencies="false" needsCompletedIntegratorStep="false" providesEvaluateDiscreteStates="false"/>"#,
-            e(info.model_identifier)
+            r#"  <ModelExchange modelIdentifier="{}" canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="false" providesAdjointDerivatives="false" providesPerElementDependencies="false" needsCompletedIntegratorStep="{}" providesEvaluateDiscreteStates="false"/>"#,
+            e(info.model_identifier),
+            me.needs_completed_integrator_step
         );
     }
     let _ = writeln!(

@@ -108,7 +108,8 @@ pub unsafe fn get_number_of_event_indicators<M: ModelExchangeModel>(c: fmi3Insta
     get_number::<M>(c, Function::GetNumberOfEventIndicators, n, value)
 }
 
-/// `fmi3CompletedIntegratorStep`: never asks for an event (`needsCompletedIntegratorStep="false"`).
+/// `fmi3CompletedIntegratorStep`: the model's update after an accepted step
+/// ([`ModelExchangeModel::completed_integrator_step`]); never asks for an event.
 ///
 /// # Safety
 /// `enter_event_mode` and `terminate_simulation` are writable.

@@ -217,6 +217,7 @@ fn with_model_exchange() -> ModelInfo {
     static ME: fmi2::model::ModelExchangeInfo = fmi2::model::ModelExchangeInfo {
         states: &[],
         event_indicators: 2,
+        needs_completed_integrator_step: false,
     };
     let mut info = clone_info(&DUMMY_INFO);
     info.model_exchange = Some(&ME);
@@ -238,6 +239,7 @@ fn the_description_has_an_independent_time_and_the_event_indicators_as_variables
     let info = with_model_exchange();
     let xml = model_description_xml(&info);
     assert!(xml.contains("<ModelExchange"));
+    assert!(xml.contains(r#"needsCompletedIntegratorStep="false""#));
     for k in 1..=2 {
         let vr = t + k;
         assert!(
@@ -249,4 +251,16 @@ fn the_description_has_an_independent_time_and_the_event_indicators_as_variables
             "{xml}"
         );
     }
+}
+
+#[test]
+fn a_model_that_updates_a_memory_after_each_step_says_it_needs_the_completed_integrator_step() {
+    static STEPPED: fmi2::model::ModelExchangeInfo = fmi2::model::ModelExchangeInfo {
+        states: &[],
+        event_indicators: 1,
+        needs_completed_integrator_step: true,
+    };
+    let mut info = clone_info(&DUMMY_INFO);
+    info.model_exchange = Some(&STEPPED);
+    assert!(model_description_xml(&info).contains(r#"needsCompletedIntegratorStep="true""#));
 }

@@ -425,6 +425,13 @@ impl Simulation {
         &self.model
     }
 
+    /// The jet_pipe_hysteresis operator's memory (its plays, or the Bouc–Wen law's input and
+    /// output where it was last advanced), when the effect is on: what Model Exchange starts
+    /// its own from.
+    pub fn hysteresis_memory(&self) -> Option<[f64; PLAY_OPERATORS]> {
+        self.model.hysteresis.is_active().then_some(self.plays)
+    }
+
     /// The integrators' work so far.
     pub fn statistics(&self) -> Statistics {
         self.statistics
