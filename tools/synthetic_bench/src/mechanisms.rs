@@ -137,6 +137,10 @@
 //! * `position_sign_force` (`mechanics`/`extra_force`, k, with `position_sign_origin` x₀):
 //!   the force gains k (x_s − x₀) tanh(v / 1 mm/s) with the stopper's own velocity.
 //!   `chamber_1_pressure_force` (`mechanics`/`extra_force`, μ): it gains μ (P1 − P_r).
+//! * `direction_friction_out`, `direction_friction_in` (`mechanics`/`asymmetry`, F_o, F_i): a
+//!   friction whose level depends on the direction of the stopper's travel, the force losing
+//!   F_o s⁺ + F_i s⁻ with s = tanh(v / 0.2 mm/s), s⁺ = max(s, 0), s⁻ = min(s, 0) (a seal that
+//!   grips harder one way); either level may be 0 (a friction one way only).
 //! * `current_offset_direction` (`current_driver`/`asymmetry`, d): the driver's offset is
 //!   i_offset + d tanh(v / 0.5 mm/s) with the stopper's own velocity.
 //!   `current_offset_ripple` (`current_driver`/`periodic`, r, with
@@ -302,6 +306,11 @@ pub struct UndeclaredEffects {
     pub position_sign_force: f64,
     /// Its origin x₀ (m).
     pub position_sign_origin: f64,
+    /// `mechanics`/`asymmetry`: a friction of level F_o (N) while the stopper moves out (v > 0)
+    /// and F_i (N) while it moves in, F_o s⁺ + F_i s⁻ taken from the force with
+    /// s = tanh(v / 0.2 mm/s); 0 = none.
+    pub direction_friction_out: f64,
+    pub direction_friction_in: f64,
     /// `current_driver`/`asymmetry`: the current driver's offset differs with the direction of
     /// the stopper's travel, i_offset + d tanh(v / 0.5 mm/s), v the stopper's own velocity (a
     /// pick-up from the stopper drive's direction line); d in A; 0 = none.

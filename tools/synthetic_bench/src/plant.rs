@@ -445,6 +445,10 @@ impl Model {
         if u.position_sign_force != 0.0 {
             fp += u.position_sign_force * (xs - u.position_sign_origin) * (xs_dot / 1e-3).tanh();
         }
+        if u.direction_friction_out != 0.0 || u.direction_friction_in != 0.0 {
+            let s = (xs_dot / 0.2e-3).tanh();
+            fp -= u.direction_friction_out * s.max(0.0) + u.direction_friction_in * s.min(0.0);
+        }
         if u.chamber_1_pressure_force != 0.0 {
             fp += u.chamber_1_pressure_force * (y[S_P1] - self.p.p_return);
         }

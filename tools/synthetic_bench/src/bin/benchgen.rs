@@ -221,6 +221,13 @@ struct Cli {
     /// With --position-sign-force: its origin x0, m (e.g. 0.054).
     #[arg(long, allow_hyphen_values = true)]
     position_sign_origin: Option<f64>,
+    /// A friction while the stopper moves out (its velocity positive), N (e.g. 2): with
+    /// --direction-friction-in, a friction whose level depends on the direction of travel.
+    #[arg(long)]
+    direction_friction_out: Option<f64>,
+    /// A friction while the stopper moves in, N (e.g. 0.5).
+    #[arg(long)]
+    direction_friction_in: Option<f64>,
     /// A force on the piston μ (P1 − P_r) (chamber 1's pressure on an annulus the thesis leaves
     /// out): μ, m², of either sign (e.g. 1e-6).
     #[arg(long, allow_hyphen_values = true)]
@@ -330,6 +337,8 @@ fn main() -> ExitCode {
     set(&mut und.position_sign_force, cli.position_sign_force);
     set(&mut und.position_sign_origin, cli.position_sign_origin);
     set(&mut und.chamber_1_pressure_force, cli.chamber_1_pressure_force);
+    set(&mut und.direction_friction_out, cli.direction_friction_out);
+    set(&mut und.direction_friction_in, cli.direction_friction_in);
     set(&mut und.force_sensor_filter_frequency, cli.force_sensor_filter);
     set(&mut und.force_sensor_filter_damping, cli.force_sensor_filter_damping);
     set(&mut und.pressure_sensor_filter_1, cli.pressure_sensor_filter_1);
@@ -376,6 +385,8 @@ fn main() -> ExitCode {
         und.command_filter_frequency,
         und.command_filter_damping,
         und.friction_smoothing_velocity,
+        und.direction_friction_out,
+        und.direction_friction_in,
     ]
     .iter()
     .any(|&x| !x.is_finite() || x < 0.0)
