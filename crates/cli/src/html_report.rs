@@ -503,6 +503,34 @@ fn split_and_checks_section(report: &Value) -> String {
         }
         html.push_str("</ul>");
     }
+    html.push_str(&glitches_table(report));
+    html
+}
+
+/// The glitches of the recording, each where it is (marked on the residual figure too).
+fn glitches_table(report: &Value) -> String {
+    let Some(rows) = report["glitches"].as_array().filter(|a| !a.is_empty()) else {
+        return String::new();
+    };
+    let mut html = String::from(
+        "<h3>Glitches in the data</h3><table><tr><th>kind</th><th>column</th><th>from (s)</th><th>to (s)</th><th>samples</th><th>set aside</th></tr>",
+    );
+    for g in rows {
+        html.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td class=n>{}</td><td class=n>{}</td><td class=n>{}</td><td>{}</td></tr>",
+            escape(g["kind"].as_str().unwrap_or("?")),
+            escape(g["column"].as_str().unwrap_or("?")),
+            number(&g["from_s"]).map_or_else(|| "—".into(), |x| format!("{x:.4}")),
+            number(&g["to_s"]).map_or_else(|| "—".into(), |x| format!("{x:.4}")),
+            g["samples"].as_u64().map_or_else(|| "—".into(), |x| x.to_string()),
+            if g["set_aside"].as_bool() == Some(true) {
+                "yes"
+            } else {
+                "no"
+            },
+        ));
+    }
+    html.push_str("</table>");
     html
 }
 
@@ -888,5 +916,25 @@ mod tests {
         report["withdrawn"]["kept"] = serde_json::json!([]);
         let html = additions_section(&report);
         assert!(html.contains("the model reported is the starting model"), "{html}");
+    }
+
+    #[test]
+    fn the_page_lists_each_glitch_and_says_nothing_of_glitches_when_there_are_none() {
+        let report = serde_json::json!({
+            "input_checks": [],
+            "glitches": [
+                {"kind": "spike", "column": "force_N", "from_s": 3.1234, "to_s": 3.1234, "samples": 1, "set_aside": true},
+                {"kind": "gap", "column": "time_s", "from_s": 8.499, "to_s": 8.501, "samples": 1, "set_aside": false}
+            ]
+        });
+        let html = split_and_checks_section(&report);
+        assert!(html.contains("<h3>Glitches in the data</h3>"), "{html}");
+        assert!(
+            html.contains("<td>spike</td><td>force_N</td><td class=n>3.1234</td>"),
+            "{html}"
+        );
+        assert!(html.contains("<td>gap</td><td>time_s</td><td class=n>8.4990</td><td class=n>8.5010</td><td class=n>1</td><td>no</td>"), "{html}");
+        let clean = serde_json::json!({"input_checks": [], "glitches": []});
+        assert!(!split_and_checks_section(&clean).contains("Glitches"));
     }
 }

@@ -49,6 +49,7 @@ const REPLAY_TOLERANCE: f64 = 1e-5;
 const MEASURED: RGBColor = RGBColor(0, 0, 0);
 const BEFORE: RGBColor = RGBColor(214, 39, 40);
 const AFTER: RGBColor = RGBColor(31, 119, 180);
+const GLITCH: RGBColor = RGBColor(148, 103, 189);
 const MEASURED_OPACITY: f64 = 0.45;
 const WIDTH: u32 = 900;
 const LEGEND_HEIGHT: u32 = 34;
@@ -366,20 +367,40 @@ fn residual_over_time(recording: &Recording, diagnosis: &Diagnosis) -> Result<Fi
         format!("after: RMS {:.4} N", diagnosis.after.rms),
     );
     let noise = diagnosis.noise_floor;
-    let svg = svg(560, &[&before, &after], 2, |areas| {
+    // The glitches set aside, marked where they are on each residual.
+    let marks = |model: &[f64]| -> Series {
+        let r = residual(model);
+        let points = diagnosis
+            .glitches
+            .iter()
+            .filter(|g| g.sets_aside())
+            .filter_map(|g| {
+                let k = t.partition_point(|&x| x < g.from_s);
+                r.get(k).map(|&y| (g.from_s, y))
+            })
+            .collect();
+        Series::means(points, GLITCH, "glitches set aside (not fitted, not scored)")
+    };
+    let (before_marks, after_marks) = (marks(&diagnosis.before_force), marks(&diagnosis.after_force));
+    let legend: Vec<&Series> = if diagnosis.glitches.iter().any(|g| g.sets_aside()) {
+        vec![&before, &after, &after_marks]
+    } else {
+        vec![&before, &after]
+    };
+    let svg = svg(560, &legend, 2, |areas| {
         panel(
             &areas[0],
             "residual before (measured − model)",
             "time (s)",
             "residual (N)",
-            &[&before],
+            &[&before, &before_marks],
         )?;
         panel(
             &areas[1],
             &format!("residual after (noise floor {noise:.4} N)"),
             "time (s)",
             "residual (N)",
-            &[&after],
+            &[&after, &after_marks],
         )
     })?;
     Ok(Figure {

@@ -392,9 +392,10 @@ pub fn sentence(glitches: &[Glitch]) -> Option<String> {
                 )
             }
             GlitchKind::Gap => format!(
-                "{} gap{} in time ({samples} samples missing)",
+                "{} gap{} in time ({samples} sample{} missing)",
                 of_kind.len(),
-                plural(of_kind.len())
+                plural(of_kind.len()),
+                plural(samples)
             ),
             GlitchKind::RepeatedRow => format!(
                 "{samples} row{} repeating the row before exactly (dropped)",
