@@ -1,6 +1,9 @@
 //! What every stage of a diagnosis reads: the recording, its blocks, the noise floors and the options.
 
 use crate::input::blocks::Block;
+use crate::input::noise::noise_floor;
+use crate::input::noise::varying;
+use crate::input::noise::VaryingNoise;
 use crate::input::recording::Recording;
 use crate::replay::replay_fast;
 use crate::replay::signals::difference;
@@ -65,6 +68,9 @@ pub(crate) struct Context<'a> {
     /// Where the replays drive the stopper with smoothed positions, the residual limit of
     /// the smoothing ([`crate::input::recording::smoothed_stopper_positions`]), m².
     pub(crate) stopper_smoothing: Option<f64>,
+    /// Which channels' noise is not steady ([`crate::input::noise::varying`]): their floors are
+    /// the RMS of the local level, and stay so when taken again after an addition.
+    pub(crate) noise_varies: [bool; CHANNELS],
 }
 
 impl<'a> Context<'a> {
@@ -83,26 +89,66 @@ impl<'a> Context<'a> {
         // The noise floors from every sample. A sharp line (a pick-up) is a departure to
         // find, not noise.
         let sample_rate = full.sample_rate();
-        let floor =
-            |x: &[f64]| crate::input::noise::noise_floor(&crate::input::lines::without_lines(x, sample_rate, 3));
         // A signal that curves within a few samples (a 20 Hz multisine or a shaken stopper
         // sampled at 250 Hz) lifts the floor of the recorded channel; the model follows most
         // of it, so the channel's departure from the model keeps the noise alone. A model far
         // off in fast motion lifts the departure's instead: each floor is the lower of the two.
         let modelled = replay_fast(model, full, full.len()).ok();
-        let floor_of = |x: &[f64], channel: fn(&Replay) -> &Vec<f64>| {
-            let recorded = floor(x);
-            match &modelled {
-                Some(m) if channel(m).len() == x.len() => recorded.min(floor(&difference(x, channel(m)))),
-                _ => recorded,
+        // Noise whose level varies (growing with the signal, wandering in time) has for its
+        // floor the RMS of its local level, where both the channel and its departure from
+        // the model show the variation (a departure alone that varies is the model's error).
+        let floor_of = |x: &[f64], channel: fn(&Replay) -> &Vec<f64>| -> (f64, Option<VaryingNoise>) {
+            let recorded = crate::input::lines::without_lines(x, sample_rate, 3);
+            let departure = match &modelled {
+                Some(m) if channel(m).len() == x.len() => Some(crate::input::lines::without_lines(
+                    &difference(x, channel(m)),
+                    sample_rate,
+                    3,
+                )),
+                _ => None,
+            };
+            let quantile = departure
+                .as_ref()
+                .map_or(noise_floor(&recorded), |d| noise_floor(&recorded).min(noise_floor(d)));
+            let varies = match (varying(&recorded, x), departure.as_ref().map(|d| varying(d, x))) {
+                (Some(r), None) => Some(r),
+                (Some(r), Some(Some(d))) => Some(if d.rms < r.rms { d } else { r }),
+                _ => None,
+            };
+            match varies {
+                Some(v) if v.rms > quantile => (v.rms, Some(v)),
+                _ => (quantile, None),
             }
         };
-        let noise = floor_of(&full.force, |m| &m.force);
+        let (noise, force_varies) = floor_of(&full.force, |m| &m.force);
+        let mut varies = [force_varies, None, None];
         let pressure_noise = match (&full.p1, &full.p2) {
-            (Some(a), Some(b)) => Some([floor_of(a, |m| &m.p1), floor_of(b, |m| &m.p2)]),
+            (Some(a), Some(b)) => {
+                let ((first, first_varies), (second, second_varies)) = (floor_of(a, |m| &m.p1), floor_of(b, |m| &m.p2));
+                varies[1] = first_varies;
+                varies[2] = second_varies;
+                Some([first, second])
+            }
             _ => None,
         };
         drop(modelled);
+        for (name, unit, v) in [
+            ("force", "N", varies[0]),
+            ("P1", "Pa", varies[1]),
+            ("P2", "Pa", varies[2]),
+        ] {
+            if let Some(v) = v {
+                let message = format!(
+                    "The {name} channel's noise is not steady: its local level runs from {:.4} to {:.4} {unit} (tenth to ninetieth percentile over 64-sample windows), {}; its noise floor is the RMS of that level, {:.4} {unit}, and explained means within 1.5 times it.",
+                    v.lowest,
+                    v.highest,
+                    if v.follows_level { "growing with the channel's level" } else { "wandering in time" },
+                    v.rms
+                );
+                progress(&message);
+                input_checks.push(message);
+            }
+        }
         if n < full.len() {
             let message = format!(
                 "The fits use {n} of the {} samples: stretches of {} s spread over the whole recording. The errors reported are of every sample, and so are the noise floors but for one taken again on the stretches after an addition.",
@@ -152,6 +198,7 @@ impl<'a> Context<'a> {
             mechanical_noise: noise,
             piston_area: 0.0,
             stopper_smoothing: None,
+            noise_varies: varies.map(|v| v.is_some()),
         })
     }
 
@@ -185,11 +232,17 @@ impl<'a> Context<'a> {
         let with = replay_fast(&Actuator::new(params.clone())?, self.recording, self.n)?;
         *replays += 1;
         let sample_rate = self.recording.sample_rate();
-        let floor = |x: &[f64], m: &[f64]| {
-            crate::input::noise::noise_floor(&crate::input::lines::without_lines(&difference(x, m), sample_rate, 3))
+        let varies = self.noise_varies;
+        let floor = |x: &[f64], m: &[f64], channel: usize| {
+            let departure = crate::input::lines::without_lines(&difference(x, m), sample_rate, 3);
+            let quantile = noise_floor(&departure);
+            match varies[channel].then(|| varying(&departure, x)).flatten() {
+                Some(v) if v.rms > quantile => v.rms,
+                _ => quantile,
+            }
         };
         // Lower by a hundredth at least: the same floor again is no news.
-        let force = floor(&self.recording.force, &with.force);
+        let force = floor(&self.recording.force, &with.force, FORCE);
         if force < 0.99 * self.noise {
             progress(&format!(
                 "force noise floor {force:.4} N from the departure after the additions (was {:.4} N)",
@@ -200,7 +253,7 @@ impl<'a> Context<'a> {
         }
         if let (Some(p), Some(p1), Some(p2)) = (self.pressure_noise.as_mut(), &self.recording.p1, &self.recording.p2) {
             for (c, (x, m)) in [(p1, &with.p1), (p2, &with.p2)].into_iter().enumerate() {
-                let lower = floor(x, m);
+                let lower = floor(x, m, c + 1);
                 if lower < 0.99 * p[c] {
                     p[c] = lower;
                     self.channel_noise[c + 1] = lower;

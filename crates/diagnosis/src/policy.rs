@@ -25,6 +25,12 @@ pub const STUCK_SAMPLES: usize = 10;
 /// A step in time longer than this many median steps is a gap (a dropped sample doubles one).
 pub const GAP_STEPS: f64 = 1.5;
 
+/// A channel's noise is not steady when its local level's ninetieth percentile over windows
+/// of 64 samples is this many times its tenth (white noise of one level: about 1.2). Its
+/// floor is then the RMS of its local level, what a model without error leaves, so that
+/// `explained` still means within [`EXPLAINED_WITHIN_NOISE`] of the noise measured.
+pub const NOISE_VARIES: f64 = 1.6;
+
 /// The most places a report names as not told apart (`tied_locations`).
 pub const MOST_TIED_LOCATIONS: usize = 3;
 /// A named effect must lower the held-out force error by this fraction…

@@ -64,6 +64,94 @@ pub fn noise_floor(x: &[f64]) -> f64 {
     (kept / quantile_over_mean(z) / 6.0).sqrt()
 }
 
+/// Windows either side whose median gives a window's local noise level.
+const LEVEL_NEIGHBOURS: usize = 5;
+
+/// The local noise level of `x` (σ) in each window of [`WINDOW`] samples: from its fourth
+/// differences (variance 70 σ² for white noise), which a signal slow against the sampling
+/// leaves nearly alone, the median over the window and [`LEVEL_NEIGHBOURS`] either side, so
+/// that a step or a kink lifts no window. Empty when `x` is too short for five windows.
+pub fn local_levels(x: &[f64]) -> Vec<f64> {
+    if x.len() < 5 * WINDOW + 4 {
+        return vec![];
+    }
+    let fourth: Vec<f64> = x
+        .windows(5)
+        .map(|w| w[4] - 4.0 * w[3] + 6.0 * w[2] - 4.0 * w[1] + w[0])
+        .collect();
+    let squares: Vec<f64> = fourth
+        .chunks_exact(WINDOW)
+        .map(|c| c.iter().map(|d| d * d).sum::<f64>() / (70.0 * WINDOW as f64))
+        .collect();
+    (0..squares.len())
+        .map(|w| {
+            let from = w.saturating_sub(LEVEL_NEIGHBOURS);
+            let to = (w + LEVEL_NEIGHBOURS + 1).min(squares.len());
+            let mut around = squares[from..to].to_vec();
+            let mid = around.len() / 2;
+            around.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1.sqrt()
+        })
+        .collect()
+}
+
+/// Noise whose level is not steady: the local level's tenth and ninetieth percentiles over
+/// the windows, its RMS over the recording (the noise a model without error leaves), and
+/// whether it follows the channel's level or wanders in time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VaryingNoise {
+    pub lowest: f64,
+    pub highest: f64,
+    pub rms: f64,
+    pub follows_level: bool,
+}
+
+/// How the noise of `x` (a channel, or its departure from a model) varies, when its local
+/// level's ninetieth percentile is more than [`crate::policy::NOISE_VARIES`] times its tenth;
+/// `None` for noise of a steady level. `level` is the channel itself, whose size the noise
+/// may follow.
+pub fn varying(x: &[f64], level: &[f64]) -> Option<VaryingNoise> {
+    let levels = local_levels(x);
+    if levels.len() < 10 {
+        return None;
+    }
+    let mut sorted = levels.clone();
+    sorted.sort_by(|a, b| a.total_cmp(b));
+    let at = |q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
+    let (lowest, highest) = (at(0.1), at(0.9));
+    if highest.is_nan() || highest <= crate::policy::NOISE_VARIES * lowest {
+        return None;
+    }
+    let rms = (levels.iter().map(|l| l * l).sum::<f64>() / levels.len() as f64).sqrt();
+    let magnitude: Vec<f64> = level
+        .chunks_exact(WINDOW)
+        .take(levels.len())
+        .map(|c| c.iter().map(|v| v.abs()).sum::<f64>() / WINDOW as f64)
+        .collect();
+    let follows_level = correlation(&levels[..magnitude.len()], &magnitude).abs() > 0.5;
+    Some(VaryingNoise {
+        lowest,
+        highest,
+        rms,
+        follows_level,
+    })
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()) as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        ab += (x - ma) * (y - mb);
+        aa += (x - ma) * (x - ma);
+        bb += (y - mb) * (y - mb);
+    }
+    if aa > 0.0 && bb > 0.0 {
+        ab / (aa * bb).sqrt()
+    } else {
+        0.0
+    }
+}
+
 /// The step to which `x` is quantised, if it looks quantised: the largest of the smallest
 /// step between samples (the one at the first percentile) and its whole fractions down to a
 /// tenth of which nine in ten of the nonzero steps are whole multiples, or else the smallest
@@ -231,6 +319,41 @@ mod tests {
         }
         let sigma = noise_floor(&x);
         assert!((sigma - 0.05).abs() < 0.05 * 0.05, "{sigma}");
+    }
+
+    #[test]
+    fn white_noise_of_one_level_under_a_slow_signal_does_not_vary() {
+        for seed in 1..=10 {
+            for lsb in [0.0, 0.0153] {
+                let x = bench_like(seed, 0.05, lsb);
+                assert_eq!(varying(&x, &x), None, "seed {seed}, lsb {lsb}");
+            }
+        }
+    }
+
+    #[test]
+    fn noise_growing_with_the_level_or_wandering_in_time_varies_and_says_which() {
+        let e = normals(3, 80_000);
+        let level: Vec<f64> = (0..80_000)
+            .map(|k| 45.0 + 30.0 * (0.3 * k as f64 * 1e-3).sin())
+            .collect();
+        let growing: Vec<f64> = level.iter().zip(&e).map(|(l, e)| l + 0.004 * l * e).collect();
+        let v = varying(&growing, &growing).expect("varies");
+        assert!(v.follows_level);
+        let truth = (level.iter().map(|l| (0.004 * l).powi(2)).sum::<f64>() / level.len() as f64).sqrt();
+        assert!((v.rms / truth - 1.0).abs() < 0.1, "{} against {truth}", v.rms);
+        assert!(v.lowest < 0.004 * 25.0 && v.highest > 0.004 * 65.0, "{v:?}");
+
+        let wandering: Vec<f64> = level
+            .iter()
+            .zip(&e)
+            .enumerate()
+            .map(|(k, (l, e))| l + 0.05 * (1.0 + 0.8 * (2.0 * std::f64::consts::PI * k as f64 * 1e-3 / 7.0).sin()) * e)
+            .collect();
+        let v = varying(&wandering, &wandering).expect("varies");
+        assert!(!v.follows_level, "{v:?}");
+        let truth = 0.05 * (1.0f64 + 0.32).sqrt();
+        assert!((v.rms / truth - 1.0).abs() < 0.1, "{} against {truth}", v.rms);
     }
 
     #[test]

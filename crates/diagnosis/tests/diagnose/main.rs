@@ -29,6 +29,7 @@ mod curves;
 mod flows;
 mod glitches;
 mod modulations;
+mod noise;
 mod protocols;
 mod search;
 mod shared;
