@@ -16,10 +16,10 @@
 //!   of the two lines; and the samples either side of a spike are closer to each other than
 //!   to it, where those either side of a step are not;
 //! - a **repeated**, **stuck** or **clipped** stretch is a run of exactly equal values in a
-//!   measured channel that its noise makes improbable: fewer than one such run in a hundred
-//!   recordings, given how often the channel repeats a value around it. A rounded channel
-//!   repeats values naturally where it is quiet, and there its noise may be below its
-//!   rounding: only a run of [`STUCK_SAMPLES`] repeats counts there. It is clipped
+//!   measured channel that is improbable: fewer than one such run in a hundred recordings,
+//!   given how often the channel repeats a value around it. A channel rounded to a step its
+//!   noise hardly exceeds may be quieter than its step for a while: only a run of
+//!   [`STUCK_SAMPLES`] repeats counts there. It is clipped
 //!   when it sits at the channel's highest or lowest value, stuck when it lasts
 //!   [`STUCK_SAMPLES`] samples or more, repeated below that;
 //!   A spike within a sample of an abrupt change of the inputs (a command step, a kink of the
@@ -168,20 +168,19 @@ fn runs(values: &mut [f64], noise: f64, time: &[f64], column: &'static str, rang
     let repeats = values.windows(2).filter(|w| w[1] == w[0]).count();
     // How often the channel repeats a value by itself: never when it is not rounded (a
     // float of noise), as often as it does when rounded coarser than a small part of it.
-    // A rounded channel repeats values most where it is quietest, and its noise there may be
-    // below its rounding: its rate is taken around each run, and only a run of
-    // [`STUCK_SAMPLES`] is a glitch (a single repeat is one only in an unrounded channel).
+    // A channel written to a few decimals repeats values where it is quiet: the rate of
+    // repeats is taken around each run (and over the whole, the run left out). A channel
+    // rounded to a step its noise hardly exceeds may be quieter than its step for a while:
+    // there only a run of [`STUCK_SAMPLES`] is a glitch.
     let rounded = quantisation_step(values).map_or(false, |q| q > 1e-3 * noise) || repeats * 1000 > n;
     let shortest = if rounded { STUCK_SAMPLES + 1 } else { 2 };
     let repeated: Vec<bool> = (0..n).map(|k| k > 0 && values[k] == values[k - 1]).collect();
     let natural_around = |from: usize, to: usize| -> f64 {
-        if !rounded {
-            return 0.0;
-        }
         let (a, b) = (from.saturating_sub(RATE_WINDOW), (to + RATE_WINDOW).min(n));
         let outside = (a..from).chain(to..b);
         let count = outside.clone().count().max(1);
-        (outside.filter(|&k| repeated[k]).count() as f64 / count as f64).max(repeats as f64 / n as f64)
+        let elsewhere = repeats.saturating_sub(to - from - 1) as f64 / n as f64;
+        (outside.filter(|&k| repeated[k]).count() as f64 / count as f64).max(elsewhere)
     };
     let mut found = vec![];
     let mut k = 0;
@@ -276,8 +275,9 @@ fn spikes(values: &mut [f64], noise: f64, time: &[f64], column: &'static str, ev
 }
 
 /// Whether the sample `k` strays from the cubic through its neighbours by a quarter more than
-/// they do from theirs (a spike's neighbours stray by two thirds of it, a step's by as much
-/// as its edge),
+/// they do from theirs and twice as much as the samples two away (a spike's neighbours stray
+/// by two thirds of it and those two away by a sixth; a step's by as much as its edge, a
+/// ringing at half the sampling rate's by as much every other sample),
 /// and with `k` on that cubic its neighbours lie on their cubics within a quarter of its
 /// departure (a step's would not: its edge moves along).
 fn isolated(values: &[f64], k: usize) -> bool {
@@ -285,13 +285,16 @@ fn isolated(values: &[f64], k: usize) -> bool {
     let departure = |x: &[f64], j: usize| x[j] - cubic_between(&x[j - 2..=j + 2]);
     let own = departure(values, k).abs();
     let others = (k.saturating_sub(2).max(2)..=(k + 2).min(n - 3)).filter(|&j| j != k);
-    if others.clone().any(|j| 1.25 * departure(values, j).abs() > own) {
+    if others.clone().any(|j| {
+        let bar = if j + 1 == k || j == k + 1 { 1.25 } else { 2.0 };
+        bar * departure(values, j).abs() > own
+    }) {
         return false;
     }
-    let mut repaired = values[k.saturating_sub(4)..(k + 5).min(n)].to_vec();
-    let at = k - k.saturating_sub(4);
+    let mut repaired = values[k.saturating_sub(5)..(k + 6).min(n)].to_vec();
+    let at = k - k.saturating_sub(5);
     repaired[at] = cubic_between(&repaired[at - 2..=at + 2]);
-    (at.saturating_sub(1).max(2)..=(at + 1).min(repaired.len() - 3))
+    (at.saturating_sub(2).max(2)..=(at + 2).min(repaired.len() - 3))
         .filter(|&j| j != at)
         .all(|j| departure(&repaired, j).abs() <= 0.25 * own)
 }
