@@ -136,12 +136,40 @@ pub fn varying(x: &[f64], level: &[f64]) -> Option<VaryingNoise> {
         .map(|c| c.iter().map(|v| v.abs()).sum::<f64>() / WINDOW as f64)
         .collect();
     let follows_level = correlation(&levels[..magnitude.len()], &magnitude).abs() > 0.5;
+    // Noise that wanders does so slowly: most of its level's variance stays in a mean over
+    // a few seconds. A level that changes from window to window is a signal's activity.
+    if !follows_level && slow_share(&levels) < SLOW_SHARE {
+        return None;
+    }
     Some(VaryingNoise {
         lowest,
         highest,
         rms,
         follows_level,
     })
+}
+
+/// Windows either side of the running mean that keeps a wandering level.
+const WANDER_WINDOWS: usize = 16;
+
+/// The share of a level's variance a wander keeps in its running mean.
+const SLOW_SHARE: f64 = 0.6;
+
+/// The variance of the running mean over [`WANDER_WINDOWS`] either side, over the variance.
+fn slow_share(levels: &[f64]) -> f64 {
+    let n = levels.len();
+    let mean = levels.iter().sum::<f64>() / n as f64;
+    let variance = levels.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / n as f64;
+    if variance <= 0.0 {
+        return 0.0;
+    }
+    let smooth: Vec<f64> = (0..n)
+        .map(|w| {
+            let (a, b) = (w.saturating_sub(WANDER_WINDOWS), (w + WANDER_WINDOWS + 1).min(n));
+            levels[a..b].iter().sum::<f64>() / (b - a) as f64
+        })
+        .collect();
+    smooth.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / n as f64 / variance
 }
 
 fn correlation(a: &[f64], b: &[f64]) -> f64 {
