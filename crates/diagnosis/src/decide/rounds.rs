@@ -167,6 +167,7 @@ pub(crate) fn run_rounds(
             }
             other => other,
         };
+        let earlier = (f.effects.len(), f.discovered.len());
         match added {
             Some(Addition::Discovered(term, trial, _)) => {
                 match f.discovered.iter().position(|d| same_term(d, &term)) {
@@ -222,6 +223,18 @@ pub(crate) fn run_rounds(
                 f.localization = Some(found);
                 break;
             }
+        }
+        // How clearly the place of each addition this round made won in its localization.
+        for (place, margin) in f.effects[earlier.0..]
+            .iter_mut()
+            .map(|e| (e.location, &mut e.margin))
+            .chain(
+                f.discovered[earlier.1..]
+                    .iter_mut()
+                    .map(|d| (d.location, &mut d.margin)),
+            )
+        {
+            *margin = found.margin(place);
         }
         // Each addition was fitted with those before it held. Refitting them together now,
         // not only at the end, lets the next round start from where they explain most: a
@@ -546,6 +559,8 @@ fn add_effect(
             crate::decide::named_rivals::rivals_of(name, place, s.explained, &found.candidates)
         },
         tied_effects: vec![],
+        intervals: vec![],
+        margin: None,
     })
 }
 
@@ -567,6 +582,8 @@ mod tests {
             share: 0.75,
             pressures_heldout: None,
             tied_locations: vec![],
+            intervals: vec![],
+            margin: None,
         }
     }
 
