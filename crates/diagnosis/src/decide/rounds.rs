@@ -168,6 +168,9 @@ pub(crate) fn run_rounds(
             other => other,
         };
         let earlier = (f.effects.len(), f.discovered.len());
+        // Two terms added as a pair were judged together, against no single place: their
+        // places get no margin.
+        let paired = matches!(added, Some(Addition::Pair(..)));
         match added {
             Some(Addition::Discovered(term, trial, _)) => {
                 match f.discovered.iter().position(|d| same_term(d, &term)) {
@@ -234,7 +237,7 @@ pub(crate) fn run_rounds(
                     .map(|d| (d.location, &mut d.margin)),
             )
         {
-            *margin = found.margin(place);
+            *margin = if paired { None } else { found.margin(place) };
         }
         // Each addition was fitted with those before it held. Refitting them together now,
         // not only at the end, lets the next round start from where they explain most: a
