@@ -60,7 +60,11 @@ fn set_intervals(cx: &Context, found: &mut crate::decide::findings::Findings, pr
     if names.is_empty() {
         return;
     }
-    progress(&format!("95 % intervals of the {} amounts added", names.len()));
+    progress(&format!(
+        "95 % intervals of the {} amount{} added",
+        names.len(),
+        if names.len() == 1 { "" } else { "s" }
+    ));
     let problem = crate::fit::Problem::new(cx.recording, &found.params, &cx.blocks, cx.channel_noise);
     let intervals = match crate::fit::intervals::intervals(&problem, &found.params, &names, cx.options.jobs) {
         Ok((intervals, _)) => intervals,
