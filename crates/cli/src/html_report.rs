@@ -257,10 +257,14 @@ fn slot_code_name(name: &str, value: f64) -> Option<&'static str> {
 /// Tables of more rows than this fold under the sentence that states them.
 const FOLD_ROWS: usize = 8;
 
-fn parameters_table(parameters: &Value, units: Option<&Value>) -> String {
-    let Some(object) = parameters.as_object() else {
+/// An addition's parameters with, where the report has them (`intervals_95`,
+/// `interval_method`), their 95 % intervals: a column that reports written before intervals
+/// do not get.
+fn parameters_table(addition: &Value, units: Option<&Value>) -> String {
+    let Some(object) = addition["parameters"].as_object() else {
         return String::new();
     };
+    let intervals = addition["intervals_95"].as_object();
     let mut rows = String::new();
     for (name, value) in object {
         let unit = slot_unit(name, object)
@@ -275,9 +279,37 @@ fn parameters_table(parameters: &Value, units: Option<&Value>) -> String {
             ),
             None => format!("<td class=n>{}</td>", escape(&value.to_string())),
         };
-        rows.push_str(&format!("<tr><td><code>{}</code></td>{cell}</tr>", escape(name)));
+        let interval = intervals.map(|i| {
+            let bounds = i.get(name).and_then(Value::as_array);
+            match bounds.and_then(|b| Some((number(b.first()?)?, number(b.get(1)?)?))) {
+                Some((low, high)) => format!(
+                    "<td class=n title=\"{} to {}, from the {}\">{} to {}</td>",
+                    escape(&exact(low, unit)),
+                    escape(&exact(high, unit)),
+                    match addition["interval_method"][name].as_str() {
+                        Some("heldout_blocks") => "spread over the held-out blocks",
+                        _ => "curvature of the fit",
+                    },
+                    escape(&amount(low, unit)),
+                    escape(&amount(high, unit)),
+                ),
+                None => "<td class=n>—</td>".to_string(),
+            }
+        });
+        rows.push_str(&format!(
+            "<tr><td><code>{}</code></td>{cell}{}</tr>",
+            escape(name),
+            interval.unwrap_or_default()
+        ));
     }
-    let table = format!("<table><tr><th>parameter</th><th>value</th></tr>{rows}</table>");
+    let table = format!(
+        "<table><tr><th>parameter</th><th>value</th>{}</tr>{rows}</table>",
+        if intervals.is_some() {
+            "<th>95 % interval</th>"
+        } else {
+            ""
+        }
+    );
     if object.len() > FOLD_ROWS {
         format!(
             "<details><summary>the {} parameters that carry it</summary>{table}</details>",
@@ -371,7 +403,7 @@ fn additions_section(report: &Value) -> String {
             escape(e["location"].as_str().unwrap_or("?")),
             escape(e["evidence"].as_str().unwrap_or("")),
         ));
-        html.push_str(&parameters_table(&e["parameters"], None));
+        html.push_str(&parameters_table(e, None));
         html.push_str(&format!(
             "<p>Held-out force error {} → {}: it removes {} of the held-out mean square.{}</p>",
             newtons(&e["heldout_before_rms_N"]),
@@ -382,6 +414,7 @@ fn additions_section(report: &Value) -> String {
                 _ => String::new(),
             }
         ));
+        html.push_str(&margin_sentence(e));
     }
     for d in &discovered {
         html.push_str(&format!(
@@ -391,13 +424,14 @@ fn additions_section(report: &Value) -> String {
             escape(d["family"].as_str().unwrap_or("?")),
             escape(d["reading"].as_str().unwrap_or("")),
         ));
-        html.push_str(&parameters_table(&d["parameters"], Some(&d["units"])));
+        html.push_str(&parameters_table(d, Some(&d["units"])));
         html.push_str(&format!(
             "<p>Held-out force error {} → {}: it removes {} of the held-out mean square.</p>",
             newtons(&d["heldout_before_rms_N"]),
             newtons(&d["heldout_after_rms_N"]),
             percent(&d["share_of_heldout_explained"]),
         ));
+        html.push_str(&margin_sentence(d));
     }
     let joint = &report["joint_refit"];
     if let (Some(_), Some(_)) = (
@@ -414,6 +448,20 @@ fn additions_section(report: &Value) -> String {
     html
 }
 
+/// How clearly an addition's place won, from its `margin_noise_floors`; nothing without one.
+fn margin_sentence(addition: &Value) -> String {
+    match number(&addition["margin_noise_floors"]) {
+        Some(m) if m >= 0.0 => format!(
+            "<p class=margin>Its place won by a margin of {m:.2} noise floors: the next-best place's best candidate left that much more of the held-out error.</p>"
+        ),
+        Some(m) => format!(
+            "<p class=margin>Its place was not the best of its round: another place's best candidate left {:.2} noise floors less of the held-out error.</p>",
+            -m
+        ),
+        None => String::new(),
+    }
+}
+
 fn remainder_section(report: &Value) -> String {
     let u = &report["unexplained"];
     if u.is_null() {
@@ -426,7 +474,7 @@ fn remainder_section(report: &Value) -> String {
     format!(
         "<h2>What stays unexplained ({})</h2><p>{}</p><table><tr><th>location</th><td>{}</td></tr>\
          <tr><th>family</th><td>{}</td></tr><tr><th>alternatives</th><td>{}</td></tr>\
-         <tr><th>RMS</th><td>{} ({:.1}× the noise floor)</td></tr></table>",
+         <tr><th>RMS</th><td>{} ({:.1}× the noise floor)</td></tr>{}</table>",
         escape(u["channel"].as_str().unwrap_or("force")),
         escape(u["sentence"].as_str().unwrap_or("")),
         escape(u["location"].as_str().unwrap_or("?")),
@@ -438,6 +486,9 @@ fn remainder_section(report: &Value) -> String {
         },
         newtons(&u["rms_N"]),
         number(&u["ratio_to_noise"]).unwrap_or(f64::NAN),
+        number(&u["margin_noise_floors"]).map_or_else(String::new, |m| format!(
+            "<tr><th>margin</th><td>{m:.2} noise floors of held-out error over the next-best place</td></tr>"
+        )),
     )
 }
 
@@ -831,7 +882,10 @@ mod tests {
 
     #[test]
     fn a_parameters_cell_shows_the_amount_and_keeps_the_exact_value_in_its_title() {
-        let table = parameters_table(&serde_json::json!({"P_s": 652_925.123_456_789, "C_d": 0.85}), None);
+        let table = parameters_table(
+            &serde_json::json!({"parameters": {"P_s": 652_925.123_456_789, "C_d": 0.85}}),
+            None,
+        );
         assert!(
             table.contains("<td class=n title=\"652925.123456789 Pa\">652.9 kPa</td>"),
             "{table}"
@@ -841,13 +895,32 @@ mod tests {
     }
 
     #[test]
+    fn the_parameters_table_gives_each_interval_in_the_amounts_unit_and_a_dash_where_there_is_none() {
+        let addition = serde_json::json!({
+            "parameters": {"force_sensor_lag": 0.009982, "command_curve_knots": 3},
+            "intervals_95": {"force_sensor_lag": [0.00995, 0.01001], "command_curve_knots": null},
+            "interval_method": {"force_sensor_lag": "heldout_blocks", "command_curve_knots": null},
+            "margin_noise_floors": 1.234,
+        });
+        let table = parameters_table(&addition, None);
+        assert!(table.contains("<th>95 % interval</th>"), "{table}");
+        assert!(table.contains(">9.950 ms to 10.01 ms</td>"), "{table}");
+        assert!(table.contains("from the spread over the held-out blocks"), "{table}");
+        assert!(table.contains("<td class=n>—</td></tr>"), "{table}");
+        assert!(margin_sentence(&addition).contains("a margin of 1.23 noise floors"));
+        let older = parameters_table(&serde_json::json!({"parameters": {"k_cd": 0.036}}), None);
+        assert!(!older.contains("interval"), "a report without intervals: {older}");
+        assert_eq!(margin_sentence(&serde_json::json!({"margin_noise_floors": null})), "");
+    }
+
+    #[test]
     fn a_modulation_slots_knots_read_in_the_units_of_its_signal_and_of_its_constant() {
         let constant = jetpipe_model::variables::vr::F_JP_SAT;
         let table = parameters_table(
-            &serde_json::json!({
+            &serde_json::json!({"parameters": {
                 "modulation_1_parameter": constant, "modulation_1_signal": 5, "modulation_1_knots": 2,
                 "modulation_1_x_1": 0.044, "modulation_1_y_1": -0.0235,
-            }),
+            }}),
             Some(&serde_json::json!({"modulation_1_x_1": "1", "modulation_1_y_1": "1"})),
         );
         assert_eq!(unit_of("F_jp_sat"), "N");

@@ -312,6 +312,24 @@ fn one_recording_with_a_report_path_gets_its_page_beside_the_report_and_chromium
     ] {
         assert!(dom.contains(figure), "no {figure}");
     }
+    // How sure: the hysteresis width's 95 % interval holds its value, the rendered table has
+    // the interval column, and the page says by how much the jet pipe won its place.
+    let effect = &report["effects"][0];
+    let width = effect["parameters"]["hysteresis_width"].as_f64().unwrap();
+    let interval = &effect["intervals_95"]["hysteresis_width"];
+    assert!(
+        interval[0].as_f64().unwrap() < width && width < interval[1].as_f64().unwrap(),
+        "{width} outside {interval}"
+    );
+    assert!(
+        dom.contains("<th>95 % interval</th>"),
+        "the rendered page has no interval column"
+    );
+    assert!(
+        effect["margin_noise_floors"].as_f64().unwrap() > 0.0 && dom.contains("Its place won by a margin of"),
+        "margin {} not shown as a win",
+        effect["margin_noise_floors"]
+    );
     let screenshot = root.join("r.png");
     render(
         &page,

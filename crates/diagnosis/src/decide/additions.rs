@@ -2,6 +2,9 @@
 //! error it removed and the places it cannot be told from.
 
 use crate::candidates::Candidate;
+use crate::fit::intervals::Interval;
+#[cfg(doc)]
+use crate::fit::scored::Localization;
 use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -24,6 +27,12 @@ pub struct AddedEffect {
     /// The named effects this recording cannot tell it from, its own name first; empty when
     /// it tells them apart.
     pub tied_effects: Vec<&'static str>,
+    /// The 95 % interval of each of `parameters`, in their order, taken once on the final
+    /// model ([`crate::fit::intervals`]): empty until then, `None` for an amount without one.
+    pub intervals: Vec<Option<Interval>>,
+    /// How clearly its place won in the round that added it ([`Localization::margin`]), in
+    /// noise floors; `None` where that round ranked no other place.
+    pub margin: Option<f64>,
 }
 
 /// A term outside the named effects that was added (see `discover.rs`).
@@ -45,6 +54,10 @@ pub struct DiscoveredTerm {
     /// The places this recording cannot tell the term's from, its own first (at most
     /// [`crate::policy::MOST_TIED_LOCATIONS`]); empty when it tells the place.
     pub tied_locations: Vec<Place>,
+    /// As [`AddedEffect::intervals`].
+    pub intervals: Vec<Option<Interval>>,
+    /// As [`AddedEffect::margin`].
+    pub margin: Option<f64>,
 }
 
 impl DiscoveredTerm {
@@ -75,6 +88,8 @@ impl DiscoveredTerm {
             share: 1.0 - (after / before).powi(2),
             pressures_heldout: None,
             tied_locations: vec![],
+            intervals: vec![],
+            margin: None,
         }
     }
 }

@@ -185,6 +185,9 @@ fn named_in_place_of(
             remainder_follows: String::new(),
             rivals: vec![],
             tied_effects: vec![],
+            intervals: vec![],
+            // The effect stands at the term's place, which won by as much.
+            margin: term.margin,
         },
         fit.params,
     )))

@@ -189,6 +189,9 @@ fn rival_in_place_of(
             remainder_follows: String::new(),
             rivals: vec![],
             tied_effects: vec![],
+            intervals: vec![],
+            // The rival stands at the same place, which won by as much.
+            margin: effect.margin,
         },
         Box::new(fit.params),
     ))

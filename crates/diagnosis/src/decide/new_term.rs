@@ -205,6 +205,8 @@ pub(crate) fn discover_term(
                 share: 1.0 - (after / force_before).powi(2),
                 pressures_heldout: pressures,
                 tied_locations: found.tied_with(candidate.location),
+                intervals: vec![],
+                margin: None,
             };
             let is_modulation = crate::candidates::modulation::is_modulation(candidate);
             match &modulation {

@@ -167,6 +167,10 @@ pub(crate) fn run_rounds(
             }
             other => other,
         };
+        let earlier = (f.effects.len(), f.discovered.len());
+        // Two terms added as a pair were judged together, against no single place: their
+        // places get no margin.
+        let paired = matches!(added, Some(Addition::Pair(..)));
         match added {
             Some(Addition::Discovered(term, trial, _)) => {
                 match f.discovered.iter().position(|d| same_term(d, &term)) {
@@ -222,6 +226,18 @@ pub(crate) fn run_rounds(
                 f.localization = Some(found);
                 break;
             }
+        }
+        // How clearly the place of each addition this round made won in its localization.
+        for (place, margin) in f.effects[earlier.0..]
+            .iter_mut()
+            .map(|e| (e.location, &mut e.margin))
+            .chain(
+                f.discovered[earlier.1..]
+                    .iter_mut()
+                    .map(|d| (d.location, &mut d.margin)),
+            )
+        {
+            *margin = if paired { None } else { found.margin(place) };
         }
         // Each addition was fitted with those before it held. Refitting them together now,
         // not only at the end, lets the next round start from where they explain most: a
@@ -546,6 +562,8 @@ fn add_effect(
             crate::decide::named_rivals::rivals_of(name, place, s.explained, &found.candidates)
         },
         tied_effects: vec![],
+        intervals: vec![],
+        margin: None,
     })
 }
 
@@ -567,6 +585,8 @@ mod tests {
             share: 0.75,
             pressures_heldout: None,
             tied_locations: vec![],
+            intervals: vec![],
+            margin: None,
         }
     }
 

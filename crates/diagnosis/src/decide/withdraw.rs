@@ -142,6 +142,8 @@ mod tests {
             remainder_follows: String::new(),
             rivals: vec![],
             tied_effects: vec![],
+            intervals: vec![],
+            margin: None,
         }];
         findings::Findings {
             params,
@@ -163,6 +165,8 @@ mod tests {
                 share: 0.2,
                 pressures_heldout: None,
                 tied_locations: vec![],
+                intervals: vec![],
+                margin: None,
             }],
             first_candidates: vec![],
             localization: None,

@@ -335,7 +335,10 @@ pub(crate) fn localize(
     for (l, e, label) in rank(&mut scored).by_location.iter().take(4) {
         progress(&format!("  {l:<16} explains {:5.1} % ({label})", 100.0 * e));
     }
-    (rank(&mut scored), replays)
+    let mut ranked = rank(&mut scored);
+    let measured = problem.weights.iter().filter(|w| **w > 0.0).count().max(1);
+    ranked.before_mean_square = before_total / (heldout_count(problem.blocks) * measured) as f64;
+    (ranked, replays)
 }
 
 /// Whether a candidate is a transducer's lag alone.
@@ -373,6 +376,8 @@ pub(crate) fn rank(scored: &mut [Scored]) -> Localization {
         family,
         by_location,
         candidates: scored.to_vec(),
+        // Set by the caller, which knows the misfit before the candidates.
+        before_mean_square: 0.0,
     }
 }
 
@@ -410,6 +415,7 @@ mod tests {
             family: Family::ParameterOffset,
             by_location,
             candidates: vec![],
+            before_mean_square: 4.0,
         }
     }
 
@@ -454,5 +460,24 @@ mod tests {
         ]);
         assert_eq!(l.undecided_beside(l.location, false), None);
         assert!(l.alternatives().is_empty());
+    }
+
+    #[test]
+    fn the_margin_is_the_next_places_held_out_error_minus_the_winners_in_noise_floors() {
+        // Two noise floors RMS before (4 floors squared a sample): the winner leaves a
+        // quarter of the misfit (one floor), the next place 64 % of it (1.6 floors), the third
+        // all of it.
+        let l = located(vec![
+            (Place::ForceSensor, 0.75, "force sensor lag"),
+            (Place::JetPipe, 0.36, "jet pipe lag"),
+            (Place::Supply, 0.0, "supply pressure"),
+        ]);
+        let winner = l.margin(Place::ForceSensor).unwrap();
+        assert!((winner - 0.6).abs() < 1e-12, "{winner}");
+        // The runner-up is measured against the winner: behind by as much.
+        let runner_up = l.margin(Place::JetPipe).unwrap();
+        assert!((runner_up + 0.6).abs() < 1e-12, "{runner_up}");
+        assert_eq!(l.margin(Place::Valve), None, "no candidate there");
+        assert_eq!(located(vec![(Place::Valve, 0.9, "valve")]).margin(Place::Valve), None);
     }
 }

@@ -39,6 +39,9 @@ pub struct Localization {
     /// Best share explained at each place, best first, with the candidate that did it.
     pub by_location: Vec<(Place, f64, &'static str)>,
     pub candidates: Vec<Scored>,
+    /// The held-out misfit before any candidate, per held-out sample and measured channel,
+    /// in noise floors squared: what turns a share explained into an error, for the margins.
+    pub before_mean_square: f64,
 }
 
 impl Localization {
@@ -86,6 +89,24 @@ impl Localization {
             return vec![];
         }
         std::iter::once(added).chain(others).take(MOST_TIED_LOCATIONS).collect()
+    }
+
+    /// How clearly `place` won: the held-out misfit the best candidate of the next-best place
+    /// leaves, minus the one `place`'s best leaves, each as an RMS in noise floors over the
+    /// held-out samples of every measured channel (with the force alone, the difference of
+    /// the two held-out force errors over its floor). Negative for a place that is not the
+    /// best; `None` when `place` has no candidate or no other place has one. RMS, not mean
+    /// square: a margin of one noise floor then reads the same at 2 floors as at 20.
+    pub fn margin(&self, place: Place) -> Option<f64> {
+        let own = self.by_location.iter().find(|(l, _, _)| *l == place)?.1;
+        let next = self
+            .by_location
+            .iter()
+            .filter(|(l, _, _)| *l != place)
+            .map(|(_, e, _)| *e)
+            .max_by(f64::total_cmp)?;
+        let left = |share: f64| (self.before_mean_square * (1.0 - share)).max(0.0).sqrt();
+        Some(left(next) - left(own))
     }
 
     /// Places that explain nearly as much as the best: they leave at most a quarter more

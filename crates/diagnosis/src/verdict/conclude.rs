@@ -40,6 +40,48 @@ fn drop_terms_at_defaults(found: &mut crate::decide::findings::Findings, progres
     });
 }
 
+/// How sure each amount added is: its 95 % interval at the final model
+/// ([`crate::fit::intervals`]), from that model's replay on the fits' rows and blocks. Taken
+/// after every decision, which none of them reads, and not counted in the report's replays,
+/// so that a report says what it said before it had intervals. A model the moved values
+/// refuse leaves the intervals out, with a line of progress, rather than the report.
+fn set_intervals(cx: &Context, found: &mut crate::decide::findings::Findings, progress: &mut dyn FnMut(&str)) {
+    let mut names: Vec<&'static str> = vec![];
+    for (name, _) in found
+        .effects
+        .iter()
+        .flat_map(|e| e.parameters.iter())
+        .chain(found.discovered.iter().flat_map(|d| d.parameters.iter()))
+    {
+        if !names.contains(name) {
+            names.push(name);
+        }
+    }
+    if names.is_empty() {
+        return;
+    }
+    progress(&format!(
+        "95 % intervals of the {} amount{} added",
+        names.len(),
+        if names.len() == 1 { "" } else { "s" }
+    ));
+    let problem = crate::fit::Problem::new(cx.recording, &found.params, &cx.blocks, cx.channel_noise);
+    let intervals = match crate::fit::intervals::intervals(&problem, &found.params, &names, cx.options.jobs) {
+        Ok((intervals, _)) => intervals,
+        Err(why) => {
+            progress(&format!("  no intervals: {why}"));
+            return;
+        }
+    };
+    let of = |name: &str| names.iter().position(|n| *n == name).and_then(|k| intervals[k]);
+    for e in found.effects.iter_mut() {
+        e.intervals = e.parameters.iter().map(|(name, _)| of(name)).collect();
+    }
+    for d in found.discovered.iter_mut() {
+        d.intervals = d.parameters.iter().map(|(name, _)| of(name)).collect();
+    }
+}
+
 /// The final accurate replay, the verdict (step 6) and the tests of the residual; `start` is
 /// the starting model, its accurate replay and the check of the fits' replay against it.
 pub(crate) fn conclude(
@@ -104,6 +146,7 @@ pub(crate) fn conclude(
         w
     });
     drop_terms_at_defaults(&mut found, progress);
+    set_intervals(cx, &mut found, progress);
     let final_model = Actuator::new(found.params.clone())?;
     let after = after;
     // The additions were scored on the fixed-step replay, checked against the accurate one

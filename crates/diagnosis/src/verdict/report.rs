@@ -1,5 +1,6 @@
 //! The report: the printed summary and the JSON of `jetpipe diagnose --report`.
 
+use crate::fit::intervals::Interval;
 use crate::policy::MOST_TIED_LOCATIONS;
 use crate::replay::errors::Errors;
 use crate::verdict::diagnosis::Diagnosis;
@@ -10,6 +11,41 @@ use serde_json::Value;
 
 fn parameters_json(values: &[(&'static str, f64)]) -> Value {
     Value::Object(values.iter().map(|(n, v)| (n.to_string(), json!(v))).collect())
+}
+
+/// Beside an addition's `parameters`, per amount: `intervals_95` (`[low, high]`),
+/// `interval_method` and `interval_heldout_ratio` (the held-out blocks' standard error over the
+/// curvature's), each `null` for an amount without an interval.
+fn intervals_json(values: &[(&'static str, f64)], intervals: &[Option<Interval>]) -> [(&'static str, Value); 3] {
+    let per_amount = |f: &dyn Fn(&Interval) -> Value| {
+        Value::Object(
+            values
+                .iter()
+                .enumerate()
+                .map(|(k, (n, _))| {
+                    (
+                        n.to_string(),
+                        intervals.get(k).copied().flatten().as_ref().map_or(Value::Null, f),
+                    )
+                })
+                .collect(),
+        )
+    };
+    [
+        ("intervals_95", per_amount(&|i| json!([i.low, i.high]))),
+        ("interval_method", per_amount(&|i| json!(i.method.as_str()))),
+        ("interval_heldout_ratio", per_amount(&|i| json!(i.heldout_ratio))),
+    ]
+}
+
+/// `object` with `fields` added.
+fn with(mut object: Value, fields: impl IntoIterator<Item = (&'static str, Value)>) -> Value {
+    if let Some(map) = object.as_object_mut() {
+        for (key, value) in fields {
+            map.insert(key.to_string(), value);
+        }
+    }
+    object
 }
 
 impl Diagnosis {
@@ -168,7 +204,7 @@ impl Diagnosis {
                 "after_rms_N": self.after.heldout_rms,
                 "settling_s": self.settling,
             },
-            "effects": self.effects.iter().map(|e| json!({
+            "effects": self.effects.iter().map(|e| with(json!({
                 "name": e.name,
                 "location": e.location,
                 "parameters": parameters_json(&e.parameters),
@@ -178,8 +214,8 @@ impl Diagnosis {
                 "remainder_follows": e.remainder_follows,
                 "tied_effects": e.tied_effects,
                 "evidence": e.evidence,
-            })).collect::<Vec<_>>(),
-            "discovered": self.discovered.iter().map(|d| json!({
+            }), intervals_json(&e.parameters, &e.intervals).into_iter().chain([("margin_noise_floors", json!(e.margin))]))).collect::<Vec<_>>(),
+            "discovered": self.discovered.iter().map(|d| with(json!({
                 "location": d.location,
                 "family": d.family,
                 "candidate": d.candidate,
@@ -192,7 +228,7 @@ impl Diagnosis {
                 "pressures_heldout_before_rms_Pa": d.pressures_heldout.map(|(b, _)| b.to_vec()),
                 "pressures_heldout_after_rms_Pa": d.pressures_heldout.map(|(_, a)| a.to_vec()),
                 "tied_locations": d.tied_locations,
-            })).collect::<Vec<_>>(),
+            }), intervals_json(&d.parameters, &d.intervals).into_iter().chain([("margin_noise_floors", json!(d.margin))]))).collect::<Vec<_>>(),
             "calibrated": self.calibrated.iter().map(|c| (c.name.to_string(), json!({
                 "value": c.value,
                 "thesis": c.thesis,
@@ -265,6 +301,7 @@ impl Diagnosis {
                     "signature": u.signature.to_json("N"),
                     "sentence": u.sentence,
                     "channel": if self.force_explained() { "pressures" } else { "force" },
+                    "margin_noise_floors": self.localization.as_ref().and_then(|l| l.margin(u.location)),
                 }),
             );
         }

@@ -10,7 +10,8 @@
 //! * `curves`: the static-curve class at the command and the transducers;
 //! * `search`: compounds and mechanisms that a search locking in on its first choice missed;
 //! * `constants`: a thesis constant of the plant other than the model's, re-identified;
-//! * `modulations`: a constant of the model varying with a signal of the chain.
+//! * `modulations`: a constant of the model varying with a signal of the chain;
+//! * `intervals`: the intervals and margins of a report.
 //!
 //! The test command runs a representative subset: every module, each place of the chain
 //! and each function class at least once. The other cases are `#[ignore]`d with the reason
@@ -28,6 +29,7 @@ mod constants;
 mod curves;
 mod flows;
 mod glitches;
+mod intervals;
 mod modulations;
 mod noise;
 mod protocols;
