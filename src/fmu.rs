@@ -182,8 +182,8 @@ pub static MODEL_INFO: ModelInfo = ModelInfo {
     guid_cache: GuidCache::new(),
 };
 
-/// Model Exchange: the eleven states (the six of (4.1), the volumes' pressures and the mount's
-/// load), the event indicators and the hysteresis memory of the private module
+/// Model Exchange: the twenty-three states (the six of (4.1), the volumes' pressures and the
+/// mount's load, the command stage's and the transducers' lags and filters), the event indicators and the hysteresis memory of the private module
 /// `model_exchange`.
 // The state vector of `model_exchange` is the model description's.
 const _: () = assert!(model_exchange::STATES == CONTINUOUS_STATES.len());
@@ -292,16 +292,19 @@ impl ActuatorFmu {
                     &computed
                 }
             };
-            return model_exchange::state_variable(
-                simulation.model(),
-                simulation.state(),
-                &model_exchange::nodes_of(simulation),
-                simulation.v_da(),
-                simulation.x_s(),
-                simulation.hysteresis_memory().as_ref(),
-                value_reference,
-            )
-            .ok_or_else(|| format!("no Real variable with value reference {value_reference}"));
+            let memory = simulation.hysteresis_memory();
+            let at = model_exchange::At {
+                model: simulation.model(),
+                x: simulation.state(),
+                nodes: &model_exchange::nodes_of(simulation),
+                filters: &model_exchange::filters_of(simulation),
+                v_da: simulation.v_da(),
+                x_s: simulation.x_s(),
+                time: simulation.time(),
+                memory: memory.as_ref(),
+            };
+            return model_exchange::state_variable(&at, value_reference)
+                .ok_or_else(|| format!("no Real variable with value reference {value_reference}"));
         }
         match value_reference {
             vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, Simulation::v_da)),
@@ -643,9 +646,9 @@ impl CoSimModel for ActuatorFmu {
 /// interface and the Model Exchange state; version 6: the modulation slots' parameters;
 /// version 7: the laminar chamber leaks and the extra force's product slots; version 8: the
 /// extra flow slots; version 9: the stopper acceleration input; version 10: Model Exchange's
-/// hysteresis memory.
+/// hysteresis memory; version 11: Model Exchange's states of the lags and filters.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 10, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 11, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped
