@@ -261,7 +261,7 @@ def test_an_fmi3_instance_runs_model_exchange_calls_and_its_event_indicator_vari
     try:
         nx = fmu.getNumberOfContinuousStates()
         nz = fmu.getNumberOfEventIndicators()
-        assert (nx, nz) == (11, 8)
+        assert (nx, nz) == (23, 8)
         fmu.setFloat64([vrs["v_DA"]], [2.5])
         fmu.enterInitializationMode(startTime=0.0)
         fmu.exitInitializationMode()
@@ -326,7 +326,7 @@ def test_in_step_mode_model_exchange_calls_and_enter_step_mode_are_errors_that_s
         derivatives = fmu.dll.fmi3GetContinuousStateDerivatives
         derivatives.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t]
         derivatives.restype = ctypes.c_int
-        assert derivatives(fmu.component, (ctypes.c_double * 11)(), 11) == 3
+        assert derivatives(fmu.component, (ctypes.c_double * 23)(), 23) == 3
         assert "fmi3GetContinuousStateDerivatives: illegal call in state stepMode" in fmu.log.last()
         assert "is a Model Exchange function" in fmu.log.last()
         with pytest.raises(Exception):
