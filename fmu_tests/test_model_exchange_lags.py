@@ -3,7 +3,9 @@
 form over each communication step. FMPy's CVODE at relative tolerances 1e-4 to 1e-8, both
 archives, follows Co-Simulation within the input hold (0.02 N RMS, and 100 Pa for a pressure,
 0.02 N over the piston area; inputs every 0.1 ms, held as a D/A converter holds them) on a
-20 Hz sine with ±1 V steps every 30 ms (`tolerance_sweep.LAGS_AND_FILTERS`).
+20 Hz sine with ±1 V steps every 30 ms (`tolerance_sweep.LAGS_AND_FILTERS`). The transport
+delay, which is not an ODE, as its closest state form: a chain of eight Padé sections
+(`command_delay_pade_sections`, Model Exchange only) against Co-Simulation's exact delay.
 """
 
 from __future__ import annotations
@@ -52,7 +54,15 @@ def test_the_transducers_lags_and_filters_in_model_exchange_follow_co_simulation
     assert errors["P1_meas"] <= PRESSURE_LIMIT_PA and errors["P2_meas"] <= PRESSURE_LIMIT_PA
 
 
-@pytest.mark.parametrize("name, output, limit", [("command_lag", "F_act", RMS_LIMIT_N),
+@pytest.mark.parametrize("archive", ["fmi2", "fmi3"])
+@pytest.mark.parametrize("rtol", [1e-4, 1e-6, 1e-8])
+def test_the_transport_delay_as_a_pade_chain_in_model_exchange_follows_co_simulation_s_exact_delay(archive, rtol):
+    errors = run(archive, "transport_delay_pade", rtol)
+    assert errors["F_act"] <= RMS_LIMIT_N
+
+
+@pytest.mark.parametrize("name, output, limit", [("transport_delay_pade", "F_act", RMS_LIMIT_N),
+                                                 ("command_lag", "F_act", RMS_LIMIT_N),
                                                  ("command_filter", "F_act", RMS_LIMIT_N),
                                                  ("transducers", "F_meas", RMS_LIMIT_N),
                                                  ("transducers", "P1_meas", PRESSURE_LIMIT_PA),

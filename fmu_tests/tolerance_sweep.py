@@ -118,17 +118,21 @@ SIGNALS = {
     "command_lag": _v_preset_sine_and_steps,
     "command_filter": _v_preset_sine_and_steps,
     "transducers": _v_preset_sine_and_steps,
+    "transport_delay_pade": _v_preset_sine_and_steps,
 }
 
 # The command stage's lag, its filter (each alone: with both on, Co-Simulation feeds the
-# filter the lag's output held over each communication step, see docs/importing.md) and the
-# transducers' lags and filters, as the inputs' start values.
+# filter the lag's output held over each communication step, see docs/importing.md), the
+# transducers' lags and filters, and the transport delay's Pade chain, as start values.
 LAGS_AND_FILTERS = {
     "command_lag": {"command_lag": 3e-3},
     "command_filter": {"command_filter_frequency": 150.0, "command_filter_damping": 0.5},
     "transducers": {"force_sensor_lag": 2e-3, "force_sensor_filter_frequency": 200.0,
                     "force_sensor_filter_damping": 0.4, "p1_sensor_lag": 3e-3,
                     "p2_sensor_filter_frequency": 60.0},
+    # a 1 ms transport delay, in Model Exchange as a chain of eight Pade sections (Co-Simulation
+    # ignores the count and keeps its exact delay)
+    "transport_delay_pade": {"command_delay": 1e-3, "command_delay_pade_sections": 8},
 }
 
 PRESET = json.loads((Path(__file__).resolve().parent.parent / "presets" / "thesis_measured.json").read_text())

@@ -370,38 +370,38 @@ pub mod me_vr {
     /// then their derivatives.
     pub const FILTER_STATES: [u32; 12] = [918, 919, 920, 921, 922, 923, 924, 925, 926, 927, 928, 929];
     pub const FILTER_DERIVATIVES: [u32; 12] = [930, 931, 932, 933, 934, 935, 936, 937, 938, 939, 940, 941];
+    /// The Padé chain of the transport delay in Model Exchange: its number of sections (a
+    /// parameter), its sections' states and their derivatives.
+    pub const COMMAND_DELAY_PADE_SECTIONS: u32 = 942;
+    pub const PADE_STATES: [u32; 8] = [943, 944, 945, 946, 947, 948, 949, 950];
+    pub const PADE_DERIVATIVES: [u32; 8] = [951, 952, 953, 954, 955, 956, 957, 958];
     /// The states beyond the six, in the order of the state vector (the volumes' pressures,
-    /// the mount's load, the lags and filters), and their derivatives.
-    pub const STATES: [u32; 17] = {
-        let mut out = [
+    /// the mount's load, the lags and filters, the Padé chain).
+    pub const STATES: [u32; 25] = {
+        let nodes = [
             P_SUPPLY_PLENUM,
             P_RETURN_PLENUM,
             P_PORT_LINE_1,
             P_PORT_LINE_2,
             STOPPER_MOUNT_LOAD,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
         ];
+        let mut out = [0; 25];
         let mut k = 0;
-        while k < 12 {
-            out[5 + k] = FILTER_STATES[k];
+        while k < 25 {
+            out[k] = if k < 5 {
+                nodes[k]
+            } else if k < 17 {
+                FILTER_STATES[k - 5]
+            } else {
+                PADE_STATES[k - 17]
+            };
             k += 1;
         }
         out
     };
     /// The derivatives of every state, in the order of the state vector.
-    pub const DERIVATIVES: [u32; 23] = {
-        let mut out = [
+    pub const DERIVATIVES: [u32; 31] = {
+        let first = [
             DER_I,
             DER_X_JP,
             DER_X_JP_VELOCITY,
@@ -413,29 +413,24 @@ pub mod me_vr {
             DER_P_PORT_LINE_1,
             DER_P_PORT_LINE_2,
             DER_STOPPER_MOUNT_LOAD,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
         ];
+        let mut out = [0; 31];
         let mut k = 0;
-        while k < 12 {
-            out[11 + k] = FILTER_DERIVATIVES[k];
+        while k < 31 {
+            out[k] = if k < 11 {
+                first[k]
+            } else if k < 23 {
+                FILTER_DERIVATIVES[k - 11]
+            } else {
+                PADE_DERIVATIVES[k - 23]
+            };
             k += 1;
         }
         out
     };
     /// The first and the last of them.
     pub const FIRST: u32 = X_JP_VELOCITY;
-    pub const LAST: u32 = FILTER_DERIVATIVES[11];
+    pub const LAST: u32 = PADE_DERIVATIVES[7];
 }
 
 /// A continuous local of Model Exchange.
@@ -459,7 +454,7 @@ const fn local(name: &'static str, value_reference: u32, unit: &'static str, des
 /// the pressures of the gas volumes behind restrictions and the lagging stopper mount's load,
 /// then the command stage's and the transducers' lags and filters (each constant, its
 /// derivative 0, while its effect is off).
-pub const MODEL_EXCHANGE_VARIABLES: [Variable; 42] = [
+pub const MODEL_EXCHANGE_VARIABLES: [Variable; 59] = [
     local(
         "x_jp_velocity",
         me_vr::X_JP_VELOCITY,
@@ -682,10 +677,118 @@ pub const MODEL_EXCHANGE_VARIABLES: [Variable; 42] = [
         "Pa/s2",
         "rate of P2_meas_filtered_rate",
     ),
+    Variable {
+        name: "command_delay_pade_sections",
+        value_reference: me_vr::COMMAND_DELAY_PADE_SECTIONS,
+        var_type: VarType::Real,
+        causality: Causality::Parameter,
+        variability: Variability::Fixed,
+        unit: None,
+        start: 0.0,
+        min: Some(0.0),
+        max: Some(8.0),
+        description: "Model Exchange only: the transport delay (command_delay) as a chain of this many first-order Pade sections (1 - s d/2n)/(1 + s d/2n), a whole number from 0 to 8 (0 = off: Model Exchange refuses command_delay); Co-Simulation keeps its exact delay",
+    },
+    local(
+        "command_delay_pade_1",
+        me_vr::PADE_STATES[0],
+        "V",
+        "state of section 1 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 1)",
+    ),
+    local(
+        "command_delay_pade_2",
+        me_vr::PADE_STATES[1],
+        "V",
+        "state of section 2 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 2)",
+    ),
+    local(
+        "command_delay_pade_3",
+        me_vr::PADE_STATES[2],
+        "V",
+        "state of section 3 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 3)",
+    ),
+    local(
+        "command_delay_pade_4",
+        me_vr::PADE_STATES[3],
+        "V",
+        "state of section 4 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 4)",
+    ),
+    local(
+        "command_delay_pade_5",
+        me_vr::PADE_STATES[4],
+        "V",
+        "state of section 5 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 5)",
+    ),
+    local(
+        "command_delay_pade_6",
+        me_vr::PADE_STATES[5],
+        "V",
+        "state of section 6 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 6)",
+    ),
+    local(
+        "command_delay_pade_7",
+        me_vr::PADE_STATES[6],
+        "V",
+        "state of section 7 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 7)",
+    ),
+    local(
+        "command_delay_pade_8",
+        me_vr::PADE_STATES[7],
+        "V",
+        "state of section 8 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 8)",
+    ),
+    local(
+        "der(command_delay_pade_1)",
+        me_vr::PADE_DERIVATIVES[0],
+        "V/s",
+        "rate of command_delay_pade_1",
+    ),
+    local(
+        "der(command_delay_pade_2)",
+        me_vr::PADE_DERIVATIVES[1],
+        "V/s",
+        "rate of command_delay_pade_2",
+    ),
+    local(
+        "der(command_delay_pade_3)",
+        me_vr::PADE_DERIVATIVES[2],
+        "V/s",
+        "rate of command_delay_pade_3",
+    ),
+    local(
+        "der(command_delay_pade_4)",
+        me_vr::PADE_DERIVATIVES[3],
+        "V/s",
+        "rate of command_delay_pade_4",
+    ),
+    local(
+        "der(command_delay_pade_5)",
+        me_vr::PADE_DERIVATIVES[4],
+        "V/s",
+        "rate of command_delay_pade_5",
+    ),
+    local(
+        "der(command_delay_pade_6)",
+        me_vr::PADE_DERIVATIVES[5],
+        "V/s",
+        "rate of command_delay_pade_6",
+    ),
+    local(
+        "der(command_delay_pade_7)",
+        me_vr::PADE_DERIVATIVES[6],
+        "V/s",
+        "rate of command_delay_pade_7",
+    ),
+    local(
+        "der(command_delay_pade_8)",
+        me_vr::PADE_DERIVATIVES[7],
+        "V/s",
+        "rate of command_delay_pade_8",
+    ),
 ];
 
 /// The states' value references in the order of the state vector, with their derivatives'.
-pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 23] = [
+pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 31] = [
     state(vr::I, me_vr::DER_I),
     state(vr::X_JP, me_vr::DER_X_JP),
     state(me_vr::X_JP_VELOCITY, me_vr::DER_X_JP_VELOCITY),
@@ -709,6 +812,14 @@ pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 23] = [
     state(me_vr::FILTER_STATES[9], me_vr::FILTER_DERIVATIVES[9]),
     state(me_vr::FILTER_STATES[10], me_vr::FILTER_DERIVATIVES[10]),
     state(me_vr::FILTER_STATES[11], me_vr::FILTER_DERIVATIVES[11]),
+    state(me_vr::PADE_STATES[0], me_vr::PADE_DERIVATIVES[0]),
+    state(me_vr::PADE_STATES[1], me_vr::PADE_DERIVATIVES[1]),
+    state(me_vr::PADE_STATES[2], me_vr::PADE_DERIVATIVES[2]),
+    state(me_vr::PADE_STATES[3], me_vr::PADE_DERIVATIVES[3]),
+    state(me_vr::PADE_STATES[4], me_vr::PADE_DERIVATIVES[4]),
+    state(me_vr::PADE_STATES[5], me_vr::PADE_DERIVATIVES[5]),
+    state(me_vr::PADE_STATES[6], me_vr::PADE_DERIVATIVES[6]),
+    state(me_vr::PADE_STATES[7], me_vr::PADE_DERIVATIVES[7]),
 ];
 
 const fn state(state: u32, derivative: u32) -> fmi2::model::ContinuousState {

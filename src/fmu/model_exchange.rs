@@ -1,8 +1,9 @@
-//! The actuator as an FMI 2.0 Model Exchange model: twenty-three states, the six of (4.1),
+//! The actuator as an FMI 2.0 Model Exchange model: thirty-one states, the six of (4.1),
 //! [i, x_jp, ẋ_jp, ẍ_jp, P1, P2], then the pressures of the four gas volumes behind
 //! restrictions and the lagging stopper mount's load, then the lags and second-order filters
-//! of the command stage and of the three transducers (module `filters`: three states each;
-//! every state beyond the six constant while its effect is off); their derivatives from
+//! of the command stage and of the three transducers (module `filters`: three states each),
+//! then the eight sections of the transport delay's optional Padé chain (every state beyond
+//! the six constant while its effect is off); their derivatives from
 //! `Actuator::derivatives`, `Actuator::pressure_rates_with_volumes` and the lag and filter
 //! equations of `physics::sensors` (the equations the Co-Simulation step integrates or
 //! solves in closed form), and event indicators where the right-hand side is not smooth.
@@ -26,8 +27,12 @@
 //! available in Co-Simulation):
 //! * the transport delay (`command_delay`) and the transducers' delays: a pure delay
 //!   y(t) = u(t − d) is not an ODE; its state at t is the whole of u over (t − d, t], which no
-//!   finite set of continuous states holds. Its closest state form is a Padé approximant
-//!   (a chain of first-order sections), which is not offered;
+//!   finite set of continuous states holds. For the transport delay its closest state form is
+//!   offered instead: with `command_delay_pade_sections` = n (1 to 8; Model Exchange only,
+//!   Co-Simulation keeps its exact delay) a chain of n first-order Padé sections
+//!   (`filters::delayed_command`, `filters::chain_rates`); without it `command_delay` is
+//!   refused when initialisation ends (not when set: importers set the parameters in the
+//!   model description's order, the delay before the count);
 //! * the command stage's slew limit: the limited command follows
 //!   ds/dt = sign(u − s)·S until it reaches u, then s = u, a right-hand side that jumps where
 //!   s meets u and holds s there on a sliding surface; exact only as a hybrid state (a ramp or
@@ -61,8 +66,8 @@ use jetpipe_model::physics::time_varying;
 use jetpipe_model::simulation::Simulation;
 
 mod filters;
-pub(super) use filters::filters_of;
-use filters::Filters;
+pub(super) use filters::{filters_of, seen_command, PADE_SECTIONS};
+use filters::{Chain, Filters};
 
 /// The number of event indicators (see [`event_indicators`]).
 pub const EVENT_INDICATORS: usize = 8;
@@ -73,10 +78,13 @@ pub(super) type Memory = [f64; PLAY_OPERATORS];
 
 /// The number of continuous states: the six of (4.1), the [`node::STATES`] beyond them and
 /// the [`filters::STATES`] of the lags and filters.
-pub const STATES: usize = 6 + node::STATES + filters::STATES;
+pub const STATES: usize = 6 + node::STATES + filters::STATES + filters::PADE_SECTIONS;
 
 /// Where the lags' and filters' states start in the state vector.
 const FILTERS: usize = 6 + node::STATES;
+
+/// Where the transport delay's Padé chain starts in the state vector.
+const CHAIN: usize = FILTERS + filters::STATES;
 
 /// The states beyond the six of (4.1), in the order of [`node`]: the volumes' pressures, the
 /// mount's load.
@@ -107,6 +115,9 @@ pub(super) struct MeState {
     nodes: Nodes,
     /// The lags' and filters' states (module `filters`).
     filters: Filters,
+    /// The transport delay's Padé chain, its first `sections` states in use (0: no delay).
+    chain: Chain,
+    sections: usize,
     /// The hysteresis memory when the effect is on (see the module's text).
     memory: Option<Memory>,
     /// Where the stopper is: the last x_s set that is inside the cylinder (see
@@ -123,14 +134,17 @@ struct Refused {
     parameters: &'static [u32],
 }
 
-const DELAY: &str = "a pure delay y(t) = u(t - d) is not an ODE: its state is the whole of u over the last d seconds, which no finite set of continuous states holds (its closest state form, a Pade chain, is not offered)";
+const DELAY: &str = "a pure delay y(t) = u(t - d) is not an ODE: its state is the whole of u over the last d seconds, which no finite set of continuous states holds";
+
+/// The transport delay's reason, with the option.
+const TRANSPORT_DELAY: &str = "a pure delay y(t) = u(t - d) is not an ODE: its state is the whole of u over the last d seconds, which no finite set of continuous states holds; set command_delay_pade_sections (1 to 8) first for its closest state form, a chain of Pade sections";
 
 /// The effects that Model Exchange refuses, each with its parameters (any of them away from
 /// its default switches the effect on).
 const REFUSED: &[Refused] = &[
     Refused {
         effect: "transport_delay",
-        why: DELAY,
+        why: TRANSPORT_DELAY,
         parameters: &[vr::COMMAND_DELAY],
     },
     Refused {
@@ -196,7 +210,14 @@ fn refusal_message(r: &Refused, switched_on: &str) -> String {
 
 /// Whether setting `value_reference` to `value` switches on an effect Model Exchange refuses:
 /// the message that names it.
+///
+/// `command_delay` is taken when set and refused when initialisation ends if
+/// `command_delay_pade_sections` is still 0 then: an importer sets the parameters in the model
+/// description's order, in which the delay comes first.
 pub(super) fn refused_setting(value_reference: u32, value: f64) -> Result<(), String> {
+    if value_reference == vr::COMMAND_DELAY {
+        return Ok(());
+    }
     for r in REFUSED {
         if r.parameters.contains(&value_reference) && value != table_start(value_reference) {
             let what = format!("{} = {value}", variable_name(value_reference));
@@ -208,10 +229,13 @@ pub(super) fn refused_setting(value_reference: u32, value: f64) -> Result<(), St
 
 /// The effects a model has that Model Exchange refuses, named with the parameters that
 /// switch them on; also what the model's own flags say is on (whatever parameter did it).
-fn refused_effects(model: &Actuator) -> Result<(), String> {
+fn refused_effects(model: &Actuator, pade_sections: usize) -> Result<(), String> {
     let p = &model.params;
     let mut problems = Vec::new();
     for r in REFUSED {
+        if pade_sections > 0 && r.parameters == [vr::COMMAND_DELAY] {
+            continue;
+        }
         let on: Vec<String> = r
             .parameters
             .iter()
@@ -225,7 +249,7 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
         }
     }
     let flags = [
-        (p.command_delay != 0.0, "transport_delay"),
+        (p.command_delay != 0.0 && pade_sections == 0, "transport_delay"),
         (p.current_slew_limit > 0.0, "the command stage's slew limit"),
         (
             Channel::ALL.iter().any(|&c| {
@@ -256,14 +280,42 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
 }
 
 /// The inputs of the right-hand side: v_DA through the command stage (its static part, then
-/// its lag and filter from their states; its slew limit is refused), the stopper held, the
-/// hysteresis memory.
-fn inputs(model: &Actuator, v_da: f64, x_s: f64, filters: &Filters, memory: Option<&Memory>) -> Inputs {
+/// its lag and filter from their states; its slew limit is refused) and the transport delay's
+/// Padé chain when it is on, the stopper held, the hysteresis memory.
+fn inputs(at: &At<'_>, memory: Option<&Memory>) -> Inputs {
+    let command = filters::seen_command(&at.model.params, at.v_da, at.filters);
     Inputs {
-        v_da: filters::seen_command(&model.params, v_da, filters),
-        x_s,
+        v_da: filters::delayed_command(at.sections, command, at.chain),
+        x_s: at.x_s,
         x_s_rate: 0.0,
         plays: memory.copied(),
+    }
+}
+
+/// `command_delay_pade_sections` when set: from 0 to [`filters::PADE_SECTIONS`] (a whole
+/// number, checked when initialisation ends, as the curves' knot counts are).
+pub(super) fn check_pade_sections(value: f64) -> Result<f64, String> {
+    if (0.0..=filters::PADE_SECTIONS as f64).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!(
+            "command_delay_pade_sections = {value} is invalid: must be a whole number from 0 to {}",
+            filters::PADE_SECTIONS
+        ))
+    }
+}
+
+/// `command_delay_pade_sections` as a number of sections: a whole number from 0 to
+/// [`filters::PADE_SECTIONS`].
+pub(super) fn pade_sections(value: f64) -> Result<usize, String> {
+    check_pade_sections(value)?;
+    if value.fract() == 0.0 {
+        Ok(value as usize)
+    } else {
+        Err(format!(
+            "command_delay_pade_sections = {value} is invalid: must be a whole number from 0 to {}",
+            filters::PADE_SECTIONS
+        ))
     }
 }
 
@@ -288,13 +340,7 @@ pub(super) fn advance_memory(model: &Actuator, memory: &mut Option<Memory>, curr
 ///   sees, after the command stage's lag and filter), where the hysteresis memory is advanced.
 fn event_indicators(at: &At<'_>, z: &mut [f64]) {
     let At {
-        model,
-        x,
-        filters,
-        v_da,
-        x_s,
-        memory,
-        ..
+        model, x, x_s, memory, ..
     } = *at;
     // (the places' pressures with restrictions do not reverse the flows the valve sees
     // between them and the chambers: the same indicators)
@@ -312,7 +358,7 @@ fn event_indicators(at: &At<'_>, z: &mut [f64]) {
         (std::f64::consts::PI * x_abs / p.d_jp).sin(),
         match memory {
             Some(_) => {
-                let command = inputs(model, v_da, x_s, filters, None).v_da;
+                let command = inputs(at, None).v_da;
                 current_driver::static_current(p.k_cd, p.i_offset, command) - x[index::CURRENT]
             }
             None => 1.0,
@@ -329,6 +375,8 @@ pub(super) struct At<'a> {
     pub x: &'a State,
     pub nodes: &'a Nodes,
     pub filters: &'a Filters,
+    pub chain: &'a Chain,
+    pub sections: usize,
     pub v_da: f64,
     pub x_s: f64,
     pub time: f64,
@@ -342,6 +390,8 @@ impl MeState {
             x: &self.x,
             nodes: &self.nodes,
             filters: &self.filters,
+            chain: &self.chain,
+            sections: self.sections,
             v_da,
             x_s: self.x_s,
             time: self.time,
@@ -362,12 +412,14 @@ fn rates(at: &At<'_>) -> [f64; STATES] {
         x,
         nodes,
         filters,
+        chain,
+        sections,
         v_da,
         x_s,
         time,
         memory,
     } = *at;
-    let d = model.derivatives(x, &inputs(model, v_da, x_s, filters, memory));
+    let d = model.derivatives(x, &inputs(at, memory));
     let mut out = [0.0; STATES];
     out[..6].copy_from_slice(d.as_slice());
     if model.has_volume_states() {
@@ -380,7 +432,16 @@ fn rates(at: &At<'_>) -> [f64; STATES] {
     }
     if filters::any_on(&model.params) {
         let y = model.outputs_at(x, x_s, 0.0, time);
-        out[FILTERS..].copy_from_slice(&filters::rates(&model.params, v_da, &y, filters));
+        out[FILTERS..CHAIN].copy_from_slice(&filters::rates(&model.params, v_da, &y, filters));
+    }
+    if sections > 0 {
+        let command = filters::seen_command(&model.params, v_da, filters);
+        out[CHAIN..].copy_from_slice(&filters::chain_rates(
+            model.params.command_delay,
+            sections,
+            command,
+            chain,
+        ));
     }
     out
 }
@@ -391,8 +452,10 @@ pub(super) fn state_variable(at: &At<'_>, value_reference: u32) -> Option<f64> {
     if let Some(k) = me_vr::STATES.iter().position(|&v| v == value_reference) {
         return Some(if k < node::STATES {
             at.nodes[k]
-        } else {
+        } else if k < node::STATES + filters::STATES {
             at.filters[k - node::STATES]
+        } else {
+            at.chain[k - node::STATES - filters::STATES]
         });
     }
     if let Some(k) = me_vr::DERIVATIVES.iter().position(|&v| v == value_reference) {
@@ -412,7 +475,7 @@ impl ActuatorFmu {
     /// starts its connectors at 0) leaves the stopper at the last valid x_s set (or the start
     /// value), and the derivatives are refused until a valid x_s is set.
     pub(super) fn exit_initialization_model_exchange(&mut self) -> Result<(), String> {
-        refused_effects(&Actuator::new(self.params.clone())?)?;
+        refused_effects(&Actuator::new(self.params.clone())?, pade_sections(self.pade_sections)?)?;
         let me = match self.params.check_stopper(self.x_s) {
             Ok(()) => self.initial_me_state()?,
             Err(e) => {
@@ -442,12 +505,16 @@ impl ActuatorFmu {
     /// The Model Exchange state at the end of initialisation.
     fn initial_me_state(&self) -> Result<MeState, String> {
         let simulation = self.initial_simulation()?;
+        let filters = filters::filters_of(&simulation);
         Ok(MeState {
             model: simulation.model().clone(),
             time: self.start_time,
             x: *simulation.state(),
             nodes: nodes_of(&simulation),
-            filters: filters::filters_of(&simulation),
+            filters,
+            chain: [filters::seen_command(&simulation.model().params, simulation.v_da(), &filters);
+                filters::PADE_SECTIONS],
+            sections: pade_sections(self.pade_sections)?,
             memory: simulation.hysteresis_memory(),
             x_s: simulation.x_s(),
             states_changed: false,
@@ -519,6 +586,7 @@ impl ActuatorFmu {
     /// time, states and whether the states changed.
     pub(super) fn serialize_model_exchange(&self, w: &mut fmi2::state_bytes::ByteWriter) {
         w.bool(self.model_exchange);
+        w.f64(self.pade_sections);
         match &self.me {
             None => w.bool(false),
             Some(me) => {
@@ -527,6 +595,7 @@ impl ActuatorFmu {
                 w.f64s(me.x.as_slice());
                 w.f64s(&me.nodes);
                 w.f64s(&me.filters);
+                w.f64s(&me.chain);
                 w.f64(me.x_s);
                 w.bool(me.states_changed);
                 w.bool(me.memory.is_some());
@@ -543,6 +612,7 @@ impl ActuatorFmu {
         restored: &mut ActuatorFmu,
     ) -> Result<(), String> {
         restored.model_exchange = r.bool("modelExchange")?;
+        restored.pade_sections = check_pade_sections(r.f64()?)?;
         if r.bool("modelExchangeRunning")? {
             let time = r.f64()?;
             let values = r.f64s_at_most(6, "continuous states")?;
@@ -567,6 +637,17 @@ impl ActuatorFmu {
             }
             let mut filter_states = [0.0; filters::STATES];
             filter_states.copy_from_slice(&filter_values);
+            let chain_values = r.f64s_at_most(filters::PADE_SECTIONS, "states of the Pade chain")?;
+            let sections = pade_sections(restored.pade_sections)?;
+            if chain_values.len() != filters::PADE_SECTIONS {
+                return Err(format!(
+                    "{} states of the Pade chain, not {} (an FMU state of another version of the model)",
+                    chain_values.len(),
+                    filters::PADE_SECTIONS
+                ));
+            }
+            let mut chain = [0.0; filters::PADE_SECTIONS];
+            chain.copy_from_slice(&chain_values);
             let x_s = r.f64()?;
             restored.params.check_stopper(x_s)?;
             let states_changed = r.bool("statesChanged")?;
@@ -597,6 +678,8 @@ impl ActuatorFmu {
                 x: State::from_column_slice(&values),
                 nodes,
                 filters: filter_states,
+                chain,
+                sections,
                 memory,
                 x_s,
                 states_changed,
@@ -621,7 +704,8 @@ impl ModelExchangeModel for ActuatorFmu {
         let me = self.me_view()?;
         x[..6].copy_from_slice(me.x.as_slice());
         x[6..FILTERS].copy_from_slice(&me.nodes);
-        x[FILTERS..].copy_from_slice(&me.filters);
+        x[FILTERS..CHAIN].copy_from_slice(&me.filters);
+        x[CHAIN..].copy_from_slice(&me.chain);
         Ok(())
     }
 
@@ -641,7 +725,8 @@ impl ModelExchangeModel for ActuatorFmu {
         }
         me.x = State::from_column_slice(&x[..6]);
         me.nodes.copy_from_slice(&x[6..FILTERS]);
-        me.filters.copy_from_slice(&x[FILTERS..]);
+        me.filters.copy_from_slice(&x[FILTERS..CHAIN]);
+        me.chain.copy_from_slice(&x[CHAIN..]);
         Ok(())
     }
 
@@ -677,7 +762,8 @@ impl ModelExchangeModel for ActuatorFmu {
         };
         nominals[..6].copy_from_slice(scales.as_slice());
         nominals[6..FILTERS].iter_mut().for_each(|n| *n = scales[index::P1]);
-        nominals[FILTERS..].copy_from_slice(&filters::scales(&self.params));
+        nominals[FILTERS..CHAIN].copy_from_slice(&filters::scales(&self.params));
+        nominals[CHAIN..].iter_mut().for_each(|n| *n = 1.0);
     }
 
     /// Every event (a reversal of the current, z7, among them) advances the hysteresis memory.

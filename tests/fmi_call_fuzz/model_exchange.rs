@@ -25,7 +25,7 @@ use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 
-const NX: usize = 23;
+const NX: usize = 31;
 const NZ: usize = 8;
 
 /// The states a Model Exchange instance reaches.
@@ -108,7 +108,7 @@ pub unsafe fn call(c: fmi2Component, f: Function, valid: bool) -> (String, fmi2S
                 )
             } else {
                 (
-                    "fmi2GetEventIndicators(ni 23)".into(),
+                    "fmi2GetEventIndicators(ni 31)".into(),
                     fmi2GetEventIndicators(c, x.as_mut_ptr(), NX),
                 )
             }

@@ -2,7 +2,8 @@
 //! states of Model Exchange: twelve states, three for each of four stages (the command
 //! stage, the force sensor, the two pressure transducers), each [the lag's output, the
 //! filter's output, the filter's rate] (constant, their rates 0, while the stage's lag or
-//! filter is off).
+//! filter is off). And the transport delay's optional Padé chain ([`delayed_command`],
+//! [`chain_rates`]), after the command stage, as Co-Simulation delays the stage's output.
 //!
 //! The equations are the ones whose exact solutions the Co-Simulation step takes over each
 //! communication interval, from `jetpipe_model::physics::sensors`: the lag τ y' = u − y
@@ -197,4 +198,33 @@ pub fn filters_of(simulation: &Simulation) -> Filters {
 /// A simulation's outputs with the static readings of its transducers (no memory).
 fn static_outputs(model: &Actuator, simulation: &Simulation) -> Outputs {
     model.outputs_at(simulation.state(), simulation.x_s(), 0.0, simulation.time())
+}
+
+/// The most sections of the transport delay's Padé chain.
+pub const PADE_SECTIONS: usize = 8;
+
+/// The chain's states, one a section (constant beyond the sections in use).
+pub type Chain = [f64; PADE_SECTIONS];
+
+/// The transport delay e^{−sd} as its closest state form, a chain of `sections` first-order
+/// Padé sections (1 − sτ)/(1 + sτ), τ = d/(2n) (each the (1,1) Padé approximant of
+/// e^{−s d/n}): section k is the lag τ x' = u_k − x (`first_order_rate`) with output
+/// u_{k+1} = 2x − u_k. The command after the chain: what the current driver sees.
+pub fn delayed_command(sections: usize, command: f64, chain: &Chain) -> f64 {
+    chain[..sections].iter().fold(command, |u, &x| 2.0 * x - u)
+}
+
+/// The rates of the chain's states (0 beyond the `sections` in use).
+pub fn chain_rates(delay: f64, sections: usize, command: f64, chain: &Chain) -> Chain {
+    let mut out = [0.0; PADE_SECTIONS];
+    if sections == 0 || delay <= 0.0 {
+        return out;
+    }
+    let tau = delay / (2.0 * sections as f64);
+    let mut u = command;
+    for k in 0..sections {
+        out[k] = first_order_rate(tau, u, chain[k]);
+        u = 2.0 * chain[k] - u;
+    }
+    out
 }
