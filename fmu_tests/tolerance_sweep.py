@@ -36,7 +36,7 @@ import numpy as np
 from fmpy.sundials.libraries import sundials_cvode
 from pathlib import Path
 
-OUTPUTS = ["F_act", "P1", "P2", "i", "x_jp"]
+OUTPUTS = ["F_act", "P1", "P2", "i", "x_jp", "F_meas", "P1_meas", "P2_meas"]
 HOLD = 1e-4  # s: the inputs' sample period
 DTYPE = [("time", np.float64), ("v_DA", np.float64), ("x_s", np.float64)]
 
@@ -114,6 +114,25 @@ SIGNALS = {
     # presets/thesis_measured.json, its Bouc-Wen hysteresis among its terms
     "measured_preset": _v_preset_sine_and_steps,
     "measured_preset_sine": _v_preset_sine,
+    # the lags and second-order filters that are states of Model Exchange (`LAGS_AND_FILTERS`)
+    "command_lag": _v_preset_sine_and_steps,
+    "command_filter": _v_preset_sine_and_steps,
+    "transducers": _v_preset_sine_and_steps,
+    "transport_delay_pade": _v_preset_sine_and_steps,
+}
+
+# The command stage's lag, its filter (each alone: with both on, Co-Simulation feeds the
+# filter the lag's output held over each communication step, see docs/importing.md), the
+# transducers' lags and filters, and the transport delay's Pade chain, as start values.
+LAGS_AND_FILTERS = {
+    "command_lag": {"command_lag": 3e-3},
+    "command_filter": {"command_filter_frequency": 150.0, "command_filter_damping": 0.5},
+    "transducers": {"force_sensor_lag": 2e-3, "force_sensor_filter_frequency": 200.0,
+                    "force_sensor_filter_damping": 0.4, "p1_sensor_lag": 3e-3,
+                    "p2_sensor_filter_frequency": 60.0},
+    # a 1 ms transport delay, in Model Exchange as a chain of eight Pade sections (Co-Simulation
+    # ignores the count and keeps its exact delay)
+    "transport_delay_pade": {"command_delay": 1e-3, "command_delay_pade_sections": 8},
 }
 
 PRESET = json.loads((Path(__file__).resolve().parent.parent / "presets" / "thesis_measured.json").read_text())
@@ -128,6 +147,8 @@ def delayed(law, delay: float = HOLD / 2):
 def start_values(name: str) -> dict:
     if name.startswith("measured_preset"):
         return dict(PRESET)
+    if name in LAGS_AND_FILTERS:
+        return dict(LAGS_AND_FILTERS[name])
     return dict(VOLUMES_AND_MOUNT) if name in ("volumes_and_mount", "moving_stopper_volumes") else {}
 
 

@@ -182,8 +182,9 @@ pub static MODEL_INFO: ModelInfo = ModelInfo {
     guid_cache: GuidCache::new(),
 };
 
-/// Model Exchange: the eleven states (the six of (4.1), the volumes' pressures and the mount's
-/// load), the event indicators and the hysteresis memory of the private module
+/// Model Exchange: the thirty-one states (the six of (4.1), the volumes' pressures and the
+/// mount's load, the command stage's and the transducers' lags and filters, the transport
+/// delay's Padé chain), the event indicators and the hysteresis memory of the private module
 /// `model_exchange`.
 // The state vector of `model_exchange` is the model description's.
 const _: () = assert!(model_exchange::STATES == CONTINUOUS_STATES.len());
@@ -242,6 +243,9 @@ pub struct ActuatorFmu {
     model_exchange: bool,
     /// A Model Exchange instance after initialisation (then `simulation` stays `None`).
     me: Option<model_exchange::MeState>,
+    /// `command_delay_pade_sections`: the transport delay as a Padé chain in Model Exchange
+    /// (0: refused there; Co-Simulation keeps its exact delay).
+    pade_sections: f64,
 }
 
 fn start(value_reference: u32) -> f64 {
@@ -280,6 +284,9 @@ impl ActuatorFmu {
     #[cold]
     #[inline(never)]
     fn get_real_otherwise(&self, value_reference: u32) -> Result<f64, String> {
+        if value_reference == me_vr::COMMAND_DELAY_PADE_SECTIONS {
+            return Ok(self.pade_sections);
+        }
         if let Some(x) = self.me_real(value_reference) {
             return Ok(x);
         }
@@ -292,16 +299,23 @@ impl ActuatorFmu {
                     &computed
                 }
             };
-            return model_exchange::state_variable(
-                simulation.model(),
-                simulation.state(),
-                &model_exchange::nodes_of(simulation),
-                simulation.v_da(),
-                simulation.x_s(),
-                simulation.hysteresis_memory().as_ref(),
-                value_reference,
-            )
-            .ok_or_else(|| format!("no Real variable with value reference {value_reference}"));
+            let memory = simulation.hysteresis_memory();
+            let filters = model_exchange::filters_of(simulation);
+            let command = model_exchange::seen_command(&simulation.model().params, simulation.v_da(), &filters);
+            let at = model_exchange::At {
+                model: simulation.model(),
+                x: simulation.state(),
+                nodes: &model_exchange::nodes_of(simulation),
+                filters: &filters,
+                chain: &[command; model_exchange::PADE_SECTIONS],
+                sections: 0,
+                v_da: simulation.v_da(),
+                x_s: simulation.x_s(),
+                time: simulation.time(),
+                memory: memory.as_ref(),
+            };
+            return model_exchange::state_variable(&at, value_reference)
+                .ok_or_else(|| format!("no Real variable with value reference {value_reference}"));
         }
         match value_reference {
             vr::V_DA => Ok(self.simulation.as_ref().map_or(self.v_da, Simulation::v_da)),
@@ -371,6 +385,7 @@ impl CoSimModel for ActuatorFmu {
             x_s_valid: start(vr::X_S),
             model_exchange: false,
             me: None,
+            pade_sections: 0.0,
         }
     }
 
@@ -439,6 +454,10 @@ impl CoSimModel for ActuatorFmu {
                     Ok(())
                 }
             },
+            me_vr::COMMAND_DELAY_PADE_SECTIONS => {
+                self.pade_sections = model_exchange::check_pade_sections(value)?;
+                Ok(())
+            }
             vr::P1_START | vr::P2_START => {
                 jetpipe_model::variables::check(value_reference, value)?;
                 if value_reference == vr::P1_START {
@@ -643,9 +662,10 @@ impl CoSimModel for ActuatorFmu {
 /// interface and the Model Exchange state; version 6: the modulation slots' parameters;
 /// version 7: the laminar chamber leaks and the extra force's product slots; version 8: the
 /// extra flow slots; version 9: the stopper acceleration input; version 10: Model Exchange's
-/// hysteresis memory.
+/// hysteresis memory; version 11: Model Exchange's states of the lags, filters and Padé chain
+/// and `command_delay_pade_sections`.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 10, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 11, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped

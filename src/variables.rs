@@ -267,6 +267,38 @@ pub const UNITS: &[UnitDefinition] = &[
         a: 0,
         k: 0,
     },
+    UnitDefinition {
+        name: "V/s",
+        kg: 1,
+        m: 2,
+        s: -4,
+        a: -1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "V/s2",
+        kg: 1,
+        m: 2,
+        s: -5,
+        a: -1,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "N/s2",
+        kg: 1,
+        m: 1,
+        s: -4,
+        a: 0,
+        k: 0,
+    },
+    UnitDefinition {
+        name: "Pa/s2",
+        kg: 1,
+        m: -1,
+        s: -4,
+        a: 0,
+        k: 0,
+    },
 ];
 
 const fn causality(c: table::Causality) -> Causality {
@@ -333,9 +365,72 @@ pub mod me_vr {
     pub const DER_P_PORT_LINE_1: u32 = 915;
     pub const DER_P_PORT_LINE_2: u32 = 916;
     pub const DER_STOPPER_MOUNT_LOAD: u32 = 917;
+    /// The lags' and filters' states (three for each of the command stage, the force sensor
+    /// and the two pressure transducers: the lag's output, the filter's output and rate),
+    /// then their derivatives.
+    pub const FILTER_STATES: [u32; 12] = [918, 919, 920, 921, 922, 923, 924, 925, 926, 927, 928, 929];
+    pub const FILTER_DERIVATIVES: [u32; 12] = [930, 931, 932, 933, 934, 935, 936, 937, 938, 939, 940, 941];
+    /// The Padé chain of the transport delay in Model Exchange: its number of sections (a
+    /// parameter), its sections' states and their derivatives.
+    pub const COMMAND_DELAY_PADE_SECTIONS: u32 = 942;
+    pub const PADE_STATES: [u32; 8] = [943, 944, 945, 946, 947, 948, 949, 950];
+    pub const PADE_DERIVATIVES: [u32; 8] = [951, 952, 953, 954, 955, 956, 957, 958];
+    /// The states beyond the six, in the order of the state vector (the volumes' pressures,
+    /// the mount's load, the lags and filters, the Padé chain).
+    pub const STATES: [u32; 25] = {
+        let nodes = [
+            P_SUPPLY_PLENUM,
+            P_RETURN_PLENUM,
+            P_PORT_LINE_1,
+            P_PORT_LINE_2,
+            STOPPER_MOUNT_LOAD,
+        ];
+        let mut out = [0; 25];
+        let mut k = 0;
+        while k < 25 {
+            out[k] = if k < 5 {
+                nodes[k]
+            } else if k < 17 {
+                FILTER_STATES[k - 5]
+            } else {
+                PADE_STATES[k - 17]
+            };
+            k += 1;
+        }
+        out
+    };
+    /// The derivatives of every state, in the order of the state vector.
+    pub const DERIVATIVES: [u32; 31] = {
+        let first = [
+            DER_I,
+            DER_X_JP,
+            DER_X_JP_VELOCITY,
+            DER_X_JP_ACCELERATION,
+            DER_P1,
+            DER_P2,
+            DER_P_SUPPLY_PLENUM,
+            DER_P_RETURN_PLENUM,
+            DER_P_PORT_LINE_1,
+            DER_P_PORT_LINE_2,
+            DER_STOPPER_MOUNT_LOAD,
+        ];
+        let mut out = [0; 31];
+        let mut k = 0;
+        while k < 31 {
+            out[k] = if k < 11 {
+                first[k]
+            } else if k < 23 {
+                FILTER_DERIVATIVES[k - 11]
+            } else {
+                PADE_DERIVATIVES[k - 23]
+            };
+            k += 1;
+        }
+        out
+    };
     /// The first and the last of them.
     pub const FIRST: u32 = X_JP_VELOCITY;
-    pub const LAST: u32 = DER_STOPPER_MOUNT_LOAD;
+    pub const LAST: u32 = PADE_DERIVATIVES[7];
 }
 
 /// A continuous local of Model Exchange.
@@ -356,9 +451,10 @@ const fn local(name: &'static str, value_reference: u32, unit: &'static str, des
 
 /// The continuous states of Model Exchange and their derivatives, after the table's rows: the
 /// six states of (4.1), [i, x_jp, ẋ_jp, ẍ_jp, P1, P2] (i, x_jp, P1 and P2 are outputs), then
-/// the pressures of the gas volumes behind restrictions and the lagging stopper mount's load
-/// (each constant, its derivative 0, while its effect is off).
-pub const MODEL_EXCHANGE_VARIABLES: [Variable; 18] = [
+/// the pressures of the gas volumes behind restrictions and the lagging stopper mount's load,
+/// then the command stage's and the transducers' lags and filters (each constant, its
+/// derivative 0, while its effect is off).
+pub const MODEL_EXCHANGE_VARIABLES: [Variable; 59] = [
     local(
         "x_jp_velocity",
         me_vr::X_JP_VELOCITY,
@@ -437,10 +533,262 @@ pub const MODEL_EXCHANGE_VARIABLES: [Variable; 18] = [
         "Pa/s",
         "rate of the lagging stopper mount's load",
     ),
+    local(
+        "command_lagged",
+        me_vr::FILTER_STATES[0],
+        "V",
+        "the command stage's lag output (a state of Model Exchange; constant without command_lag)",
+    ),
+    local(
+        "command_filtered",
+        me_vr::FILTER_STATES[1],
+        "V",
+        "the command stage's second-order filter output (a state of Model Exchange; constant without command_filter_frequency)",
+    ),
+    local(
+        "command_filtered_rate",
+        me_vr::FILTER_STATES[2],
+        "V/s",
+        "rate of the command stage's filter output (a state of Model Exchange; constant without command_filter_frequency)",
+    ),
+    local(
+        "F_meas_lagged",
+        me_vr::FILTER_STATES[3],
+        "N",
+        "the force sensor's lag output (a state of Model Exchange; constant without force_sensor_lag)",
+    ),
+    local(
+        "F_meas_filtered",
+        me_vr::FILTER_STATES[4],
+        "N",
+        "the force sensor's second-order filter output (a state of Model Exchange; constant without force_sensor_filter_frequency)",
+    ),
+    local(
+        "F_meas_filtered_rate",
+        me_vr::FILTER_STATES[5],
+        "N/s",
+        "rate of the force sensor's filter output (a state of Model Exchange; constant without force_sensor_filter_frequency)",
+    ),
+    local(
+        "P1_meas_lagged",
+        me_vr::FILTER_STATES[6],
+        "Pa",
+        "pressure transducer 1's lag output (a state of Model Exchange; constant without p1_sensor_lag)",
+    ),
+    local(
+        "P1_meas_filtered",
+        me_vr::FILTER_STATES[7],
+        "Pa",
+        "pressure transducer 1's second-order filter output (a state of Model Exchange; constant without p1_sensor_filter_frequency)",
+    ),
+    local(
+        "P1_meas_filtered_rate",
+        me_vr::FILTER_STATES[8],
+        "Pa/s",
+        "rate of pressure transducer 1's filter output (a state of Model Exchange; constant without p1_sensor_filter_frequency)",
+    ),
+    local(
+        "P2_meas_lagged",
+        me_vr::FILTER_STATES[9],
+        "Pa",
+        "pressure transducer 2's lag output (a state of Model Exchange; constant without p2_sensor_lag)",
+    ),
+    local(
+        "P2_meas_filtered",
+        me_vr::FILTER_STATES[10],
+        "Pa",
+        "pressure transducer 2's second-order filter output (a state of Model Exchange; constant without p2_sensor_filter_frequency)",
+    ),
+    local(
+        "P2_meas_filtered_rate",
+        me_vr::FILTER_STATES[11],
+        "Pa/s",
+        "rate of pressure transducer 2's filter output (a state of Model Exchange; constant without p2_sensor_filter_frequency)",
+    ),
+    local(
+        "der(command_lagged)",
+        me_vr::FILTER_DERIVATIVES[0],
+        "V/s",
+        "rate of command_lagged",
+    ),
+    local(
+        "der(command_filtered)",
+        me_vr::FILTER_DERIVATIVES[1],
+        "V/s",
+        "rate of command_filtered",
+    ),
+    local(
+        "der(command_filtered_rate)",
+        me_vr::FILTER_DERIVATIVES[2],
+        "V/s2",
+        "rate of command_filtered_rate",
+    ),
+    local(
+        "der(F_meas_lagged)",
+        me_vr::FILTER_DERIVATIVES[3],
+        "N/s",
+        "rate of F_meas_lagged",
+    ),
+    local(
+        "der(F_meas_filtered)",
+        me_vr::FILTER_DERIVATIVES[4],
+        "N/s",
+        "rate of F_meas_filtered",
+    ),
+    local(
+        "der(F_meas_filtered_rate)",
+        me_vr::FILTER_DERIVATIVES[5],
+        "N/s2",
+        "rate of F_meas_filtered_rate",
+    ),
+    local(
+        "der(P1_meas_lagged)",
+        me_vr::FILTER_DERIVATIVES[6],
+        "Pa/s",
+        "rate of P1_meas_lagged",
+    ),
+    local(
+        "der(P1_meas_filtered)",
+        me_vr::FILTER_DERIVATIVES[7],
+        "Pa/s",
+        "rate of P1_meas_filtered",
+    ),
+    local(
+        "der(P1_meas_filtered_rate)",
+        me_vr::FILTER_DERIVATIVES[8],
+        "Pa/s2",
+        "rate of P1_meas_filtered_rate",
+    ),
+    local(
+        "der(P2_meas_lagged)",
+        me_vr::FILTER_DERIVATIVES[9],
+        "Pa/s",
+        "rate of P2_meas_lagged",
+    ),
+    local(
+        "der(P2_meas_filtered)",
+        me_vr::FILTER_DERIVATIVES[10],
+        "Pa/s",
+        "rate of P2_meas_filtered",
+    ),
+    local(
+        "der(P2_meas_filtered_rate)",
+        me_vr::FILTER_DERIVATIVES[11],
+        "Pa/s2",
+        "rate of P2_meas_filtered_rate",
+    ),
+    Variable {
+        name: "command_delay_pade_sections",
+        value_reference: me_vr::COMMAND_DELAY_PADE_SECTIONS,
+        var_type: VarType::Real,
+        causality: Causality::Parameter,
+        variability: Variability::Fixed,
+        unit: None,
+        start: 0.0,
+        min: Some(0.0),
+        max: Some(8.0),
+        description: "Model Exchange only: the transport delay (command_delay) as a chain of this many first-order Pade sections (1 - s d/2n)/(1 + s d/2n), a whole number from 0 to 8 (0 = off: Model Exchange refuses command_delay); Co-Simulation keeps its exact delay",
+    },
+    local(
+        "command_delay_pade_1",
+        me_vr::PADE_STATES[0],
+        "V",
+        "state of section 1 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 1)",
+    ),
+    local(
+        "command_delay_pade_2",
+        me_vr::PADE_STATES[1],
+        "V",
+        "state of section 2 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 2)",
+    ),
+    local(
+        "command_delay_pade_3",
+        me_vr::PADE_STATES[2],
+        "V",
+        "state of section 3 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 3)",
+    ),
+    local(
+        "command_delay_pade_4",
+        me_vr::PADE_STATES[3],
+        "V",
+        "state of section 4 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 4)",
+    ),
+    local(
+        "command_delay_pade_5",
+        me_vr::PADE_STATES[4],
+        "V",
+        "state of section 5 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 5)",
+    ),
+    local(
+        "command_delay_pade_6",
+        me_vr::PADE_STATES[5],
+        "V",
+        "state of section 6 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 6)",
+    ),
+    local(
+        "command_delay_pade_7",
+        me_vr::PADE_STATES[6],
+        "V",
+        "state of section 7 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 7)",
+    ),
+    local(
+        "command_delay_pade_8",
+        me_vr::PADE_STATES[7],
+        "V",
+        "state of section 8 of the transport delay's Pade chain (a state of Model Exchange; constant unless command_delay_pade_sections >= 8)",
+    ),
+    local(
+        "der(command_delay_pade_1)",
+        me_vr::PADE_DERIVATIVES[0],
+        "V/s",
+        "rate of command_delay_pade_1",
+    ),
+    local(
+        "der(command_delay_pade_2)",
+        me_vr::PADE_DERIVATIVES[1],
+        "V/s",
+        "rate of command_delay_pade_2",
+    ),
+    local(
+        "der(command_delay_pade_3)",
+        me_vr::PADE_DERIVATIVES[2],
+        "V/s",
+        "rate of command_delay_pade_3",
+    ),
+    local(
+        "der(command_delay_pade_4)",
+        me_vr::PADE_DERIVATIVES[3],
+        "V/s",
+        "rate of command_delay_pade_4",
+    ),
+    local(
+        "der(command_delay_pade_5)",
+        me_vr::PADE_DERIVATIVES[4],
+        "V/s",
+        "rate of command_delay_pade_5",
+    ),
+    local(
+        "der(command_delay_pade_6)",
+        me_vr::PADE_DERIVATIVES[5],
+        "V/s",
+        "rate of command_delay_pade_6",
+    ),
+    local(
+        "der(command_delay_pade_7)",
+        me_vr::PADE_DERIVATIVES[6],
+        "V/s",
+        "rate of command_delay_pade_7",
+    ),
+    local(
+        "der(command_delay_pade_8)",
+        me_vr::PADE_DERIVATIVES[7],
+        "V/s",
+        "rate of command_delay_pade_8",
+    ),
 ];
 
 /// The states' value references in the order of the state vector, with their derivatives'.
-pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 11] = [
+pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 31] = [
     state(vr::I, me_vr::DER_I),
     state(vr::X_JP, me_vr::DER_X_JP),
     state(me_vr::X_JP_VELOCITY, me_vr::DER_X_JP_VELOCITY),
@@ -452,6 +800,26 @@ pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 11] = [
     state(me_vr::P_PORT_LINE_1, me_vr::DER_P_PORT_LINE_1),
     state(me_vr::P_PORT_LINE_2, me_vr::DER_P_PORT_LINE_2),
     state(me_vr::STOPPER_MOUNT_LOAD, me_vr::DER_STOPPER_MOUNT_LOAD),
+    state(me_vr::FILTER_STATES[0], me_vr::FILTER_DERIVATIVES[0]),
+    state(me_vr::FILTER_STATES[1], me_vr::FILTER_DERIVATIVES[1]),
+    state(me_vr::FILTER_STATES[2], me_vr::FILTER_DERIVATIVES[2]),
+    state(me_vr::FILTER_STATES[3], me_vr::FILTER_DERIVATIVES[3]),
+    state(me_vr::FILTER_STATES[4], me_vr::FILTER_DERIVATIVES[4]),
+    state(me_vr::FILTER_STATES[5], me_vr::FILTER_DERIVATIVES[5]),
+    state(me_vr::FILTER_STATES[6], me_vr::FILTER_DERIVATIVES[6]),
+    state(me_vr::FILTER_STATES[7], me_vr::FILTER_DERIVATIVES[7]),
+    state(me_vr::FILTER_STATES[8], me_vr::FILTER_DERIVATIVES[8]),
+    state(me_vr::FILTER_STATES[9], me_vr::FILTER_DERIVATIVES[9]),
+    state(me_vr::FILTER_STATES[10], me_vr::FILTER_DERIVATIVES[10]),
+    state(me_vr::FILTER_STATES[11], me_vr::FILTER_DERIVATIVES[11]),
+    state(me_vr::PADE_STATES[0], me_vr::PADE_DERIVATIVES[0]),
+    state(me_vr::PADE_STATES[1], me_vr::PADE_DERIVATIVES[1]),
+    state(me_vr::PADE_STATES[2], me_vr::PADE_DERIVATIVES[2]),
+    state(me_vr::PADE_STATES[3], me_vr::PADE_DERIVATIVES[3]),
+    state(me_vr::PADE_STATES[4], me_vr::PADE_DERIVATIVES[4]),
+    state(me_vr::PADE_STATES[5], me_vr::PADE_DERIVATIVES[5]),
+    state(me_vr::PADE_STATES[6], me_vr::PADE_DERIVATIVES[6]),
+    state(me_vr::PADE_STATES[7], me_vr::PADE_DERIVATIVES[7]),
 ];
 
 const fn state(state: u32, derivative: u32) -> fmi2::model::ContinuousState {

@@ -17,7 +17,7 @@ use jetpipe::variables::{me_vr, vr};
 use jetpipe_model::physics::actuator::{Actuator, Inputs, State as ModelState};
 use jetpipe_model::physics::parameters::Parameters;
 
-const NX: usize = 11;
+const NX: usize = 31;
 const NZ: usize = 8;
 
 unsafe fn states(c: fmi2Component) -> [f64; NX] {
@@ -69,8 +69,9 @@ fn the_states_start_at_the_co_simulations_equilibrium_and_the_derivatives_are_th
         let dx = derivatives(c);
         assert!(dx[..4].iter().all(|d| d.abs() < 1e-9), "{dx:?}");
         assert!(dx[4].abs() < 1.0 && dx[5].abs() < 1.0, "{dx:?}");
-        // without volumes or a lagging mount the five states beyond the six stay put
-        assert_eq!(dx[6..], [0.0; 5]);
+        // without volumes, a lagging mount, lags, filters or Padé chain the twenty-five states beyond the
+        // six stay put
+        assert_eq!(dx[6..], [0.0; 25]);
         // away from rest: Actuator::derivatives itself
         let moved = [0.12, 1.5e-4, 0.02, -30.0, 4.1e5, 1.9e5];
         let mut all = x;
@@ -187,8 +188,8 @@ fn an_effect_with_a_memory_is_refused_in_model_exchange_by_name_and_stays_in_co_
     let sink = Sink::default();
     unsafe {
         for (parameter, value, effect) in [
-            (vr::COMMAND_DELAY, 2e-3, "transport_delay"),
-            (vr::FORCE_SENSOR_LAG, 1e-3, "the transducers' lags"),
+            (vr::CURRENT_SLEW_LIMIT, 2.0, "slew limit"),
+            (vr::FORCE_SENSOR_DELAY, 1e-3, "the transducers' delays"),
             (vr::FRICTION_COULOMB, 1.0, "piston_friction"),
             (vr::MODULATION_1_PARAMETER, vr::P_S as f64, "the modulation slots"),
         ] {
@@ -276,7 +277,7 @@ fn wrong_lengths_null_arrays_and_non_states_are_errors_that_change_nothing() {
             (
                 "nx",
                 fmi2GetContinuousStates(c, x.as_mut_ptr(), NX + 1),
-                "nx = 12, but the model description declares 11",
+                "nx = 32, but the model description declares 31",
             ),
             (
                 "ni",
@@ -393,10 +394,11 @@ fn the_gas_volumes_and_the_lagging_mount_are_states_with_the_co_simulations_rate
         let mut pressures = [0.0; PRESSURES_WITH_VOLUMES];
         pressures[0] = x[4];
         pressures[1] = x[5];
-        pressures[2..].copy_from_slice(&x[6..]);
+        pressures[2..].copy_from_slice(&x[6..11]);
         let expected = model.pressure_rates_with_volumes(&model.areas(x[1]), &pressures, 0.054, 0.0);
         let dx = derivatives(c);
-        assert_eq!(dx[4..].to_vec(), expected.to_vec());
+        assert_eq!(dx[4..11].to_vec(), expected.to_vec());
+        assert_eq!(dx[11..], [0.0; 20], "no lag, filter or Pade chain");
         assert!(dx[6] != 0.0 && dx[8] != 0.0 && dx[10] != 0.0, "{dx:?}");
         assert_eq!(dx[7], 0.0, "no return plenum");
         free(c);

@@ -33,7 +33,7 @@ typedef void *library_t;
 
 #include "fmi3Functions.h"
 
-#define NX 11
+#define NX 31
 #define NZ 8
 #define SUBSTEPS 1000 /* 10 us steps within a 10 ms sample */
 

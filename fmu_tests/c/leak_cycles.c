@@ -197,12 +197,12 @@ int main(int argc, char **argv) {
             return 1;
         }
         {
-            fmi2Real x[11], dx[11], z[8], nominal[11];
+            fmi2Real x[31], dx[31], z[8], nominal[31];
             fmi2EventInfo info;
             fmi2Boolean enter = fmi2True, stop = fmi2True;
             const fmi2ValueReference vr_delay[1] = {350u}; /* command_delay: refused in Model Exchange */
             const fmi2Real delay[1] = {1e-3};
-            EXPECT(fmi2GetNominalsOfContinuousStates(m, nominal, 11), fmi2OK);
+            EXPECT(fmi2GetNominalsOfContinuousStates(m, nominal, 31), fmi2OK);
             EXPECT(fmi2SetupExperiment(m, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
             EXPECT(fmi2EnterInitializationMode(m), fmi2OK);
             EXPECT(fmi2SetReal(m, vr_delay, 1, delay), fmi2Error);
@@ -211,15 +211,15 @@ int main(int argc, char **argv) {
             EXPECT(fmi2NewDiscreteStates(m, &info), fmi2OK);
             EXPECT(fmi2DoStep(m, 0.0, 1e-3, fmi2True), fmi2Error); /* a Co-Simulation call */
             EXPECT(fmi2EnterContinuousTimeMode(m), fmi2OK);
-            EXPECT(fmi2GetContinuousStates(m, x, 11), fmi2OK);
+            EXPECT(fmi2GetContinuousStates(m, x, 31), fmi2OK);
             EXPECT(fmi2GetContinuousStates(m, x, 6), fmi2Error);
             for (int j = 0; j < 5; j++) {
                 EXPECT(fmi2SetTime(m, j * 1e-6), fmi2OK);
-                EXPECT(fmi2SetContinuousStates(m, x, 11), fmi2OK);
-                EXPECT(fmi2GetDerivatives(m, dx, 11), fmi2OK);
+                EXPECT(fmi2SetContinuousStates(m, x, 31), fmi2OK);
+                EXPECT(fmi2GetDerivatives(m, dx, 31), fmi2OK);
                 EXPECT(fmi2GetEventIndicators(m, z, 8), fmi2OK);
                 EXPECT(fmi2CompletedIntegratorStep(m, fmi2True, &enter, &stop), fmi2OK);
-                for (int i = 0; i < 11; i++) x[i] += 1e-6 * dx[i];
+                for (int i = 0; i < 31; i++) x[i] += 1e-6 * dx[i];
             }
             EXPECT(fmi2EnterEventMode(m), fmi2OK);
             EXPECT(fmi2SetReal(m, vr_in, 2, in), fmi2OK);

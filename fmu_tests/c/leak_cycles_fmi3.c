@@ -27,7 +27,7 @@
 #define VR_F_ACT 10u
 #define VR_P1 11u
 #define VR_P2 12u
-#define NX 11
+#define NX 31
 #define NZ 8
 
 static long n_messages = 0, n_error_messages = 0;

@@ -1,9 +1,12 @@
-//! The actuator as an FMI 2.0 Model Exchange model: eleven states, the six of (4.1),
+//! The actuator as an FMI 2.0 Model Exchange model: thirty-one states, the six of (4.1),
 //! [i, x_jp, ẋ_jp, ẍ_jp, P1, P2], then the pressures of the four gas volumes behind
-//! restrictions and the lagging stopper mount's load (constant while their effects are off);
-//! their derivatives from `Actuator::derivatives` and `Actuator::pressure_rates_with_volumes`
-//! (the equations the Co-Simulation step integrates), and event indicators where the
-//! right-hand side is not smooth.
+//! restrictions and the lagging stopper mount's load, then the lags and second-order filters
+//! of the command stage and of the three transducers (module `filters`: three states each),
+//! then the eight sections of the transport delay's optional Padé chain (every state beyond
+//! the six constant while its effect is off); their derivatives from
+//! `Actuator::derivatives`, `Actuator::pressure_rates_with_volumes` and the lag and filter
+//! equations of `physics::sensors` (the equations the Co-Simulation step integrates or
+//! solves in closed form), and event indicators where the right-hand side is not smooth.
 //!
 //! The jet pipe's hysteresis (`jet_pipe_hysteresis`, either law: plays or Bouc–Wen) is a
 //! discrete state, its memory, as in Co-Simulation: the operator is rate-independent, and
@@ -19,14 +22,27 @@
 //! integrates, with the same law and the same memory: what differs is only where the
 //! reversal is put, CVODE's root of z7 in place of the closed form's turning point.
 //!
-//! What Model Exchange does not have, and why:
-//! * effects with a memory of the past that is not the hysteresis', which the Co-Simulation
-//!   step updates at communication points or keeps in a history buffer (the transport delay,
-//!   the command stage's lag, filter and slew limit, the transducers' lags, delays, plays
-//!   and filters, and the forces that read the stopper's motion over the last intervals) are
-//!   refused, each named, when set and when initialisation ends; they stay available in
-//!   Co-Simulation;
-//! * the constants that vary in time are refused too (not yet part of Model Exchange).
+//! What Model Exchange does not have, and why (the `REFUSED` table gives each reason in the
+//! message that refuses it, when a parameter is set and when initialisation ends; all stay
+//! available in Co-Simulation):
+//! * the transport delay (`command_delay`) and the transducers' delays: a pure delay
+//!   y(t) = u(t − d) is not an ODE; its state at t is the whole of u over (t − d, t], which no
+//!   finite set of continuous states holds. For the transport delay its closest state form is
+//!   offered instead: with `command_delay_pade_sections` = n (1 to 8; Model Exchange only,
+//!   Co-Simulation keeps its exact delay) a chain of n first-order Padé sections
+//!   (`filters::delayed_command`, `filters::chain_rates`); without it `command_delay` is
+//!   refused when initialisation ends (not when set: importers set the parameters in the
+//!   model description's order, the delay before the count);
+//! * the command stage's slew limit: the limited command follows
+//!   ds/dt = sign(u − s)·S until it reaches u, then s = u, a right-hand side that jumps where
+//!   s meets u and holds s there on a sliding surface; exact only as a hybrid state (a ramp or
+//!   a hold, switched at events), which this FMU does not have;
+//! * the transducers' plays: a play is a rate-independent operator whose output holds until
+//!   its input has moved half its width from it, a memory moved at the input's reversals, not
+//!   an ODE (the FMU has such a memory, with its events, for the jet pipe's hysteresis only);
+//! * the forces that read the stopper's motion, formed from its positions at the last
+//!   communication points, and the modulation slots, held over each communication step;
+//! * the constants that vary in time (not yet part of Model Exchange).
 //!
 //! The stopper: a new x_s set in event mode moves it at once as in Co-Simulation (the air in
 //! each chamber conserved, P V^γ constant), and `fmi2NewDiscreteStates` reports the changed
@@ -39,7 +55,6 @@ use crate::variables::{me_vr, vr};
 use fmi2::model::{EventUpdate, ModelExchangeModel};
 use jetpipe_model::physics::actuator::{index, Actuator, Inputs, State};
 use jetpipe_model::physics::chambers::pressure_after_volume_jump;
-use jetpipe_model::physics::command_stage;
 use jetpipe_model::physics::current_driver;
 use jetpipe_model::physics::effects::PLAY_OPERATORS;
 use jetpipe_model::physics::jet_pipe;
@@ -50,6 +65,10 @@ use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 use jetpipe_model::physics::time_varying;
 use jetpipe_model::simulation::Simulation;
 
+mod filters;
+pub(super) use filters::{filters_of, seen_command, PADE_SECTIONS};
+use filters::{Chain, Filters};
+
 /// The number of event indicators (see [`event_indicators`]).
 pub const EVENT_INDICATORS: usize = 8;
 
@@ -57,8 +76,15 @@ pub const EVENT_INDICATORS: usize = 8;
 /// law's input and output where it was last advanced.
 pub(super) type Memory = [f64; PLAY_OPERATORS];
 
-/// The number of continuous states: the six of (4.1) and the [`node::STATES`] beyond them.
-pub const STATES: usize = 6 + node::STATES;
+/// The number of continuous states: the six of (4.1), the [`node::STATES`] beyond them and
+/// the [`filters::STATES`] of the lags and filters.
+pub const STATES: usize = 6 + node::STATES + filters::STATES + filters::PADE_SECTIONS;
+
+/// Where the lags' and filters' states start in the state vector.
+const FILTERS: usize = 6 + node::STATES;
+
+/// Where the transport delay's Padé chain starts in the state vector.
+const CHAIN: usize = FILTERS + filters::STATES;
 
 /// The states beyond the six of (4.1), in the order of [`node`]: the volumes' pressures, the
 /// mount's load.
@@ -87,6 +113,11 @@ pub(super) struct MeState {
     time: f64,
     x: State,
     nodes: Nodes,
+    /// The lags' and filters' states (module `filters`).
+    filters: Filters,
+    /// The transport delay's Padé chain, its first `sections` states in use (0: no delay).
+    chain: Chain,
+    sections: usize,
     /// The hysteresis memory when the effect is on (see the module's text).
     memory: Option<Memory>,
     /// Where the stopper is: the last x_s set that is inside the cylinder (see
@@ -103,37 +134,33 @@ struct Refused {
     parameters: &'static [u32],
 }
 
-const MEMORY: &str =
-    "it is not an ODE: the Co-Simulation step keeps a memory of the past for it, updated at communication points";
+const DELAY: &str = "a pure delay y(t) = u(t - d) is not an ODE: its state is the whole of u over the last d seconds, which no finite set of continuous states holds";
+
+/// The transport delay's reason, with the option.
+const TRANSPORT_DELAY: &str = "a pure delay y(t) = u(t - d) is not an ODE: its state is the whole of u over the last d seconds, which no finite set of continuous states holds; set command_delay_pade_sections (1 to 8) first for its closest state form, a chain of Pade sections";
 
 /// The effects that Model Exchange refuses, each with its parameters (any of them away from
 /// its default switches the effect on).
 const REFUSED: &[Refused] = &[
     Refused {
         effect: "transport_delay",
-        why: "it is not an ODE: a history buffer of the command",
+        why: TRANSPORT_DELAY,
         parameters: &[vr::COMMAND_DELAY],
     },
     Refused {
-        effect: "the command stage's lag, filter and slew limit",
-        why: MEMORY,
-        parameters: &[vr::COMMAND_LAG, vr::COMMAND_FILTER_FREQUENCY, vr::CURRENT_SLEW_LIMIT],
+        effect: "the command stage's slew limit",
+        why: "the slew-limited command moves at +-current_slew_limit/k_cd towards the command until it reaches it, then holds it: a right-hand side that jumps where the two meet and holds them together on a sliding surface, exact only as a hybrid state (a ramp or a hold switched at events), which this FMU does not have",
+        parameters: &[vr::CURRENT_SLEW_LIMIT],
     },
     Refused {
-        effect: "the transducers' lags, delays, plays and filters",
-        why: MEMORY,
-        parameters: &[
-            vr::FORCE_SENSOR_LAG,
-            vr::FORCE_SENSOR_DELAY,
-            vr::FORCE_SENSOR_PLAY,
-            vr::FORCE_SENSOR_FILTER_FREQUENCY,
-            vr::P1_SENSOR_LAG,
-            vr::P1_SENSOR_DELAY,
-            vr::P1_SENSOR_FILTER_FREQUENCY,
-            vr::P2_SENSOR_LAG,
-            vr::P2_SENSOR_DELAY,
-            vr::P2_SENSOR_FILTER_FREQUENCY,
-        ],
+        effect: "the transducers' delays",
+        why: DELAY,
+        parameters: &[vr::FORCE_SENSOR_DELAY, vr::P1_SENSOR_DELAY, vr::P2_SENSOR_DELAY],
+    },
+    Refused {
+        effect: "the force sensor's play",
+        why: "a play (backlash) is a rate-independent operator whose output holds until its input has moved half its width away: a memory moved where its input reverses, not an ODE, and this FMU has such a memory with its event indicator for the jet pipe's hysteresis only",
+        parameters: &[vr::FORCE_SENSOR_PLAY],
     },
     Refused {
         effect: "piston_friction and the forces on the stopper's motion",
@@ -183,7 +210,14 @@ fn refusal_message(r: &Refused, switched_on: &str) -> String {
 
 /// Whether setting `value_reference` to `value` switches on an effect Model Exchange refuses:
 /// the message that names it.
+///
+/// `command_delay` is taken when set and refused when initialisation ends if
+/// `command_delay_pade_sections` is still 0 then: an importer sets the parameters in the model
+/// description's order, in which the delay comes first.
 pub(super) fn refused_setting(value_reference: u32, value: f64) -> Result<(), String> {
+    if value_reference == vr::COMMAND_DELAY {
+        return Ok(());
+    }
     for r in REFUSED {
         if r.parameters.contains(&value_reference) && value != table_start(value_reference) {
             let what = format!("{} = {value}", variable_name(value_reference));
@@ -195,10 +229,13 @@ pub(super) fn refused_setting(value_reference: u32, value: f64) -> Result<(), St
 
 /// The effects a model has that Model Exchange refuses, named with the parameters that
 /// switch them on; also what the model's own flags say is on (whatever parameter did it).
-fn refused_effects(model: &Actuator) -> Result<(), String> {
+fn refused_effects(model: &Actuator, pade_sections: usize) -> Result<(), String> {
     let p = &model.params;
     let mut problems = Vec::new();
     for r in REFUSED {
+        if pade_sections > 0 && r.parameters == [vr::COMMAND_DELAY] {
+            continue;
+        }
         let on: Vec<String> = r
             .parameters
             .iter()
@@ -212,14 +249,14 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
         }
     }
     let flags = [
-        (p.command_delay != 0.0, "transport_delay"),
+        (p.command_delay != 0.0 && pade_sections == 0, "transport_delay"),
+        (p.current_slew_limit > 0.0, "the command stage's slew limit"),
         (
-            p.command_lag > 0.0 || p.command_filter_frequency > 0.0 || p.current_slew_limit > 0.0,
-            "the command stage's memory",
-        ),
-        (
-            Channel::ALL.iter().any(|&c| SensorLaw::of(p, c).filters()),
-            "a transducer's memory",
+            Channel::ALL.iter().any(|&c| {
+                let law = SensorLaw::of(p, c);
+                law.delay > 0.0 || law.play > 0.0
+            }),
+            "a transducer's delay or play",
         ),
         (model.reads_stopper_motion, "a force on the stopper's motion"),
         (time_varying::varies(p), "constants that vary in time"),
@@ -242,21 +279,43 @@ fn refused_effects(model: &Actuator) -> Result<(), String> {
     }
 }
 
-/// The inputs of the right-hand side: v_DA through the command stage's static part (its
-/// curve, cubic and limits; its memories are refused), the stopper held, the hysteresis
-/// memory.
-fn inputs(model: &Actuator, v_da: f64, x_s: f64, memory: Option<&Memory>) -> Inputs {
-    let p = &model.params;
-    let v_da = if command_stage::is_active(p) {
-        command_stage::static_map(p, v_da)
-    } else {
-        v_da
-    };
+/// The inputs of the right-hand side: v_DA through the command stage (its static part, then
+/// its lag and filter from their states; its slew limit is refused) and the transport delay's
+/// Padé chain when it is on, the stopper held, the hysteresis memory.
+fn inputs(at: &At<'_>, memory: Option<&Memory>) -> Inputs {
+    let command = filters::seen_command(&at.model.params, at.v_da, at.filters);
     Inputs {
-        v_da,
-        x_s,
+        v_da: filters::delayed_command(at.sections, command, at.chain),
+        x_s: at.x_s,
         x_s_rate: 0.0,
         plays: memory.copied(),
+    }
+}
+
+/// `command_delay_pade_sections` when set: from 0 to [`filters::PADE_SECTIONS`] (a whole
+/// number, checked when initialisation ends, as the curves' knot counts are).
+pub(super) fn check_pade_sections(value: f64) -> Result<f64, String> {
+    if (0.0..=filters::PADE_SECTIONS as f64).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!(
+            "command_delay_pade_sections = {value} is invalid: must be a whole number from 0 to {}",
+            filters::PADE_SECTIONS
+        ))
+    }
+}
+
+/// `command_delay_pade_sections` as a number of sections: a whole number from 0 to
+/// [`filters::PADE_SECTIONS`].
+pub(super) fn pade_sections(value: f64) -> Result<usize, String> {
+    check_pade_sections(value)?;
+    if value.fract() == 0.0 {
+        Ok(value as usize)
+    } else {
+        Err(format!(
+            "command_delay_pade_sections = {value} is invalid: must be a whole number from 0 to {}",
+            filters::PADE_SECTIONS
+        ))
     }
 }
 
@@ -277,8 +336,12 @@ pub(super) fn advance_memory(model: &Actuator, memory: &mut Option<Memory>, curr
 /// * z6 = sin(π x_abs/D_jp): the jet pipe crosses a tangency of the orifice geometry, where
 ///   the areas (2.8)–(2.17) stop being analytic (every multiple of D_jp);
 /// * z7 = ī − i, with the hysteresis on (else 1): the current, and so f3's output, reverses
-///   (di/dt = ω_cd (ī − i), (2.1)–(2.3)), where the hysteresis memory is advanced.
-fn event_indicators(model: &Actuator, x: &State, v_da: f64, x_s: f64, memory: Option<&Memory>, z: &mut [f64]) {
+///   (di/dt = ω_cd (ī − i), (2.1)–(2.3), ī the static current of the command the driver
+///   sees, after the command stage's lag and filter), where the hysteresis memory is advanced.
+fn event_indicators(at: &At<'_>, z: &mut [f64]) {
+    let At {
+        model, x, x_s, memory, ..
+    } = *at;
     // (the places' pressures with restrictions do not reverse the flows the valve sees
     // between them and the chambers: the same indicators)
     let p = &model.params;
@@ -295,7 +358,7 @@ fn event_indicators(model: &Actuator, x: &State, v_da: f64, x_s: f64, memory: Op
         (std::f64::consts::PI * x_abs / p.d_jp).sin(),
         match memory {
             Some(_) => {
-                let command = inputs(model, v_da, x_s, None).v_da;
+                let command = inputs(at, None).v_da;
                 current_driver::static_current(p.k_cd, p.i_offset, command) - x[index::CURRENT]
             }
             None => 1.0,
@@ -304,13 +367,59 @@ fn event_indicators(model: &Actuator, x: &State, v_da: f64, x_s: f64, memory: Op
     z.copy_from_slice(&values);
 }
 
+/// A point of the right-hand side: the model, the states, the inputs, the time and the
+/// hysteresis memory.
+#[derive(Clone, Copy)]
+pub(super) struct At<'a> {
+    pub model: &'a Actuator,
+    pub x: &'a State,
+    pub nodes: &'a Nodes,
+    pub filters: &'a Filters,
+    pub chain: &'a Chain,
+    pub sections: usize,
+    pub v_da: f64,
+    pub x_s: f64,
+    pub time: f64,
+    pub memory: Option<&'a Memory>,
+}
+
+impl MeState {
+    fn at(&self, v_da: f64) -> At<'_> {
+        At {
+            model: &self.model,
+            x: &self.x,
+            nodes: &self.nodes,
+            filters: &self.filters,
+            chain: &self.chain,
+            sections: self.sections,
+            v_da,
+            x_s: self.x_s,
+            time: self.time,
+            memory: self.memory.as_ref(),
+        }
+    }
+}
+
 /// The rates of the [`STATES`] states: (4.1) from `Actuator::derivatives`; with gas volumes
 /// behind restrictions or a lagging mount, the pressures' from
 /// `Actuator::pressure_rates_with_volumes` (the law the Co-Simulation step integrates them
-/// with), else 0 for the states beyond the six. The jet pipe's input is f3's output through
-/// the hysteresis from `memory` when that is on.
-fn rates(model: &Actuator, x: &State, nodes: &Nodes, v_da: f64, x_s: f64, memory: Option<&Memory>) -> [f64; STATES] {
-    let d = model.derivatives(x, &inputs(model, v_da, x_s, memory));
+/// with), else 0 for the volumes and the mount; the lags' and filters' from `filters::rates`
+/// at the transducers' static readings at the time (0 for those off). The jet pipe's input
+/// is f3's output through the hysteresis from the memory when that is on.
+fn rates(at: &At<'_>) -> [f64; STATES] {
+    let At {
+        model,
+        x,
+        nodes,
+        filters,
+        chain,
+        sections,
+        v_da,
+        x_s,
+        time,
+        memory,
+    } = *at;
+    let d = model.derivatives(x, &inputs(at, memory));
     let mut out = [0.0; STATES];
     out[..6].copy_from_slice(d.as_slice());
     if model.has_volume_states() {
@@ -319,51 +428,42 @@ fn rates(model: &Actuator, x: &State, nodes: &Nodes, v_da: f64, x_s: f64, memory
         p[1] = x[index::P2];
         p[2..].copy_from_slice(nodes);
         let r = model.pressure_rates_with_volumes(&model.areas(x[index::JET_POSITION]), &p, x_s, 0.0);
-        out[index::P1..].copy_from_slice(&r);
+        out[index::P1..FILTERS].copy_from_slice(&r);
+    }
+    if filters::any_on(&model.params) {
+        let y = model.outputs_at(x, x_s, 0.0, time);
+        out[FILTERS..CHAIN].copy_from_slice(&filters::rates(&model.params, v_da, &y, filters));
+    }
+    if sections > 0 {
+        let command = filters::seen_command(&model.params, v_da, filters);
+        out[CHAIN..].copy_from_slice(&filters::chain_rates(
+            model.params.command_delay,
+            sections,
+            command,
+            chain,
+        ));
     }
     out
 }
 
 /// The value of a variable of Model Exchange (a state or a derivative beyond the table's
-/// outputs) at a state; `None` for any other value reference.
-pub(super) fn state_variable(
-    model: &Actuator,
-    x: &State,
-    nodes: &Nodes,
-    v_da: f64,
-    x_s: f64,
-    memory: Option<&Memory>,
-    value_reference: u32,
-) -> Option<f64> {
-    let states = [
-        me_vr::P_SUPPLY_PLENUM,
-        me_vr::P_RETURN_PLENUM,
-        me_vr::P_PORT_LINE_1,
-        me_vr::P_PORT_LINE_2,
-        me_vr::STOPPER_MOUNT_LOAD,
-    ];
-    if let Some(k) = states.iter().position(|&v| v == value_reference) {
-        return Some(nodes[k]);
+/// outputs) at a point; `None` for any other value reference.
+pub(super) fn state_variable(at: &At<'_>, value_reference: u32) -> Option<f64> {
+    if let Some(k) = me_vr::STATES.iter().position(|&v| v == value_reference) {
+        return Some(if k < node::STATES {
+            at.nodes[k]
+        } else if k < node::STATES + filters::STATES {
+            at.filters[k - node::STATES]
+        } else {
+            at.chain[k - node::STATES - filters::STATES]
+        });
     }
-    let derivatives = [
-        me_vr::DER_I,
-        me_vr::DER_X_JP,
-        me_vr::DER_X_JP_VELOCITY,
-        me_vr::DER_X_JP_ACCELERATION,
-        me_vr::DER_P1,
-        me_vr::DER_P2,
-        me_vr::DER_P_SUPPLY_PLENUM,
-        me_vr::DER_P_RETURN_PLENUM,
-        me_vr::DER_P_PORT_LINE_1,
-        me_vr::DER_P_PORT_LINE_2,
-        me_vr::DER_STOPPER_MOUNT_LOAD,
-    ];
-    if let Some(k) = derivatives.iter().position(|&v| v == value_reference) {
-        return Some(rates(model, x, nodes, v_da, x_s, memory)[k]);
+    if let Some(k) = me_vr::DERIVATIVES.iter().position(|&v| v == value_reference) {
+        return Some(rates(at)[k]);
     }
     match value_reference {
-        me_vr::X_JP_VELOCITY => Some(x[index::JET_VELOCITY]),
-        me_vr::X_JP_ACCELERATION => Some(x[index::JET_ACCELERATION]),
+        me_vr::X_JP_VELOCITY => Some(at.x[index::JET_VELOCITY]),
+        me_vr::X_JP_ACCELERATION => Some(at.x[index::JET_ACCELERATION]),
         _ => None,
     }
 }
@@ -375,7 +475,7 @@ impl ActuatorFmu {
     /// starts its connectors at 0) leaves the stopper at the last valid x_s set (or the start
     /// value), and the derivatives are refused until a valid x_s is set.
     pub(super) fn exit_initialization_model_exchange(&mut self) -> Result<(), String> {
-        refused_effects(&Actuator::new(self.params.clone())?)?;
+        refused_effects(&Actuator::new(self.params.clone())?, pade_sections(self.pade_sections)?)?;
         let me = match self.params.check_stopper(self.x_s) {
             Ok(()) => self.initial_me_state()?,
             Err(e) => {
@@ -405,11 +505,16 @@ impl ActuatorFmu {
     /// The Model Exchange state at the end of initialisation.
     fn initial_me_state(&self) -> Result<MeState, String> {
         let simulation = self.initial_simulation()?;
+        let filters = filters::filters_of(&simulation);
         Ok(MeState {
             model: simulation.model().clone(),
             time: self.start_time,
             x: *simulation.state(),
             nodes: nodes_of(&simulation),
+            filters,
+            chain: [filters::seen_command(&simulation.model().params, simulation.v_da(), &filters);
+                filters::PADE_SECTIONS],
+            sections: pade_sections(self.pade_sections)?,
             memory: simulation.hysteresis_memory(),
             x_s: simulation.x_s(),
             states_changed: false,
@@ -437,7 +542,11 @@ impl ActuatorFmu {
             vr::I => x[index::CURRENT],
             vr::X_JP => x[index::JET_POSITION],
             vr::F_ACT | vr::F_MEAS | vr::P1_MEAS | vr::P2_MEAS => {
-                let y = me.model.outputs_at(x, me.x_s, 0.0, me.time);
+                let y = filters::filtered_outputs(
+                    &me.model.params,
+                    me.model.outputs_at(x, me.x_s, 0.0, me.time),
+                    &me.filters,
+                );
                 match value_reference {
                     vr::F_ACT => y.f_act,
                     vr::F_MEAS => y.f_meas,
@@ -445,17 +554,7 @@ impl ActuatorFmu {
                     _ => y.p2_meas,
                 }
             }
-            _ => {
-                return state_variable(
-                    &me.model,
-                    x,
-                    &me.nodes,
-                    self.v_da,
-                    me.x_s,
-                    me.memory.as_ref(),
-                    value_reference,
-                )
-            }
+            _ => return state_variable(&me.at(self.v_da), value_reference),
         })
     }
 
@@ -487,6 +586,7 @@ impl ActuatorFmu {
     /// time, states and whether the states changed.
     pub(super) fn serialize_model_exchange(&self, w: &mut fmi2::state_bytes::ByteWriter) {
         w.bool(self.model_exchange);
+        w.f64(self.pade_sections);
         match &self.me {
             None => w.bool(false),
             Some(me) => {
@@ -494,6 +594,8 @@ impl ActuatorFmu {
                 w.f64(me.time);
                 w.f64s(me.x.as_slice());
                 w.f64s(&me.nodes);
+                w.f64s(&me.filters);
+                w.f64s(&me.chain);
                 w.f64(me.x_s);
                 w.bool(me.states_changed);
                 w.bool(me.memory.is_some());
@@ -510,6 +612,7 @@ impl ActuatorFmu {
         restored: &mut ActuatorFmu,
     ) -> Result<(), String> {
         restored.model_exchange = r.bool("modelExchange")?;
+        restored.pade_sections = check_pade_sections(r.f64()?)?;
         if r.bool("modelExchangeRunning")? {
             let time = r.f64()?;
             let values = r.f64s_at_most(6, "continuous states")?;
@@ -524,6 +627,27 @@ impl ActuatorFmu {
             }
             let mut nodes = [0.0; node::STATES];
             nodes.copy_from_slice(&node_values);
+            let filter_values = r.f64s_at_most(filters::STATES, "states of the lags and filters")?;
+            if filter_values.len() != filters::STATES {
+                return Err(format!(
+                    "{} states of the lags and filters, not {} (an FMU state of another version of the model)",
+                    filter_values.len(),
+                    filters::STATES
+                ));
+            }
+            let mut filter_states = [0.0; filters::STATES];
+            filter_states.copy_from_slice(&filter_values);
+            let chain_values = r.f64s_at_most(filters::PADE_SECTIONS, "states of the Pade chain")?;
+            let sections = pade_sections(restored.pade_sections)?;
+            if chain_values.len() != filters::PADE_SECTIONS {
+                return Err(format!(
+                    "{} states of the Pade chain, not {} (an FMU state of another version of the model)",
+                    chain_values.len(),
+                    filters::PADE_SECTIONS
+                ));
+            }
+            let mut chain = [0.0; filters::PADE_SECTIONS];
+            chain.copy_from_slice(&chain_values);
             let x_s = r.f64()?;
             restored.params.check_stopper(x_s)?;
             let states_changed = r.bool("statesChanged")?;
@@ -553,6 +677,9 @@ impl ActuatorFmu {
                 time,
                 x: State::from_column_slice(&values),
                 nodes,
+                filters: filter_states,
+                chain,
+                sections,
                 memory,
                 x_s,
                 states_changed,
@@ -576,7 +703,9 @@ impl ModelExchangeModel for ActuatorFmu {
     fn continuous_states(&self, x: &mut [f64]) -> Result<(), String> {
         let me = self.me_view()?;
         x[..6].copy_from_slice(me.x.as_slice());
-        x[6..].copy_from_slice(&me.nodes);
+        x[6..FILTERS].copy_from_slice(&me.nodes);
+        x[FILTERS..CHAIN].copy_from_slice(&me.filters);
+        x[CHAIN..].copy_from_slice(&me.chain);
         Ok(())
     }
 
@@ -595,14 +724,16 @@ impl ModelExchangeModel for ActuatorFmu {
             }
         }
         me.x = State::from_column_slice(&x[..6]);
-        me.nodes.copy_from_slice(&x[6..]);
+        me.nodes.copy_from_slice(&x[6..FILTERS]);
+        me.filters.copy_from_slice(&x[FILTERS..CHAIN]);
+        me.chain.copy_from_slice(&x[CHAIN..]);
         Ok(())
     }
 
     fn derivatives(&self, dx: &mut [f64]) -> Result<(), String> {
         let me = self.me_view()?;
         self.check_stopper_set(&me)?;
-        let d = rates(&me.model, &me.x, &me.nodes, self.v_da, me.x_s, me.memory.as_ref());
+        let d = rates(&me.at(self.v_da));
         if let Some(k) = d.iter().position(|v| !v.is_finite()) {
             return Err(format!(
                 "the derivative of state {k} is {} at the states {:?}",
@@ -617,19 +748,22 @@ impl ModelExchangeModel for ActuatorFmu {
     fn event_indicators(&self, z: &mut [f64]) -> Result<(), String> {
         let me = self.me_view()?;
         self.check_stopper_set(&me)?;
-        event_indicators(&me.model, &me.x, self.v_da, me.x_s, me.memory.as_ref(), z);
+        event_indicators(&me.at(self.v_da), z);
         Ok(())
     }
 
     fn nominals(&self, nominals: &mut [f64]) {
         // The scales of the Co-Simulation's tolerances: 0.1 A, 0.1 mm and its natural-frequency
-        // derivatives, 1 bar (also for the volumes' pressures and the mount's load).
+        // derivatives, 1 bar (also for the volumes' pressures and the mount's load); the lags'
+        // and filters' of `filters::scales`.
         let scales = match Actuator::new(self.params.clone()) {
             Ok(model) => model.state_scales(),
             Err(_) => Actuator::new(Parameters::default()).map_or(State::repeat(1.0), |m| m.state_scales()),
         };
         nominals[..6].copy_from_slice(scales.as_slice());
-        nominals[6..].iter_mut().for_each(|n| *n = scales[index::P1]);
+        nominals[6..FILTERS].iter_mut().for_each(|n| *n = scales[index::P1]);
+        nominals[FILTERS..CHAIN].copy_from_slice(&filters::scales(&self.params));
+        nominals[CHAIN..].iter_mut().for_each(|n| *n = 1.0);
     }
 
     /// Every event (a reversal of the current, z7, among them) advances the hysteresis memory.
@@ -653,5 +787,7 @@ impl ModelExchangeModel for ActuatorFmu {
     }
 }
 
+#[cfg(test)]
+mod filter_tests;
 #[cfg(test)]
 mod tests;

@@ -28,7 +28,7 @@ use fmi3::types::*;
 use jetpipe::fmu3_exports::*;
 use jetpipe::variables::vr;
 
-const NX: usize = 11;
+const NX: usize = 31;
 const NZ: usize = 8;
 
 /// One instance's messages: (status, message).

@@ -25,7 +25,7 @@ use fmi2::types::*;
 use jetpipe::fmu_exports::*;
 use jetpipe::variables::vr;
 
-const NX: usize = 11;
+const NX: usize = 31;
 const NZ: usize = 8;
 
 /// The states a Model Exchange instance reaches.
@@ -50,7 +50,8 @@ pub unsafe fn call(c: fmi2Component, f: Function, valid: bool) -> (String, fmi2S
         }
         Function::SetContinuousStates => {
             if fmi2GetContinuousStates(c, x.as_mut_ptr(), NX) != fmi2OK {
-                x = [0.1, 1e-4, 0.0, 0.0, 3e5, 2e5, 6e5, 1e5, 3e5, 2e5, 1e5];
+                x = [0.0; NX];
+                x[..11].copy_from_slice(&[0.1, 1e-4, 0.0, 0.0, 3e5, 2e5, 6e5, 1e5, 3e5, 2e5, 1e5]);
             }
             if valid {
                 x[4] *= 1.0 + 1e-6;
@@ -107,7 +108,7 @@ pub unsafe fn call(c: fmi2Component, f: Function, valid: bool) -> (String, fmi2S
                 )
             } else {
                 (
-                    "fmi2GetEventIndicators(ni 11)".into(),
+                    "fmi2GetEventIndicators(ni 31)".into(),
                     fmi2GetEventIndicators(c, x.as_mut_ptr(), NX),
                 )
             }

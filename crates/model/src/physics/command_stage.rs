@@ -307,6 +307,14 @@ impl CommandStage {
         }
     }
 
+    /// The lag's output, the second-order filter's output and its rate at the last
+    /// communication point: the continuous states of [`super::sensors::first_order_rate`]
+    /// and [`super::sensors::second_order_rates`] (the lag driven by [`static_map`] of the
+    /// command, the filter by the lag's output, or by the static map without the lag).
+    pub fn dynamic_states(&self) -> [f64; 3] {
+        [self.lagged, self.filtered, self.filtered_rate]
+    }
+
     /// The stage as numbers (for FMU states): time, held, target, lagged, filtered and its
     /// rate.
     pub fn to_values(&self) -> [f64; VALUES] {

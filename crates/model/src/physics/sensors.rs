@@ -262,6 +262,21 @@ struct Advanced {
     played: f64,
 }
 
+/// The first-order lag τ y' = u − y: its rate (the equation whose exact solutions the
+/// command stage's and the transducers' lags step over communication intervals; Model
+/// Exchange integrates it as it stands).
+pub fn first_order_rate(lag: f64, input: f64, y: f64) -> f64 {
+    (input - y) / lag
+}
+
+/// The second-order low-pass filter y'' + 2ζω y' + ω² y = ω² u, ω = 2π `frequency`, as a
+/// first-order system: the rates (y', y'') of (y, y') under the input `input` (the equation
+/// [`second_order_step`] solves exactly; Model Exchange integrates it as it stands).
+pub fn second_order_rates(frequency: f64, damping: f64, (y, rate): (f64, f64), input: f64) -> (f64, f64) {
+    let omega = 2.0 * std::f64::consts::PI * frequency;
+    (rate, omega * omega * (input - y) - 2.0 * damping * omega * rate)
+}
+
 /// The second-order low-pass filter y'' + 2ζω y' + ω² y = ω² u over an interval h in which
 /// its input u moves linearly from `from` to `to`, exactly: the particular solution of the
 /// ramp, u − 2ζ u'/ω, plus the homogeneous motion e^{Ah} of what departs from it. Returns
@@ -430,6 +445,12 @@ impl SensorMemory {
         self.played = a.played;
         self.last_time = time;
         a.played
+    }
+
+    /// The lag's output, the second-order filter's output and its rate at the last time
+    /// recorded: the continuous states of [`first_order_rate`] and [`second_order_rates`].
+    pub fn dynamic_states(&self) -> [f64; 3] {
+        [self.lagged, self.filtered, self.filtered_rate]
     }
 
     /// The memory as numbers (for FMU states): the last time recorded, delayed, lagged,

@@ -432,6 +432,20 @@ impl Simulation {
         self.model.hysteresis.is_active().then_some(self.plays)
     }
 
+    /// The command stage's lag output, second-order filter output and its rate at the last
+    /// communication point ([`CommandStage::dynamic_states`]): what Model Exchange starts
+    /// its states of them from.
+    pub fn command_dynamics(&self) -> [f64; 3] {
+        self.command_stage.dynamic_states()
+    }
+
+    /// The same for the transducer of `channel`, when it has a memory (a delay, lag, filter
+    /// or play; `None` when it reads its static reading).
+    pub fn transducer_dynamics(&self, channel: Channel) -> Option<[f64; 3]> {
+        let k = Channel::ALL.iter().position(|&c| c == channel)?;
+        self.transducers[k].as_ref().map(SensorMemory::dynamic_states)
+    }
+
     /// The integrators' work so far.
     pub fn statistics(&self) -> Statistics {
         self.statistics
