@@ -73,7 +73,7 @@ const LOWER_QUARTILE_OVER_MEAN: f64 = 0.78;
 
 /// The local noise level of `x` (σ) in each window of [`WINDOW`] samples: from its fourth
 /// differences (variance 70 σ² for white noise), which a signal slow against the sampling
-/// leaves nearly alone, the lower quartile over the window and [`LEVEL_NEIGHBOURS`] either
+/// leaves nearly alone, the lower quartile over the window and `LEVEL_NEIGHBOURS` either
 /// side, so that what lifts up to two thirds of them (a step and the transient after it, a
 /// model departing at each step) lifts no level. The mean square of 64 fourth differences
 /// has about 24 degrees of freedom (adjacent ones correlate by −0.8, 0.4, −0.11), and the
