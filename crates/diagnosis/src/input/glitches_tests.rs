@@ -1,21 +1,5 @@
 use super::*;
-
-/// Deterministic standard normal samples (Box–Muller on an LCG).
-fn normals(seed: u64, n: usize) -> Vec<f64> {
-    let mut state = seed;
-    let mut uniform = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    };
-    (0..n)
-        .map(|_| {
-            let (a, b) = (uniform(), uniform());
-            (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
-        })
-        .collect()
-}
+use crate::input::noise::tests::normals;
 
 /// A recording at 1 kHz whose force is `force(t)` plus 0.05 N of noise, with pressures.
 fn recording(seconds: f64, force: impl Fn(f64) -> f64, seed: u64) -> Recording {

@@ -223,11 +223,11 @@ pub fn quantisation_step(x: &[f64]) -> Option<f64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// Deterministic standard normal samples (Box–Muller on an LCG).
-    fn normals(seed: u64, n: usize) -> Vec<f64> {
+    pub(crate) fn normals(seed: u64, n: usize) -> Vec<f64> {
         let mut state = seed;
         let mut uniform = || {
             state = state
