@@ -66,11 +66,10 @@ pub fn blocks(time: &[f64], x_s: &[f64], settled_from: f64, set_aside: &[(f64, f
             }
         }
     }
-    if !set_aside.is_empty() {
-        for (block, &t) in blocks.iter_mut().zip(time) {
-            if crate::input::glitches::is_set_aside(t, set_aside) {
-                *block = Block::SetAside;
-            }
+    for &(from, to) in set_aside {
+        let (first, end) = (time.partition_point(|&t| t < from), time.partition_point(|&t| t <= to));
+        for block in &mut blocks[first..end] {
+            *block = Block::SetAside;
         }
     }
     blocks
@@ -203,6 +202,18 @@ pub(crate) mod tests {
         for x_s in [shaken, toggling, long_move] {
             assert!(short_stopper_moves(&time, &x_s).is_empty());
             assert_eq!(blocks(&time, &x_s, 0.0, &[]), plain);
+        }
+    }
+
+    #[test]
+    fn samples_within_a_glitch_span_are_set_aside_and_no_others() {
+        let time: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-3).collect();
+        let x_s = vec![0.05; time.len()];
+        let plain = blocks(&time, &x_s, 0.5, &[]);
+        let marked = blocks(&time, &x_s, 0.5, &[(3.0, 3.0), (6.1, 6.1795)]);
+        for (k, (&p, &m)) in plain.iter().zip(&marked).enumerate() {
+            let inside = k == 3000 || (6100..=6179).contains(&k);
+            assert_eq!(m, if inside { Block::SetAside } else { p }, "sample {k}");
         }
     }
 }

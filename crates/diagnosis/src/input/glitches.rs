@@ -90,11 +90,6 @@ pub fn set_aside_spans(glitches: &[Glitch]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Whether time `t` lies in one of `spans`.
-pub fn is_set_aside(t: f64, spans: &[(f64, f64)]) -> bool {
-    spans.iter().any(|&(a, b)| t >= a && t <= b)
-}
-
 /// Find the recording's glitches and replace the values of the samples set aside by
 /// interpolation. The command is what was played and is never changed.
 pub fn find_and_repair(recording: &mut Recording) -> Vec<Glitch> {
