@@ -663,9 +663,10 @@ impl CoSimModel for ActuatorFmu {
 /// version 7: the laminar chamber leaks and the extra force's product slots; version 8: the
 /// extra flow slots; version 9: the stopper acceleration input; version 10: Model Exchange's
 /// hysteresis memory; version 11: Model Exchange's states of the lags, filters and Padé chain
-/// and `command_delay_pade_sections`.
+/// and `command_delay_pade_sections`; version 12: the plain constants `extra_force_offset`,
+/// `extra_inflow_1`, `extra_inflow_2`.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 11, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 12, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped

@@ -6,6 +6,7 @@ pub use crate::variable::{Causality, VarType, Variability, Variable};
 
 mod extra_flow;
 mod extra_force;
+mod flexible;
 mod interface_table;
 mod modulation;
 
@@ -192,7 +193,7 @@ pub mod vr {
     // Modulation slots (crate::physics::modulation), off with no constant named.
     pub use super::modulation::vr::*;
     // The extra force's product slots and the extra flow slots, off with a coefficient of 0.
-    pub use super::{extra_flow::vr::*, extra_force::vr::*};
+    pub use super::{extra_flow::vr::*, extra_force::vr::*, flexible::vr::*};
 }
 
 /// The D/A converter's range: a command outside it is refused.
@@ -397,7 +398,8 @@ const CURVE_DISCHARGE: &str = "a discharge coefficient lies between 0 (closed) a
 /// Every variable of the FMU, one row each: name, value reference, unit, start, limits,
 /// description and thesis reference. Defaults: Table 3.1 of the thesis and docs/model.md.
 /// Then the modulation slots' rows (`variables/modulation.rs`), the extra force's product
-/// slots (`variables/extra_force.rs`) and the extra flow slots (`variables/extra_flow.rs`).
+/// slots (`variables/extra_force.rs`), the extra flow slots (`variables/extra_flow.rs`) and the
+/// plain constants and flexible slots of `variables/flexible.rs`.
 pub const TABLE: &[Row] = &TABLE_ARRAY;
 const TABLE_LENGTH: usize = ROWS_BEFORE_THE_SLOTS.len() + modulation::length(&modulation::SLOT_ROWS);
 #[allow(clippy::large_const_arrays)]

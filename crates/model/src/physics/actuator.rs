@@ -226,7 +226,10 @@ impl Actuator {
         ]
         .iter()
         .any(|&leak| leak != 0.0)
-            || super::extra_flow::flows_on(&params.extra_flows);
+            || super::extra_flow::flows_on(&params.extra_flows)
+            || params.extra_inflow_1 != 0.0
+            || params.extra_inflow_2 != 0.0
+            || super::modulation::modulates_inflows(&params);
         let rate_terms =
             if restrictions.any() || discharge_curve.is_some() || chamber_leaks || params.stopper_compliance != 0.0 {
                 RateTerms::Extended
@@ -256,6 +259,7 @@ impl Actuator {
             && params.position_force_rate == 0.0
             && !extra_library
             && !extra_products
+            && params.extra_force_offset == 0.0
             && Channel::ALL
                 .iter()
                 .all(|&channel| SensorLaw::of(&params, channel).is_identity());
@@ -361,7 +365,7 @@ impl Actuator {
     /// the `chamber_vent_*` orifices to the return pressure, the `chamber_laminar_vent_*`
     /// paths to it, less what the `chamber_supply_leak_*` orifices and the
     /// `chamber_laminar_supply_leak_*` paths bring in from the supply and the extra flow
-    /// slots bring in ([`super::extra_flow`]).
+    /// slots and `extra_inflow_1`, `extra_inflow_2` bring in ([`super::extra_flow`]).
     fn chamber_vents(&self, p1: f64, p2: f64) -> (f64, f64) {
         if !self.chamber_leaks {
             return (0.0, 0.0);
@@ -377,7 +381,10 @@ impl Actuator {
             p_s: p.p_s,
             p_r: p.p_r,
         };
-        let [extra_1, extra_2] = super::extra_flow::inflows(&p.extra_flows, &pressures);
+        let [mut extra_1, mut extra_2] = super::extra_flow::inflows(&p.extra_flows, &pressures);
+        // After the slots, as a slot of signal code 0 would add them.
+        extra_1 += super::extra_flow::faded(p.extra_inflow_1, p1);
+        extra_2 += super::extra_flow::faded(p.extra_inflow_2, p2);
         (
             lost(p.chamber_vent_1, p.chamber_laminar_vent_1, p.chamber_supply_leak_1, p1)
                 - p.chamber_laminar_supply_leak_1 * (p.p_s - p1)
@@ -946,6 +953,8 @@ impl Actuator {
             };
             f -= extra_force::product_force(&p.extra_force_products, &signals);
         }
+        // Where a product slot of codes 0 × 0 adds its coefficient (so the two agree).
+        f -= p.extra_force_offset;
         if p.viscous_friction != 0.0 {
             f += p.viscous_friction * stopper_velocity;
         }

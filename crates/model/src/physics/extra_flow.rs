@@ -186,16 +186,23 @@ pub fn inflows(slots: &[FlowSlot; FLOW_SLOTS], p: &ChamberPressures) -> [f64; 2]
     let mut out = [0.0; 2];
     for slot in slots.iter().filter(|s| s.is_on()) {
         if let Some(i) = slot.chamber_index() {
-            let flow = slot.coefficient * slot.regressor(p);
             let own = if i == 0 { p.p1 } else { p.p2 };
-            out[i] += if flow < 0.0 && own < FADE_PRESSURE {
-                flow * (own / FADE_PRESSURE).max(0.0)
-            } else {
-                flow
-            };
+            out[i] += faded(slot.coefficient * slot.regressor(p), own);
         }
     }
     out
+}
+
+/// A mass flow `flow` (kg/s) into a chamber at absolute pressure `own` (Pa), an outflow
+/// faded below [`FADE_PRESSURE`] (see the module's comment): the slots' law, which the plain
+/// constants `extra_inflow_1` and `extra_inflow_2` share (a constant inflow is a slot of
+/// signal code 0).
+pub fn faded(flow: f64, own: f64) -> f64 {
+    if flow < 0.0 && own < FADE_PRESSURE {
+        flow * (own / FADE_PRESSURE).max(0.0)
+    } else {
+        flow
+    }
 }
 
 /// Whether an extra flow slot is on.

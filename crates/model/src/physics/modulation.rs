@@ -117,6 +117,7 @@ const OUTPUT_LAW: &[u32] = &[
     vr::P2_SENSOR_OFFSET,
     vr::P2_SENSOR_GAIN,
     vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
+    vr::EXTRA_FORCE_OFFSET,
 ];
 
 /// The constants the outputs at a communication point read, beyond the states: those of
@@ -133,6 +134,7 @@ const OUTPUTS: &[u32] = &[
     vr::K_SPRING,
     vr::P_R,
     vr::EXTRA_FORCE_PRESSURE_DIFFERENCE,
+    vr::EXTRA_FORCE_OFFSET,
     vr::D_CYL,
 ];
 
@@ -397,6 +399,12 @@ pub fn modulates_friction(p: &Parameters) -> bool {
 /// are then formed even where the coefficient's nominal value is 0).
 pub fn modulates_extra_force(p: &Parameters) -> bool {
     modulates_any_of(p, &[vr::EXTRA_FORCE_PRESSURE_DIFFERENCE])
+}
+
+/// Whether a slot modulates a chamber's plain extra inflow (the chambers' leaks are then
+/// formed even where its nominal value is 0).
+pub fn modulates_inflows(p: &Parameters) -> bool {
+    modulates_any_of(p, &[vr::EXTRA_INFLOW_1, vr::EXTRA_INFLOW_2])
 }
 
 /// Whether a slot modulates a constant the outputs read.

@@ -159,6 +159,12 @@ pub struct Parameters {
     /// The extra flow slots: a flow into one chamber alone (off with a coefficient of 0; see
     /// [`super::extra_flow`]).
     pub extra_flows: [FlowSlot; FLOW_SLOTS],
+    /// Plain additive constants, off at 0: a force where the pressures set the force
+    /// ([`super::extra_force`]) and a mass flow into each chamber alone
+    /// ([`super::extra_flow::faded`]).
+    pub extra_force_offset: f64,
+    pub extra_inflow_1: f64,
+    pub extra_inflow_2: f64,
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -304,6 +310,9 @@ impl Default for Parameters {
             modulation: [Slot::default(); SLOTS],
             extra_force_products: [ProductSlot::default(); PRODUCT_SLOTS],
             extra_flows: [FlowSlot::default(); FLOW_SLOTS],
+            extra_force_offset: 0.0,
+            extra_inflow_1: 0.0,
+            extra_inflow_2: 0.0,
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -575,6 +584,9 @@ impl Parameters {
         vr::EXTRA_FLOW_3_CHAMBER,
         vr::EXTRA_FLOW_3_CHAMBER + 1,
         vr::EXTRA_FLOW_3_CHAMBER + 2,
+        vr::EXTRA_FORCE_OFFSET,
+        vr::EXTRA_INFLOW_1,
+        vr::EXTRA_INFLOW_2,
     ];
 
     pub(crate) fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
@@ -701,6 +713,9 @@ impl Parameters {
             vr::PORT_RESTRICTION_AREA_2 => &mut self.port_restriction_area_2,
             vr::PORT_LINE_VOLUME_1 => &mut self.port_line_volume_1,
             vr::PORT_LINE_VOLUME_2 => &mut self.port_line_volume_2,
+            vr::EXTRA_FORCE_OFFSET => &mut self.extra_force_offset,
+            vr::EXTRA_INFLOW_1 => &mut self.extra_inflow_1,
+            vr::EXTRA_INFLOW_2 => &mut self.extra_inflow_2,
             vr::COMMAND_CURVE_KNOTS => &mut self.command_curve.knots,
             r @ vr::COMMAND_CURVE_X..=vr::COMMAND_CURVE_X_LAST => {
                 &mut self.command_curve.x[(r - vr::COMMAND_CURVE_X) as usize]

@@ -17,6 +17,8 @@ mod chambers;
 mod commands;
 #[cfg(test)]
 mod effect_tests;
+#[cfg(test)]
+mod flexible_tests;
 mod equilibrium;
 mod fixed_step;
 mod modulated;

@@ -129,8 +129,15 @@ pub(super) const SLOT_1: [Row; 16] = slot_rows!(1, vr::MODULATION_1_PARAMETER);
 pub(super) const SLOT_2: [Row; 16] = slot_rows!(2, vr::MODULATION_2_PARAMETER);
 
 /// The slots' rows after the table's others: the modulation slots', the extra force's product
-/// slots' (`variables/extra_force.rs`), the extra flow slots' (`variables/extra_flow.rs`).
-pub(super) const SLOT_ROWS: [&[Row]; 4] = [&SLOT_1, &SLOT_2, &super::extra_force::SLOTS, &super::extra_flow::SLOTS];
+/// slots' (`variables/extra_force.rs`), the extra flow slots' (`variables/extra_flow.rs`), the
+/// plain constants of `variables/flexible.rs`.
+pub(super) const SLOT_ROWS: [&[Row]; 5] = [
+    &SLOT_1,
+    &SLOT_2,
+    &super::extra_force::SLOTS,
+    &super::extra_flow::SLOTS,
+    &super::flexible::CONSTANTS,
+];
 
 /// The number of rows in `parts`.
 pub(super) const fn length(parts: &[&[Row]]) -> usize {

@@ -90,9 +90,10 @@ fn the_thesis_rates_are_the_general_paths_to_the_last_bit() {
 #[test]
 fn a_vent_a_restriction_or_a_compliant_stopper_takes_the_general_rates() {
     type Setter = fn(&mut Parameters);
-    let terms: [(&str, Setter); 10] = [
+    let terms: [(&str, Setter); 11] = [
         ("chamber_vent_2", |p| p.chamber_vent_2 = 2e-9),
         ("extra_flow_1_coefficient", |p| p.extra_flows[0].coefficient = 1e-6),
+        ("extra_inflow_2", |p| p.extra_inflow_2 = -1e-6),
         ("chamber_supply_leak_1", |p| p.chamber_supply_leak_1 = 2e-9),
         ("chamber_laminar_vent_2", |p| p.chamber_laminar_vent_2 = 1e-11),
         ("chamber_laminar_supply_leak_1", |p| {
