@@ -41,7 +41,8 @@
 //!   its input has moved half its width from it, a memory moved at the input's reversals, not
 //!   an ODE (the FMU has such a memory, with its events, for the jet pipe's hysteresis only);
 //! * the forces that read the stopper's motion, formed from its positions at the last
-//!   communication points, and the modulation slots, held over each communication step;
+//!   communication points, and the modulation and flexible slots, held over each
+//!   communication step (a flexible slot's lags advanced from step to step);
 //! * the constants that vary in time (not yet part of Model Exchange).
 //!
 //! The stopper: a new x_s set in event mode moves it at once as in Co-Simulation (the air in
@@ -58,7 +59,7 @@ use jetpipe_model::physics::chambers::pressure_after_volume_jump;
 use jetpipe_model::physics::current_driver;
 use jetpipe_model::physics::effects::PLAY_OPERATORS;
 use jetpipe_model::physics::jet_pipe;
-use jetpipe_model::physics::modulation;
+use jetpipe_model::physics::{flexible, modulation};
 use jetpipe_model::physics::parameters::{table_start, variable_name, Parameters};
 use jetpipe_model::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
@@ -193,6 +194,11 @@ const REFUSED: &[Refused] = &[
         why: "a slot's constant is held over each communication step at the signals at its start",
         parameters: &[vr::MODULATION_1_PARAMETER, vr::MODULATION_2_PARAMETER],
     },
+    Refused {
+        effect: "the flexible slots",
+        why: "a slot's constant is held over each communication step at the signals at its start, and its lags are advanced from step to step",
+        parameters: &[vr::FLEXIBLE_1_PARAMETER, vr::FLEXIBLE_2_PARAMETER],
+    },
 ];
 
 fn refusal_message(r: &Refused, switched_on: &str) -> String {
@@ -260,6 +266,7 @@ fn refused_effects(model: &Actuator, pade_sections: usize) -> Result<(), String>
         ),
         (model.reads_stopper_motion, "a force on the stopper's motion"),
         (time_varying::varies(p), "constants that vary in time"),
+        (flexible::any_on(p), "a flexible slot"),
         (modulation::any_on(p), "a modulation slot"),
     ];
     if problems.is_empty() {

@@ -75,6 +75,13 @@ pub fn linearize(model: &Actuator, v_da: f64, x_s: f64) -> Result<LinearModel, S
             model.params.modulation[slot].parameter
         ));
     }
+    if let Some(slot) = model.params.flexible.iter().position(|slot| slot.is_on()) {
+        return Err(format!(
+            "flexible_{}_parameter = {}: the linearisation does not carry the flexible slots; switch them off (0) to linearise the model without them",
+            slot + 1,
+            model.params.flexible[slot].parameter
+        ));
+    }
     let y0 = equilibrium(model, v_da, x_s)?;
     let u = Inputs {
         v_da,

@@ -22,6 +22,7 @@
 //! | static curves at the command and the transducers (off by default) | [`static_curve`] | docs/model.md |
 //! | constants that vary in time (off by default) | [`time_varying`] | docs/model.md |
 //! | a constant that varies with a signal of the chain: the modulation slots (off by default) | [`modulation`] | docs/model.md |
+//! | a constant plus a function of one or two signals, each optionally low-passed: the flexible slots (off by default) | [`flexible`] | docs/model.md |
 //! | the assembled six-state model | [`actuator`] | (4.1) |
 
 pub mod actuator;
@@ -31,6 +32,7 @@ pub mod current_driver;
 pub mod effects;
 pub mod extra_flow;
 pub mod extra_force;
+pub mod flexible;
 pub mod jet_pipe;
 pub mod modulation;
 pub mod orifice_flow;

@@ -14,11 +14,16 @@
 //! that point's signals (the ones the next step holds). A modulation on top of a drift adds to
 //! the drifted value.
 //!
+//! The flexible slots ([`super::flexible`]) are the generalisation of these (two signals, a
+//! lag on each): [`apply`] and [`restore`] walk both kinds, and every question below of
+//! which constants the slots vary asks it of both.
+//!
 //! The chambers' dead volumes are modulatable as the pressure equations' capacity
 //! (`DEAD_VOLUMES`), and the cylinder's bore as the piston's area (`BORE`), which the force and
 //! both chambers' volumes read.
 
 use super::actuator::Actuator;
+use super::flexible::{self, FLEXIBLE_SLOTS};
 use super::parameters::{variable_name, Parameters};
 use crate::variables::{self, number, vr};
 
@@ -260,9 +265,12 @@ impl ModulationSignal {
 
 /// The signals of the chain at one instant, in SI units. `f_act` is the actuator force with
 /// the constants at their nominal values (a friction modulated by the force reads the force
-/// without its own modulation: no algebraic loop).
+/// without its own modulation: no algebraic loop). `lagged` holds the flexible slots'
+/// low-passed signals ([`super::flexible`], per slot and axis) where a simulation follows
+/// them; `None` reads the raw signals, as at the steady state a simulation starts from.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Signals {
+    pub lagged: Option<[[f64; 2]; FLEXIBLE_SLOTS]>,
     pub time: f64,
     pub v_da: f64,
     pub current: f64,
@@ -343,21 +351,7 @@ impl Slot {
     /// The increment at signal value `s`: linear between knots, held beyond the end ones.
     pub fn increment(&self, s: f64) -> f64 {
         let n = self.len();
-        if n == 0 {
-            return 0.0;
-        }
-        if n == 1 || s <= self.x[0] {
-            return self.y[0];
-        }
-        if s >= self.x[n - 1] {
-            return self.y[n - 1];
-        }
-        let mut k = 0;
-        while k + 2 < n && s > self.x[k + 1] {
-            k += 1;
-        }
-        let (x0, x1, y0, y1) = (self.x[k], self.x[k + 1], self.y[k], self.y[k + 1]);
-        y0 + (s - x0) * (y1 - y0) / (x1 - x0)
+        interpolate(&self.x[..n], &self.y[..n], s)
     }
 
     /// The increment at `signals`.
@@ -366,16 +360,82 @@ impl Slot {
     }
 }
 
-/// Whether any slot is on.
-pub fn any_on(p: &Parameters) -> bool {
-    p.modulation.iter().any(Slot::is_on)
+/// The values `y` at the knots `x` (increasing) interpolated at `s`: linear between knots,
+/// held at the end values beyond the end knots, `y[0]` for one knot, 0 for none. The law of
+/// both kinds of slot (a flexible slot's along each axis), so that a flexible slot of one
+/// signal is a modulation slot to the last bit.
+pub(crate) fn interpolate(x: &[f64], y: &[f64], s: f64) -> f64 {
+    let n = x.len();
+    if n == 0 {
+        return 0.0;
+    }
+    if n == 1 || s <= x[0] {
+        return y[0];
+    }
+    if s >= x[n - 1] {
+        return y[n - 1];
+    }
+    let mut k = 0;
+    while k + 2 < n && s > x[k + 1] {
+        k += 1;
+    }
+    let (x0, x1, y0, y1) = (x[k], x[k + 1], y[k], y[k + 1]);
+    y0 + (s - x0) * (y1 - y0) / (x1 - x0)
 }
 
-/// Whether a slot that is on modulates one of `constants`.
+/// Every slot of both kinds, modulation slots first.
+pub const ALL_SLOTS: usize = SLOTS + FLEXIBLE_SLOTS;
+
+/// Whether any slot of either kind is on.
+pub fn any_on(p: &Parameters) -> bool {
+    p.modulation.iter().any(Slot::is_on) || flexible::any_on(p)
+}
+
+/// The constants of the slots that are on, of both kinds (0 for a slot that is off), in the
+/// order of [`increments`].
+pub(crate) fn constants(p: &Parameters) -> [u32; ALL_SLOTS] {
+    let mut out = [0; ALL_SLOTS];
+    for (k, slot) in p.modulation.iter().enumerate() {
+        out[k] = slot.constant();
+    }
+    for (k, slot) in p.flexible.iter().enumerate() {
+        out[SLOTS + k] = slot.constant();
+    }
+    out
+}
+
+/// Each slot's increment at `signals` (0 for a slot that is off): the modulation slots', then
+/// the flexible slots'.
+pub(crate) fn increments(p: &Parameters, signals: &Signals) -> [f64; ALL_SLOTS] {
+    let mut out = [0.0; ALL_SLOTS];
+    for (k, slot) in p.modulation.iter().enumerate() {
+        if slot.is_on() {
+            out[k] = slot.increment_at(signals);
+        }
+    }
+    for (k, slot) in p.flexible.iter().enumerate() {
+        if slot.is_on() {
+            out[SLOTS + k] = slot.increment_at(k, signals);
+        }
+    }
+    out
+}
+
+/// Each slot's largest |increment| over its knots, in the order of [`increments`].
+pub(crate) fn largest_increments(p: &Parameters) -> [f64; ALL_SLOTS] {
+    let mut out = [0.0; ALL_SLOTS];
+    for (k, slot) in p.modulation.iter().enumerate() {
+        out[k] = slot.y[..slot.len()].iter().fold(0.0_f64, |m, y| m.max(y.abs()));
+    }
+    for (k, slot) in p.flexible.iter().enumerate() {
+        out[SLOTS + k] = slot.largest_increment();
+    }
+    out
+}
+
+/// Whether a slot of either kind that is on varies one of `constants`.
 fn modulates_any_of(p: &Parameters, constants: &[u32]) -> bool {
-    p.modulation
-        .iter()
-        .any(|slot| slot.is_on() && constants.contains(&slot.constant()))
+    self::constants(p).iter().any(|&c| c != 0 && constants.contains(&c))
 }
 
 /// Whether a slot modulates the current driver or the jet pipe (their propagator is then
@@ -412,11 +472,12 @@ pub fn modulates_outputs(p: &Parameters) -> bool {
     modulates_any_of(p, OUTPUTS)
 }
 
-/// Whether a slot follows the force F_act (the signals then need it).
+/// Whether a slot of either kind follows the force F_act (the signals then need it).
 pub fn follows_the_force(p: &Parameters) -> bool {
     p.modulation
         .iter()
         .any(|slot| slot.is_on() && slot.signal() == ModulationSignal::Force)
+        || flexible::follows_the_force(p)
 }
 
 /// For the Model Exchange interface, which does not have the slots: an error naming each
@@ -584,6 +645,7 @@ pub fn validate(p: &Parameters) -> Result<(), String> {
             }
             let mut at = p.clone();
             at.modulation = [Slot::default(); SLOTS];
+            at.flexible = Default::default();
             at.set(constant, value).map_err(at_knot)?;
             at.validate().map_err(at_knot)?;
         }
@@ -595,7 +657,7 @@ pub fn validate(p: &Parameters) -> Result<(), String> {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Held {
     /// The constants' values before, in the order set.
-    values: [(u32, f64); SLOTS],
+    values: [(u32, f64); ALL_SLOTS],
     count: usize,
     discharge: [f64; 4],
     area_scales: [f64; 4],
@@ -604,14 +666,14 @@ pub(crate) struct Held {
     bore_and_area: (f64, f64),
 }
 
-/// Each slot's constant set to its value plus the slot's increment at `signals`, with what
-/// the model derives from it (the discharge factors, 1/√T, the chambers' dead volumes; the
-/// propagator is the simulation's); an error, with the model unchanged, when a constant would
-/// leave its limits (a drift adding to a modulation) or the supply fall below the return
-/// pressure.
+/// Each slot's constant, of both kinds (the modulation slots', then the flexible slots'),
+/// set to its value plus the slot's increment at `signals`, with what the model derives from
+/// it (the discharge factors, 1/√T, the chambers' dead volumes; the propagator is the
+/// simulation's); an error, with the model unchanged, when a constant would leave its limits
+/// (a drift adding to a modulation) or the supply fall below the return pressure.
 pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, String> {
     let mut held = Held {
-        values: [(0, 0.0); SLOTS],
+        values: [(0, 0.0); ALL_SLOTS],
         count: 0,
         discharge: model.discharge,
         area_scales: model.area_scales,
@@ -619,19 +681,19 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         dead_volumes: [model.cylinder.dead_volume_1, model.cylinder.dead_volume_2],
         bore_and_area: (model.cylinder.d_cyl, model.piston_area),
     };
-    let slots = model.params.modulation;
-    for (k, slot) in slots.iter().enumerate() {
-        if !slot.is_on() {
+    let constants = constants(&model.params);
+    let increments = increments(&model.params, signals);
+    for k in 0..ALL_SLOTS {
+        let constant = constants[k];
+        if constant == 0 {
             continue;
         }
-        let constant = slot.constant();
-        let x = slot.signal().value(signals, slot.frequency);
         let field = model
             .params
             .field_mut(constant)
-            .expect("a modulatable constant is a parameter");
+            .expect("a slot's constant is a parameter");
         let before = *field;
-        let value = before + slot.increment(x);
+        let value = before + increments[k];
         held.values[held.count] = (constant, before);
         held.count += 1;
         *field = value;
@@ -647,20 +709,27 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         };
         if let Some(e) = refused {
             restore(model, held);
-            return Err(format!(
-                "modulation slot {} at {} = {} {} (t = {} s): {e}",
-                k + 1,
-                slot.signal().name(),
-                number(x),
-                slot.signal().unit(),
-                signals.time
-            ));
+            let p = &model.params;
+            let slot = if k < SLOTS {
+                let slot = &p.modulation[k];
+                format!(
+                    "modulation slot {} at {} = {} {}",
+                    k + 1,
+                    slot.signal().name(),
+                    number(slot.signal().value(signals, slot.frequency)),
+                    slot.signal().unit()
+                )
+            } else {
+                let f = k - SLOTS;
+                format!("flexible slot {} at {}", f + 1, p.flexible[f].describe_at(f, signals))
+            };
+            return Err(format!("{slot} (t = {} s): {e}", signals.time));
         }
     }
     let p = &model.params;
     if p.p_s < p.p_r {
         let e = format!(
-            "the modulation slots take P_s to {} Pa and P_r to {} Pa at t = {} s: P_s must stay >= P_r",
+            "the modulation and flexible slots take P_s to {} Pa and P_r to {} Pa at t = {} s: P_s must stay >= P_r",
             number(p.p_s),
             number(p.p_r),
             signals.time
@@ -698,7 +767,7 @@ pub(crate) fn restore(model: &mut Actuator, held: Held) {
         *model
             .params
             .field_mut(constant)
-            .expect("a modulatable constant is a parameter") = before;
+            .expect("a slot's constant is a parameter") = before;
     }
     model.discharge = held.discharge;
     model.area_scales = held.area_scales;

@@ -4,6 +4,7 @@
 use super::chambers::CylinderGeometry;
 use super::extra_flow::{FlowSlot, FLOW_SLOTS};
 use super::extra_force::{ProductSlot, PRODUCT_SLOTS};
+use super::flexible::{FlexibleSlot, FLEXIBLE_SLOTS};
 use super::modulation::{Slot, SLOTS};
 use super::orifice_flow::FlowConstants;
 use super::static_curve::StaticCurve;
@@ -165,6 +166,9 @@ pub struct Parameters {
     pub extra_force_offset: f64,
     pub extra_inflow_1: f64,
     pub extra_inflow_2: f64,
+    /// The flexible slots: a constant plus a function of one or two signals, each optionally
+    /// low-passed (off with no constant named; see [`super::flexible`]).
+    pub flexible: [FlexibleSlot; FLEXIBLE_SLOTS],
 }
 
 /// Start value of a variable of the table (panics only on a programming error: a value
@@ -313,6 +317,7 @@ impl Default for Parameters {
             extra_force_offset: 0.0,
             extra_inflow_1: 0.0,
             extra_inflow_2: 0.0,
+            flexible: [FlexibleSlot::default(); FLEXIBLE_SLOTS],
         };
         for &vr in Parameters::VALUE_REFERENCES {
             *p.field_mut(vr).expect("every parameter value reference has a field") = table_start(vr);
@@ -321,9 +326,33 @@ impl Default for Parameters {
     }
 }
 
+/// `first` then `second`, as one array of `N` (their total length).
+const fn concatenated<const N: usize>(first: &[u32], second: &[u32]) -> [u32; N] {
+    let mut out = [0u32; N];
+    let mut k = 0;
+    while k < first.len() {
+        out[k] = first[k];
+        k += 1;
+    }
+    let mut j = 0;
+    while j < second.len() {
+        out[k + j] = second[j];
+        j += 1;
+    }
+    assert!(k + j == N, "the list's length is the sum of its parts'");
+    out
+}
+
+const ALL_VALUE_REFERENCES: [u32; BEFORE_THE_FLEXIBLE_SLOTS.len() + super::flexible::VALUE_REFERENCES.len()] =
+    concatenated(BEFORE_THE_FLEXIBLE_SLOTS, super::flexible::VALUE_REFERENCES);
+
 impl Parameters {
     /// Value references of the fields, in the table's order.
-    pub const VALUE_REFERENCES: &'static [u32] = &[
+    pub const VALUE_REFERENCES: &'static [u32] = &ALL_VALUE_REFERENCES;
+}
+
+/// [`Parameters::VALUE_REFERENCES`] but the flexible slots' (listed in their module).
+const BEFORE_THE_FLEXIBLE_SLOTS: &[u32] = &[
         vr::P_S,
         vr::P_R,
         vr::T_GAS,
@@ -587,7 +616,9 @@ impl Parameters {
         vr::EXTRA_FORCE_OFFSET,
         vr::EXTRA_INFLOW_1,
         vr::EXTRA_INFLOW_2,
-    ];
+];
+
+impl Parameters {
 
     pub(crate) fn field_mut(&mut self, value_reference: u32) -> Option<&mut f64> {
         Some(match value_reference {
@@ -760,6 +791,9 @@ impl Parameters {
             r @ vr::EXTRA_FLOW_1_CHAMBER..=vr::EXTRA_FLOW_LAST => {
                 return super::extra_flow::flow_field_mut(&mut self.extra_flows, r)
             }
+            r @ vr::FLEXIBLE_1_PARAMETER..=vr::FLEXIBLE_LAST => {
+                return super::flexible::field_mut(&mut self.flexible, r)
+            }
             _ => return None,
         })
     }
@@ -848,8 +882,9 @@ impl Parameters {
         }
         super::extra_force::check_products(&self.extra_force_products)?;
         super::extra_flow::check_flows(&self.extra_flows)?;
-        // Last: it validates the model with each slot's constant at each of its knots.
-        super::modulation::validate(self)
+        // Last: they validate the model with each slot's constant at each of its knots.
+        super::modulation::validate(self)?;
+        super::flexible::validate(self)
     }
 
     pub fn cylinder(&self) -> CylinderGeometry {

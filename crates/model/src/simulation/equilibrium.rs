@@ -9,7 +9,7 @@ use crate::integrator::{Sdirk4, Statistics, Tolerances};
 use crate::physics::actuator::{index, Actuator, State};
 use crate::physics::command_stage;
 use crate::physics::current_driver;
-use crate::physics::modulation::{self, SLOTS};
+use crate::physics::modulation::{self, ALL_SLOTS};
 use crate::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use crate::physics::time_varying;
 
@@ -228,32 +228,35 @@ pub fn balance_with_volumes(
 /// The most equilibria [`modulated_equilibrium`] computes.
 const MODULATED_EQUILIBRIUM_ROUNDS: usize = 50;
 
-/// The equilibrium with the modulation slots' constants at the equilibrium's own signals
-/// (time `time`, the stopper at rest), and the model with the constants there. A fixed
-/// point: the equilibrium of the nominal constants, the slots' increments at its signals, the
-/// equilibrium again with the constants so modulated, until the increments at the
-/// equilibrium's signals are those it was computed with (to 1e-9 of the constant's scale, its
-/// nominal value plus its largest increment). The constants that vary in time are at their
-/// values at `time`, the increments added to them. An error names the slots when the
-/// increments do not settle (a modulation so steep that it has no equilibrium, or several).
+/// The equilibrium with the modulation and flexible slots' constants at the equilibrium's own
+/// signals (time `time`, the stopper at rest; a lag has settled there, at the signal itself),
+/// and the model with the constants there. A fixed point: the equilibrium of the nominal
+/// constants, the slots' increments at its signals, the equilibrium again with the constants
+/// so modulated, until the increments at the equilibrium's signals are those it was computed
+/// with (to 1e-9 of the constant's scale, its nominal value plus its largest increment). The
+/// constants that vary in time are at their values at `time`, the increments added to them.
+/// An error names the slots when the increments do not settle (a modulation so steep that it
+/// has no equilibrium, or several).
 pub fn modulated_equilibrium(model: &Actuator, v_da: f64, x_s: f64, time: f64) -> Result<(State, Actuator), String> {
     let mut base = model.clone();
     if time_varying::varies(&model.params) {
         time_varying::set_model_at(&mut base, &model.params, time)?;
     }
-    let slots = model.params.modulation;
-    let scales = slots.map(|slot| {
-        let nominal = base.params.get(slot.constant()).unwrap_or(0.0).abs();
-        let largest = slot.y[..slot.len()].iter().fold(0.0_f64, |m, y| m.max(y.abs()));
-        1e-9 * (nominal + largest).max(f64::MIN_POSITIVE)
-    });
+    let p = &model.params;
+    let constants = modulation::constants(p);
+    let largest = modulation::largest_increments(p);
+    let mut scales = [0.0; ALL_SLOTS];
+    for k in 0..ALL_SLOTS {
+        let nominal = base.params.get(constants[k]).unwrap_or(0.0).abs();
+        scales[k] = 1e-9 * (nominal + largest[k]).max(f64::MIN_POSITIVE);
+    }
     let mut state = equilibrium(&base, v_da, x_s)?;
     let mut at = base.clone();
-    let mut used = [0.0; SLOTS];
+    let mut used = [0.0; ALL_SLOTS];
     for _ in 0..MODULATED_EQUILIBRIUM_ROUNDS {
         let signals = super::modulated::signals_at(&base, &state, v_da, x_s, 0.0, 0.0, time);
-        let next = slots.map(|slot| if slot.is_on() { slot.increment_at(&signals) } else { 0.0 });
-        if (0..SLOTS).all(|k| (next[k] - used[k]).abs() <= scales[k]) {
+        let next = modulation::increments(p, &signals);
+        if (0..ALL_SLOTS).all(|k| (next[k] - used[k]).abs() <= scales[k]) {
             return Ok((state, at));
         }
         at = modulation::model_at(&base, &signals)?;
@@ -261,8 +264,8 @@ pub fn modulated_equilibrium(model: &Actuator, v_da: f64, x_s: f64, time: f64) -
         used = next;
     }
     Err(format!(
-        "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m with the modulation slots (modulation_1_parameter = {}, modulation_2_parameter = {}): the increments at the equilibrium's signals did not settle in {MODULATED_EQUILIBRIUM_ROUNDS} rounds",
-        slots[0].parameter, slots[1].parameter
+        "could not find the equilibrium for v_DA = {v_da} V, x_s = {x_s} m with the modulation and flexible slots (modulation_1_parameter = {}, modulation_2_parameter = {}, flexible_1_parameter = {}, flexible_2_parameter = {}): the increments at the equilibrium's signals did not settle in {MODULATED_EQUILIBRIUM_ROUNDS} rounds",
+        p.modulation[0].parameter, p.modulation[1].parameter, p.flexible[0].parameter, p.flexible[1].parameter
     ))
 }
 

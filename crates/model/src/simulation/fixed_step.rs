@@ -227,6 +227,11 @@ impl FixedStep {
                 sim.stopper_acceleration = sim.stopper_motion.advance((x_s - x_start) / length, length);
             }
         }
+        if let Some(signals) = signals {
+            // The flexible slots' lags over the completed step, from its start's signals.
+            let start = crate::physics::modulation::Signals { time: t0, ..signals };
+            sim.advance_lags(step, &start);
+        }
         let mut y = sim.outputs_at_sample();
         sim.record_transducers(&mut y, interval_start.is_some());
         self.outputs = y;

@@ -1,11 +1,16 @@
-//! The plain constants `extra_force_offset`, `extra_inflow_1` and `extra_inflow_2` against the
-//! slots that already add the same terms (a product slot of codes 0 × 0, an extra flow slot
-//! of code 0), over recording-like runs of a [`Simulation`].
+//! Recording-like runs of a [`Simulation`] with the plain constants `extra_force_offset`,
+//! `extra_inflow_1` and `extra_inflow_2` and with the flexible slots, against what already adds
+//! the same terms: a product slot of codes 0 × 0, an extra flow slot of code 0, modulation
+//! slots through the same knots; a lagged slot against the analytic lag response; snapshots
+//! with a lag state.
 
 use super::*;
 use crate::physics::extra_flow::{FlowSlot, FADE_PRESSURE};
 use crate::physics::extra_force::ProductSlot;
+use crate::physics::flexible::FlexibleSlot;
+use crate::physics::modulation::{ModulationSignal, Slot};
 use crate::physics::parameters::Parameters;
+use crate::variables::vr;
 
 /// The command of a recording-like run at 1 kHz: steps, a ramp and a sine.
 pub(super) fn command(k: usize) -> f64 {
@@ -115,3 +120,191 @@ fn extra_inflow_gives_the_outputs_of_an_extra_flow_slot_of_code_0_in_its_chamber
         }
     }
 }
+
+/// The readings of the same run through the fixed-step replay (the diagnosis's).
+fn replay(p: &Parameters, samples: usize) -> Vec<[f64; 8]> {
+    let model = Actuator::new(p.clone()).unwrap();
+    let mut fixed = FixedStep::at_equilibrium(model, command(0), stopper(0), 0.0)
+        .unwrap()
+        .unwrap();
+    (0..samples)
+        .map(|k| {
+            fixed.set_command(command(k)).unwrap();
+            fixed.step_to((k + 1) as f64 * 1e-3, stopper(k + 1)).unwrap();
+            let y = fixed.outputs();
+            [y.f_act, y.f_meas, y.p1, y.p2, y.p1_meas, y.p2_meas, y.current, y.x_jp]
+        })
+        .collect()
+}
+
+#[test]
+fn a_flexible_slot_of_one_signal_without_lag_gives_the_outputs_of_a_modulation_slot_through_the_same_knots() {
+    let cases = [
+        // A flow constant on the stopper position.
+        (vr::C_D, ModulationSignal::StopperPosition, vec![0.05, 0.054, 0.058], vec![-0.05, 0.02, 0.06]),
+        // A transducer offset on the command, past the end knots at both ends of the run.
+        (vr::P1_SENSOR_OFFSET, ModulationSignal::Command, vec![-1.0, 1.5, 3.0, 4.0], vec![-2e3, 5e3, 1e3, 8e3]),
+    ];
+    let thesis = recording(&Parameters::default(), 300);
+    for (constant, signal, x, y) in cases {
+        let mut modulated = Parameters::default();
+        modulated.modulation[1] = Slot::through(constant, signal, &x, &y);
+        let mut flexible = Parameters::default();
+        flexible.flexible[0] = FlexibleSlot::through(constant, signal, &x, &y);
+        let name = crate::physics::parameters::variable_name(constant);
+        let (a, b) = (recording(&modulated, 300), recording(&flexible, 300));
+        let gap = relative_gap(&a, &b);
+        assert!(gap <= 1e-12, "{name}: {gap}");
+        assert!(relative_gap(&a, &thesis) > 1e-4, "{name}: the slot changes nothing");
+        let gap = relative_gap(&replay(&modulated, 300), &replay(&flexible, 300));
+        assert!(gap <= 1e-12, "{name}, fixed steps: {gap}");
+    }
+}
+
+#[test]
+fn a_two_signal_slot_with_separable_increments_gives_the_outputs_of_two_modulation_slots_on_its_constant() {
+    // y_ij = a_i + b_j on C_d, a over x_s and b over v_DA: the two modulation slots a and b.
+    let (x1, a) = ([0.05, 0.054, 0.058], [-0.04, 0.01, 0.05]);
+    let (x2, b) = ([-2.0, 0.0, 2.0, 4.0], [0.03, -0.02, 0.04, 0.0]);
+    let mut two = Parameters::default();
+    two.modulation = [
+        Slot::through(vr::C_D, ModulationSignal::StopperPosition, &x1, &a),
+        Slot::through(vr::C_D, ModulationSignal::Command, &x2, &b),
+    ];
+    let mut grid = FlexibleSlot::through(vr::C_D, ModulationSignal::StopperPosition, &x1, &[0.0; 3]);
+    grid.signals[1] = ModulationSignal::Command.code() as f64;
+    grid.knots[1] = 4.0;
+    grid.x[1][..4].copy_from_slice(&x2);
+    for i in 0..3 {
+        for j in 0..4 {
+            grid.y[i][j] = a[i] + b[j];
+        }
+    }
+    let mut flexible = Parameters::default();
+    flexible.flexible[1] = grid;
+    let (expected, got) = (recording(&two, 300), recording(&flexible, 300));
+    let gap = relative_gap(&expected, &got);
+    assert!(gap <= 1e-12, "{gap}");
+    // Each axis acts: b alone is another run.
+    let mut one = Parameters::default();
+    one.modulation[0] = two.modulation[0];
+    assert!(relative_gap(&expected, &recording(&one, 300)) > 1e-4);
+}
+
+/// The force F_act after each of the steps of 1 ms at the commands `commands` (their rates
+/// `rates` over the step) from the equilibrium at the first command, the stopper held.
+fn forces(p: &Parameters, commands: &[(f64, f64)]) -> Vec<f64> {
+    let model = Actuator::new(p.clone()).unwrap();
+    let mut sim = Simulation::at_equilibrium(model, commands[0].0, 0.054, 0.0, 1e-8).unwrap();
+    commands
+        .iter()
+        .map(|&(v, rate)| {
+            sim.set_command(v).unwrap();
+            sim.set_command_rate(rate).unwrap();
+            sim.step(1e-3).unwrap();
+            sim.outputs().f_act
+        })
+        .collect()
+}
+
+#[test]
+fn a_lagged_slot_on_extra_force_offset_adds_the_analytic_lag_response_to_the_command() {
+    // The increment c' u of the command's low-pass u (τ = 20 ms), c' = 0.4 N/V: the force the
+    // slot adds is F_act less the thesis model's, since the offset moves no pressure.
+    let (tau, gain, h) = (0.02, 0.4, 1e-3);
+    let mut slot = FlexibleSlot::through(vr::EXTRA_FORCE_OFFSET, ModulationSignal::Command, &[-10.0, 10.0], &[-4.0, 4.0]);
+    slot.lags[0] = tau;
+    let mut p = Parameters::default();
+    p.flexible[0] = slot;
+    // A step from 1 V to 4.5 V held over each step: the lag's update is the exact response of a
+    // held signal, u = 4.5 − 3.5 e^(−t/τ), so the bound is rounding (1e-12 N here).
+    let step: Vec<(f64, f64)> = (0..150).map(|k| (if k == 0 { 1.0 } else { 4.5 }, 0.0)).collect();
+    let (with, thesis_step) = (forces(&p, &step), forces(&Parameters::default(), &step));
+    for k in 1..150 {
+        let t = k as f64 * h;
+        let c = gain * 3.5;
+        let expected = gain * 1.0 + c * (1.0 - (-t / tau).exp());
+        let added = with[k] - thesis_step[k];
+        assert!((added - expected).abs() < 1e-12, "t = {t} s: {added} N against {expected} N");
+    }
+    // A ramp of r = 40 V/s from 1 V: u lags it by the exact response's r (t − τ(1 − e^(−t/τ)))
+    // to within r h²/(12 τ) (the trapezoid of each step's ends: see physics::flexible's tests).
+    let r = 40.0;
+    let ramp: Vec<(f64, f64)> = (0..100).map(|k| (1.0 + r * k as f64 * h, r)).collect();
+    let (with, without) = (forces(&p, &ramp), forces(&Parameters::default(), &ramp));
+    let bound = gain * r * h * h / (12.0 * tau);
+    for k in 0..100 {
+        let t = (k + 1) as f64 * h;
+        let expected = gain * (1.0 + r * (t - tau * (1.0 - (-t / tau).exp())));
+        let added = with[k] - without[k];
+        assert!(
+            (added - expected).abs() <= 1.01 * bound + 1e-12,
+            "t = {t} s: {added} N against {expected} N (bound {bound} N)"
+        );
+    }
+    // Without the lag, the raw command: a different force from the first step on.
+    let mut raw = p.clone();
+    raw.flexible[0].lags[0] = 0.0;
+    let unlagged = forces(&raw, &step);
+    let added = unlagged[1] - thesis_step[1];
+    assert!((added - gain * 4.5).abs() < 1e-12, "{added} N");
+}
+
+/// A 2-D slot on C_d with a lag on each axis (command and P1 − P2).
+fn with_lagged_grid() -> Parameters {
+    let mut slot = FlexibleSlot::through(vr::C_D, ModulationSignal::Command, &[0.0, 3.0, 6.0], &[0.0; 3]);
+    slot.signals[1] = ModulationSignal::PressureDifference.code() as f64;
+    slot.knots[1] = 2.0;
+    slot.x[1][..2].copy_from_slice(&[-2e5, 2e5]);
+    slot.lags = [0.015, 0.004];
+    for i in 0..3 {
+        for j in 0..2 {
+            slot.y[i][j] = 0.05 * i as f64 - 0.04 * j as f64;
+        }
+    }
+    let mut p = Parameters::default();
+    p.flexible[1] = slot;
+    p.force_sensor_offset = 0.1;
+    p
+}
+
+#[test]
+fn a_snapshot_mid_run_continues_bit_for_bit_with_a_lagged_slot_and_carries_its_lag_state() {
+    let model = Actuator::new(with_lagged_grid()).unwrap();
+    let mut original = Simulation::at_equilibrium(model.clone(), command(0), stopper(0), 0.0, 1e-6).unwrap();
+    let drive = |sim: &mut Simulation, k: usize| {
+        sim.set_command(command(k)).unwrap();
+        sim.set_stopper_rate((stopper(k + 1) - sim.x_s()) / 1e-3).unwrap();
+        sim.step(1e-3).unwrap();
+        sim.land_stopper_at(stopper(k + 1));
+        let y = sim.outputs();
+        [y.f_act, y.f_meas, y.p1, y.p2].map(f64::to_bits)
+    };
+    for k in 0..70 {
+        drive(&mut original, k);
+    }
+    let snapshot = original.snapshot();
+    let values = snapshot.to_values();
+    let mut decoded = Simulation::restore(model.clone(), &SimulationSnapshot::from_values(&values).unwrap()).unwrap();
+    // The lag state moved from its start, so that carrying it matters.
+    let lags = original.flexible_lags[1];
+    let settled = Simulation::at_equilibrium(model.clone(), command(0), stopper(0), 0.0, 1e-6).unwrap();
+    assert!(lags != settled.flexible_lags[1], "{lags:?}");
+    // The same snapshot with the lag state of the start.
+    let position = values.iter().position(|v| v.to_bits() == lags[0].to_bits()).unwrap();
+    assert_eq!(values[position + 1].to_bits(), lags[1].to_bits());
+    let mut forgetful_values = values.clone();
+    forgetful_values[position] = settled.flexible_lags[1][0];
+    forgetful_values[position + 1] = settled.flexible_lags[1][1];
+    let mut forgetful =
+        Simulation::restore(model, &SimulationSnapshot::from_values(&forgetful_values).unwrap()).unwrap();
+    let mut differs = false;
+    for k in 70..200 {
+        let expected = drive(&mut original, k);
+        assert_eq!(drive(&mut decoded, k), expected, "step {k}");
+        differs |= drive(&mut forgetful, k) != expected;
+    }
+    assert_eq!(original.snapshot(), decoded.snapshot());
+    assert!(differs, "the lag state changed nothing");
+}
+

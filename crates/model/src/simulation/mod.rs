@@ -44,6 +44,7 @@ use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::extra_force::{self, StopperMotion};
+use crate::physics::flexible::{self, FLEXIBLE_SLOTS};
 use crate::physics::modulation;
 use crate::physics::restrictions::node;
 use crate::physics::sensors::{Channel, SensorLaw, SensorMemory};
@@ -167,6 +168,9 @@ pub struct Simulation {
     /// The propagator of the last step whose modulation slots changed the current driver's or
     /// the jet pipe's constants, kept for the next step with the same constants.
     modulated_propagator: Option<modulated::PropagatorOf>,
+    /// The flexible slots' low-passed signals at the last sample, per slot and axis
+    /// ([`crate::physics::flexible`]; followed only where a slot lags).
+    flexible_lags: [[f64; 2]; FLEXIBLE_SLOTS],
 }
 
 /// The optional stages of a step, decided once when a simulation is built from its model (its
@@ -185,6 +189,8 @@ struct StepPlan {
     /// A slot modulates a constant the outputs read: they are formed with it at the sample's
     /// signals.
     modulated_outputs: bool,
+    /// A flexible slot low-passes a signal: its lag state is advanced after each step.
+    lagged: bool,
     /// The command reaches the driver through the command stage or the transport delay.
     command_path: bool,
     /// A transducer filters its reading (and so has a memory, which records the reading after
@@ -206,6 +212,7 @@ impl StepPlan {
             varying_constants: time_varying::varies(p),
             modulated: modulation::any_on(p),
             modulated_outputs: modulation::modulates_outputs(p),
+            lagged: flexible::lags_on(p),
             command_path: command_stage::is_active(p) || p.command_delay != 0.0,
             filtering_transducers: transducers.iter().any(Option::is_some),
             hysteresis: model.hysteresis.is_active(),
@@ -299,7 +306,14 @@ impl Simulation {
         let propagator = ElectromechanicalPropagator::new(&model.params);
         let plays = model.initial_hysteresis_memory(state[index::CURRENT]);
         let command_stage = CommandStage::at_rest(&model.params, time, v_da);
-        let readings = modulated::outputs_in_motion(&model, &state, x_s, 0.0, 0.0, time, v_da).readings();
+        let readings = modulated::outputs_in_motion(&model, &state, x_s, 0.0, 0.0, time, v_da, None).readings();
+        // The lags start settled at the signals of the starting state (the steady state).
+        let flexible_lags = if flexible::any_on(&model.params) {
+            let signals = modulated::signals_at(&model, &state, v_da, x_s, 0.0, 0.0, time);
+            flexible::initial_lags(&model.params, &signals)
+        } else {
+            [[0.0; 2]; FLEXIBLE_SLOTS]
+        };
         let transducers = [0, 1, 2].map(|k| {
             SensorLaw::of(&model.params, Channel::ALL[k])
                 .filters()
@@ -366,6 +380,7 @@ impl Simulation {
             stage_areas: std::cell::RefCell::new(chambers::StageAreas::default()),
             plan,
             modulated_propagator: None,
+            flexible_lags,
         }
     }
 

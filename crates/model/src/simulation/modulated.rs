@@ -1,11 +1,13 @@
-//! The modulation slots ([`crate::physics::modulation`]) in a simulation: the signals at a
-//! sample, the slots' constants held over a step (with the propagator rebuilt when they are
-//! the current driver's or the jet pipe's) and released after it, and the outputs at a sample
-//! with the constants at its signals.
+//! The modulation and flexible slots ([`crate::physics::modulation`],
+//! [`crate::physics::flexible`]) in a simulation: the signals at a sample, the slots'
+//! constants held over a step (with the propagator rebuilt when they are the current driver's
+//! or the jet pipe's) and released after it, the flexible slots' lags advanced after it, and
+//! the outputs at a sample with the constants at its signals.
 
 use super::Simulation;
 use crate::electromechanics::ElectromechanicalPropagator;
 use crate::physics::actuator::{index, Actuator, Outputs, State};
+use crate::physics::flexible::{self, FLEXIBLE_SLOTS};
 use crate::physics::modulation::{self, Held, Signals};
 
 /// What [`Simulation::hold_modulated`] changed, for [`Simulation::release_modulated`].
@@ -51,6 +53,7 @@ pub(super) fn signals_at(
         0.0
     };
     Signals {
+        lagged: None,
         time,
         v_da,
         current: state[index::CURRENT],
@@ -63,9 +66,11 @@ pub(super) fn signals_at(
     }
 }
 
-/// [`Actuator::outputs_in_motion`] with the slots' constants at the sample's signals (the
-/// nominal outputs when no slot modulates a constant the outputs read, or when the
-/// constants at these signals are refused, which a step from here reports).
+/// [`Actuator::outputs_in_motion`] with the slots' constants at the sample's signals, the
+/// flexible slots' lagged ones `lagged` (the raw signals for `None`): the nominal outputs when
+/// no slot modulates a constant the outputs read, or when the constants at these signals are
+/// refused, which a step from here reports.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn outputs_in_motion(
     model: &Actuator,
     state: &State,
@@ -74,9 +79,11 @@ pub(super) fn outputs_in_motion(
     stopper_acceleration: f64,
     time: f64,
     v_da: f64,
+    lagged: Option<[[f64; 2]; FLEXIBLE_SLOTS]>,
 ) -> Outputs {
     if modulation::modulates_outputs(&model.params) {
-        let signals = signals_at(model, state, v_da, x_s, stopper_velocity, stopper_acceleration, time);
+        let mut signals = signals_at(model, state, v_da, x_s, stopper_velocity, stopper_acceleration, time);
+        signals.lagged = lagged;
         if let Ok(at) = modulation::model_at(model, &signals) {
             return at.outputs_in_motion(state, x_s, stopper_velocity, stopper_acceleration, time);
         }
@@ -85,9 +92,10 @@ pub(super) fn outputs_in_motion(
 }
 
 impl Simulation {
-    /// The signals at the last sample, the time signals at `time`.
+    /// The signals at the last sample, the time signals at `time`, with the flexible slots'
+    /// lag state where they lag.
     pub(super) fn modulation_signals(&self, time: f64) -> Signals {
-        signals_at(
+        let mut signals = signals_at(
             &self.model,
             &self.state,
             self.v_da,
@@ -95,7 +103,24 @@ impl Simulation {
             self.stopper_velocity_at_sample(),
             self.acceleration_read(),
             time,
-        )
+        );
+        signals.lagged = self.lags();
+        signals
+    }
+
+    /// The flexible slots' lag state, when one lags.
+    fn lags(&self) -> Option<[[f64; 2]; FLEXIBLE_SLOTS]> {
+        self.plan.lagged.then_some(self.flexible_lags)
+    }
+
+    /// After a completed step of `step` seconds that started at the signals `start` (the time
+    /// signals at the step's start), with the model's constants nominal again: the flexible
+    /// slots' lags advanced to the signals at the new sample, as the outputs there read them.
+    pub(super) fn advance_lags(&mut self, step: f64, start: &Signals) {
+        if self.plan.lagged {
+            let end = self.modulation_signals(self.time);
+            flexible::advance_lags(&self.model.params, &mut self.flexible_lags, step, start, &end);
+        }
     }
 
     /// The slots' constants set at `signals` for a step, with the propagator of those
@@ -156,6 +181,7 @@ impl Simulation {
             acceleration,
             self.time,
             self.v_da,
+            self.lags(),
         )
     }
 }

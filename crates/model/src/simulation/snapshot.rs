@@ -4,8 +4,8 @@
 //!
 //! Everything that carries memory from one step to the next is in it: time, state, inputs
 //! and their rates, the integrators' step sizes, the hysteresis plays, the commands of the
-//! recent past (transport delay), the command stage and the transducers' filters, the work
-//! counters.
+//! recent past (transport delay), the command stage and the transducers' filters, the flexible
+//! slots' lags, the work counters.
 //! What is derived from the model (the jet pipe's propagator) is built again on restore, and
 //! the chambers' rates kept from the last step are left out: they are a memo, the results
 //! are the same to the last bit without them.
@@ -19,6 +19,7 @@ use crate::physics::actuator::{Actuator, State, N_STATES};
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::extra_force::StopperMotion;
+use crate::physics::flexible::FLEXIBLE_SLOTS;
 use crate::physics::restrictions::node;
 use crate::physics::sensors::SensorMemory;
 
@@ -52,16 +53,22 @@ pub struct SimulationSnapshot {
     acceleration_input_rate: f64,
     command_stage: CommandStage,
     transducers: [Option<SensorMemory>; 3],
+    flexible_lags: [[f64; 2]; FLEXIBLE_SLOTS],
 }
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-pub const SNAPSHOT_LAYOUT: f64 = 9.0;
+/// Layout 10: the flexible slots' lags.
+pub const SNAPSHOT_LAYOUT: f64 = 10.0;
 
 /// Numbers before the two counted lists: the layout, 26 scalars, the state, the volumes'
-/// pressures, the plays, the command stage ([`command_stage::VALUES`]) and the six work counters as two halves each.
-const FIXED_VALUES: usize = 1 + 26 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + 2 * STATISTICS;
+/// pressures, the plays, the command stage ([`command_stage::VALUES`]), the flexible slots'
+/// lags and the six work counters as two halves each.
+const FIXED_VALUES: usize =
+    1 + 26 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + LAGS + 2 * STATISTICS;
 const STATISTICS: usize = 6;
+/// The flexible slots' lag states: two axes per slot.
+const LAGS: usize = 2 * FLEXIBLE_SLOTS;
 
 impl Simulation {
     /// The simulation's memory, to continue it later with [`Simulation::restore`].
@@ -96,6 +103,7 @@ impl Simulation {
             acceleration_input_rate: self.acceleration_input_rate,
             command_stage: self.command_stage,
             transducers: self.transducers.clone(),
+            flexible_lags: self.flexible_lags,
         }
     }
 
@@ -132,6 +140,7 @@ impl Simulation {
         sim.acceleration_input_rate = s.acceleration_input_rate;
         sim.command_stage = s.command_stage;
         sim.transducers = s.transducers.clone();
+        sim.flexible_lags = s.flexible_lags;
         sim.plan = StepPlan::of(&sim.model, &sim.transducers);
         Ok(sim)
     }
@@ -152,7 +161,8 @@ impl SimulationSnapshot {
     /// velocity over the step before the last and that step's length, and the stopper
     /// acceleration they gave, the acceleration input a_s and its rate; the state;
     /// the pressures of the gas volumes behind restrictions (supply, return, line 1, line 2); the
-    /// plays; the command stage (time, held, lagged, filtered and its rate); the work counters (steps, rejected,
+    /// plays; the command stage (time, held, lagged, filtered and its rate); the flexible slots'
+    /// lag states (slot 1's two axes, then slot 2's); the work counters (steps, rejected,
     /// right-hand sides, Jacobians, Newton failures, stiff hand-overs), each as its low then
     /// its high 32 bits, since an `f64` holds integers exactly only up to 2^53; then the
     /// number of past commands and their (time, v_DA, rate); then for each transducer (force,
@@ -198,6 +208,9 @@ impl SimulationSnapshot {
         v.extend_from_slice(&self.nodes);
         v.extend_from_slice(&self.plays);
         v.extend_from_slice(&self.command_stage.to_values());
+        for lags in &self.flexible_lags {
+            v.extend_from_slice(lags);
+        }
         for count in statistics_counts(&self.statistics) {
             v.push((count & 0xffff_ffff) as f64);
             v.push((count >> 32) as f64);
@@ -251,6 +264,11 @@ impl SimulationSnapshot {
         let stage: [f64; command_stage::VALUES] = next(command_stage::VALUES)
             .try_into()
             .expect("the command stage's values");
+        let lag_values = next(LAGS);
+        let mut flexible_lags = [[0.0; 2]; FLEXIBLE_SLOTS];
+        for (k, lags) in flexible_lags.iter_mut().enumerate() {
+            lags.copy_from_slice(&lag_values[2 * k..2 * k + 2]);
+        }
         let halves = next(2 * STATISTICS);
         let mut counts = [0u64; STATISTICS];
         for (k, count) in counts.iter_mut().enumerate() {
@@ -317,7 +335,14 @@ impl SimulationSnapshot {
             acceleration_input_rate,
             next_rate,
         ];
-        let finite = numbers.iter().chain(&state).chain(&nodes).chain(&stage).chain(sensor).all(|v| v.is_finite())
+        let finite = numbers
+            .iter()
+            .chain(&state)
+            .chain(&nodes)
+            .chain(&stage)
+            .chain(lag_values)
+            .chain(sensor)
+            .all(|v| v.is_finite())
             && command_history.iter().all(|c| c.v_da.is_finite() && c.rate.is_finite())
             // The step caps may be unlimited; the oldest past command is from −∞.
             && !max_step.is_nan()
@@ -384,6 +409,7 @@ impl SimulationSnapshot {
             acceleration_input_rate,
             command_stage: CommandStage::from_values(stage),
             transducers,
+            flexible_lags,
         })
     }
 }

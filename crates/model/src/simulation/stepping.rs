@@ -12,6 +12,7 @@ use crate::electromechanics::{ElectromechanicalState, Trajectory};
 use crate::integrator::{ExplicitPair, IntegrationFailure, OdeSystem, Sdirk4, Statistics, Tolerances};
 use crate::physics::actuator::{index, Actuator, Outputs, RateTerms, State, N_STATES};
 use crate::physics::effects::PLAY_OPERATORS;
+use crate::physics::modulation::Signals;
 use crate::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use crate::physics::sensors::{Channel, SensorLaw};
 use crate::physics::time_varying;
@@ -92,15 +93,20 @@ impl Simulation {
         result
     }
 
-    /// [`Self::step`] with modulation slots: the signals at the step's start (the time signals
-    /// at mid-step), the drifting constants at mid-step, the slots' increments added to them,
-    /// all held over the step and restored after it.
+    /// [`Self::step`] with modulation or flexible slots: the signals at the step's start (the
+    /// time signals at mid-step), the drifting constants at mid-step, the slots' increments
+    /// added to them, all held over the step and restored after it; then the flexible slots'
+    /// lags advanced over the completed step.
     fn step_modulated(&mut self, step: f64) -> Result<(), StepFailure> {
         if !(step.is_finite() && step > 0.0) {
             return self.step_with_constants_held(step);
         }
         let mid = self.time + 0.5 * step;
         let signals = self.modulation_signals(mid);
+        let start = Signals {
+            time: self.time,
+            ..signals
+        };
         let nominal = self.plan.varying_constants.then(|| self.model.params.clone());
         let mut held = Ok(None);
         if let Some(nominal) = &nominal {
@@ -125,6 +131,9 @@ impl Simulation {
             self.model.params = nominal;
         }
         self.chamber_rates_at_end = None;
+        if result.is_ok() {
+            self.advance_lags(step, &start);
+        }
         result
     }
 

@@ -130,13 +130,15 @@ pub(super) const SLOT_2: [Row; 16] = slot_rows!(2, vr::MODULATION_2_PARAMETER);
 
 /// The slots' rows after the table's others: the modulation slots', the extra force's product
 /// slots' (`variables/extra_force.rs`), the extra flow slots' (`variables/extra_flow.rs`), the
-/// plain constants of `variables/flexible.rs`.
-pub(super) const SLOT_ROWS: [&[Row]; 5] = [
+/// plain constants and the flexible slots of `variables/flexible.rs`.
+pub(super) const SLOT_ROWS: [&[Row]; 7] = [
     &SLOT_1,
     &SLOT_2,
     &super::extra_force::SLOTS,
     &super::extra_flow::SLOTS,
     &super::flexible::CONSTANTS,
+    &super::flexible::SLOT_1,
+    &super::flexible::SLOT_2,
 ];
 
 /// The number of rows in `parts`.
