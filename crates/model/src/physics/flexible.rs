@@ -98,7 +98,7 @@ pub struct FlexibleSlot {
     pub knots: [f64; 2],
     /// The knots' signal values on each axis, in the signal's unit.
     pub x: [[f64; MAX_GRID]; 2],
-    /// The constant's increments at the nodes: `y[i][j]` at (x[0][i], x[1][j]).
+    /// The constant's increments at the nodes: `y[i][j]` at (`x[0][i]`, `x[1][j]`).
     pub y: [[f64; MAX_GRID]; MAX_GRID],
 }
 

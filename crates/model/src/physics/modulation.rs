@@ -15,7 +15,7 @@
 //! the drifted value.
 //!
 //! The flexible slots ([`super::flexible`]) are the generalisation of these (two signals, a
-//! lag on each): [`apply`] and [`restore`] walk both kinds, and every question below of
+//! lag on each): `apply` and `restore` walk both kinds, and every question below of
 //! which constants the slots vary asks it of both.
 //!
 //! The chambers' dead volumes are modulatable as the pressure equations' capacity

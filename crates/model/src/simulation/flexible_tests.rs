@@ -166,11 +166,13 @@ fn a_two_signal_slot_with_separable_increments_gives_the_outputs_of_two_modulati
     // y_ij = a_i + b_j on C_d, a over x_s and b over v_DA: the two modulation slots a and b.
     let (x1, a) = ([0.05, 0.054, 0.058], [-0.04, 0.01, 0.05]);
     let (x2, b) = ([-2.0, 0.0, 2.0, 4.0], [0.03, -0.02, 0.04, 0.0]);
-    let mut two = Parameters::default();
-    two.modulation = [
-        Slot::through(vr::C_D, ModulationSignal::StopperPosition, &x1, &a),
-        Slot::through(vr::C_D, ModulationSignal::Command, &x2, &b),
-    ];
+    let two = Parameters {
+        modulation: [
+            Slot::through(vr::C_D, ModulationSignal::StopperPosition, &x1, &a),
+            Slot::through(vr::C_D, ModulationSignal::Command, &x2, &b),
+        ],
+        ..Parameters::default()
+    };
     let mut grid = FlexibleSlot::through(vr::C_D, ModulationSignal::StopperPosition, &x1, &[0.0; 3]);
     grid.signals[1] = ModulationSignal::Command.code() as f64;
     grid.knots[1] = 4.0;
