@@ -103,6 +103,7 @@ fn diagnose_one(item: &Item, options: &BatchOptions, jobs: usize) -> Result<Summ
         calibrate: options.calibrate,
         jobs,
         bars: None,
+        flexible: false,
     };
     // The diagnosis keeps the recording; the figures read it again once the report is written.
     let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &options.base, &diagnosis_options, &mut |_| {})?;

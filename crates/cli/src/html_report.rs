@@ -229,26 +229,41 @@ fn variable_of_code(code: f64) -> Option<&'static jetpipe_model::variable::Varia
         .find(|v| code.fract() == 0.0 && f64::from(v.value_reference) == code)
 }
 
-/// What a modulation slot's setting `name` is in, from the slot's other settings in
-/// `parameters`: a knot's abscissa in the unit of the slot's signal, its increment in the unit
-/// of the constant it modulates (the variable table writes "1" for both).
+/// What a modulation or flexible slot's setting `name` is in, from the slot's other settings
+/// in `parameters`: a knot's abscissa in the unit of the slot's signal (a flexible slot's
+/// `x1_j` of its first signal, `x2_j` of its second), its increment in the unit of the
+/// constant it modulates (the variable table writes "1" for all).
 fn slot_unit(name: &str, parameters: &serde_json::Map<String, Value>) -> Option<&'static str> {
-    let (slot, setting) = name.strip_prefix("modulation_")?.split_once('_')?;
-    let code = |what: &str| number(parameters.get(&format!("modulation_{slot}_{what}"))?);
-    if setting.starts_with("x_") {
-        ModulationSignal::from_code(code("signal")?).map(ModulationSignal::unit)
+    let (kind, rest) = if let Some(rest) = name.strip_prefix("modulation_") {
+        ("modulation", rest)
+    } else {
+        ("flexible", name.strip_prefix("flexible_")?)
+    };
+    let (slot, setting) = rest.split_once('_')?;
+    let code = |what: &str| number(parameters.get(&format!("{kind}_{slot}_{what}"))?);
+    let signal = match setting {
+        s if kind == "modulation" && s.starts_with("x_") => Some("signal"),
+        s if s.starts_with("x1_") => Some("signal_1"),
+        s if s.starts_with("x2_") => Some("signal_2"),
+        _ => None,
+    };
+    if let Some(signal) = signal {
+        ModulationSignal::from_code(code(signal)?).map(ModulationSignal::unit)
     } else if setting.starts_with("y_") {
         variable_of_code(code("parameter")?)?.unit
+    } else if setting.starts_with("lag_") {
+        Some("s")
     } else {
         None
     }
 }
 
-/// What a modulation slot's code names: its signal, or the constant it modulates.
+/// What a modulation or flexible slot's code names: its signal, or the constant it modulates.
 fn slot_code_name(name: &str, value: f64) -> Option<&'static str> {
-    let (_, setting) = name.strip_prefix("modulation_")?.split_once('_')?;
+    let rest = name.strip_prefix("modulation_").or_else(|| name.strip_prefix("flexible_"))?;
+    let (_, setting) = rest.split_once('_')?;
     match setting {
-        "signal" => ModulationSignal::from_code(value).map(ModulationSignal::name),
+        "signal" | "signal_1" | "signal_2" => ModulationSignal::from_code(value).map(ModulationSignal::name),
         "parameter" => variable_of_code(value).map(|v| v.name),
         _ => None,
     }

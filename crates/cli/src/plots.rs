@@ -1,7 +1,7 @@
 //! The figures of a diagnosis, as SVG text: the force over time, the residual before and
 //! after in time and against the signal it follows, the force against the command (the loops
-//! of Fig. 3.13), the pressure channels when the recording has them, and the static curve of a
-//! term that is one. `jetpipe diagnose --plots DIR` writes them as files, the HTML page
+//! of Fig. 3.13), the pressure channels when the recording has them, the static curve of a
+//! term that is one, and the shape of each flexible term. `jetpipe diagnose --plots DIR` writes them as files, the HTML page
 //! inlines them.
 //!
 //! What a reader must be able to trust: the measured series is drawn last and semi-transparent,
@@ -323,6 +323,7 @@ pub fn diagnosis_figures(inputs: &FigureInputs) -> Result<Vec<Figure>, String> {
         figures.push(figure);
     }
     figures.extend(static_curves(recording, diagnosis, inputs.base)?);
+    figures.extend(flexible_shapes(diagnosis)?);
     Ok(figures)
 }
 
@@ -709,6 +710,98 @@ pub fn write_diagnosis_plots(dir: &Path, inputs: &FigureInputs) -> Result<Vec<Fi
         std::fs::write(&path, &figure.svg).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     Ok(figures)
+}
+
+/// Colours of a flexible term's lines, one per knot of its second signal.
+const SHAPE_COLOURS: [RGBColor; 5] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+];
+
+/// Each flexible term's surface: what it adds to its constant along its first signal, one
+/// line at each knot of its second (a single line for a term of one signal).
+fn flexible_shapes(diagnosis: &Diagnosis) -> Result<Vec<Figure>, String> {
+    use jetpipe_diagnosis::candidates::flexible;
+    let mut figures = vec![];
+    for (k, term) in diagnosis.discovered.iter().filter(|d| d.flexible.is_some()).take(2).enumerate() {
+        let Some(shape) = flexible::shape(&term.parameters) else {
+            continue;
+        };
+        let value = |name: String| term.parameters.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
+        let Some(slot) = (1..=flexible::SLOTS).find(|&s| value(format!("flexible_{s}_parameter")).is_some()) else {
+            continue;
+        };
+        let knots = |axis: usize| -> Vec<f64> {
+            let n = value(format!("flexible_{slot}_knots_{axis}")).unwrap_or(0.0) as usize;
+            (1..=n).filter_map(|j| value(format!("flexible_{slot}_x{axis}_{j}"))).collect()
+        };
+        let (first, second) = (knots(1), knots(2));
+        let Some((axis, _)) = shape.axes.first() else {
+            continue;
+        };
+        let (x_label, x_scale) = signal_unit_scale(axis.signal.unit());
+        let columns = second.len().max(1);
+        let series: Vec<Series> = (0..columns)
+            .map(|j| {
+                let points = first
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| {
+                        (
+                            x * x_scale,
+                            value(format!("flexible_{slot}_y_{}_{}", i + 1, j + 1)).unwrap_or(0.0),
+                        )
+                    })
+                    .collect();
+                let label = match (shape.axes.get(1), second.get(j)) {
+                    (Some((other, _)), Some(x2)) => {
+                        let (unit, scale) = signal_unit_scale(other.signal.unit());
+                        format!("{} = {:.3} {unit}", other.signal.name(), x2 * scale)
+                    }
+                    _ => "the term".to_string(),
+                };
+                Series::line(points, SHAPE_COLOURS[j % SHAPE_COLOURS.len()], label).wide()
+            })
+            .collect();
+        let refs: Vec<&Series> = series.iter().collect();
+        let caption = format!("flexible term {}: added to {}", k + 1, shape.constant);
+        let x_desc = format!("{} ({x_label})", axis.name());
+        let y_desc = format!("added to {} ({})", shape.constant, shape.unit);
+        let svg = svg(420, &refs, 1, |areas| panel(&areas[0], &caption, &x_desc, &y_desc, &refs))?;
+        figures.push(Figure {
+            name: if k == 0 { "flexible_term_1" } else { "flexible_term_2" },
+            title: format!("The shape of flexible term {}", k + 1),
+            caption: format!(
+                "What the flexible term adds to {} at its knots, joined by straight lines as the model interpolates \
+                 them, along {}{}: a departure no readable form at any place closed. Held beyond the end knots.",
+                shape.constant,
+                axis.name(),
+                match shape.axes.get(1) {
+                    Some((other, _)) => format!(", one line at each knot of {}", other.name()),
+                    None => String::new(),
+                }
+            ),
+            svg,
+        });
+    }
+    Ok(figures)
+}
+
+/// The unit an engineer reads an SI unit of the chain's signals in, with its scale.
+fn signal_unit_scale(unit: &str) -> (&'static str, f64) {
+    match unit {
+        "m" => ("mm", 1e3),
+        "m/s" => ("mm/s", 1e3),
+        "Pa" => ("kPa", 1e-3),
+        "A" => ("mA", 1e3),
+        "V" => ("V", 1.0),
+        "N" => ("N", 1.0),
+        "s" => ("s", 1.0),
+        _ => ("1", 1.0),
+    }
 }
 
 #[cfg(test)]

@@ -30,6 +30,10 @@ pub struct Options {
     /// Worker threads for the candidates.
     pub jobs: usize,
     pub bars: Option<std::sync::Arc<dyn ProgressBars>>,
+    /// Try a flexible term where the readable ones leave a channel above its bar
+    /// (`decide/flexible.rs`). Off by default: on the cases at hand it does not yet close what
+    /// the readable terms leave (it is fitted after them, not in their place).
+    pub flexible: bool,
 }
 
 impl Default for Options {
@@ -38,6 +42,7 @@ impl Default for Options {
             calibrate: false,
             jobs: std::thread::available_parallelism().map_or(2, |n| n.get()),
             bars: None,
+            flexible: false,
         }
     }
 }

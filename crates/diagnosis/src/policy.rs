@@ -181,6 +181,16 @@ pub const WRITTEN_FIRST_WITHIN: f64 = 1.25;
 /// is tried before a modulation at its place: its refit in the model usually gains the rest.
 pub const WRITTEN_ADEQUATE_WITHIN: f64 = 2.0;
 
+/// A readable candidate whose held-out misfit is within this factor of a flexible term's
+/// stands instead of it (`decide/flexible.rs`): a form a person reads is worth a little misfit.
+pub const READABLE_WINS_WITHIN: f64 = 1.25;
+
+/// The flexible surfaces, best screened first, fitted through the model in a slot.
+pub const FLEXIBLE_FITTED: usize = 3;
+
+/// Gauss–Newton linearisations of a flexible term's fit through the model.
+pub const FLEXIBLE_ITERATIONS: usize = 3;
+
 #[cfg(test)]
 mod tests {
     use super::*;

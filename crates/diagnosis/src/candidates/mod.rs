@@ -34,6 +34,7 @@ pub(crate) mod curve_reading;
 pub mod curves;
 pub mod discharge;
 pub mod extra_flows;
+pub mod flexible;
 pub mod modulation;
 pub mod products;
 pub(crate) mod quantiser;

@@ -111,6 +111,10 @@ pub fn sensitivity_step(constant: &'static str, base: &Parameters, catalogue: &[
         "x_jp_offset" => 2e-6,
         // About 0.5 % of the thesis piston's area (1.98e-4 m²).
         "extra_force_pressure_difference" => 1e-6,
+        // A hundredth of a newton, and a tenth of a milligram a second (the valve passes
+        // about a gram a second at full opening).
+        "extra_force_offset" => 0.01,
+        "extra_inflow_1" | "extra_inflow_2" => 1e-7,
         _ => 1e-3,
     }
 }

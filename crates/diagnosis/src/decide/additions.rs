@@ -58,6 +58,8 @@ pub struct DiscoveredTerm {
     pub intervals: Vec<Option<Interval>>,
     /// As [`AddedEffect::margin`].
     pub margin: Option<f64>,
+    /// For a flexible term, how it compares with the nearest readable form.
+    pub flexible: Option<crate::candidates::flexible::Nearest>,
 }
 
 impl DiscoveredTerm {
@@ -90,6 +92,7 @@ impl DiscoveredTerm {
             tied_locations: vec![],
             intervals: vec![],
             margin: None,
+            flexible: None,
         }
     }
 }

@@ -296,6 +296,9 @@ pub fn reading(
     if let Some(discharge) = crate::candidates::discharge::reading(set, before) {
         return discharge;
     }
+    if let Some(flexible) = crate::candidates::flexible::reading(set) {
+        return format!("At the {location} ({family}): {flexible}.");
+    }
     if let Some(modulation) = crate::candidates::modulation::reading(set, before) {
         return format!("At the {location} ({family}): {modulation}.");
     }

@@ -207,6 +207,7 @@ pub(crate) fn discover_term(
                 tied_locations: found.tied_with(candidate.location),
                 intervals: vec![],
                 margin: None,
+                flexible: None,
             };
             let is_modulation = crate::candidates::modulation::is_modulation(candidate);
             match &modulation {

@@ -587,6 +587,7 @@ mod tests {
             tied_locations: vec![],
             intervals: vec![],
             margin: None,
+            flexible: None,
         }
     }
 

@@ -167,6 +167,7 @@ mod tests {
                 tied_locations: vec![],
                 intervals: vec![],
                 margin: None,
+                flexible: None,
             }],
             first_candidates: vec![],
             localization: None,

@@ -19,9 +19,14 @@ use jetpipe_model::physics::parameters::Parameters;
 /// abscissae are its grid, and a modulation slot's constant, signal, frequency and knot
 /// count say what varies with what (its knots' abscissae move: a band of friction 60–66 mm
 /// wide, first placed at the signal's quantiles, was refitted from 2.5 noise floors to 1.2).
+/// A flexible slot's grid values move; its constant, signals, lags and knots stay.
 pub(crate) fn refittable(name: &str) -> bool {
     if name.starts_with("modulation_") {
         return name.contains("_y_") || name.contains("_x_");
+    }
+    // A flexible slot's grid values; its signals, lags and knots say what the surface is over.
+    if name.starts_with("flexible_") {
+        return name.contains("_y_");
     }
     !name.ends_with("_curve_knots") && !name.contains("_curve_x_")
 }

@@ -77,7 +77,7 @@ pub struct Screened {
 }
 
 /// The signal's value at every sample, from the recording and the current model's replay.
-fn signal_values(signal: ModulationSignal, problem: &Problem, replay: &Replay) -> Vec<f64> {
+pub(crate) fn signal_values(signal: ModulationSignal, problem: &Problem, replay: &Replay) -> Vec<f64> {
     let recording = problem.recording;
     match signal {
         ModulationSignal::Time => recording.time.clone(),
@@ -168,7 +168,7 @@ fn simplified(x: &[f64], y: &[f64]) -> Vec<Vec<usize>> {
 }
 
 /// The weighted residual of each measured channel against `replay`.
-fn residuals(problem: &Problem, replay: &Replay) -> [Vec<f64>; CHANNELS] {
+pub(crate) fn residuals(problem: &Problem, replay: &Replay) -> [Vec<f64>; CHANNELS] {
     let modelled = [&replay.force, &replay.p1, &replay.p2];
     let mut out: [Vec<f64>; CHANNELS] = [vec![], vec![], vec![]];
     for c in 0..CHANNELS {

@@ -228,6 +228,25 @@ impl Diagnosis {
                 "pressures_heldout_before_rms_Pa": d.pressures_heldout.map(|(b, _)| b.to_vec()),
                 "pressures_heldout_after_rms_Pa": d.pressures_heldout.map(|(_, a)| a.to_vec()),
                 "tied_locations": d.tied_locations,
+                "flexible": d.flexible.is_some(),
+                "flexible_shape": d.flexible.as_ref().and_then(|n| {
+                    let shape = crate::candidates::flexible::shape(&d.parameters)?;
+                    Some(json!({
+                        "adds_to": shape.constant,
+                        "unit": shape.unit,
+                        "largest": shape.largest,
+                        "depends_on": shape.axes.iter().map(|(axis, strength)| json!({
+                            "signal": axis.signal.name(),
+                            "low_pass_s": axis.lag,
+                            "change_along": strength,
+                        })).collect::<Vec<_>>(),
+                        "heldout_noise_floors": n.flexible_noise_floors,
+                        "nearest_readable": n.readable.map(|(label, floors)| json!({
+                            "candidate": label,
+                            "heldout_noise_floors": floors,
+                        })),
+                    }))
+                }),
             }), intervals_json(&d.parameters, &d.intervals).into_iter().chain([("margin_noise_floors", json!(d.margin))]))).collect::<Vec<_>>(),
             "calibrated": self.calibrated.iter().map(|c| (c.name.to_string(), json!({
                 "value": c.value,
