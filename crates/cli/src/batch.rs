@@ -33,6 +33,8 @@ pub struct BatchOptions {
     /// The parameters every diagnosis starts from (the thesis's, or `--params`).
     pub base: Parameters,
     pub calibrate: bool,
+    /// Try a flexible term where the readable ones leave a channel above its bar.
+    pub flexible: bool,
     /// Cores to use in all: recordings run side by side, and a recording's candidate fits
     /// share what is left over.
     pub jobs: usize,
@@ -103,7 +105,7 @@ fn diagnose_one(item: &Item, options: &BatchOptions, jobs: usize) -> Result<Summ
         calibrate: options.calibrate,
         jobs,
         bars: None,
-        flexible: false,
+        flexible: options.flexible,
     };
     // The diagnosis keeps the recording; the figures read it again once the report is written.
     let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &options.base, &diagnosis_options, &mut |_| {})?;

@@ -31,8 +31,8 @@ pub struct Options {
     pub jobs: usize,
     pub bars: Option<std::sync::Arc<dyn ProgressBars>>,
     /// Try a flexible term where the readable ones leave a channel above its bar
-    /// (`decide/flexible.rs`). Off by default: on the cases at hand it does not yet close what
-    /// the readable terms leave (it is fitted after them, not in their place).
+    /// (`decide/flexible.rs`; `jetpipe diagnose --flexible`). Off by default until it has been
+    /// measured on the practice batches and the kept cases.
     pub flexible: bool,
 }
 

@@ -88,6 +88,10 @@ enum Command {
         /// Re-identify jet pipe offset, C_d and leakage (§3.3.1) first.
         #[arg(long)]
         calibrate: bool,
+        /// Where the readable terms leave a channel above its bar, try a flexible term (a smooth
+        /// function of one or two signals, with memory) in their place or beside them.
+        #[arg(long)]
+        flexible: bool,
         /// Directory for the SVG figures of the one recording (with --out they are in the pages).
         #[arg(long, conflicts_with = "out")]
         plots: Option<PathBuf>,
@@ -285,11 +289,12 @@ fn run(cli: Cli) -> Result<(), String> {
             out,
             params,
             calibrate,
+            flexible,
             plots,
             no_html,
             jobs,
         } => match out {
-            Some(out) => diagnose_batch(recordings, out, params.as_deref(), calibrate, jobs),
+            Some(out) => diagnose_batch(recordings, out, params.as_deref(), (calibrate, flexible), jobs),
             None => {
                 let [recording] = recordings.as_slice() else {
                     return Err(match report {
@@ -319,7 +324,7 @@ fn run(cli: Cli) -> Result<(), String> {
                     page: page.as_deref(),
                     plots: plots.as_deref(),
                 };
-                diagnose(recording, &destination, params.as_deref(), calibrate, jobs)
+                diagnose(recording, &destination, params.as_deref(), (calibrate, flexible), jobs)
             }
         },
     }
@@ -498,7 +503,7 @@ fn diagnose(
     recording_path: &std::path::Path,
     destination: &Destination,
     params: Option<&std::path::Path>,
-    calibrate: bool,
+    (calibrate, flexible): (bool, bool),
     jobs: Option<usize>,
 ) -> Result<(), String> {
     let report = destination.report;
@@ -515,6 +520,7 @@ fn diagnose(
     };
     let mut options = jetpipe_diagnosis::Options {
         calibrate,
+        flexible,
         bars: Some(bars.clone()),
         ..Default::default()
     };
@@ -578,7 +584,7 @@ fn diagnose_batch(
     inputs: Vec<PathBuf>,
     out: PathBuf,
     params: Option<&std::path::Path>,
-    calibrate: bool,
+    (calibrate, flexible): (bool, bool),
     jobs: Option<usize>,
 ) -> Result<(), String> {
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get()));
@@ -587,6 +593,7 @@ fn diagnose_batch(
         out,
         base: read_parameters(params)?,
         calibrate,
+        flexible,
         jobs,
     };
     let started = Instant::now();

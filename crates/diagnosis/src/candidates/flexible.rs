@@ -346,6 +346,14 @@ pub fn screen(
                 pairs.push((c, best[i], best[j]));
             }
         }
+        // The best signal beside every other one read directly: the leading few often carry
+        // one piece of information (the command, the current and the jet's position), and the
+        // second factor is then none of them.
+        if let Some(&first) = best.first() {
+            for &signal in SIGNALS.iter().filter(|&&s| !best.iter().any(|a| a.signal == s)) {
+                pairs.push((c, first, Axis { signal, lag: 0.0 }));
+            }
+        }
     }
     let paired: Vec<Option<Surface>> = crate::parallel::parallel_map(&pairs, jobs, |&(c, a, b)| {
         let (place, constant, sensitivity) = &sensitivities[c];
@@ -372,8 +380,55 @@ pub fn screen(
             kept.push(s);
         }
     }
-    kept
+    // The low-passes between the grid's: each kept surface's lags scaled by the factors of
+    // [`LAG_REFINEMENTS`], one axis at a time, the best kept.
+    crate::parallel::parallel_map(&kept, jobs, |surface| {
+        let mut best = surface.clone();
+        for a in 0..surface.axes.len() {
+            if surface.axes[a].lag == 0.0 {
+                continue;
+            }
+            let start = best.clone();
+            for factor in LAG_REFINEMENTS {
+                let mut axes = start.axes.clone();
+                axes[a].lag *= factor;
+                let values: Vec<Vec<f64>> = axes.iter().map(values_of).collect();
+                let slices: Vec<&[f64]> = values.iter().map(Vec::as_slice).collect();
+                let count = if axes.len() == 1 { KNOTS_ALONE } else { KNOTS_PAIRED };
+                let Some(knots) = values
+                    .iter()
+                    .map(|v| quantile_knots(v, problem.blocks, count))
+                    .collect::<Option<Vec<_>>>()
+                else {
+                    continue;
+                };
+                let sensitivity = &sensitivities
+                    .iter()
+                    .find(|(_, c, _)| *c == surface.constant)
+                    .expect("a kept surface's constant was screened")
+                    .2;
+                let Some((y, ss)) = screen_surface(problem, &residual, sensitivity, &slices, &knots) else {
+                    continue;
+                };
+                let size: usize = knots.iter().map(Vec::len).product();
+                let penalised = ss + penalty * size as f64;
+                if penalised < best.penalised {
+                    best = Surface {
+                        axes,
+                        knots,
+                        values: y,
+                        penalised,
+                        ..surface.clone()
+                    };
+                }
+            }
+        }
+        best
+    })
 }
+
+/// The factors a kept surface's low-passes are scaled by, between the screen's grid of lags.
+const LAG_REFINEMENTS: [f64; 6] = [0.5, 0.6, 0.75, 1.3, 1.6, 2.0];
 
 /// The flexible slot `slot`'s FMU parameter `field` (`"y_2_3"`, `"signal_1"`...).
 pub fn slot_parameter(slot: usize, field: &str) -> &'static str {

@@ -17,6 +17,7 @@ use crate::replay::replay_fast;
 use crate::replay::signals::{difference, rms_where, CHANNELS, FORCE, P1, P2};
 use crate::replay::Replay;
 use crate::vocabulary::Place;
+use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::actuator::Actuator;
 
 /// The held-out misfit of each measured channel, in noise floors (RMS over the held-out
@@ -40,6 +41,19 @@ pub(crate) fn close_with_flexible(
     if count == 0.0 {
         return Ok(());
     }
+    let unexplained = {
+        let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
+        let current = replay_fast(&Actuator::new(f.params.clone())?, cx.recording, cx.n)?;
+        *replays += 1;
+        let prediction = [current.force.clone(), current.p1.clone(), current.p2.clone()];
+        misfits(&problem, &prediction, count).iter().any(|m| *m > EXPLAINED_WITHIN_NOISE)
+    };
+    // Once a flexible term replaced the discovered terms, the last localization's readable
+    // candidates were fitted to another model: their misfits no longer compare.
+    let mut localization_stale = false;
+    if unexplained {
+        localization_stale = in_place_of_discovered(cx, f, count, replays, progress)?;
+    }
     while let Some(&slot) = free_slots(&f.params).first() {
         let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
         let current = replay_fast(&Actuator::new(f.params.clone())?, cx.recording, cx.n)?;
@@ -59,7 +73,7 @@ pub(crate) fn close_with_flexible(
         };
         let after = misfits(&problem, &fit.prediction, count);
         let flexible_rms = (fit.heldout_total() / count).sqrt();
-        let readable = nearest_readable(f, surface.place);
+        let readable = nearest_readable(f, surface.place).filter(|_| !localization_stale);
         if let Some((label, readable_total)) = readable {
             let readable_rms = (readable_total / count).sqrt();
             if readable_rms <= READABLE_WINS_WITHIN * flexible_rms {
@@ -69,27 +83,7 @@ pub(crate) fn close_with_flexible(
                 break;
             }
         }
-        let mut trial = f.params.clone();
-        let mut set: Vec<(&'static str, f64)> = fit.candidate.settings.clone();
-        set.extend(fit.candidate.terms.iter().zip(&fit.values).map(|(t, v)| (t.name, *v)));
-        for &(name, value) in &set {
-            set_parameter(&mut trial, name, value)?;
-        }
-        trial.validate()?;
-        let force_before = rms_where(&difference(&cx.recording.force, &current.force), &cx.blocks, Block::HeldOut);
-        let force_after = rms_where(&difference(&cx.recording.force, &fit.prediction[FORCE]), &cx.blocks, Block::HeldOut);
-        let mut term = DiscoveredTerm::fitted(&fit.candidate, set, &f.params, force_before, force_after);
-        if let (Some(p1), Some(p2)) = (&cx.recording.p1, &cx.recording.p2) {
-            let rms = |measured: &[f64], modelled: &[f64]| rms_where(&difference(measured, modelled), &cx.blocks, Block::HeldOut);
-            term.pressures_heldout = Some((
-                [rms(p1, &current.p1), rms(p2, &current.p2)],
-                [rms(p1, &fit.prediction[P1]), rms(p2, &fit.prediction[P2])],
-            ));
-        }
-        term.flexible = Some(flexible::Nearest {
-            readable: readable.map(|(label, total)| (label, (total / count).sqrt())),
-            flexible_noise_floors: flexible_rms,
-        });
+        let (term, trial) = flexible_term(cx, &f.params, &fit, &current, readable, count)?;
         progress(&format!(
             "  added: the {} ({} noise floors after)",
             fit.candidate.label,
@@ -101,6 +95,98 @@ pub(crate) fn close_with_flexible(
         f.stages.push(Stage::of(f));
     }
     Ok(())
+}
+
+/// The fitted flexible `fit` as a discovered term on `base` (whose replay is `current`), and
+/// the parameters with it.
+fn flexible_term(
+    cx: &Context,
+    base: &Parameters,
+    fit: &Fit,
+    current: &Replay,
+    readable: Option<(&'static str, f64)>,
+    count: f64,
+) -> Result<(DiscoveredTerm, Parameters), String> {
+    let flexible_rms = (fit.heldout_total() / count).sqrt();
+    let mut trial = base.clone();
+    let mut set: Vec<(&'static str, f64)> = fit.candidate.settings.clone();
+    set.extend(fit.candidate.terms.iter().zip(&fit.values).map(|(t, v)| (t.name, *v)));
+    for &(name, value) in &set {
+        set_parameter(&mut trial, name, value)?;
+    }
+    trial.validate()?;
+    let force_before = rms_where(&difference(&cx.recording.force, &current.force), &cx.blocks, Block::HeldOut);
+    let force_after = rms_where(&difference(&cx.recording.force, &fit.prediction[FORCE]), &cx.blocks, Block::HeldOut);
+    let mut term = DiscoveredTerm::fitted(&fit.candidate, set, base, force_before, force_after);
+    if let (Some(p1), Some(p2)) = (&cx.recording.p1, &cx.recording.p2) {
+        let rms = |measured: &[f64], modelled: &[f64]| rms_where(&difference(measured, modelled), &cx.blocks, Block::HeldOut);
+        term.pressures_heldout = Some((
+            [rms(p1, &current.p1), rms(p2, &current.p2)],
+            [rms(p1, &fit.prediction[P1]), rms(p2, &fit.prediction[P2])],
+        ));
+    }
+    term.flexible = Some(flexible::Nearest {
+        readable: readable.map(|(label, total)| (label, (total / count).sqrt())),
+        flexible_noise_floors: flexible_rms,
+    });
+    Ok((term, trial))
+}
+
+/// A flexible term in place of every discovered term: fitted to what they were added for, on
+/// the model without them (named effects kept), and taken when its penalised held-out misfit
+/// is below the discovered terms' (each amount they fitted charged the same penalty). A
+/// readable term fitted first may take a share of a departure that one surface holds whole, and
+/// a surface fitted beside it only the leftover's.
+fn in_place_of_discovered(
+    cx: &Context,
+    f: &mut Findings,
+    count: f64,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<bool, String> {
+    if f.discovered.is_empty() {
+        return Ok(false);
+    }
+    let added: Vec<(&'static str, f64)> = f.discovered.iter().flat_map(|d| d.parameters.iter().copied()).collect();
+    let Ok(without) = crate::candidates::without_addition(&f.params, &f.start, &added) else {
+        return Ok(false);
+    };
+    let Some(&slot) = free_slots(&without).first() else {
+        return Ok(false);
+    };
+    let penalty = discovery_penalty_per_term(count);
+    let amounts = added.iter().filter(|(name, _)| crate::fit::refit::refittable(name)).count() as f64;
+    let now = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
+    let current = replay_fast(&Actuator::new(f.params.clone())?, cx.recording, cx.n)?;
+    let (_, heldout) = now.errors(&[current.force.clone(), current.p1.clone(), current.p2.clone()]);
+    let discovered_penalised = heldout.iter().sum::<f64>() + amounts * penalty;
+    let problem = Problem::new(cx.recording, &without, &cx.blocks, cx.channel_noise);
+    let bare = replay_fast(&Actuator::new(without.clone())?, cx.recording, cx.n)?;
+    *replays += 2;
+    progress("a flexible term in place of the discovered terms");
+    let Some((fit, surface)) = best_surface(cx, &problem, &bare, slot, count, replays, progress)? else {
+        return Ok(false);
+    };
+    let penalised = fit.heldout_total() + terms_used(&fit) * penalty;
+    if penalised >= discovered_penalised {
+        progress(&format!(
+            "  the discovered terms stand: {discovered_penalised:.0} against {penalised:.0} (noise floors squared, with penalties)"
+        ));
+        return Ok(false);
+    }
+    let readable = nearest_readable(f, surface.place);
+    let (term, trial) = flexible_term(cx, &without, &fit, &bare, readable, count)?;
+    progress(&format!(
+        "  the {} replaces {}: {penalised:.0} against {discovered_penalised:.0} (noise floors squared, with penalties)",
+        fit.candidate.label,
+        f.discovered.iter().map(|d| d.candidate).collect::<Vec<_>>().join(" and ")
+    ));
+    f.discovered = vec![term];
+    f.newest = Some((false, 0));
+    f.params = trial;
+    f.joint_refit = None;
+    f.stages.push(Stage::of(f));
+    Ok(true)
 }
 
 /// The best readable candidate of the last localization, at `place` or anywhere, with its
