@@ -815,9 +815,15 @@ mod tests {
                     && ["_first = ", "_second = "].iter().any(|field| message.contains(field))
                     && message.contains("is invalid: must be a whole number"))
                 || (message.starts_with("flexible_")
-                    && ["_parameter = ", "_signal_1 = ", "_signal_2 = ", "_knots_1 = ", "_knots_2 = "]
-                        .iter()
-                        .any(|field| message.contains(field))
+                    && [
+                        "_parameter = ",
+                        "_signal_1 = ",
+                        "_signal_2 = ",
+                        "_knots_1 = ",
+                        "_knots_2 = ",
+                    ]
+                    .iter()
+                    .any(|field| message.contains(field))
                     && message.contains("is invalid: must be"))
                 || (message.starts_with("extra_flow_")
                     && ["_chamber = ", "_signal = "]

@@ -71,7 +71,8 @@ fn library() -> Vec<[u64; 4]> {
         p.set(r, x).unwrap();
     }
     let (v0, x0) = inputs(0);
-    let mut sim = Simulation::at_equilibrium(Actuator::new(p).unwrap(), v0, x0, 0.0, DEFAULT_RELATIVE_TOLERANCE).unwrap();
+    let mut sim =
+        Simulation::at_equilibrium(Actuator::new(p).unwrap(), v0, x0, 0.0, DEFAULT_RELATIVE_TOLERANCE).unwrap();
     (0..SAMPLES)
         .map(|k| {
             let (v, x) = inputs(k);

@@ -59,11 +59,11 @@ use jetpipe_model::physics::chambers::pressure_after_volume_jump;
 use jetpipe_model::physics::current_driver;
 use jetpipe_model::physics::effects::PLAY_OPERATORS;
 use jetpipe_model::physics::jet_pipe;
-use jetpipe_model::physics::{flexible, modulation};
 use jetpipe_model::physics::parameters::{table_start, variable_name, Parameters};
 use jetpipe_model::physics::restrictions::{node, PRESSURES_WITH_VOLUMES};
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 use jetpipe_model::physics::time_varying;
+use jetpipe_model::physics::{flexible, modulation};
 use jetpipe_model::simulation::Simulation;
 
 mod filters;

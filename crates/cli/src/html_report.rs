@@ -260,7 +260,9 @@ fn slot_unit(name: &str, parameters: &serde_json::Map<String, Value>) -> Option<
 
 /// What a modulation or flexible slot's code names: its signal, or the constant it modulates.
 fn slot_code_name(name: &str, value: f64) -> Option<&'static str> {
-    let rest = name.strip_prefix("modulation_").or_else(|| name.strip_prefix("flexible_"))?;
+    let rest = name
+        .strip_prefix("modulation_")
+        .or_else(|| name.strip_prefix("flexible_"))?;
     let (_, setting) = rest.split_once('_')?;
     match setting {
         "signal" | "signal_1" | "signal_2" => ModulationSignal::from_code(value).map(ModulationSignal::name),

@@ -726,7 +726,13 @@ const SHAPE_COLOURS: [RGBColor; 5] = [
 fn flexible_shapes(diagnosis: &Diagnosis) -> Result<Vec<Figure>, String> {
     use jetpipe_diagnosis::candidates::flexible;
     let mut figures = vec![];
-    for (k, term) in diagnosis.discovered.iter().filter(|d| d.flexible.is_some()).take(2).enumerate() {
+    for (k, term) in diagnosis
+        .discovered
+        .iter()
+        .filter(|d| d.flexible.is_some())
+        .take(2)
+        .enumerate()
+    {
         let Some(shape) = flexible::shape(&term.parameters) else {
             continue;
         };
@@ -736,7 +742,9 @@ fn flexible_shapes(diagnosis: &Diagnosis) -> Result<Vec<Figure>, String> {
         };
         let knots = |axis: usize| -> Vec<f64> {
             let n = value(format!("flexible_{slot}_knots_{axis}")).unwrap_or(0.0) as usize;
-            (1..=n).filter_map(|j| value(format!("flexible_{slot}_x{axis}_{j}"))).collect()
+            (1..=n)
+                .filter_map(|j| value(format!("flexible_{slot}_x{axis}_{j}")))
+                .collect()
         };
         let (first, second) = (knots(1), knots(2));
         let Some((axis, _)) = shape.axes.first() else {
@@ -770,7 +778,9 @@ fn flexible_shapes(diagnosis: &Diagnosis) -> Result<Vec<Figure>, String> {
         let caption = format!("flexible term {}: added to {}", k + 1, shape.constant);
         let x_desc = format!("{} ({x_label})", axis.name());
         let y_desc = format!("added to {} ({})", shape.constant, shape.unit);
-        let svg = svg(420, &refs, 1, |areas| panel(&areas[0], &caption, &x_desc, &y_desc, &refs))?;
+        let svg = svg(420, &refs, 1, |areas| {
+            panel(&areas[0], &caption, &x_desc, &y_desc, &refs)
+        })?;
         figures.push(Figure {
             name: if k == 0 { "flexible_term_1" } else { "flexible_term_2" },
             title: format!("The shape of flexible term {}", k + 1),

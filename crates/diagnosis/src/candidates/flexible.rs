@@ -68,19 +68,14 @@ pub const TARGETS: [(Place, &str); 11] = [
 
 /// The signals a flexible term may follow: every signal of the chain the slots read but the
 /// sinusoids (a line is the modulation class's).
-pub const SIGNALS: [ModulationSignal; 11] = [
-    ModulationSignal::Time,
-    ModulationSignal::Command,
-    ModulationSignal::Current,
-    ModulationSignal::JetPosition,
-    ModulationSignal::StopperPosition,
-    ModulationSignal::StopperVelocity,
-    ModulationSignal::StopperVelocitySign,
-    ModulationSignal::Force,
-    ModulationSignal::P1,
-    ModulationSignal::P2,
-    ModulationSignal::PressureDifference,
-];
+pub fn signals() -> impl Iterator<Item = ModulationSignal> {
+    ModulationSignal::ALL.into_iter().filter(|s| {
+        !matches!(
+            s,
+            ModulationSignal::None | ModulationSignal::Sine | ModulationSignal::Cosine
+        )
+    })
+}
 
 /// One axis of a surface: a signal, read through a low-pass of `lag` seconds (0: directly).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -280,7 +275,7 @@ pub fn screen_surface(
 
 /// Every surface worth fitting through the model, best first: for each place's constant, its
 /// surfaces of one signal (every signal at every lag of [`LAGS`]) and of two (pairs of the
-/// best [`PAIRED_FROM`] signals of one), each kept where it beats a constant shift of the
+/// best `PAIRED_FROM` (4) signals of one), each kept where it beats a constant shift of the
 /// constant by its penalty; at most `most`, one per constant. `sensitivities` are the
 /// constants' (one replay each, made by the caller), `penalty` what each coefficient must
 /// earn, in noise floors squared.
@@ -294,9 +289,8 @@ pub fn screen(
 ) -> Vec<Surface> {
     let residual = crate::fit::screen::residuals(problem, replay);
     let time = &problem.recording.time;
-    let axes: Vec<Axis> = SIGNALS
-        .iter()
-        .flat_map(|&signal| LAGS.iter().map(move |&lag| Axis { signal, lag }))
+    let axes: Vec<Axis> = signals()
+        .flat_map(|signal| LAGS.iter().map(move |&lag| Axis { signal, lag }))
         .filter(|a| a.lag == 0.0 || a.signal != ModulationSignal::Time)
         .collect();
     let values_of = |axis: &Axis| {
@@ -315,7 +309,13 @@ pub fn screen(
         sensitivities
             .iter()
             .map(|(place, constant, sensitivity)| {
-                let (y, ss) = screen_surface(problem, &residual, sensitivity, &[&values], std::slice::from_ref(&knots))?;
+                let (y, ss) = screen_surface(
+                    problem,
+                    &residual,
+                    sensitivity,
+                    &[&values],
+                    std::slice::from_ref(&knots),
+                )?;
                 let (_, shift_ss) = screen_surface(problem, &residual, sensitivity, &[&values], &[vec![0.0]])
                     .unwrap_or((vec![], f64::INFINITY));
                 let penalised = ss + penalty * knots.len() as f64;
@@ -350,7 +350,7 @@ pub fn screen(
         // one piece of information (the command, the current and the jet's position), and the
         // second factor is then none of them.
         if let Some(&first) = best.first() {
-            for &signal in SIGNALS.iter().filter(|&&s| !best.iter().any(|a| a.signal == s)) {
+            for signal in signals().filter(|&s| !best.iter().any(|a| a.signal == s)) {
                 pairs.push((c, first, Axis { signal, lag: 0.0 }));
             }
         }
@@ -458,9 +458,15 @@ pub fn candidate(s: &Surface, slot: usize, params: &Parameters, catalogue: &[Can
         (slot_parameter(slot, "frequency"), 0.0),
     ];
     for (a, axis) in s.axes.iter().enumerate() {
-        settings.push((slot_parameter(slot, &format!("signal_{}", a + 1)), f64::from(axis.signal.code())));
+        settings.push((
+            slot_parameter(slot, &format!("signal_{}", a + 1)),
+            f64::from(axis.signal.code()),
+        ));
         settings.push((slot_parameter(slot, &format!("lag_{}", a + 1)), axis.lag));
-        settings.push((slot_parameter(slot, &format!("knots_{}", a + 1)), s.knots[a].len() as f64));
+        settings.push((
+            slot_parameter(slot, &format!("knots_{}", a + 1)),
+            s.knots[a].len() as f64,
+        ));
         for (j, &x) in s.knots[a].iter().enumerate() {
             settings.push((slot_parameter(slot, &format!("x{}_{}", a + 1, j + 1)), x));
         }
@@ -545,8 +551,16 @@ pub fn shape(set: &[(&'static str, f64)]) -> Option<Shape> {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
         hi - lo
     };
-    let along_1 = range((0..n1).map(|i| (0..n2).map(|j| y(i, j)).sum::<f64>() / n2 as f64).collect());
-    let along_2 = range((0..n2).map(|j| (0..n1).map(|i| y(i, j)).sum::<f64>() / n1 as f64).collect());
+    let along_1 = range(
+        (0..n1)
+            .map(|i| (0..n2).map(|j| y(i, j)).sum::<f64>() / n2 as f64)
+            .collect(),
+    );
+    let along_2 = range(
+        (0..n2)
+            .map(|j| (0..n1).map(|i| y(i, j)).sum::<f64>() / n1 as f64)
+            .collect(),
+    );
     let largest = (0..n1)
         .flat_map(|i| (0..n2).map(move |j| (i, j)))
         .map(|(i, j)| y(i, j))
@@ -612,7 +626,13 @@ mod tests {
         // A product of the two, which no function of one alone holds.
         let truth: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.5 * x * y).collect();
         let blocks: Vec<Block> = (0..n)
-            .map(|k| if (k / 2000) % 2 == 0 { Block::Training } else { Block::HeldOut })
+            .map(|k| {
+                if (k / 2000) % 2 == 0 {
+                    Block::Training
+                } else {
+                    Block::HeldOut
+                }
+            })
             .collect();
         let recording = crate::input::recording::Recording {
             time: time.clone(),
@@ -641,12 +661,20 @@ mod tests {
             .filter(|(_, b)| **b == Block::HeldOut)
             .map(|(r, _)| r * r)
             .sum();
-        let (_, alone) =
-            screen_surface(&problem, &residual, &sensitivity, &[&a], &[quantile_knots(&a, &blocks, KNOTS_ALONE).unwrap()])
-                .unwrap();
-        let (values, paired) = screen_surface(&problem, &residual, &sensitivity, &[&a, &b], &[ka.clone(), kb.clone()])
-            .unwrap();
-        assert!(alone > 0.8 * heldout_ss, "one signal alone left {alone} of {heldout_ss}");
+        let (_, alone) = screen_surface(
+            &problem,
+            &residual,
+            &sensitivity,
+            &[&a],
+            &[quantile_knots(&a, &blocks, KNOTS_ALONE).unwrap()],
+        )
+        .unwrap();
+        let (values, paired) =
+            screen_surface(&problem, &residual, &sensitivity, &[&a, &b], &[ka.clone(), kb.clone()]).unwrap();
+        assert!(
+            alone > 0.8 * heldout_ss,
+            "one signal alone left {alone} of {heldout_ss}"
+        );
         assert!(paired < 0.05 * heldout_ss, "the surface left {paired} of {heldout_ss}");
         // At the grid's corners the surface is the product's sign.
         let corner = |i: usize, j: usize| values[i * kb.len() + j];
@@ -658,10 +686,16 @@ mod tests {
     fn a_flexible_term_reads_its_constant_its_signals_with_their_lags_and_its_size() {
         let set = vec![
             (slot_parameter(1, "parameter"), value_reference("extra_force_offset")),
-            (slot_parameter(1, "signal_1"), f64::from(ModulationSignal::Command.code())),
+            (
+                slot_parameter(1, "signal_1"),
+                f64::from(ModulationSignal::Command.code()),
+            ),
             (slot_parameter(1, "lag_1"), 0.3),
             (slot_parameter(1, "knots_1"), 2.0),
-            (slot_parameter(1, "signal_2"), f64::from(ModulationSignal::StopperPosition.code())),
+            (
+                slot_parameter(1, "signal_2"),
+                f64::from(ModulationSignal::StopperPosition.code()),
+            ),
             (slot_parameter(1, "lag_2"), 0.0),
             (slot_parameter(1, "knots_2"), 2.0),
             (slot_parameter(1, "y_1_1"), 0.0),
@@ -672,10 +706,16 @@ mod tests {
         let s = shape(&set).unwrap();
         assert_eq!(s.constant, "extra_force_offset");
         assert_eq!(s.unit, "N");
-        assert!((s.axes[0].1 - 0.4).abs() < 1e-12 && (s.axes[1].1 - 0.1).abs() < 1e-12, "{s:?}");
+        assert!(
+            (s.axes[0].1 - 0.4).abs() < 1e-12 && (s.axes[1].1 - 0.1).abs() < 1e-12,
+            "{s:?}"
+        );
         assert_eq!(s.largest, 0.5);
         let text = reading(&set).unwrap();
-        assert!(text.contains("v_DA low-passed over 0.300 s") && text.contains("x_s"), "{text}");
+        assert!(
+            text.contains("v_DA low-passed over 0.300 s") && text.contains("x_s"),
+            "{text}"
+        );
         assert_eq!(family(Place::Mechanics, &[s.axes[0].0]), Family::Dynamics);
         assert_eq!(family(Place::Mechanics, &[s.axes[1].0]), Family::ExtraForce);
         assert_eq!(family(Place::ForceSensor, &[s.axes[1].0]), Family::Nonlinearity);

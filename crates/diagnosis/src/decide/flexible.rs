@@ -17,8 +17,8 @@ use crate::replay::replay_fast;
 use crate::replay::signals::{difference, rms_where, CHANNELS, FORCE, P1, P2};
 use crate::replay::Replay;
 use crate::vocabulary::Place;
-use jetpipe_model::physics::parameters::Parameters;
 use jetpipe_model::physics::actuator::Actuator;
+use jetpipe_model::physics::parameters::Parameters;
 
 /// The held-out misfit of each measured channel, in noise floors (RMS over the held-out
 /// samples), of a prediction.
@@ -46,7 +46,9 @@ pub(crate) fn close_with_flexible(
         let current = replay_fast(&Actuator::new(f.params.clone())?, cx.recording, cx.n)?;
         *replays += 1;
         let prediction = [current.force.clone(), current.p1.clone(), current.p2.clone()];
-        misfits(&problem, &prediction, count).iter().any(|m| *m > EXPLAINED_WITHIN_NOISE)
+        misfits(&problem, &prediction, count)
+            .iter()
+            .any(|m| *m > EXPLAINED_WITHIN_NOISE)
     };
     // Once a flexible term replaced the discovered terms, the last localization's readable
     // candidates were fitted to another model: their misfits no longer compare.
@@ -115,11 +117,20 @@ fn flexible_term(
         set_parameter(&mut trial, name, value)?;
     }
     trial.validate()?;
-    let force_before = rms_where(&difference(&cx.recording.force, &current.force), &cx.blocks, Block::HeldOut);
-    let force_after = rms_where(&difference(&cx.recording.force, &fit.prediction[FORCE]), &cx.blocks, Block::HeldOut);
+    let force_before = rms_where(
+        &difference(&cx.recording.force, &current.force),
+        &cx.blocks,
+        Block::HeldOut,
+    );
+    let force_after = rms_where(
+        &difference(&cx.recording.force, &fit.prediction[FORCE]),
+        &cx.blocks,
+        Block::HeldOut,
+    );
     let mut term = DiscoveredTerm::fitted(&fit.candidate, set, base, force_before, force_after);
     if let (Some(p1), Some(p2)) = (&cx.recording.p1, &cx.recording.p2) {
-        let rms = |measured: &[f64], modelled: &[f64]| rms_where(&difference(measured, modelled), &cx.blocks, Block::HeldOut);
+        let rms =
+            |measured: &[f64], modelled: &[f64]| rms_where(&difference(measured, modelled), &cx.blocks, Block::HeldOut);
         term.pressures_heldout = Some((
             [rms(p1, &current.p1), rms(p2, &current.p2)],
             [rms(p1, &fit.prediction[P1]), rms(p2, &fit.prediction[P2])],
@@ -155,7 +166,10 @@ fn in_place_of_discovered(
         return Ok(false);
     };
     let penalty = discovery_penalty_per_term(count);
-    let amounts = added.iter().filter(|(name, _)| crate::fit::refit::refittable(name)).count() as f64;
+    let amounts = added
+        .iter()
+        .filter(|(name, _)| crate::fit::refit::refittable(name))
+        .count() as f64;
     let now = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
     let current = replay_fast(&Actuator::new(f.params.clone())?, cx.recording, cx.n)?;
     let (_, heldout) = now.errors(&[current.force.clone(), current.p1.clone(), current.p2.clone()]);
@@ -179,7 +193,11 @@ fn in_place_of_discovered(
     progress(&format!(
         "  the {} replaces {}: {penalised:.0} against {discovered_penalised:.0} (noise floors squared, with penalties)",
         fit.candidate.label,
-        f.discovered.iter().map(|d| d.candidate).collect::<Vec<_>>().join(" and ")
+        f.discovered
+            .iter()
+            .map(|d| d.candidate)
+            .collect::<Vec<_>>()
+            .join(" and ")
     ));
     f.discovered = vec![term];
     f.newest = Some((false, 0));
@@ -193,11 +211,9 @@ fn in_place_of_discovered(
 /// held-out misfit (noise floors squared, summed over the samples and channels).
 fn nearest_readable(f: &Findings, place: Place) -> Option<(&'static str, f64)> {
     let l = f.localization.as_ref()?;
-    let best = l.best_at(place).or_else(|| {
-        l.candidates
-            .iter()
-            .max_by(|a, b| a.explained.total_cmp(&b.explained))
-    })?;
+    let best = l
+        .best_at(place)
+        .or_else(|| l.candidates.iter().max_by(|a, b| a.explained.total_cmp(&b.explained)))?;
     Some((best.fit.candidate.label, best.fit.heldout_total()))
 }
 

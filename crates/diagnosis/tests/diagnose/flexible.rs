@@ -16,7 +16,8 @@ use synthetic_bench::BenchEffects;
 fn lagged_command_times_position() -> Vec<[f64; 6]> {
     use std::f64::consts::PI;
     let command = |t: f64| {
-        1.0 + 2.0 * (2.0 * PI * 0.23 * t).sin() + 1.2 * (2.0 * PI * 0.91 * t + 1.0).sin()
+        1.0 + 2.0 * (2.0 * PI * 0.23 * t).sin()
+            + 1.2 * (2.0 * PI * 0.91 * t + 1.0).sin()
             + 0.8 * (2.0 * PI * 2.9 * t + 2.0).sin()
     };
     let home = synthetic_bench::STOPPER_HOME;
@@ -66,10 +67,17 @@ fn a_force_of_a_lagged_command_times_the_position_is_closed_by_a_flexible_term_t
         d.after.heldout_rms,
         d.noise_floor,
         names(&d),
-        d.discovered.iter().map(|t| (t.candidate, t.location, t.family)).collect::<Vec<_>>()
+        d.discovered
+            .iter()
+            .map(|t| (t.candidate, t.location, t.family))
+            .collect::<Vec<_>>()
     );
     let flexible: Vec<_> = d.discovered.iter().filter(|t| t.flexible.is_some()).collect();
-    assert!(!flexible.is_empty(), "no flexible term: {:?}", d.discovered.iter().map(|t| &t.reading).collect::<Vec<_>>());
+    assert!(
+        !flexible.is_empty(),
+        "no flexible term: {:?}",
+        d.discovered.iter().map(|t| &t.reading).collect::<Vec<_>>()
+    );
     let term = flexible[0];
     let shape = jetpipe_diagnosis::candidates::flexible::shape(&term.parameters).unwrap();
     let signals: Vec<_> = shape.axes.iter().map(|(a, _)| a.signal.name()).collect();
@@ -80,8 +88,16 @@ fn a_force_of_a_lagged_command_times_the_position_is_closed_by_a_flexible_term_t
     assert!(term.reading.contains("flexible term"), "{}", term.reading);
     // The report says what it stands against.
     let json = d.to_json("flexible");
-    let reported = &json["discovered"].as_array().unwrap().iter().find(|t| t["flexible"] == true).unwrap()["flexible_shape"];
-    assert!(reported["depends_on"].as_array().is_some_and(|a| !a.is_empty()), "{reported}");
+    let reported = &json["discovered"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["flexible"] == true)
+        .unwrap()["flexible_shape"];
+    assert!(
+        reported["depends_on"].as_array().is_some_and(|a| !a.is_empty()),
+        "{reported}"
+    );
     // The departure is 0.6 N at most, some 0.3 N RMS: the model must close it to the bar.
     assert!(
         d.after.heldout_rms <= 1.5 * d.noise_floor,

@@ -198,7 +198,11 @@ impl FlexibleSlot {
 
     /// The increment at `signals` for slot `k` (0-based).
     pub fn increment_at(&self, k: usize, signals: &Signals) -> f64 {
-        let u2 = if self.grid().1 > 1 { self.input(k, 1, signals) } else { 0.0 };
+        let u2 = if self.grid().1 > 1 {
+            self.input(k, 1, signals)
+        } else {
+            0.0
+        };
         self.increment(self.input(k, 0, signals), u2)
     }
 
@@ -261,13 +265,7 @@ pub fn initial_lags(p: &Parameters, signals: &Signals) -> [[f64; 2]; FLEXIBLE_SL
 /// The lag states after a completed step of `step` seconds between the raw signals `start`
 /// and `end`: u ← u + (1 − e^(−h/τ)) ((s_start + s_end)/2 − u) on each axis that lags (see
 /// the module's comment); the others keep their values.
-pub fn advance_lags(
-    p: &Parameters,
-    lags: &mut [[f64; 2]; FLEXIBLE_SLOTS],
-    step: f64,
-    start: &Signals,
-    end: &Signals,
-) {
+pub fn advance_lags(p: &Parameters, lags: &mut [[f64; 2]; FLEXIBLE_SLOTS], step: f64, start: &Signals, end: &Signals) {
     for (slot, u) in p.flexible.iter().zip(lags.iter_mut()) {
         if !slot.is_on() {
             continue;

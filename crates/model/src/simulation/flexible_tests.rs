@@ -85,7 +85,10 @@ fn extra_force_offset_gives_the_outputs_of_a_product_slot_of_codes_0_by_0() {
             moved_by_c += usize::from((shift - c).abs() < 1e-9);
             assert_eq!(r[2], t[2]);
         }
-        assert!(moved_by_c > 150, "c = {c} N: the force moved by c at {moved_by_c} samples");
+        assert!(
+            moved_by_c > 150,
+            "c = {c} N: the force moved by c at {moved_by_c} samples"
+        );
     }
 }
 
@@ -108,7 +111,10 @@ fn extra_inflow_gives_the_outputs_of_an_extra_flow_slot_of_code_0_in_its_chamber
         let gap = relative_gap(&a, &b);
         assert!(gap <= 1e-12, "chamber {chamber}, {c} kg/s: {gap}");
         let thesis = recording(&Parameters::default(), 300);
-        assert!(relative_gap(&a, &thesis) > 1e-4, "chamber {chamber}: the inflow changes nothing");
+        assert!(
+            relative_gap(&a, &thesis) > 1e-4,
+            "chamber {chamber}: the inflow changes nothing"
+        );
         // The rates, with the outflow's fade near vacuum, to the last bit.
         let (with_constant, with_slot) = (Actuator::new(constant).unwrap(), Actuator::new(slot).unwrap());
         for (p1, p2) in [(4e5, 3e5), (0.4 * FADE_PRESSURE, 0.3 * FADE_PRESSURE), (-1.0, 2e5)] {
@@ -141,9 +147,19 @@ fn replay(p: &Parameters, samples: usize) -> Vec<[f64; 8]> {
 fn a_flexible_slot_of_one_signal_without_lag_gives_the_outputs_of_a_modulation_slot_through_the_same_knots() {
     let cases = [
         // A flow constant on the stopper position.
-        (vr::C_D, ModulationSignal::StopperPosition, vec![0.05, 0.054, 0.058], vec![-0.05, 0.02, 0.06]),
+        (
+            vr::C_D,
+            ModulationSignal::StopperPosition,
+            vec![0.05, 0.054, 0.058],
+            vec![-0.05, 0.02, 0.06],
+        ),
         // A transducer offset on the command, past the end knots at both ends of the run.
-        (vr::P1_SENSOR_OFFSET, ModulationSignal::Command, vec![-1.0, 1.5, 3.0, 4.0], vec![-2e3, 5e3, 1e3, 8e3]),
+        (
+            vr::P1_SENSOR_OFFSET,
+            ModulationSignal::Command,
+            vec![-1.0, 1.5, 3.0, 4.0],
+            vec![-2e3, 5e3, 1e3, 8e3],
+        ),
     ];
     let thesis = recording(&Parameters::default(), 300);
     for (constant, signal, x, y) in cases {
@@ -214,7 +230,12 @@ fn a_lagged_slot_on_extra_force_offset_adds_the_analytic_lag_response_to_the_com
     // The increment c' u of the command's low-pass u (τ = 20 ms), c' = 0.4 N/V: the force the
     // slot adds is F_act less the thesis model's, since the offset moves no pressure.
     let (tau, gain, h) = (0.02, 0.4, 1e-3);
-    let mut slot = FlexibleSlot::through(vr::EXTRA_FORCE_OFFSET, ModulationSignal::Command, &[-10.0, 10.0], &[-4.0, 4.0]);
+    let mut slot = FlexibleSlot::through(
+        vr::EXTRA_FORCE_OFFSET,
+        ModulationSignal::Command,
+        &[-10.0, 10.0],
+        &[-4.0, 4.0],
+    );
     slot.lags[0] = tau;
     let mut p = Parameters::default();
     p.flexible[0] = slot;
@@ -227,7 +248,10 @@ fn a_lagged_slot_on_extra_force_offset_adds_the_analytic_lag_response_to_the_com
         let c = gain * 3.5;
         let expected = gain * 1.0 + c * (1.0 - (-t / tau).exp());
         let added = with[k] - thesis_step[k];
-        assert!((added - expected).abs() < 1e-12, "t = {t} s: {added} N against {expected} N");
+        assert!(
+            (added - expected).abs() < 1e-12,
+            "t = {t} s: {added} N against {expected} N"
+        );
     }
     // A ramp of r = 40 V/s from 1 V: u lags it by the exact response's r (t − τ(1 − e^(−t/τ)))
     // to within r h²/(12 τ) (the trapezoid of each step's ends: see physics::flexible's tests).
@@ -309,4 +333,3 @@ fn a_snapshot_mid_run_continues_bit_for_bit_with_a_lagged_slot_and_carries_its_l
     assert_eq!(original.snapshot(), decoded.snapshot());
     assert!(differs, "the lag state changed nothing");
 }
-

@@ -17,10 +17,10 @@ mod chambers;
 mod commands;
 #[cfg(test)]
 mod effect_tests;
-#[cfg(test)]
-mod flexible_tests;
 mod equilibrium;
 mod fixed_step;
+#[cfg(test)]
+mod flexible_tests;
 mod modulated;
 mod monolithic;
 mod snapshot;

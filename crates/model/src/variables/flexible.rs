@@ -37,7 +37,8 @@ const OFFSET: &str = "extra force on the piston: a constant force added to the f
 const INFLOW_1: &str = "extra mass flow into chamber 1 alone, at the chamber's gas temperature (negative: out of it, fading below 0.1 bar absolute in the chamber, as the extra flow slots' outflows; 0 = off)";
 const INFLOW_2: &str = "extra mass flow into chamber 2 alone, at the chamber's gas temperature (negative: out of it, fading below 0.1 bar absolute in the chamber, as the extra flow slots' outflows; 0 = off)";
 const FORCE: &str = "1000 N: nine times the largest force the actuator gives (109 N)";
-const FLOW: &str = "1e-2 kg/s: ten times the jet pipe's whole flow of about 1e-3 kg/s; a constant flow that large is no leak";
+const FLOW: &str =
+    "1e-2 kg/s: ten times the jet pipe's whole flow of about 1e-3 kg/s; a constant flow that large is no leak";
 
 /// The three constants' rows.
 pub(super) const CONSTANTS: [Row; 3] = [
@@ -60,8 +61,10 @@ pub(super) const CONSTANTS: [Row; 3] = [
 
 const PARAMETER: &str = "flexible slot: the value reference of the constant it varies (0 = off): one of the constants a modulation slot may modulate (see modulation_1_parameter) or extra_force_offset 780, extra_inflow_1 781, extra_inflow_2 782; the constant is its start value plus the slot's increment at the signals, held over each step at the step's start";
 const SIGNAL_1: &str = "flexible slot: the code of signal 1, as modulation_1_signal's: 0 none (reads 0), 1 time t (s), 2 the command v_DA (V), 3 the coil current i (A), 4 the jet pipe position x_jp (m), 5 the stopper position x_s (m), 6 the stopper velocity (m/s), 7 its sign tanh(v / 1 mm/s) (1), 8 the force F_act (N), 9 P1 (Pa), 10 P2 (Pa), 11 P1 - P2 (Pa), 12 sin(2 pi f t) (1), 13 cos(2 pi f t) (1)";
-const SIGNAL_2: &str = "flexible slot: the code of signal 2, as signal 1's (0 none: the increment is a function of signal 1 alone)";
-const FREQUENCY: &str = "flexible slot: the frequency f of the signals sin(2 pi f t) and cos(2 pi f t) (codes 12 and 13)";
+const SIGNAL_2: &str =
+    "flexible slot: the code of signal 2, as signal 1's (0 none: the increment is a function of signal 1 alone)";
+const FREQUENCY: &str =
+    "flexible slot: the frequency f of the signals sin(2 pi f t) and cos(2 pi f t) (codes 12 and 13)";
 const LAG_1: &str = "flexible slot: the time constant of a first-order low-pass on signal 1, advanced after each step by the exact response to the signal's mean over the step (0 = the signal itself)";
 const LAG_2: &str = "flexible slot: the time constant of a first-order low-pass on signal 2 (0 = the signal itself)";
 const KNOTS_1: &str = "flexible slot: the number of knots in use on axis 1 (0 = off; 1 = constant along it; else piecewise linear between the knots, held beyond the first and the last)";

@@ -64,7 +64,10 @@ fn a_grid_interpolates_a_product_exactly_within_its_cells_and_holds_its_edges_be
     );
     for (u1, u2) in [(-1.3, 0.25), (0.0, 2.5), (2.9, 3.99), (-2.0, 4.0), (1.0, 1.0)] {
         let inc = slot.increment(u1, u2);
-        assert!((inc - u1 * u2).abs() < 1e-14 * (1.0 + (u1 * u2).abs()), "({u1}, {u2}): {inc}");
+        assert!(
+            (inc - u1 * u2).abs() < 1e-14 * (1.0 + (u1 * u2).abs()),
+            "({u1}, {u2}): {inc}"
+        );
     }
     // Beyond the end knots: held at the edge (u clamped to the grid).
     assert_eq!(slot.increment(10.0, 2.0), slot.increment(3.0, 2.0));
@@ -113,7 +116,11 @@ fn the_lag_of_a_held_signal_is_the_exact_first_order_response_and_of_a_ramp_with
     for k in 1..=100 {
         advance_lags(&p, &mut lags, h, &at(4.0), &at(4.0));
         let exact = 4.0 - 3.0 * (-(k as f64) * h / tau).exp();
-        assert!((lags[0][0] - exact).abs() < 1e-13, "step {k}: {} against {exact}", lags[0][0]);
+        assert!(
+            (lags[0][0] - exact).abs() < 1e-13,
+            "step {k}: {} against {exact}",
+            lags[0][0]
+        );
     }
     // A ramp s = r t from rest: the exact response is r (t − τ (1 − e^(−t/τ))); the trapezoid
     // of each step's ends is off by r h³/(12 τ²) per step to leading order, which the lag's
@@ -129,7 +136,10 @@ fn the_lag_of_a_held_signal_is_the_exact_first_order_response_and_of_a_ramp_with
         worst = worst.max((lags[0][0] - exact).abs());
     }
     assert!(worst <= 1.01 * bound, "{worst} against the bound {bound}");
-    assert!(worst >= 0.9 * bound, "{worst}: the bound {bound} is not the discretisation's");
+    assert!(
+        worst >= 0.9 * bound,
+        "{worst}: the bound {bound} is not the discretisation's"
+    );
     // An axis without lag, a slot that is off: nothing to follow.
     let mut unlagged = p.clone();
     unlagged.flexible[0].lags[0] = 0.0;
@@ -247,7 +257,10 @@ fn validation_refuses_bad_codes_targets_knots_and_grid_values_naming_variable_va
 
     let mut s = good;
     s.signals[0] = 2.5;
-    refused(s, &["flexible_1_signal_1 = 2.5 is invalid", "whole number from 0 to 13"]);
+    refused(
+        s,
+        &["flexible_1_signal_1 = 2.5 is invalid", "whole number from 0 to 13"],
+    );
     let mut s = good;
     s.knots[1] = 1.5;
     refused(s, &["flexible_1_knots_2 = 1.5 is invalid", "whole number from 0 to 5"]);
@@ -266,10 +279,16 @@ fn validation_refuses_bad_codes_targets_knots_and_grid_values_naming_variable_va
     refused(s, &["flexible_1_parameter = 131.5 is invalid"]);
     let mut s = good;
     s.x[1][2] = 1.0;
-    refused(s, &["flexible_1_x2_3 = 1 V is invalid: must exceed flexible_1_x2_2 = 2 V"]);
+    refused(
+        s,
+        &["flexible_1_x2_3 = 1 V is invalid: must exceed flexible_1_x2_2 = 2 V"],
+    );
     let mut s = good;
     s.x[0][1] = 0.05;
-    refused(s, &["flexible_1_x1_2 = 0.05 m is invalid: must exceed flexible_1_x1_1 = 0.05 m"]);
+    refused(
+        s,
+        &["flexible_1_x1_2 = 0.05 m is invalid: must exceed flexible_1_x1_1 = 0.05 m"],
+    );
     // C_d = 0.696 plus 0.4 at node (2, 3) leaves (0, 1].
     let mut s = good;
     s.y[1][2] = 0.4;
@@ -288,7 +307,13 @@ fn validation_refuses_bad_codes_targets_knots_and_grid_values_naming_variable_va
         (ModulationSignal::None, &[]),
         |i, _| if i == 1 { 6e5 } else { 0.0 },
     );
-    refused(p_r, &["flexible_1_y_2_1 = 600000 takes P_r from 101325 to 701325", "must be >= P_r"]);
+    refused(
+        p_r,
+        &[
+            "flexible_1_y_2_1 = 600000 takes P_r from 101325 to 701325",
+            "must be >= P_r",
+        ],
+    );
     // A node's value is checked only where the grid uses it.
     let mut s = good;
     s.y[4][4] = 5.0;
