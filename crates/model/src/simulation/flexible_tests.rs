@@ -333,3 +333,68 @@ fn a_snapshot_mid_run_continues_bit_for_bit_with_a_lagged_slot_and_carries_its_l
     assert_eq!(original.snapshot(), decoded.snapshot());
     assert!(differs, "the lag state changed nothing");
 }
+
+#[test]
+fn a_slot_on_a_lagging_or_filtering_transducers_offset_reads_as_the_same_offset_set_directly() {
+    // Each transducer's memory records the reading once a step, with the slot's increment
+    // set once: a constant increment of the offset gives the readings of that offset.
+    type Case = (u32, fn(&mut Parameters, f64), fn(&mut Parameters), usize);
+    let cases: [Case; 4] = [
+        (
+            vr::P1_SENSOR_OFFSET,
+            |p, c| p.p1_sensor_offset += c,
+            |p| p.p1_sensor_lag = 1e-3,
+            4,
+        ),
+        (
+            vr::P2_SENSOR_OFFSET,
+            |p, c| p.p2_sensor_offset += c,
+            |p| p.p2_sensor_lag = 4e-3,
+            5,
+        ),
+        (
+            vr::FORCE_SENSOR_OFFSET,
+            |p, c| p.force_sensor_offset += c,
+            |p| {
+                p.force_sensor_filter_frequency = 150.0;
+                p.force_sensor_filter_damping = 0.6;
+            },
+            1,
+        ),
+        (
+            vr::P1_SENSOR_OFFSET,
+            |p, c| p.p1_sensor_offset += c,
+            |p| p.p1_sensor_delay = 2.5e-3,
+            4,
+        ),
+    ];
+    for (constant, add, filter, channel) in cases {
+        let increment = if channel == 1 { 0.75 } else { 1000.0 };
+        let mut direct = Parameters::default();
+        filter(&mut direct);
+        let mut slotted = direct.clone();
+        add(&mut direct, increment);
+        slotted.modulation[0] = Slot::through(
+            constant,
+            ModulationSignal::Command,
+            &[-10.0, 10.0],
+            &[increment, increment],
+        );
+        let (a, b) = (recording(&direct, 300), recording(&slotted, 300));
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x[channel] - y[channel]).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-9 * increment, "vr {constant}: {worst}");
+        // The increment acts, once.
+        let mut plain = direct.clone();
+        add(&mut plain, -increment);
+        let settled = recording(&plain, 300);
+        let moved = b[299][channel] - settled[299][channel];
+        assert!(
+            (moved - increment).abs() <= 1e-6 * increment,
+            "vr {constant}: moved by {moved}"
+        );
+    }
+}

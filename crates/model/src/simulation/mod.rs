@@ -168,6 +168,9 @@ pub struct Simulation {
     /// The propagator of the last step whose modulation slots changed the current driver's or
     /// the jet pipe's constants, kept for the next step with the same constants.
     modulated_propagator: Option<modulated::PropagatorOf>,
+    /// Whether the slots' constants are set in `model` for a step: the readings within it
+    /// take them as they are rather than setting them a second time.
+    slots_held: bool,
     /// The flexible slots' low-passed signals at the last sample, per slot and axis
     /// ([`crate::physics::flexible`]; followed only where a slot lags).
     flexible_lags: [[f64; 2]; FLEXIBLE_SLOTS],
@@ -380,6 +383,7 @@ impl Simulation {
             stage_areas: std::cell::RefCell::new(chambers::StageAreas::default()),
             plan,
             modulated_propagator: None,
+            slots_held: false,
             flexible_lags,
         }
     }

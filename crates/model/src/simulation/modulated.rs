@@ -150,12 +150,14 @@ impl Simulation {
             None
         };
         self.chamber_rates_at_end = None;
+        self.slots_held = true;
         Ok(HeldModulation { constants, propagator })
     }
 
     /// Undo [`Self::hold_modulated`].
     pub(super) fn release_modulated(&mut self, held: HeldModulation) {
         modulation::restore(&mut self.model, held.constants);
+        self.slots_held = false;
         if let Some((own, constants)) = held.propagator {
             if let Some(propagator) = std::mem::replace(&mut self.propagator, own) {
                 self.modulated_propagator = Some(PropagatorOf { constants, propagator });
@@ -165,10 +167,10 @@ impl Simulation {
     }
 
     /// The outputs at the last sample (the transducers' static readings), with the slots'
-    /// constants at its signals.
+    /// constants at its signals; within a step, with those the step holds.
     pub(super) fn outputs_at_sample(&self) -> Outputs {
         let (velocity, acceleration) = (self.stopper_velocity_at_sample(), self.acceleration_read());
-        if !self.plan.modulated_outputs {
+        if !self.plan.modulated_outputs || self.slots_held {
             return self
                 .model
                 .outputs_in_motion(&self.state, self.x_s, velocity, acceleration, self.time);

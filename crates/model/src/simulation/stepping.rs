@@ -133,6 +133,11 @@ impl Simulation {
         self.chamber_rates_at_end = None;
         if result.is_ok() {
             self.advance_lags(step, &start);
+            // The readings at the new sample take the slots' constants at its signals, as
+            // the outputs there do; the step, which held those at its start, left them.
+            if self.plan.after_step && self.plan.filtering_transducers {
+                self.record_transducers_at_sample();
+            }
         }
         result
     }
@@ -188,15 +193,21 @@ impl Simulation {
 
     /// After a step of `step` seconds that moved the stopper linearly from
     /// `x_s_at_last_step` to `x_s`: form the stopper acceleration and record the transducers'
-    /// readings, for those of the two the model has.
+    /// readings, for those of the two the model has; with the slots' constants held, the
+    /// readings wait for [`Self::step_modulated`] to release them.
     pub(super) fn record_after_step(&mut self, step: f64) {
         if self.plan.stopper_acceleration {
             self.stopper_acceleration = self.stopper_motion.advance(self.stopper_velocity, step);
         }
-        if self.plan.filtering_transducers {
-            let mut y = self.outputs_at_sample();
-            self.record_transducers(&mut y, true);
+        if self.plan.filtering_transducers && !self.slots_held {
+            self.record_transducers_at_sample();
         }
+    }
+
+    /// Record the transducers' readings at the simulation's time, a communication point.
+    fn record_transducers_at_sample(&mut self) {
+        let mut y = self.outputs_at_sample();
+        self.record_transducers(&mut y, true);
     }
 
     /// [`Self::advance`]; on a failure the input derivatives are dropped.
