@@ -80,6 +80,10 @@ pub const NAMED_SHARE_OF_PLACE: f64 = 0.75;
 /// Bouc–Wen hysteresis lowest; 0.63–0.76 for a supply drift and a port restriction).
 pub const NAMED_MIN_SHARE: f64 = 0.8;
 pub const MAX_EFFECTS: usize = 3;
+
+/// How many additions, the earliest first, are revisited once the rounds leave a channel
+/// above its bar (`decide/revisit.rs`): each revisit costs a round.
+pub const REVISITED: usize = 2;
 /// How many of the located place's candidates are tried in the model, best first.
 pub const DISCOVERY_TRIALS: usize = 3;
 /// Candidates refitted with more Gauss–Newton iterations after the first pass.

@@ -21,9 +21,9 @@ use crate::policy::REDUNDANT_WITHIN_NOISE;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// One addition of the findings: a named effect (`true`) or a discovered term, by index.
-type Which = (bool, usize);
+pub(crate) type Which = (bool, usize);
 
-fn additions(f: &Findings) -> Vec<Which> {
+pub(crate) fn additions(f: &Findings) -> Vec<Which> {
     (0..f.effects.len())
         .map(|k| (true, k))
         .chain((0..f.discovered.len()).map(|k| (false, k)))
@@ -37,7 +37,7 @@ fn parameters_of(f: &Findings, which: Which) -> &[(&'static str, f64)] {
     }
 }
 
-fn label_of(f: &Findings, which: Which) -> &'static str {
+pub(crate) fn label_of(f: &Findings, which: Which) -> &'static str {
     match which {
         (true, k) => f.effects[k].name,
         (false, k) => f.discovered[k].candidate,
@@ -46,7 +46,7 @@ fn label_of(f: &Findings, which: Which) -> &'static str {
 
 /// The findings' model without one addition: its parameters that no other addition sets go
 /// back to their values before the rounds. `None` when that model is not valid.
-fn without(f: &Findings, which: Which) -> Option<(Parameters, usize)> {
+pub(crate) fn without(f: &Findings, which: Which) -> Option<(Parameters, usize)> {
     let others: Vec<&'static str> = additions(f)
         .into_iter()
         .filter(|w| *w != which)

@@ -20,6 +20,7 @@ use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
 /// What the rounds found: the model's parameters with every effect and term added.
+#[derive(Clone)]
 pub(crate) struct Findings {
     pub params: Parameters,
     pub effects: Vec<AddedEffect>,

@@ -16,5 +16,6 @@ pub(crate) mod named_places;
 pub(crate) mod named_rivals;
 pub(crate) mod new_term;
 pub(crate) mod pairs;
+pub(crate) mod revisit;
 pub(crate) mod rounds;
 pub(crate) mod withdraw;

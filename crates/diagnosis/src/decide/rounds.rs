@@ -69,192 +69,12 @@ pub(crate) fn run_rounds(
         if round > 0 {
             cx.lower_noise_to_departure(&f.params, replays, progress)?;
         }
-        let cx: &Context = cx;
-        let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
-        let Some(r) = replay_round(cx, &problem, &f, round, replays, progress)? else {
-            progress("every channel is within its noise on the held-out blocks");
-            f.localization = None;
+        if one_round(cx, &mut f, round, round < MAX_EFFECTS, replays, progress)? != RoundEnd::Added {
             break;
-        };
-        // Every round fits every place again: an effect added on the force side of the
-        // piston leaves the pressures as they were but not the force, and scores kept from
-        // the round before judged a command delay beside a friction on the force the
-        // friction had left (68 % where it explained all).
-        let screen = crate::fit::screen::Screen {
-            periodic_hz: r.periodic,
-        };
-        let (found, used) = localize(&problem, &r.current, &r.candidates, cx.options, Some(screen), progress);
-        *replays += used;
-        if round == 0 {
-            f.first_candidates = found.candidates.clone();
         }
-        let added = if round < MAX_EFFECTS {
-            find_addition(cx, &r, &problem, &found, &f, replays, progress)?
-        } else {
-            None
-        };
-        // What was added is a hypothesis, not a lock: a simpler term at its place that does
-        // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
-        // not a line resistance), and so does a richer one that does better than a named
-        // effect by its penalty.
-        let check = crate::decide::alternatives::Check {
-            cx,
-            problem: &problem,
-            count: r.count,
-            force_before: r.force_before,
-        };
-        let added = match added {
-            Some(Addition::Named(s, sentence)) => {
-                let mut with = f.params.clone();
-                let simpler = if apply_named(&mut with, &s).is_ok() {
-                    let a = crate::decide::alternatives::Added {
-                        scored: &s,
-                        with: &with,
-                        named: true,
-                        measured_shape: s.fit.candidate.named == Some("sensor_offset_gain")
-                            && cx.recording.p1.is_some()
-                            && cx.recording.p2.is_some(),
-                    };
-                    crate::decide::alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)?
-                } else {
-                    None
-                };
-                match simpler {
-                    Some((term, trial)) => Some(Addition::Discovered(term, Box::new(trial), None)),
-                    None => Some(Addition::Named(s, sentence)),
-                }
-            }
-            Some(Addition::Discovered(term, trial, Some(s))) => {
-                let a = crate::decide::alternatives::Added {
-                    scored: &s,
-                    with: &trial,
-                    named: false,
-                    measured_shape: false,
-                };
-                match crate::decide::alternatives::alternative_at_place(
-                    &check, &found, &f.params, &a, replays, progress,
-                )? {
-                    Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
-                    None => match crate::decide::alternatives::simpler_elsewhere(
-                        &check, &found, &f.params, &a, &r.current, replays, progress,
-                    )? {
-                        Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
-                        None => Some(Addition::Discovered(term, trial, Some(s))),
-                    },
-                }
-            }
-            other => other,
-        };
-        // A term put in another's place is tied to the places that one was.
-        let added = match added {
-            Some(Addition::Discovered(mut term, trial, s))
-                if term.tied_locations.is_empty() || is_along_the_command_path(&term) =>
-            {
-                // Ties already given (by the fit that added it) are in its reading already.
-                let mut undecided = None;
-                if term.tied_locations.is_empty() {
-                    term.tied_locations = found.tied_with(term.location);
-                    undecided = found.undecided_beside(term.location, cx.pressure_noise.is_some());
-                }
-                if is_along_the_command_path(&term) {
-                    term.tied_locations = crate::candidates::command_path::tied_along_the_command_path(term.location);
-                    undecided = Some(
-                        "a static function of the command (a curve, an offset, a gain or a limit) acts alike at the command, in the current driver and at the torque motor, which a command slower than the driver does not tell apart".to_string(),
-                    );
-                }
-                term.reading = with_undecided(std::mem::take(&mut term.reading), undecided);
-                Some(Addition::Discovered(term, trial, s))
-            }
-            other => other,
-        };
-        let earlier = (f.effects.len(), f.discovered.len());
-        // Two terms added as a pair were judged together, against no single place: their
-        // places get no margin.
-        let paired = matches!(added, Some(Addition::Pair(..)));
-        match added {
-            Some(Addition::Discovered(term, trial, _)) => {
-                match f.discovered.iter().position(|d| same_term(d, &term)) {
-                    // The same candidate with the same parameters again: a refit of the earlier
-                    // term (its first fit, through a linear regressor, left a viscous friction
-                    // 2 % short), reported as one term with its new values.
-                    Some(k) => {
-                        progress(&format!("the {} again: one term, refitted", term.candidate));
-                        let earlier = &mut f.discovered[k];
-                        earlier.parameters = term.parameters;
-                        earlier.heldout_after = term.heldout_after;
-                        earlier.share = 1.0 - (earlier.heldout_after / earlier.heldout_before).powi(2);
-                        earlier.reading = crate::decide::discover::reading(
-                            earlier.candidate,
-                            earlier.location,
-                            earlier.family,
-                            &earlier.parameters,
-                            &f.start,
-                        );
-                        earlier.pressures_heldout = term.pressures_heldout.or(earlier.pressures_heldout);
-                        f.newest = Some((false, k));
-                    }
-                    None => {
-                        f.discovered.push(term);
-                        f.newest = Some((false, f.discovered.len() - 1));
-                    }
-                }
-                f.params = *trial;
-            }
-            Some(Addition::Pair(terms, trial)) => {
-                // No terms: the earlier additions refitted beside a candidate that stayed off.
-                if !terms.is_empty() {
-                    f.discovered.extend(terms);
-                    f.newest = Some((false, f.discovered.len() - 1));
-                }
-                f.params = *trial;
-                // A term added beside the earlier ones moved their constants.
-                sync_earlier(&mut f);
-            }
-            Some(Addition::Named(s, sentence)) => {
-                let effect = add_effect(cx, &mut f.params, &r, &found, s, sentence, progress)?;
-                f.effects.push(effect);
-                f.newest = Some((true, f.effects.len() - 1));
-            }
-            Some(Addition::NamedWithTerm(s, sentence, term, trial)) => {
-                let effect = add_effect(cx, &mut f.params, &r, &found, *s, sentence, progress)?;
-                f.effects.push(effect);
-                f.discovered.push(term);
-                f.newest = Some((false, f.discovered.len() - 1));
-                f.params = *trial;
-            }
-            None => {
-                f.localization = Some(found);
-                break;
-            }
-        }
-        // How clearly the place of each addition this round made won in its localization.
-        for (place, margin) in f.effects[earlier.0..]
-            .iter_mut()
-            .map(|e| (e.location, &mut e.margin))
-            .chain(
-                f.discovered[earlier.1..]
-                    .iter_mut()
-                    .map(|d| (d.location, &mut d.margin)),
-            )
-        {
-            *margin = if paired { None } else { found.margin(place) };
-        }
-        // Each addition was fitted with those before it held. Refitting them together now,
-        // not only at the end, lets the next round start from where they explain most: a
-        // discovered restriction fitted while friction was still missing leaves the pressures
-        // a few noise floors off, and the next round would fit every upstream candidate again
-        // for that.
-        if let Some(refit) = crate::decide::joint_refit::refit_jointly(cx, &mut f, replays, progress)? {
-            f.joint_refit = Some(refit);
-        }
-        // What a later addition has made redundant goes (`eliminate.rs`).
-        if crate::decide::eliminate::drop_redundant(cx, &mut f, replays, progress)? {
-            if let Some(refit) = crate::decide::joint_refit::refit_jointly(cx, &mut f, replays, progress)? {
-                f.joint_refit = Some(refit);
-            }
-        }
-        f.stages.push(Stage::of(&f));
     }
+    let cx: &Context = cx;
+    second_opinion(crate::decide::revisit::revisit(cx, &mut f, replays, progress), progress);
     let renamed = second_opinion(
         crate::decide::named_rivals::settle_rivals(cx, &mut f, replays, progress),
         progress,
@@ -275,6 +95,215 @@ pub(crate) fn run_rounds(
     }
     crate::decide::eliminate::attribute_from_joint_fit(cx, &mut f, replays, progress)?;
     Ok(f)
+}
+
+/// How a round ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum RoundEnd {
+    /// Every channel is within its noise held out.
+    WithinNoise,
+    /// Nothing earned a place (or `may_add` was false): the findings' localization is the
+    /// remainder's.
+    NothingAdded,
+    /// An addition was made, the additions refitted together and the redundant removed.
+    Added,
+}
+
+/// One round (steps 3–5): replay the findings' model, localize what departs, and add what
+/// earns its place there when `may_add`; then refit every addition together and remove
+/// what the new one made redundant.
+pub(crate) fn one_round(
+    cx: &Context,
+    f: &mut Findings,
+    round: usize,
+    may_add: bool,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<RoundEnd, String> {
+    let problem = Problem::new(cx.recording, &f.params, &cx.blocks, cx.channel_noise);
+    let Some(r) = replay_round(cx, &problem, f, round, replays, progress)? else {
+        progress("every channel is within its noise on the held-out blocks");
+        f.localization = None;
+        return Ok(RoundEnd::WithinNoise);
+    };
+
+    // Every round fits every place again: an effect added on the force side of the
+    // piston leaves the pressures as they were but not the force, and scores kept from
+    // the round before judged a command delay beside a friction on the force the
+    // friction had left (68 % where it explained all).
+    let screen = crate::fit::screen::Screen {
+        periodic_hz: r.periodic,
+    };
+    let (found, used) = localize(&problem, &r.current, &r.candidates, cx.options, Some(screen), progress);
+    *replays += used;
+    if round == 0 {
+        f.first_candidates = found.candidates.clone();
+    }
+    let added = if may_add {
+        find_addition(cx, &r, &problem, &found, f, replays, progress)?
+    } else {
+        None
+    };
+    // What was added is a hypothesis, not a lock: a simpler term at its place that does
+    // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
+    // not a line resistance), and so does a richer one that does better than a named
+    // effect by its penalty.
+    let check = crate::decide::alternatives::Check {
+        cx,
+        problem: &problem,
+        count: r.count,
+        force_before: r.force_before,
+    };
+    let added = match added {
+        Some(Addition::Named(s, sentence)) => {
+            let mut with = f.params.clone();
+            let simpler = if apply_named(&mut with, &s).is_ok() {
+                let a = crate::decide::alternatives::Added {
+                    scored: &s,
+                    with: &with,
+                    named: true,
+                    measured_shape: s.fit.candidate.named == Some("sensor_offset_gain")
+                        && cx.recording.p1.is_some()
+                        && cx.recording.p2.is_some(),
+                };
+                crate::decide::alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)?
+            } else {
+                None
+            };
+            match simpler {
+                Some((term, trial)) => Some(Addition::Discovered(term, Box::new(trial), None)),
+                None => Some(Addition::Named(s, sentence)),
+            }
+        }
+        Some(Addition::Discovered(term, trial, Some(s))) => {
+            let a = crate::decide::alternatives::Added {
+                scored: &s,
+                with: &trial,
+                named: false,
+                measured_shape: false,
+            };
+            match crate::decide::alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)? {
+                Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
+                None => match crate::decide::alternatives::simpler_elsewhere(
+                    &check, &found, &f.params, &a, &r.current, replays, progress,
+                )? {
+                    Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
+                    None => Some(Addition::Discovered(term, trial, Some(s))),
+                },
+            }
+        }
+        other => other,
+    };
+    // A term put in another's place is tied to the places that one was.
+    let added = match added {
+        Some(Addition::Discovered(mut term, trial, s))
+            if term.tied_locations.is_empty() || is_along_the_command_path(&term) =>
+        {
+            // Ties already given (by the fit that added it) are in its reading already.
+            let mut undecided = None;
+            if term.tied_locations.is_empty() {
+                term.tied_locations = found.tied_with(term.location);
+                undecided = found.undecided_beside(term.location, cx.pressure_noise.is_some());
+            }
+            if is_along_the_command_path(&term) {
+                term.tied_locations = crate::candidates::command_path::tied_along_the_command_path(term.location);
+                undecided = Some(
+                    "a static function of the command (a curve, an offset, a gain or a limit) acts alike at the command, in the current driver and at the torque motor, which a command slower than the driver does not tell apart".to_string(),
+                );
+            }
+            term.reading = with_undecided(std::mem::take(&mut term.reading), undecided);
+            Some(Addition::Discovered(term, trial, s))
+        }
+        other => other,
+    };
+    let earlier = (f.effects.len(), f.discovered.len());
+    // Two terms added as a pair were judged together, against no single place: their
+    // places get no margin.
+    let paired = matches!(added, Some(Addition::Pair(..)));
+    match added {
+        Some(Addition::Discovered(term, trial, _)) => {
+            match f.discovered.iter().position(|d| same_term(d, &term)) {
+                // The same candidate with the same parameters again: a refit of the earlier
+                // term (its first fit, through a linear regressor, left a viscous friction
+                // 2 % short), reported as one term with its new values.
+                Some(k) => {
+                    progress(&format!("the {} again: one term, refitted", term.candidate));
+                    let earlier = &mut f.discovered[k];
+                    earlier.parameters = term.parameters;
+                    earlier.heldout_after = term.heldout_after;
+                    earlier.share = 1.0 - (earlier.heldout_after / earlier.heldout_before).powi(2);
+                    earlier.reading = crate::decide::discover::reading(
+                        earlier.candidate,
+                        earlier.location,
+                        earlier.family,
+                        &earlier.parameters,
+                        &f.start,
+                    );
+                    earlier.pressures_heldout = term.pressures_heldout.or(earlier.pressures_heldout);
+                    f.newest = Some((false, k));
+                }
+                None => {
+                    f.discovered.push(term);
+                    f.newest = Some((false, f.discovered.len() - 1));
+                }
+            }
+            f.params = *trial;
+        }
+        Some(Addition::Pair(terms, trial)) => {
+            // No terms: the earlier additions refitted beside a candidate that stayed off.
+            if !terms.is_empty() {
+                f.discovered.extend(terms);
+                f.newest = Some((false, f.discovered.len() - 1));
+            }
+            f.params = *trial;
+            // A term added beside the earlier ones moved their constants.
+            sync_earlier(f);
+        }
+        Some(Addition::Named(s, sentence)) => {
+            let effect = add_effect(cx, &mut f.params, &r, &found, s, sentence, progress)?;
+            f.effects.push(effect);
+            f.newest = Some((true, f.effects.len() - 1));
+        }
+        Some(Addition::NamedWithTerm(s, sentence, term, trial)) => {
+            let effect = add_effect(cx, &mut f.params, &r, &found, *s, sentence, progress)?;
+            f.effects.push(effect);
+            f.discovered.push(term);
+            f.newest = Some((false, f.discovered.len() - 1));
+            f.params = *trial;
+        }
+        None => {
+            f.localization = Some(found);
+            return Ok(RoundEnd::NothingAdded);
+        }
+    }
+    // How clearly the place of each addition this round made won in its localization.
+    for (place, margin) in f.effects[earlier.0..]
+        .iter_mut()
+        .map(|e| (e.location, &mut e.margin))
+        .chain(
+            f.discovered[earlier.1..]
+                .iter_mut()
+                .map(|d| (d.location, &mut d.margin)),
+        )
+    {
+        *margin = if paired { None } else { found.margin(place) };
+    }
+    // Each addition was fitted with those before it held. Refitting them together now,
+    // not only at the end, lets the next round start from where they explain most: a
+    // discovered restriction fitted while friction was still missing leaves the pressures
+    // a few noise floors off, and the next round would fit every upstream candidate again
+    // for that.
+    if let Some(refit) = crate::decide::joint_refit::refit_jointly(cx, f, replays, progress)? {
+        f.joint_refit = Some(refit);
+    }
+    // What a later addition has made redundant goes (`eliminate.rs`).
+    if crate::decide::eliminate::drop_redundant(cx, f, replays, progress)? {
+        if let Some(refit) = crate::decide::joint_refit::refit_jointly(cx, f, replays, progress)? {
+            f.joint_refit = Some(refit);
+        }
+    }
+    f.stages.push(Stage::of(f));
+    Ok(RoundEnd::Added)
 }
 
 /// Whether a second opinion on the names may have changed any. One the model refuses stops

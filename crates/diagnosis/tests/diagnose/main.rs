@@ -26,6 +26,7 @@
 
 mod balance;
 mod beside;
+mod compound;
 mod constants;
 mod curves;
 mod flexible;
