@@ -1,5 +1,5 @@
-//! The words a diagnosis speaks in: where along the chain the model departs (a [`Place`]) and
-//! what kind of departure it is (a [`Family`]). Each is an enum whose JSON word is its serde
+//! The words a diagnosis speaks in: where along the chain the model departs (a [`Place`]),
+//! what kind of departure it is (a [`Family`]) and how the term was formed (an [`Origin`]). Each is an enum whose JSON word is its serde
 //! name ([`Place::as_str`]).
 
 /// One vocabulary: an enum, its words in order, and their serde form.
@@ -99,6 +99,46 @@ vocabulary! {
     }
 }
 
+vocabulary! {
+    /// How the diagnosis formed a term: which of its classes it comes from.
+    Origin {
+        /// One of the seven named effects.
+        Named => "named",
+        /// A candidate written for its place (a constant, a transform, a law).
+        Written => "written",
+        /// A constant varying with a signal, in a modulation slot.
+        Modulation => "modulation",
+        /// A static curve through knots: a channel's, the command's, the discharge
+        /// coefficient's.
+        Curve => "curve",
+        /// A generated term of a balance: an extra force product or an extra flow slot.
+        BalanceTerm => "balance_term",
+        /// A smooth surface of one or two signals, in a flexible slot.
+        Flexible => "flexible",
+    }
+}
+
+impl Origin {
+    /// The origin the FMU parameters a term sets or fills show: each generated class has its
+    /// own slots or curves; anything else was written.
+    pub fn of_parameters<'a>(names: impl IntoIterator<Item = &'a str>) -> Origin {
+        let names: Vec<&str> = names.into_iter().collect();
+        let fills = |prefixes: &[&str]| names.iter().any(|n| prefixes.iter().any(|p| n.starts_with(p)));
+        // A slot outranks a curve or a constant it targets.
+        if fills(&["flexible_"]) {
+            Origin::Flexible
+        } else if fills(&["modulation_"]) {
+            Origin::Modulation
+        } else if fills(&["extra_force_product_", "extra_flow_"]) {
+            Origin::BalanceTerm
+        } else if names.iter().any(|n| n.contains("_curve_")) {
+            Origin::Curve
+        } else {
+            Origin::Written
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,5 +155,32 @@ mod tests {
         assert_eq!(Place::from_word("piston"), None);
         assert_eq!(Place::PressureSensors.as_str(), "pressure_sensors");
         assert!(Place::Command < Place::PressureSensors, "the chain's order");
+        for &origin in Origin::ALL {
+            assert_eq!(Origin::from_word(origin.as_str()), Some(origin));
+        }
+    }
+
+    #[test]
+    fn a_terms_origin_is_read_from_the_slots_and_curves_it_fills() {
+        assert_eq!(Origin::of_parameters(["force_sensor_lag"]), Origin::Written);
+        assert_eq!(
+            Origin::of_parameters(["command_curve_knots", "command_curve_x_1"]),
+            Origin::Curve
+        );
+        assert_eq!(Origin::of_parameters(["discharge_curve_knots"]), Origin::Curve);
+        assert_eq!(
+            Origin::of_parameters(["extra_force_product_2_first"]),
+            Origin::BalanceTerm
+        );
+        assert_eq!(Origin::of_parameters(["extra_flow_1_chamber"]), Origin::BalanceTerm);
+        assert_eq!(Origin::of_parameters(["extra_inflow_1"]), Origin::Written);
+        assert_eq!(
+            Origin::of_parameters(["P_s", "modulation_1_parameter", "modulation_1_y_2"]),
+            Origin::Modulation
+        );
+        assert_eq!(
+            Origin::of_parameters(["extra_force_product_1_first", "flexible_1_y_1_1"]),
+            Origin::Flexible
+        );
     }
 }

@@ -444,7 +444,7 @@ pub fn free_slots(params: &Parameters) -> Vec<usize> {
 
 /// Whether a candidate is a flexible term (it fills a flexible slot).
 pub fn is_flexible(c: &Candidate) -> bool {
-    c.settings.iter().any(|(name, _)| name.starts_with("flexible_"))
+    c.origin() == crate::vocabulary::Origin::Flexible
 }
 
 /// A screened surface as a candidate in flexible slot `slot`: its grid's values are the

@@ -257,6 +257,21 @@ pub struct Candidate {
     pub settings: Vec<(&'static str, f64)>,
 }
 
+impl Candidate {
+    /// How the candidate was formed: named, or as the slots and curves it fills show.
+    pub fn origin(&self) -> crate::vocabulary::Origin {
+        if self.named.is_some() {
+            return crate::vocabulary::Origin::Named;
+        }
+        crate::vocabulary::Origin::of_parameters(
+            self.settings
+                .iter()
+                .map(|(n, _)| *n)
+                .chain(self.terms.iter().map(|t| t.name)),
+        )
+    }
+}
+
 /// The unit of an FMU parameter, from the variable table.
 pub fn unit_of(name: &str) -> &'static str {
     jetpipe_model::variables::VARIABLES

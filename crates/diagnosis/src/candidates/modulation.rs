@@ -148,7 +148,7 @@ pub fn hats(knots: &[f64], s: f64, out: &mut [f64]) {
 
 /// Whether a candidate is a modulation (it fills a modulation slot).
 pub fn is_modulation(c: &Candidate) -> bool {
-    c.settings.iter().any(|(name, _)| name.starts_with("modulation_"))
+    c.origin() == crate::vocabulary::Origin::Modulation
 }
 
 /// Whether a modulation's knot values are one change of the constant (all within a tenth of

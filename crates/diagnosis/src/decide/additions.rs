@@ -63,6 +63,11 @@ pub struct DiscoveredTerm {
 }
 
 impl DiscoveredTerm {
+    /// How the term was formed, as the slots and curves its parameters fill show.
+    pub fn origin(&self) -> crate::vocabulary::Origin {
+        crate::vocabulary::Origin::of_parameters(self.parameters.iter().map(|(n, _)| *n))
+    }
+
     /// The fitted `candidate`, carried by the model parameters `set` (read against their
     /// values in `params`), as a term that takes the held-out force error from `before` to
     /// `after`; its family as the fitted shape reads (a curve that flattens is a limit).

@@ -219,6 +219,7 @@ impl Diagnosis {
                 "location": d.location,
                 "family": d.family,
                 "candidate": d.candidate,
+                "origin": d.origin(),
                 "parameters": parameters_json(&d.parameters),
                 "units": d.parameters.iter().map(|(n, _)| (n.to_string(), json!(crate::candidates::unit_of(n)))).collect::<serde_json::Map<_, _>>(),
                 "reading": d.reading,
@@ -260,6 +261,7 @@ impl Diagnosis {
             }))).collect::<serde_json::Map<_, _>>(),
             "candidates": self.candidates.iter().map(|c| json!({
                 "candidate": c.fit.candidate.label,
+                "origin": c.fit.candidate.origin(),
                 "location": c.fit.candidate.location,
                 "family": c.fit.candidate.family,
                 "named_effect": c.fit.candidate.named,

@@ -98,6 +98,14 @@ fn a_force_of_a_lagged_command_times_the_position_is_closed_by_a_flexible_term_t
         reported["depends_on"].as_array().is_some_and(|a| !a.is_empty()),
         "{reported}"
     );
+    let origins: Vec<_> = json["discovered"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|t| t["flexible"] == true)
+        .map(|t| t["origin"].clone())
+        .collect();
+    assert!(origins.iter().all(|o| o == "flexible"), "{origins:?}");
     // The departure is 0.6 N at most, some 0.3 N RMS: the model must close it to the bar.
     assert!(
         d.after.heldout_rms <= 1.5 * d.noise_floor,

@@ -37,4 +37,6 @@ fn a_force_sensor_lag_is_reported_with_an_interval_around_its_value_and_a_positi
     );
     let margin = term["margin_noise_floors"].as_f64().unwrap();
     assert!(margin > 0.0, "margin {margin}");
+    // A lag is written for the force sensor, not generated.
+    assert_eq!(term["origin"], "written", "{term}");
 }
