@@ -15,7 +15,8 @@
 # read is spent. The simulator runs in target/blindgen-venv (numpy and numba from PyPI, made on
 # first use). The last line, `TOTALS: ...` (honest / located / explained of the draws, the
 # median wall time per recorded sample and the batch's wall time), goes into the results
-# file's history table.
+# file's history table. JETPIPE_DIAGNOSE_ARGS adds options to every diagnosis (for example
+# `--flexible`); JETPIPE_RESULTS=0 prints the table without writing the file.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/results.sh
@@ -55,8 +56,9 @@ echo "|---|---|---|---|---|---|---|---|---|"
 for rec in "$draws"/bg_"$seed"_*.csv; do
     name="$(basename "$rec" .csv)"
     start=$(date +%s%N)
+    # shellcheck disable=SC2086 # JETPIPE_DIAGNOSE_ARGS is a list of options.
     "$work/jetpipe" diagnose "$rec" --report "$work/reports/$name.json" --no-html --jobs 2 \
-        >"$work/$name.log" 2>&1 || true
+        ${JETPIPE_DIAGNOSE_ARGS:-} >"$work/$name.log" 2>&1 || true
     end=$(date +%s%N)
     python3 - "$rec" "$work/reports/$name.json" "$(( (end - start) / 1000000 ))" <<'PY'
 import csv, json, os, sys
