@@ -38,8 +38,10 @@ fn assert_supply_named(d: &Diagnosis) {
     );
 }
 
+// Fails today (issue 78): the supply is named and the mass found, but the mass is fitted
+// 21 % heavy and 2.1 noise floors stay, where the mass alone is fitted within 10 %.
 #[test]
-#[ignore = "a broad case (about 2 min of wall time); scripts/bench_cases.sh runs every case"]
+#[ignore = "fails today: the mass fitted 21 % heavy, 2.1 noise floors left (issue 78); scripts/bench_cases.sh runs every case"]
 fn a_supply_restriction_beside_a_moving_mass_is_the_named_supply_drop_and_the_mass() {
     let effects = BenchEffects {
         supply_resistance: 5e8,
@@ -67,7 +69,7 @@ fn a_supply_restriction_beside_a_moving_mass_is_the_named_supply_drop_and_the_ma
 // Explained, but the mass and the lag are read together as one second-order filter of the
 // force sensor: a term that stands in for two, which the diagnosis does not yet split.
 #[test]
-#[ignore = "a broad case (about 2 min of wall time); scripts/bench_cases.sh runs every case"]
+#[ignore = "a broad case (about 30 s of wall time); scripts/bench_cases.sh runs every case"]
 fn a_supply_restriction_a_moving_mass_and_a_force_sensor_lag_are_explained_with_the_supply_named() {
     let effects = BenchEffects {
         supply_resistance: 5e8,
