@@ -625,15 +625,7 @@ mod tests {
         let b: Vec<f64> = time.iter().map(|t| (1.13 * t + 0.4).sin()).collect();
         // A product of the two, which no function of one alone holds.
         let truth: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.5 * x * y).collect();
-        let blocks: Vec<Block> = (0..n)
-            .map(|k| {
-                if (k / 2000) % 2 == 0 {
-                    Block::Training
-                } else {
-                    Block::HeldOut
-                }
-            })
-            .collect();
+        let blocks = Block::alternating(n, 2000);
         let recording = crate::input::recording::Recording {
             time: time.clone(),
             v_da: vec![0.0; n],

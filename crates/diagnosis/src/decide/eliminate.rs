@@ -44,6 +44,18 @@ pub(crate) fn label_of(f: &Findings, which: Which) -> &'static str {
     }
 }
 
+/// Take one addition out of the findings' lists (its parameters stay as they are).
+pub(crate) fn remove(f: &mut Findings, which: Which) {
+    match which {
+        (true, k) => {
+            f.effects.remove(k);
+        }
+        (false, k) => {
+            f.discovered.remove(k);
+        }
+    }
+}
+
 /// The findings' model without one addition: its parameters that no other addition sets go
 /// back to their values before the rounds. `None` when that model is not valid.
 pub(crate) fn without(f: &Findings, which: Which) -> Option<(Parameters, usize)> {
@@ -117,14 +129,7 @@ pub(crate) fn drop_redundant(
             label_of(f, which)
         ));
         f.params = trial;
-        match which {
-            (true, k) => {
-                f.effects.remove(k);
-            }
-            (false, k) => {
-                f.discovered.remove(k);
-            }
-        }
+        remove(f, which);
         if let Some((named, k)) = f.newest {
             if named == which.0 && k > which.1 {
                 f.newest = Some((named, k - 1));

@@ -14,7 +14,7 @@
 
 use crate::candidates::parameter_value;
 use crate::context::Context;
-use crate::decide::eliminate::{additions, label_of, without};
+use crate::decide::eliminate::{additions, label_of, remove, without};
 use crate::decide::findings::Findings;
 use crate::decide::rounds::{one_round, RoundEnd};
 use crate::fit::localize::discovery_penalty_per_term;
@@ -96,14 +96,7 @@ pub(crate) fn revisit(
         ));
         let mut trial = f.clone();
         trial.params = params;
-        match which {
-            (true, k) => {
-                trial.effects.remove(k);
-            }
-            (false, k) => {
-                trial.discovered.remove(k);
-            }
-        }
+        remove(&mut trial, which);
         trial.newest = None;
         trial.localization = None;
         let round = f.stages.len().clamp(1, MAX_EFFECTS - 1);

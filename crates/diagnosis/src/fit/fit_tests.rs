@@ -39,15 +39,7 @@ fn a_limit_that_clips_only_the_highest_training_level_is_found_though_held_out_r
     recording.force = replay_fast(&Actuator::new(clipped).unwrap(), &recording, n)
         .unwrap()
         .force;
-    let blocks: Vec<Block> = (0..n)
-        .map(|k| {
-            if (k / 2000) % 2 == 0 {
-                Block::Training
-            } else {
-                Block::HeldOut
-            }
-        })
-        .collect();
+    let blocks = Block::alternating(n, 2000);
     let problem = Problem::new(&recording, &base, &blocks, [0.05, 0.0, 0.0]);
     let base_replay = replay_fast(&Actuator::new(base.clone()).unwrap(), &recording, n).unwrap();
     let knots = crate::candidates::curves::CurveKnots::default();

@@ -212,15 +212,7 @@ fn the_autocorrelation_time_of_an_ar1_series_is_one_plus_rho_over_one_minus_rho(
 #[test]
 fn a_misfit_only_the_heldout_blocks_carry_widens_the_interval_and_the_method_says_so() {
     let n = 20_000;
-    let blocks: Vec<Block> = (0..n)
-        .map(|k| {
-            if (k / 1000) % 2 == 0 {
-                Block::Training
-            } else {
-                Block::HeldOut
-            }
-        })
-        .collect();
+    let blocks = Block::alternating(n, 1000);
     let column: Vec<f64> = (0..n).map(|k| (k as f64 * 0.013).sin() + 0.5).collect();
     let noise = normals(11, n);
     let white = linearised_intervals(

@@ -618,15 +618,7 @@ mod tests {
             acceleration_window: 0.0,
             repeated_rows: vec![],
         };
-        let blocks: Vec<Block> = (0..n)
-            .map(|k| {
-                if (k / 2000) % 2 == 0 {
-                    Block::Training
-                } else {
-                    Block::HeldOut
-                }
-            })
-            .collect();
+        let blocks = Block::alternating(n, 2000);
         (
             recording,
             blocks,

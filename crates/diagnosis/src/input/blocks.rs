@@ -34,6 +34,21 @@ impl Block {
     pub fn is_used(self) -> bool {
         matches!(self, Block::Training | Block::HeldOut)
     }
+
+    /// `n` samples in alternate training and held-out blocks of `length` samples, training
+    /// first: the blocks of the unit tests' recordings.
+    #[cfg(test)]
+    pub(crate) fn alternating(n: usize, length: usize) -> Vec<Block> {
+        (0..n)
+            .map(|k| {
+                if (k / length) % 2 == 0 {
+                    Block::Training
+                } else {
+                    Block::HeldOut
+                }
+            })
+            .collect()
+    }
 }
 
 /// Training samples are those in even-numbered blocks counted from the first sample,
