@@ -74,7 +74,11 @@ pub(crate) fn run_rounds(
         }
     }
     let cx: &Context = cx;
-    second_opinion(crate::decide::revisit::revisit(cx, &mut f, replays, progress), progress);
+    // A revisit the model refuses leaves the findings as they were (each replacement is made
+    // whole or not at all).
+    if let Err(why) = crate::decide::revisit::revisit(cx, &mut f, replays, progress) {
+        progress(&format!("the revisit of the additions stopped: {why}"));
+    }
     let renamed = second_opinion(
         crate::decide::named_rivals::settle_rivals(cx, &mut f, replays, progress),
         progress,
