@@ -627,19 +627,11 @@ mod tests {
         let truth: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.5 * x * y).collect();
         let blocks = Block::alternating(n, 2000);
         let recording = crate::input::recording::Recording {
-            time: time.clone(),
-            v_da: vec![0.0; n],
-            x_s: vec![0.06; n],
-            force: truth.clone(),
-            p1: None,
-            p2: None,
-            full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod {
                 step: 1e-3,
                 third_order: false,
             },
-            acceleration_window: 0.0,
-            repeated_rows: vec![],
+            ..crate::input::recording::Recording::of(time.clone(), vec![0.0; n], vec![0.06; n], truth.clone())
         };
         let base = Parameters::default();
         let problem = Problem::new(&recording, &base, &blocks, [0.01, 0.0, 0.0]);

@@ -274,18 +274,7 @@ mod tests {
                 }
             })
             .collect();
-        Recording {
-            time,
-            v_da,
-            x_s: vec![0.06; n],
-            force: vec![0.0; n],
-            p1: None,
-            p2: None,
-            full_rate: None,
-            fast_replay: crate::input::recording::FastReplayMethod::default(),
-            acceleration_window: 0.0,
-            repeated_rows: vec![],
-        }
+        Recording::of(time, v_da, vec![0.06; n], vec![0.0; n])
     }
 
     #[test]

@@ -12,7 +12,6 @@ fn a_limit_that_clips_only_the_highest_training_level_is_found_though_held_out_r
     use crate::candidates::{catalogue, set_parameter};
     use crate::fit::Problem;
     use crate::input::blocks::Block;
-    use crate::input::recording::FastReplayMethod;
     use crate::input::recording::Recording;
     use crate::replay::replay_fast;
     use jetpipe_model::physics::actuator::Actuator;
@@ -21,18 +20,7 @@ fn a_limit_that_clips_only_the_highest_training_level_is_found_though_held_out_r
     let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
     let levels = [2.0, 4.2, 3.0, 3.0, 2.0, 4.2, 3.0, 9.5];
     let v_da: Vec<f64> = (0..n).map(|k| levels[k / 1000]).collect();
-    let mut recording = Recording {
-        time,
-        v_da,
-        x_s: vec![0.06; n],
-        force: vec![0.0; n],
-        p1: None,
-        p2: None,
-        full_rate: None,
-        fast_replay: FastReplayMethod::default(),
-        acceleration_window: 0.0,
-        repeated_rows: vec![],
-    };
+    let mut recording = Recording::of(time, v_da, vec![0.06; n], vec![0.0; n]);
     let base = Parameters::default();
     let mut clipped = base.clone();
     set_parameter(&mut clipped, "command_upper_limit", 4.0).unwrap();

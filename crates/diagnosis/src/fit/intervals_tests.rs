@@ -3,7 +3,6 @@
 
 use super::*;
 use crate::candidates::set_parameter;
-use crate::input::recording::FastReplayMethod;
 use crate::input::recording::Recording;
 
 /// Deterministic standard normal samples (Box–Muller on an LCG).
@@ -58,18 +57,7 @@ fn recording(seconds: f64, noise: &dyn Fn(usize) -> Vec<f64>) -> Recording {
                 + 0.6 * square
         })
         .collect();
-    let mut r = Recording {
-        time,
-        v_da,
-        x_s: vec![0.06; n],
-        force: vec![0.0; n],
-        p1: None,
-        p2: None,
-        full_rate: None,
-        fast_replay: FastReplayMethod::default(),
-        acceleration_window: 0.0,
-        repeated_rows: vec![],
-    };
+    let mut r = Recording::of(time, v_da, vec![0.06; n], vec![0.0; n]);
     let mut truth = Parameters::default();
     for (name, value) in NAMES.iter().zip(TRUTH) {
         set_parameter(&mut truth, name, value).unwrap();

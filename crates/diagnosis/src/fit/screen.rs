@@ -604,19 +604,11 @@ mod tests {
             .map(|k| f64::from(sensitivity_force[k]) * band(x_s[k]) + noise())
             .collect();
         let recording = crate::input::recording::Recording {
-            time,
-            v_da: vec![0.0; n],
-            x_s: x_s.clone(),
-            force,
-            p1: None,
-            p2: None,
-            full_rate: None,
             fast_replay: crate::input::recording::FastReplayMethod {
                 step: 1e-3,
                 third_order: false,
             },
-            acceleration_window: 0.0,
-            repeated_rows: vec![],
+            ..crate::input::recording::Recording::of(time, vec![0.0; n], x_s.clone(), force)
         };
         let blocks = Block::alternating(n, 2000);
         (

@@ -191,16 +191,14 @@ mod tests {
     fn recording(step: f64, n: usize, force: impl Fn(f64) -> f64, pressures: Option<(f64, f64)>) -> Recording {
         let time: Vec<f64> = (0..n).map(|k| k as f64 * step).collect();
         Recording {
-            force: time.iter().map(|&t| force(t)).collect(),
-            v_da: vec![2.5; n],
-            x_s: vec![0.054; n],
             p1: pressures.map(|(a, _)| vec![a; n]),
             p2: pressures.map(|(_, b)| vec![b; n]),
-            time,
-            full_rate: None,
-            fast_replay: crate::input::recording::FastReplayMethod::default(),
-            acceleration_window: 0.0,
-            repeated_rows: vec![],
+            ..Recording::of(
+                time.clone(),
+                vec![2.5; n],
+                vec![0.054; n],
+                time.iter().map(|&t| force(t)).collect(),
+            )
         }
     }
 

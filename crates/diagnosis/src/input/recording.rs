@@ -564,6 +564,26 @@ pub struct FastReplayMethod {
     pub third_order: bool,
 }
 
+#[cfg(test)]
+impl Recording {
+    /// A recording of these columns without pressure channels, replayed with the default fast
+    /// method: the unit tests' recordings.
+    pub(crate) fn of(time: Vec<f64>, v_da: Vec<f64>, x_s: Vec<f64>, force: Vec<f64>) -> Recording {
+        Recording {
+            time,
+            v_da,
+            x_s,
+            force,
+            p1: None,
+            p2: None,
+            full_rate: None,
+            fast_replay: FastReplayMethod::default(),
+            acceleration_window: 0.0,
+            repeated_rows: vec![],
+        }
+    }
+}
+
 impl Default for FastReplayMethod {
     fn default() -> Self {
         Self {

@@ -110,18 +110,7 @@ mod tests {
                 ((level + 0.004 * phase) * 1e6).round() / 1e6
             })
             .collect();
-        let recording = Recording {
-            time: time.clone(),
-            v_da: vec![2.0; time.len()],
-            x_s: x_s.clone(),
-            force: vec![0.0; time.len()],
-            p1: None,
-            p2: None,
-            full_rate: None,
-            fast_replay: crate::input::recording::FastReplayMethod::default(),
-            acceleration_window: 0.0,
-            repeated_rows: vec![],
-        };
+        let recording = Recording::of(time.clone(), vec![2.0; time.len()], x_s.clone(), vec![0.0; time.len()]);
         for window in [0.01, 0.04] {
             let a = smoothed_accelerations(&time, &x_s, window);
             let residual: Vec<f64> = a

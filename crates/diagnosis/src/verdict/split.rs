@@ -207,16 +207,9 @@ mod tests {
                 .collect()
         };
         let recording = Recording {
-            time,
-            v_da: vec![1.0; n],
-            x_s: vec![0.054; n],
-            force: force.clone(),
             p1: Some(read(&p1_model, 1.0)),
             p2: Some(read(&p2_model, -1.0)),
-            full_rate: None,
-            fast_replay: crate::input::recording::FastReplayMethod::default(),
-            acceleration_window: 0.0,
-            repeated_rows: vec![],
+            ..Recording::of(time, vec![1.0; n], vec![0.054; n], force.clone())
         };
         let replay = Replay {
             force,
