@@ -125,7 +125,7 @@ pub(crate) fn diagnose_unguarded(
     cx.stopper_smoothing = stopper_smoothing;
     // 3–5. Replay, localize, add what earns its place; then refit the additions together.
     let mut replays = 1;
-    let mut found = crate::decide::rounds::run_rounds(&mut cx, params, &mut replays, progress)?;
+    let mut found = crate::decide::decision::run_rounds(&mut cx, params, &mut replays, progress)?;
     // Where no readable term closed the departure: a flexible one, when asked for.
     if options.flexible {
         crate::decide::flexible::close_with_flexible(&cx, &mut found, &mut replays, progress)?;

@@ -244,7 +244,8 @@ fn best_surface(
     *replays += targets.len();
     let sensitivities: Vec<(Place, &'static str, Sensitivity)> = sensitivities.into_iter().flatten().collect();
     let penalty = discovery_penalty_per_term(count);
-    let surfaces = flexible::screen(problem, current, &sensitivities, penalty, FLEXIBLE_FITTED, jobs);
+    let surfaces =
+        crate::fit::flexible_screen::screen(problem, current, &sensitivities, penalty, FLEXIBLE_FITTED, jobs);
     let start_total: f64 = {
         let (_, heldout) = problem.errors(&[current.force.clone(), current.p1.clone(), current.p2.clone()]);
         heldout.iter().sum()

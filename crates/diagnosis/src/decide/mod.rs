@@ -4,6 +4,7 @@
 pub mod additions;
 pub(crate) mod alternatives;
 pub(crate) mod beside;
+pub(crate) mod decision;
 pub(crate) mod discover;
 pub(crate) mod eliminate;
 pub(crate) mod findings;

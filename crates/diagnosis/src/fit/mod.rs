@@ -2,6 +2,7 @@
 //! sensitivities, searches (`search.rs`) for the terms with none, held-out scores.
 
 pub mod calibrate;
+pub(crate) mod flexible_screen;
 pub mod intervals;
 pub(crate) mod localize;
 pub(crate) mod normal;
