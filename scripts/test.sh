@@ -16,23 +16,24 @@ run() {
 run bash scripts/install_chromium.sh
 mkdir -p target
 # The Python environment (pip's downloads and unpacking, little CPU) is made beside the
-# release build and the Rust tests; package.sh and pytest need it.
+# release build and the Rust tests, then FMI++, the second Model Exchange importer (one core
+# for about 80 s); package.sh and pytest need them.
 venv_log=target/venv.log
 echo
-echo "==> bash scripts/venv.sh (beside cargo test; output in $venv_log)"
+echo "==> bash scripts/venv.sh && bash scripts/fmipp.sh (beside cargo test; output in $venv_log)"
 venv_started=$SECONDS
-bash scripts/venv.sh >"$venv_log" 2>&1 </dev/null &
+{ bash scripts/venv.sh && bash scripts/fmipp.sh; } >"$venv_log" 2>&1 </dev/null &
 venv_pid=$!
 background=("$venv_pid")
 trap 'kill "${background[@]}" 2>/dev/null || true' EXIT
 run cargo test --release
 if ! wait "$venv_pid"; then
     cat "$venv_log" >&2
-    echo "test.sh: scripts/venv.sh failed" >&2
+    echo "test.sh: scripts/venv.sh or scripts/fmipp.sh failed" >&2
     exit 1
 fi
 cat "$venv_log"
-echo "<== $(( SECONDS - venv_started )) s: bash scripts/venv.sh"
+echo "<== $(( SECONDS - venv_started )) s: bash scripts/venv.sh && bash scripts/fmipp.sh"
 # Lints: clippy with warnings as errors, on every crate and target (the component is
 # installed when the toolchain lacks it).
 cargo clippy --version >/dev/null 2>&1 || run rustup component add clippy
