@@ -4,7 +4,8 @@
 //! * [`plots`]: the figures of a diagnosis (`jetpipe diagnose --plots`, and its pages);
 //! * [`html_report`]: a diagnosis's self-contained HTML page, and a batch's index;
 //! * [`batch`]: `jetpipe diagnose --out DIR` on many recordings over `--jobs` cores;
-//! * [`output`]: result files written whole, and never over anything but a regular file.
+//! * [`output`]: result files written whole, and never over anything but a regular file;
+//! * [`proposal`]: `jetpipe propose`'s JSON and page beside its protocol.
 //!
 //! The model is crate `jetpipe-model`, the FMU `jetpipe-fmu` (library `jetpipe`), its archive
 //! `jetpipe-packaging`, the diagnosis `jetpipe-diagnosis`.
@@ -13,4 +14,5 @@ pub mod batch;
 pub mod html_report;
 pub mod output;
 pub mod plots;
+pub mod proposal;
 pub mod sweep;

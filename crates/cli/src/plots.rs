@@ -814,6 +814,56 @@ fn signal_unit_scale(unit: &str) -> (&'static str, f64) {
     }
 }
 
+/// Colours of a proposal's explanations, the report's model first.
+const EXPLANATION_COLOURS: [RGBColor; 4] = [AFTER, BEFORE, RGBColor(44, 160, 44), RGBColor(255, 127, 14)];
+
+/// A proposed protocol: the command and the stopper over time, and the force each
+/// explanation predicts, less the report's model's (the differences the protocol is for).
+pub fn proposal_figure(
+    time: &[f64],
+    v_da: &[f64],
+    x_s: &[f64],
+    predicted_force: &[(String, &[f64])],
+) -> Result<Figure, String> {
+    let command = Series::line(envelope(time, v_da, ENVELOPE_COLUMNS), MEASURED, "command (V)");
+    let stopper_mm: Vec<f64> = x_s.iter().map(|x| x * 1e3).collect();
+    let stopper = Series::line(envelope(time, &stopper_mm, ENVELOPE_COLUMNS), MEASURED, "stopper (mm)");
+    let reference = predicted_force.first().map(|(_, f)| *f).unwrap_or(&[]);
+    let differences: Vec<Series> = predicted_force
+        .iter()
+        .enumerate()
+        .map(|(k, (label, force))| {
+            let less: Vec<f64> = force.iter().zip(reference).map(|(f, r)| f - r).collect();
+            Series::line(
+                envelope(time, &less, ENVELOPE_COLUMNS),
+                EXPLANATION_COLOURS[k % EXPLANATION_COLOURS.len()],
+                label.clone(),
+            )
+        })
+        .collect();
+    let legend_series: Vec<&Series> = differences.iter().collect();
+    let svg = svg(760, &legend_series, 3, |areas| {
+        panel(&areas[0], "command", "time (s)", "v_DA (V)", &[&command])?;
+        panel(&areas[1], "stopper position", "time (s)", "x_s (mm)", &[&stopper])?;
+        panel(
+            &areas[2],
+            "force each explanation predicts, less the report's model's",
+            "time (s)",
+            "force (N)",
+            &legend_series,
+        )
+    })?;
+    Ok(Figure {
+        name: "proposal",
+        title: "The proposed protocol".into(),
+        caption: "The command and the stopper position to play, and the force each explanation predicts on them, \
+                  less what the report's model predicts (each trace reduced to its minimum and maximum per pixel \
+                  column)."
+            .into(),
+        svg,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

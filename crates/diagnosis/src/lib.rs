@@ -18,6 +18,8 @@
 //!    elimination, and withdrawal of anything that leaves a worse model.
 //! 6. [`verdict`]: the final accurate replays, the verdict and the remainder's signature,
 //!    and the report.
+//! 7. [`propose`]: from a report, what to record next: a protocol on which its leading
+//!    explanations differ most (`jetpipe propose`).
 //!
 //! Beside the stages: [`policy`] states every threshold and precedence rule once,
 //! `context.rs` (its `Context`) is what every stage reads, and the result types live in the stage that
@@ -27,6 +29,7 @@ pub mod candidates;
 pub mod decide;
 pub mod fit;
 pub mod input;
+pub mod propose;
 pub mod replay;
 pub mod verdict;
 

@@ -100,6 +100,30 @@ enum Command {
         #[arg(long)]
         jobs: Option<usize>,
     },
+    /// What to record next: from a diagnosis report that ties places or leaves a remainder,
+    /// a protocol (time_s, v_da_V, x_s_m) on which its leading explanations differ most,
+    /// within what a bench can play (±10 V, the stopper within 35–90 mm at most 200 mm/s).
+    /// Writes OUT, and beside it OUT's name with .json and .html: the explanations it
+    /// separates and their predicted differences in noise floors.
+    Propose {
+        /// A report of `jetpipe diagnose` (JSON).
+        report: PathBuf,
+        /// The protocol's CSV file.
+        #[arg(long)]
+        out: PathBuf,
+        /// Its length, s (5–120).
+        #[arg(long, default_value_t = 40.0)]
+        seconds: f64,
+        /// Its sampling rate, Hz (250–4000).
+        #[arg(long, default_value_t = 1000.0)]
+        rate: f64,
+        /// Seed of the random draws the design picks from (the same seed, the same protocol).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Cores to use (default: every core this process may use).
+        #[arg(long)]
+        jobs: Option<usize>,
+    },
     /// Write DIR/summary.csv and DIR/index.html from the diagnosis reports in DIR (NAME.json,
     /// with NAME.html beside it; NAME.error.txt for a recording that could not be diagnosed),
     /// e.g. reports written on a cluster by examples/dask_diagnose.py.
@@ -246,6 +270,14 @@ fn run(cli: Cli) -> Result<(), String> {
             Ok(())
         }
         Command::Simulate { step, tolerance, csv } => simulate(step, tolerance, csv),
+        Command::Propose {
+            report,
+            out,
+            seconds,
+            rate,
+            seed,
+            jobs,
+        } => propose(&report, &out, seconds, rate, seed, jobs),
         Command::DiagnosisIndex { dir, timing } => {
             let rows = jetpipe_cli::batch::index_directory(&dir, &timing)?;
             println!(
@@ -405,6 +437,62 @@ fn read_parameters(path: Option<&std::path::Path>) -> Result<Parameters, String>
         );
     }
     Ok(p)
+}
+
+/// `jetpipe propose`: the protocol, its JSON and its page.
+fn propose(
+    report: &std::path::Path,
+    out: &std::path::Path,
+    seconds: f64,
+    rate: f64,
+    seed: u64,
+    jobs: Option<usize>,
+) -> Result<(), String> {
+    let text = std::fs::read_to_string(report).map_err(|e| format!("cannot read {}: {e}", report.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: not valid JSON: {e}", report.display()))?;
+    let mut options = jetpipe_diagnosis::propose::ProposeOptions {
+        seconds,
+        rate,
+        seed,
+        ..Default::default()
+    };
+    if let Some(jobs) = jobs {
+        options.jobs = jobs.max(1);
+    }
+    let started = Instant::now();
+    let proposal = jetpipe_diagnosis::propose::propose(&value, &options, &mut |line| eprintln!("{line}"))
+        .map_err(|e| format!("{}: {e}", report.display()))?;
+    let protocol_file = out
+        .file_name()
+        .map_or_else(|| out.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let report_name = report.display().to_string();
+    jetpipe_cli::output::write_atomically(out, &proposal.protocol.to_csv())?;
+    let json = jetpipe_cli::proposal::to_json(&proposal, &report_name, &protocol_file, seed);
+    let json_path = out.with_extension("json");
+    let page_path = out.with_extension("html");
+    jetpipe_cli::output::write_atomically(
+        &json_path,
+        &(serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n"),
+    )?;
+    jetpipe_cli::output::write_atomically(
+        &page_path,
+        &jetpipe_cli::proposal::page(&proposal, &report_name, &protocol_file)?,
+    )?;
+    let smallest = proposal.smallest();
+    println!(
+        "{}: {} s at {} Hz; the closest explanations, {} and {}, differ by {:.2} noise floors ({:.1} s); {} and {}",
+        out.display(),
+        seconds,
+        rate,
+        proposal.explanations[smallest.first].label,
+        proposal.explanations[smallest.second].label,
+        smallest.noise_floors,
+        started.elapsed().as_secs_f64(),
+        json_path.display(),
+        page_path.display()
+    );
+    Ok(())
 }
 
 /// The FMU parameters that set the start state rather than the model's constants.

@@ -12,7 +12,7 @@
 //! model reads the stopper where the recording puts it.
 //!
 //! Screening is first order, as the modulation class screens
-//! ([`crate::fit::flexible_screen`]); the leading few are fitted through the model.
+//! (`fit/flexible_screen.rs`); the leading few are fitted through the model.
 
 use crate::candidates::modulation::sensitivity_step;
 use crate::candidates::modulation::value_reference;

@@ -266,6 +266,7 @@ impl Diagnosis {
                 "family": c.fit.candidate.family,
                 "named_effect": c.fit.candidate.named,
                 "parameters": parameters_json(&c.parameters()),
+                "settings": parameters_json(&c.fit.candidate.settings),
                 "explained_share_heldout": c.explained,
                 "force_heldout_rms_N": c.force_heldout_rms,
             })).collect::<Vec<_>>(),
