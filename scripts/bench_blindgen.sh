@@ -43,6 +43,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 # A copy of the program: a build during the run (cargo in another shell) does not change it.
 cp target/release/jetpipe "$work/"
+# JETPIPE_BLINDGEN_REPORTS=DIR keeps the reports in DIR (for `jetpipe propose` on them).
 # JETPIPE_BLINDGEN_DRAWS=DIR keeps the draws in DIR and takes them from there when they are
 # already drawn (blindgen is deterministic in the seed): the drawing, several minutes for 30,
 # can run while the program is still being built.
@@ -59,6 +60,10 @@ for rec in "$draws"/bg_"$seed"_*.csv; do
     # shellcheck disable=SC2086 # JETPIPE_DIAGNOSE_ARGS is a list of options.
     "$work/jetpipe" diagnose "$rec" --report "$work/reports/$name.json" --no-html --jobs 2 \
         ${JETPIPE_DIAGNOSE_ARGS:-} >"$work/$name.log" 2>&1 || true
+    if [ -n "${JETPIPE_BLINDGEN_REPORTS:-}" ] && [ -f "$work/reports/$name.json" ]; then
+        mkdir -p "$JETPIPE_BLINDGEN_REPORTS"
+        cp "$work/reports/$name.json" "$JETPIPE_BLINDGEN_REPORTS/"
+    fi
     end=$(date +%s%N)
     python3 - "$rec" "$work/reports/$name.json" "$(( (end - start) / 1000000 ))" <<'PY'
 import csv, json, os, sys
