@@ -142,8 +142,13 @@ pub fn rivals(report: &Value, most: usize) -> Result<Rivals, String> {
         tied.extend(strings(u.get("tied_locations")));
         tied.extend(strings(u.get("alternatives")));
     }
-    tied.retain(|p| !p.is_empty() && p != "unknown");
-    tied.dedup();
+    let mut seen = vec![];
+    tied.retain(|p| {
+        !p.is_empty() && p != "unknown" && !seen.contains(p) && {
+            seen.push(p.clone());
+            true
+        }
+    });
     let model = parameters_from(start).map_err(|e| format!("the report's fmu_start_values: {e}"))?;
     let mut explanations = vec![Explanation {
         label: match added_labels.is_empty() {

@@ -76,6 +76,10 @@ fn the_rivals_are_the_reports_model_then_the_tied_place_then_the_ranking_one_a_p
         "the jet pipe null is at the addition's place, which the report's model stands for"
     );
     assert_eq!(r.tied, ["jet_pipe", "command"]);
+    // A place the remainder ties again, not next to its first mention, is named once.
+    let mut again = tied_report();
+    again["unexplained"] = json!({"tied_locations": ["jet_pipe"], "alternatives": ["unknown", "command"]});
+    assert_eq!(rivals(&again, 4).unwrap().tied, ["jet_pipe", "command"]);
     let (model, delay) = (&r.explanations[0].parameters, &r.explanations[1].parameters);
     assert_eq!(model.get(vr::OMEGA_1), Some(62.4));
     assert_eq!(model.get(vr::COMMAND_DELAY), Some(0.0));
