@@ -81,7 +81,7 @@ fn discovered_as(d: &Diagnosis, label: &str, candidate: &str, parameter: &str, t
 const MOVES: StopperMotion = StopperMotion::Moves { speed: 0.2 };
 const SLOW_MOVES: StopperMotion = StopperMotion::Moves { speed: 0.05 };
 
-fn moving_mass(kg: f64) -> UndeclaredEffects {
+pub(crate) fn moving_mass(kg: f64) -> UndeclaredEffects {
     UndeclaredEffects {
         moving_mass: kg,
         ..UndeclaredEffects::default()
@@ -134,6 +134,7 @@ fn a_mass_moving_with_the_stopper_under_a_staircase_at_one_kilohertz_is_a_moving
 // motion shows in that move alone, and the fits see it only because a short move is cut in
 // pieces fitted and scored in turn.
 #[test]
+#[ignore = "a broad case (about 1e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_mass_moving_with_the_stopper_in_its_one_move_inside_a_held_out_block_is_a_moving_mass() {
     let once = StopperMotion::Move {
         at: 2.6,
@@ -188,6 +189,7 @@ fn a_mass_moving_with_the_stopper_under_a_multisine_without_pressures_is_a_movin
 // Quadratic damping q v|v|, 300 N·s²/m²: 3 N at 0.1 m/s.
 
 #[test]
+#[ignore = "a broad case (about 9e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn quadratic_damping_under_a_staircase_at_one_kilohertz_is_quadratic_not_viscous() {
     let d = diagnosed(
         "quadratic-staircase",
@@ -210,6 +212,7 @@ fn quadratic_damping_under_a_staircase_at_one_kilohertz_is_quadratic_not_viscous
 }
 
 #[test]
+#[ignore = "a broad case (about 5e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn quadratic_damping_under_ramps_at_five_hundred_hertz_is_quadratic_damping() {
     let d = diagnosed(
         "quadratic-ramps",
@@ -253,6 +256,7 @@ fn quadratic_damping_under_a_multisine_with_a_shaken_stopper_at_250_hertz_withou
 // the return, changing with the command's pressures; the named piston_friction competes.
 
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_seal_friction_growing_with_the_pressure_under_a_staircase_at_one_kilohertz_is_found() {
     let d = diagnosed(
         "seal-staircase",
@@ -270,6 +274,7 @@ fn a_seal_friction_growing_with_the_pressure_under_a_staircase_at_one_kilohertz_
 }
 
 #[test]
+#[ignore = "a broad case (about 1e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_seal_friction_growing_with_the_pressure_under_ramps_at_five_hundred_hertz_is_found() {
     let d = diagnosed(
         "seal-ramps",

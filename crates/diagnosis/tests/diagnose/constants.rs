@@ -180,6 +180,7 @@ fn a_lower_better_damped_jet_pipe_resonance_under_a_prbs_at_two_kilohertz_is_its
 /// static curve explains as much with two constants: it replaces the curve, its travel
 /// within 3 %.
 #[test]
+#[ignore = "a broad case (about 4e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_jet_pipe_travel_thirty_percent_short_under_ramps_without_pressures_is_its_travel_not_a_command_curve() {
     let plant = BenchParams {
         x_jp_sat: 0.35e-3,
@@ -239,6 +240,7 @@ fn a_current_offset_under_a_multisine_without_pressures_is_an_offset_at_the_curr
 /// The gas 20 K warmer than the model's 293.15 K under a staircase at 1 kHz with pressures:
 /// a constant of the chambers, its temperature within 2 K, not a drift.
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_warmer_gas_under_a_staircase_is_its_temperature_not_a_drift() {
     let d = re_identified(
         "gas-temperature-staircase",

@@ -125,11 +125,13 @@ fn a_force_sensor_that_saturates_under_a_multisine_at_500_hertz_without_pressure
 }
 
 #[test]
+#[ignore = "a broad case (about 1e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_force_sensor_that_saturates_under_ramps_at_250_hertz_is_a_static_curve_flat_at_the_limit() {
     force_saturation_found("saturation-ramps", &spec(CommandProtocol::Ramps, 250.0, true), 50.0);
 }
 
 #[test]
+#[ignore = "a broad case (about 1e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn an_offset_and_a_gain_of_the_force_sensor_stay_an_offset_and_a_gain_not_a_curve() {
     let effects = BenchEffects {
         force_sensor_offset: 0.7,
@@ -250,6 +252,7 @@ fn dead_zone_found(label: &str, spec: &ProtocolSpec) {
 }
 
 #[test]
+#[ignore = "a broad case (about 4e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_dead_zone_in_the_command_under_a_sine_at_500_hertz_is_a_static_curve_at_the_command_read_as_a_dead_zone() {
     dead_zone_found("dead-zone-sine", &spec(CommandProtocol::Sine, 500.0, true));
 }
@@ -346,6 +349,7 @@ fn a_discharge_coefficient_rising_as_the_flow_chokes_under_a_multisine_at_500_he
 /// force sensor's curve explains nearly all: it is added from there, flat within 0.2 N of the
 /// limit, the dead volumes in the next round, each within 5 %, and the recording explained.
 #[test]
+#[ignore = "a broad case (about 6e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_force_sensor_saturating_beside_dead_volumes_is_found_on_the_force_against_the_pressures_then_the_dead_volumes() {
     let label = "saturation-beside-dead-volumes";
     let effects = BenchEffects {

@@ -236,6 +236,7 @@ fn clean_recordings_under_three_other_protocols_get_nothing() {
 }
 
 #[test]
+#[ignore = "a broad case (about 1e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_fifty_hertz_pickup_under_force_tracking_that_feeds_it_back_into_the_command_is_discovered() {
     let spec = ProtocolSpec {
         command: CommandProtocol::ForceTracking,
@@ -307,6 +308,7 @@ fn under_force_tracking_the_start_is_left_out_and_a_force_sensors_offset_gain_an
 /// floors); searched through the model, whose transducer follows the force between samples,
 /// the lag is found.
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_half_millisecond_force_sensor_lag_under_a_prbs_at_250_hertz_is_found_with_its_value() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Prbs,
@@ -404,6 +406,7 @@ fn a_fifteen_millisecond_jet_pipe_lag_under_a_staircase_is_found_as_the_jet_pipe
 /// the corner free beside it, a second term at the jet pipe does, and the corner returns to
 /// the extra lag's own, 1/15 ms.
 #[test]
+#[ignore = "a broad case (about 4e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn an_extra_jet_pipe_lag_under_a_multisine_without_pressures_is_explained_with_the_corner_refitted_beside_a_second_term(
 ) {
     let spec = ProtocolSpec {
@@ -435,6 +438,7 @@ fn an_extra_jet_pipe_lag_under_a_multisine_without_pressures_is_explained_with_t
 /// A leak from the supply into chamber 2 (an orifice of C_d·A 0.01 mm², a worn seat) under a
 /// staircase at 1 kHz with pressures: one of the chambers' leak library, found with its area.
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_leak_from_the_supply_into_chamber_2_under_a_staircase_is_an_extra_flow_of_the_chambers_with_its_area() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Staircase,
@@ -490,6 +494,7 @@ fn a_laminar_leak_from_chamber_1_under_a_multisine_without_pressures_is_a_lamina
 /// error is 8.6 noise floors before (0.43 N); the laminar member of the library from the
 /// supply explains it, found with its conductance.
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_laminar_leak_from_the_supply_into_chamber_2_under_a_staircase_is_a_laminar_extra_flow_of_the_chambers() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Staircase,
@@ -601,6 +606,7 @@ fn a_ringing_second_order_filter_on_the_force_sensor_under_a_multisine_is_found_
 /// A critically damped 30 Hz filter on the chamber 1 transducer under a staircase at 250 Hz
 /// with pressures: found at the pressure sensors.
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_critically_damped_filter_on_a_pressure_transducer_under_a_staircase_at_250_hertz_is_found_at_the_pressure_sensors()
 {
     let spec = ProtocolSpec {
@@ -629,6 +635,7 @@ fn a_critically_damped_filter_on_a_pressure_transducer_under_a_staircase_at_250_
 /// filter) under a multisine at 1 kHz without pressures: found at the command as a
 /// second-order filter, not as a lag or a delay.
 #[test]
+#[ignore = "a broad case (about 3e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_second_order_filter_on_the_command_under_a_multisine_is_found_at_the_command_with_its_frequency_and_damping() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Multisine,
@@ -658,6 +665,7 @@ fn a_second_order_filter_on_the_command_under_a_multisine_is_found_at_the_comman
 /// makes in the force is partly undone by the command. The jet-pipe hysteresis is still named,
 /// with its width, and nothing else is added, at two rates.
 #[test]
+#[ignore = "a broad case (about 6e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn the_jet_pipe_hysteresis_is_named_under_force_tracking_that_answers_it() {
     let effects = BenchEffects {
         hysteresis_width: 0.12e-3,

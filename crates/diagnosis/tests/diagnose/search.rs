@@ -113,6 +113,7 @@ fn compound_found(label: &str, spec: &ProtocolSpec) {
 }
 
 #[test]
+#[ignore = "a broad case (about 3e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_supply_set_low_with_the_receivers_off_the_null_is_found_as_both_under_ramps_at_500_hz_without_pressures() {
     compound_found("compound-ramps", &spec(CommandProtocol::Ramps, moves(), 500.0, false));
 }
@@ -154,6 +155,7 @@ fn stopper_offset_found(label: &str, spec: &ProtocolSpec) {
 }
 
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_stopper_position_logged_one_millimetre_off_is_placed_at_the_chambers_under_a_staircase_at_500_hz_with_pressures() {
     stopper_offset_found(
         "stopper-offset-staircase",
@@ -303,6 +305,7 @@ fn a_gas_temperature_drifting_twenty_kelvin_is_found_at_the_chambers_and_explain
 /// not show, so the places upstream stay in the search (before, only the mechanics and the
 /// force sensor were fitted, and nothing was found: 2.4 noise floors, unexplained).
 #[test]
+#[ignore = "a broad case (about 1e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_gas_temperature_drift_is_found_at_the_chambers_when_the_pressures_are_too_noisy_to_show_it() {
     let shaken = StopperMotion::Sine {
         centre: 0.05,
@@ -324,6 +327,7 @@ fn a_gas_temperature_drift_is_found_at_the_chambers_when_the_pressures_are_too_n
 /// its penalty and replaced it (a cubic curve, the named effect never given). A richer term
 /// must now close a fifth of the way to the noise; the named effect stays.
 #[test]
+#[ignore = "a broad case (about 5e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_sensor_offset_and_gain_beside_a_command_delay_stays_the_named_effect_not_a_richer_curve() {
     let spec = ProtocolSpec {
         command: CommandProtocol::Prbs,

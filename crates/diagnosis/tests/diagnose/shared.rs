@@ -139,6 +139,7 @@ fn a_vent_restriction_is_found_at_the_return_as_a_vent_orifice_of_its_area() {
 }
 
 #[test]
+#[ignore = "a broad case (about 3e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn a_quadratic_force_sensor_is_found_at_the_force_sensor_with_its_curve() {
     undeclared(
         "u_sensor_quadratic.csv",

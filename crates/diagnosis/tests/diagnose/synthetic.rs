@@ -196,6 +196,7 @@ fn dead_volume_as_line_volumes() {
 }
 
 #[test]
+#[ignore = "a broad case (about 9e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn supply_pressure_drop_through_a_plenum() {
     single(
         "supply",
@@ -251,6 +252,7 @@ fn two_effects_at_once() {
 }
 
 #[test]
+#[ignore = "a broad case (about 2e+01 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn calibration_re_identifies_the_static_parameters() {
     // Start the diagnosis from a wrong discharge coefficient and jet pipe offset; with
     // --calibrate it must find the generator's values again (§3.3.1's identification).
