@@ -384,6 +384,54 @@ fn errors_section(report: &Value) -> String {
     html
 }
 
+/// A joint diagnosis's recordings, each replayed alone with the starting and the joint
+/// model, and what the joining says (none for a diagnosis of one recording).
+fn recordings_section(report: &Value) -> String {
+    let Some(recordings) = report["recordings"].as_array() else {
+        return String::new();
+    };
+    let mut html = String::from(
+        "<h2>Each recording under the joint model</h2><table id=recordings><tr><th>recording</th><th>rate</th>\
+         <th>noise floor</th><th>held-out force error before</th><th>after</th><th>after / noise floor</th>\
+         <th>within its noise</th><th>holds</th></tr>",
+    );
+    for r in recordings {
+        let holds: Vec<String> = r["holds"]
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_str).map(escape).collect())
+            .unwrap_or_default();
+        html.push_str(&format!(
+            "<tr><td>{}</td><td class=n>{}</td><td class=n>{}</td><td class=n>{}</td><td class=n>{}</td>\
+             <td class=n>{}</td><td>{}</td><td>{}</td></tr>",
+            escape(r["recording"].as_str().unwrap_or("")),
+            number(&r["rate_Hz"]).map_or_else(|| "—".into(), |x| amount(x, "Hz")),
+            newtons(&r["noise_floor_N"]),
+            newtons(&r["before"]["heldout_force_rms_N"]),
+            newtons(&r["after"]["heldout_force_rms_N"]),
+            number(&r["heldout_noise_floors"]["after"]).map_or_else(|| "—".into(), |x| format!("{x:.1}×")),
+            if r["explained"].as_bool() == Some(true) {
+                "yes"
+            } else {
+                "no"
+            },
+            if holds.is_empty() {
+                "—".to_string()
+            } else {
+                holds.join(", ")
+            },
+        ));
+    }
+    html.push_str("</table>");
+    let notes: Vec<String> = report["joint"]["notes"]
+        .as_array()
+        .map(|a| a.iter().filter_map(Value::as_str).map(escape).collect())
+        .unwrap_or_default();
+    if !notes.is_empty() {
+        html.push_str(&format!("<ul id=joint-notes><li>{}</li></ul>", notes.join("</li><li>")));
+    }
+    html
+}
+
 fn additions_section(report: &Value) -> String {
     let effects = report["effects"].as_array().cloned().unwrap_or_default();
     let discovered = report["discovered"].as_array().cloned().unwrap_or_default();
@@ -671,6 +719,7 @@ pub fn page(name: &str, report: &Value, figures: &[Figure], report_file: &str, i
         sentence = escape(summary.first().copied().unwrap_or("")),
     );
     html.push_str(&errors_section(report));
+    html.push_str(&recordings_section(report));
     html.push_str(&additions_section(report));
     html.push_str(&remainder_section(report));
     html.push_str(&figures_section(figures));

@@ -8,6 +8,7 @@ use crate::replay::replay;
 use crate::replay::replay_fast;
 use crate::replay::Replay;
 use crate::verdict::diagnosis::Diagnosis;
+use crate::verdict::joint::JointDiagnosis;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -46,10 +47,111 @@ pub fn diagnose_owned(
     options: &Options,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis, String> {
-    let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        diagnose_unguarded(recording, base, options, progress)
-    }));
-    run.unwrap_or_else(|fault| {
+    guarded(|| diagnose_unguarded(recording, base, options, progress))
+}
+
+/// Diagnose several recordings of one actuator together: one model, with one set of
+/// constants and terms, fitted to all of them (`crate::input::joint`), then each recording
+/// replayed alone with it (`crate::verdict::joint`). Each recording is named by its `String`
+/// in errors and in the report. A fault of the diagnosis itself comes back as an error.
+pub fn diagnose_joint(
+    recordings: Vec<(String, Recording)>,
+    base: &Parameters,
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<JointDiagnosis, String> {
+    guarded(|| diagnose_joint_unguarded(recordings, base, options, progress))
+}
+
+fn diagnose_joint_unguarded(
+    recordings: Vec<(String, Recording)>,
+    base: &Parameters,
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<JointDiagnosis, String> {
+    let start = Actuator::new(base.clone())?;
+    let (mut repaired, mut input_checks, mut to_judge, mut settling) = (vec![], vec![], vec![], vec![]);
+    for (name, mut recording) in recordings {
+        let glitches = crate::input::glitches::find_and_repair(&mut recording);
+        let checks = crate::input::checks::check_file(&recording, base).map_err(|e| format!("{name}: {e}"))?;
+        input_checks.extend(checks.into_iter().map(|c| format!("{name}: {c}")));
+        let spans = crate::input::glitches::set_aside_spans(&glitches);
+        // Its own start, as a diagnosis of it alone would measure it.
+        let smoothed = recording.with_stopper_smoothed();
+        let cx = Context::measure(
+            &smoothed,
+            &smoothed,
+            &start,
+            options,
+            spans.clone(),
+            &mut vec![],
+            &mut |_| {},
+        )?;
+        settling.push(cx.settled_from - smoothed.time[0]);
+        to_judge.push(crate::verdict::joint::RecordingToJudge {
+            name: name.clone(),
+            recording: recording.clone(),
+            glitch_spans: spans,
+            glitches: glitches.iter().filter(|g| g.sets_aside()).count(),
+            resampled: false,
+        });
+        repaired.push((name, recording, glitches));
+    }
+    let parts: Vec<(String, Recording)> = repaired.iter().map(|(n, r, _)| (n.clone(), r.clone())).collect();
+    let mut joined = crate::input::joint::join(&parts)?;
+    drop(parts);
+    crate::input::joint::readings_of_the_model(&mut joined, &start)?;
+    let mut glitches = vec![];
+    for ((_, _, own), part) in repaired.iter().zip(&joined.parts) {
+        glitches.extend(own.iter().cloned().map(|mut g| {
+            g.from_s += part.offset_s;
+            g.to_s += part.offset_s;
+            g
+        }));
+    }
+    drop(repaired);
+    // Each bridge and the next recording's own start are set aside together.
+    let bridges: Vec<(f64, f64)> = joined
+        .bridges
+        .iter()
+        .zip(joined.parts.iter().skip(1).zip(settling.iter().skip(1)))
+        .map(|(&(from, _), (part, &settle))| (from, joined.recording.time[part.rows.start] + settle))
+        .collect();
+    for (judged, part) in to_judge.iter_mut().zip(&joined.parts) {
+        judged.resampled = part.resampled;
+    }
+    for note in &joined.notes {
+        progress(note);
+    }
+    input_checks.extend(joined.notes.iter().cloned());
+    progress(&format!(
+        "{} recordings joined: {} samples, {} bridges set aside",
+        joined.parts.len(),
+        joined.recording.len(),
+        bridges.len()
+    ));
+    let prepared = Prepared {
+        recording: joined.recording.clone(),
+        glitches,
+        bridges: bridges.clone(),
+        input_checks,
+    };
+    let diagnosis = diagnose_prepared(prepared, base, options, progress)?;
+    let verdicts = crate::verdict::joint::judge_each(to_judge, base, &diagnosis, options, progress)?;
+    let mut notes = joined.notes.clone();
+    notes.extend(crate::verdict::joint::sentences(&verdicts));
+    joined.bridges = bridges;
+    Ok(JointDiagnosis {
+        diagnosis,
+        recordings: verdicts,
+        joined,
+        notes,
+    })
+}
+
+/// `run`, with a fault of the diagnosis itself (a panic) turned into an error that says so.
+fn guarded<T>(run: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|fault| {
         let message = fault
             .downcast_ref::<String>()
             .map(String::as_str)
@@ -70,7 +172,38 @@ pub(crate) fn diagnose_unguarded(
     // 1. The glitches set aside, the file's checks and the noise floors.
     let mut recording = recording;
     let glitches = crate::input::glitches::find_and_repair(&mut recording);
-    let mut input_checks = crate::input::checks::check_file(&recording, base)?;
+    let input_checks = crate::input::checks::check_file(&recording, base)?;
+    let prepared = Prepared {
+        recording,
+        glitches,
+        bridges: vec![],
+        input_checks,
+    };
+    diagnose_prepared(prepared, base, options, progress)
+}
+
+/// A recording ready for the diagnosis's steps: its glitches repaired, its file checked.
+pub(crate) struct Prepared {
+    pub(crate) recording: Recording,
+    pub(crate) glitches: Vec<crate::input::glitches::Glitch>,
+    /// Spans (s) set aside that are not glitches: the bridges between joined recordings.
+    pub(crate) bridges: Vec<(f64, f64)>,
+    pub(crate) input_checks: Vec<String>,
+}
+
+/// The diagnosis's steps from the noise floors on.
+pub(crate) fn diagnose_prepared(
+    prepared: Prepared,
+    base: &Parameters,
+    options: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Diagnosis, String> {
+    let Prepared {
+        recording,
+        glitches,
+        bridges,
+        mut input_checks,
+    } = prepared;
     if let Some(sentence) = crate::input::glitches::sentence(&glitches) {
         progress(&sentence);
         input_checks.push(sentence);
@@ -95,7 +228,8 @@ pub(crate) fn diagnose_unguarded(
     let departures = before_departures(&smoothed, &before_accurate);
     let departures: Vec<&[f64]> = departures.iter().map(Vec::as_slice).collect();
     let fitted = smoothed.rows_for_fits_where_departing(crate::input::recording::MAX_FIT_ROWS, &departures);
-    let set_aside = crate::input::glitches::set_aside_spans(&glitches);
+    let mut set_aside = crate::input::glitches::set_aside_spans(&glitches);
+    set_aside.extend(bridges);
     let cx = Context::measure(
         &smoothed,
         &fitted,

@@ -195,6 +195,22 @@ pub const FLEXIBLE_FITTED: usize = 3;
 /// Gauss–Newton linearisations of a flexible term's fit through the model.
 pub const FLEXIBLE_ITERATIONS: usize = 3;
 
+// Several recordings of one actuator diagnosed together ([`crate::input::joint`]).
+
+/// Rates within this fraction of each other are one rate: no recording is resampled.
+pub const SAME_RATE_WITHIN: f64 = 0.01;
+/// The stopper's speed between two recordings (m/s): half the most a bench plays (200 mm/s),
+/// so that the chambers' volumes change as on a bench.
+pub const BRIDGE_STOPPER_SPEED: f64 = 0.1;
+/// How long the bridge holds the next recording's first inputs (s): the chambers, the jet
+/// pipe and the transducers settle within tens of milliseconds.
+pub const BRIDGE_HOLD_SECONDS: f64 = 1.0;
+/// An addition is held by a recording when taking it out of the joint model raises one of
+/// that recording's channels by this many noise floors (held out for the force, over the
+/// whole for a pressure): a tenth of a floor, as an addition earns its keep
+/// ([`REDUNDANT_WITHIN_NOISE`]).
+pub const HELD_BY_RECORDING_NOISE_FLOORS: f64 = REDUNDANT_WITHIN_NOISE;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -99,6 +99,10 @@ enum Command {
         /// diagnosed side by side on them; with one recording, its candidate fits.
         #[arg(long)]
         jobs: Option<usize>,
+        /// The recordings are of one actuator: diagnose them together, one model for all
+        /// (one report, default NAME_joint.json after the first; with each recording's errors).
+        #[arg(long, conflicts_with = "out")]
+        joint: bool,
     },
     /// What to record next: from a diagnosis report that ties places or leaves a remainder,
     /// a protocol (time_s, v_da_V, x_s_m) on which its leading explanations differ most,
@@ -325,8 +329,34 @@ fn run(cli: Cli) -> Result<(), String> {
             plots,
             no_html,
             jobs,
+            joint,
         } => match out {
             Some(out) => diagnose_batch(recordings, out, params.as_deref(), (calibrate, flexible), jobs),
+            None if joint => {
+                if let Some(dir) = recordings.iter().find(|r| r.is_dir()) {
+                    return Err(format!(
+                        "{} is a directory: --joint takes the recordings' files",
+                        dir.display()
+                    ));
+                }
+                let report = match report {
+                    Some(report) => report,
+                    None => default_report_path(&recordings[0]).map(|r| joint_report_path(&r))?,
+                };
+                let page = if no_html { None } else { Some(page_path(&report)?) };
+                let destination = Destination {
+                    report: &report,
+                    page: page.as_deref(),
+                    plots: plots.as_deref(),
+                };
+                diagnose_joint(
+                    &recordings,
+                    &destination,
+                    params.as_deref(),
+                    (calibrate, flexible),
+                    jobs,
+                )
+            }
             None => {
                 let [recording] = recordings.as_slice() else {
                     return Err(match report {
@@ -335,7 +365,7 @@ fn run(cli: Cli) -> Result<(), String> {
                             recordings.len()
                         ),
                         None => format!(
-                            "{} recordings without --out: give one recording, or several with --out DIR",
+                            "{} recordings without --out: give one recording, several with --out DIR, or several of one actuator with --joint",
                             recordings.len()
                         ),
                     });
@@ -620,17 +650,107 @@ fn diagnose(
     let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &base, &options, &mut progress)?;
     let name = recording_path.display().to_string();
     let json = diagnosis.to_json(&name);
-    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
-    // An existing report is never left half-written; it is written before the figures, so
-    // that should they fail, the diagnosis is not lost with them.
-    jetpipe_cli::output::write_atomically(report, &text)?;
+    write_report(destination, &json)?;
+    let recording = jetpipe_diagnosis::input::recording::Recording::read(recording_path, &base)
+        .map_err(|e| format!("{e} (the report {} was written)", report.display()))?;
+    write_figures_and_page(destination, &name, &json, (&recording, &diagnosis, &base))?;
+    print_summary(&name, &diagnosis, destination);
+    println!("  ({:.1} s)", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// `report.json` for `report_joint.json`.
+fn joint_report_path(report: &std::path::Path) -> PathBuf {
+    let stem = report
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    report.with_file_name(format!("{stem}_joint.json"))
+}
+
+/// Several recordings of one actuator, one model for all (`diagnose --joint`).
+fn diagnose_joint(
+    paths: &[PathBuf],
+    destination: &Destination,
+    params: Option<&std::path::Path>,
+    (calibrate, flexible): (bool, bool),
+    jobs: Option<usize>,
+) -> Result<(), String> {
+    if jobs == Some(0) {
+        return Err("--jobs 0 is invalid: must be at least 1".to_string());
+    }
+    let started = Instant::now();
+    let base = read_parameters(params)?;
+    let mut recordings = vec![];
+    for path in paths {
+        let recording = jetpipe_diagnosis::input::recording::Recording::read(path, &base)?;
+        recordings.push((path.display().to_string(), recording));
+    }
+    let bars = std::sync::Arc::new(TerminalBars::default());
+    let mut progress = |line: &str| {
+        let line = format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
+        bars.println(&line);
+    };
+    let mut options = jetpipe_diagnosis::Options {
+        calibrate,
+        flexible,
+        bars: Some(bars.clone()),
+        ..Default::default()
+    };
+    if let Some(jobs) = jobs {
+        options.jobs = jobs;
+    }
+    let joint = jetpipe_diagnosis::diagnose_joint(recordings, &base, &options, &mut progress)?;
+    let json = joint.to_json();
+    let name = json["recording"].as_str().unwrap_or("joint").to_string();
+    write_report(destination, &json)?;
+    write_figures_and_page(
+        destination,
+        &name,
+        &json,
+        (&joint.joined.recording, &joint.diagnosis, &base),
+    )?;
+    print_summary(&name, &joint.diagnosis, destination);
+    for r in &joint.recordings {
+        println!(
+            "  {}: held-out force error {:.4} → {:.4} N ({:.2} noise floors){}",
+            r.name,
+            r.before.heldout_rms,
+            r.after.heldout_rms,
+            r.after.heldout_rms / r.noise_floor,
+            if r.explained() { ", within its noise" } else { "" }
+        );
+    }
+    for note in &joint.notes {
+        println!("  {note}");
+    }
+    println!("  ({:.1} s)", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// The report, written whole or not at all: an existing report is never left half-written,
+/// and it is written before the figures, so that should they fail the diagnosis is not lost.
+fn write_report(destination: &Destination, json: &serde_json::Value) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(json).map_err(|e| e.to_string())? + "\n";
+    jetpipe_cli::output::write_atomically(destination.report, &text)
+}
+
+/// The figures (with --plots) and the page beside the report.
+fn write_figures_and_page(
+    destination: &Destination,
+    name: &str,
+    json: &serde_json::Value,
+    (recording, diagnosis, base): (
+        &jetpipe_diagnosis::input::recording::Recording,
+        &jetpipe_diagnosis::Diagnosis,
+        &Parameters,
+    ),
+) -> Result<(), String> {
+    let report = destination.report;
     let figures_failed = |e: String| format!("{e} (the report {} was written)", report.display());
-    let recording =
-        jetpipe_diagnosis::input::recording::Recording::read(recording_path, &base).map_err(figures_failed)?;
     let inputs = jetpipe_cli::plots::FigureInputs {
-        recording: &recording,
-        diagnosis: &diagnosis,
-        base: &base,
+        recording,
+        diagnosis,
+        base,
     };
     let figures = match destination.plots {
         Some(dir) => {
@@ -649,9 +769,13 @@ fn diagnose(
         let report_file = report
             .file_name()
             .map_or_else(|| report.display().to_string(), |f| f.to_string_lossy().into_owned());
-        let html = jetpipe_cli::html_report::page(&name, &json, &figures, &report_file, None);
+        let html = jetpipe_cli::html_report::page(name, json, &figures, &report_file, None);
         jetpipe_cli::output::write_atomically(page, &html)?;
     }
+    Ok(())
+}
+
+fn print_summary(name: &str, diagnosis: &jetpipe_diagnosis::Diagnosis, destination: &Destination) {
     println!(
         "{name}: {} samples, noise floor {:.4} N",
         diagnosis.samples, diagnosis.noise_floor
@@ -660,12 +784,10 @@ fn diagnose(
     for line in diagnosis.summary() {
         println!("  {line}");
     }
-    println!("  report: {}", report.display());
+    println!("  report: {}", destination.report.display());
     if let Some(page) = destination.page {
         println!("  page: {}", page.display());
     }
-    println!("  ({:.1} s)", started.elapsed().as_secs_f64());
-    Ok(())
 }
 
 fn diagnose_batch(

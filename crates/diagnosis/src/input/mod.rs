@@ -5,6 +5,7 @@ pub mod acceleration;
 pub mod blocks;
 pub mod checks;
 pub mod glitches;
+pub mod joint;
 pub mod lines;
 pub mod noise;
 pub mod recording;

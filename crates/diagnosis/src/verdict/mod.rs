@@ -3,5 +3,6 @@
 
 pub(crate) mod conclude;
 pub mod diagnosis;
+pub mod joint;
 pub(crate) mod report;
 pub(crate) mod split;

@@ -12,6 +12,7 @@
 //! * `constants`: a thesis constant of the plant other than the model's, re-identified;
 //! * `modulations`: a constant of the model varying with a signal of the chain;
 //! * `intervals`: the intervals and margins of a report;
+//! * `joint`: several recordings of one actuator diagnosed together;
 //! * `flexible`: a departure no readable class holds, closed by a flexible term.
 //!
 //! The test command runs a representative subset: every module, each place of the chain
@@ -33,6 +34,7 @@ mod flexible;
 mod flows;
 mod glitches;
 mod intervals;
+mod joint;
 mod modulations;
 mod noise;
 mod protocols;
