@@ -121,7 +121,9 @@ def force_errors_through_fmu(unzipdir, model_description, vrs, recording, report
     return rms, reported, before
 
 
+# Broad: crates/cli/tests/diagnosis_through_fmu.rs drives the FMU as a report says on a friction.
 @needs_binaries
+@pytest.mark.broad
 def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description, vrs, tmp_path):
     recording, report = generated_and_diagnosed(tmp_path, "friction", "--seed", "31", "--friction-coulomb", "2.5")
     assert [e["name"] for e in report["effects"]][:1] == ["piston_friction"], report["effects"]
@@ -139,7 +141,8 @@ def test_fmu_start_values_reproduce_the_after_error(unzipdir, model_description,
 @pytest.mark.parametrize("mechanism,parameter,duration", [pytest.param("current_slew_limit", "current_slew_limit", 80,
                                                                        marks=pytest.mark.broad),
                                                           ("force_sensor_lag", "force_sensor_lag", 20),
-                                                          ("port_1_restriction", "port_line_volume_1", 40)])
+                                                          pytest.param("port_1_restriction", "port_line_volume_1", 40,
+                                                                       marks=pytest.mark.broad)])
 def test_fmu_start_values_of_a_discovered_term_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path, mechanism, parameter, duration):
     recording, report = generated_and_diagnosed(tmp_path, mechanism, "--seed", "41", "--duration", str(duration),
@@ -202,7 +205,8 @@ def test_fmu_start_values_of_a_pressure_transducer_reproduce_the_pressure_errors
 @needs_binaries
 @pytest.mark.parametrize("name,args,parameter", [
     ("moving_mass", ("--moving-mass", "0.1", "--stopper", "moves:0.2"), "extra_force_acceleration"),
-    ("seal_friction", ("--seal-pressure-friction", "1e-6", "--stopper", "moves:0.05"), "extra_force_sign_pressure"),
+    pytest.param("seal_friction", ("--seal-pressure-friction", "1e-6", "--stopper", "moves:0.05"),
+                 "extra_force_sign_pressure", marks=pytest.mark.broad),
 ])
 def test_fmu_start_values_of_an_extra_force_on_the_piston_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path, name, args, parameter):
@@ -227,8 +231,8 @@ def test_fmu_start_values_of_an_extra_force_on_the_piston_reproduce_the_after_er
 @pytest.mark.parametrize("name,options,prefix,outputs", [
     ("force_saturation", ("--protocol", "staircase", "--force-sensor-saturation", "40"),
      "force_sensor_curve", ("F_meas",)),
-    ("p1_saturation", ("--protocol", "ramps", "--sample-rate", "500", "--pressure-sensor-saturation", "450000"),
-     "p1_sensor_curve", ("P1_meas", "P2_meas")),
+    pytest.param("p1_saturation", ("--protocol", "ramps", "--sample-rate", "500", "--pressure-sensor-saturation", "450000"),
+                 "p1_sensor_curve", ("P1_meas", "P2_meas"), marks=pytest.mark.broad),
 ])
 def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
         unzipdir, model_description, vrs, tmp_path, name, options, prefix, outputs):
@@ -261,10 +265,10 @@ def test_fmu_start_values_of_a_static_curve_reproduce_the_errors_after(
      "force_sensor_filter_frequency"),
     ("mount_lag", ("--protocol", "staircase", "--sample-rate", "500", "--contact-stiffness", "2e4",
                    "--contact-lag", "1e-3"), "stopper_mount_lag"),
-    ("discharge_rise", ("--protocol", "multisine", "--sample-rate", "500", "--no-pressures",
-                        "--discharge-ratio-rise", "0.3"), "discharge_curve_y_2"),
-    ("supply_leak", ("--protocol", "staircase", "--sample-rate", "500", "--supply-leak-2", "1e-8"),
-     "chamber_supply_leak_2"),
+    pytest.param("discharge_rise", ("--protocol", "multisine", "--sample-rate", "500", "--no-pressures",
+                                    "--discharge-ratio-rise", "0.3"), "discharge_curve_y_2", marks=pytest.mark.broad),
+    pytest.param("supply_leak", ("--protocol", "staircase", "--sample-rate", "500", "--supply-leak-2", "1e-8"),
+                 "chamber_supply_leak_2", marks=pytest.mark.broad),
 ])
 def test_fmu_start_values_of_a_general_class_at_the_valve_chambers_sensor_or_mount_reproduce_the_after_error(
         unzipdir, model_description, vrs, tmp_path, name, options, parameter):

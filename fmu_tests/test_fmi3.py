@@ -196,6 +196,9 @@ def test_fmi3_co_simulation_follows_fmi2_co_simulation_in_a_chirp_within_1e_9_ne
     assert diff <= CS_LIMIT_N
 
 
+# Broad: test_tolerance_sweep.py runs FMI 3.0 Model Exchange on steps, sines, a chirp and a
+# moving stopper against Co-Simulation.
+@pytest.mark.broad
 def test_fmi3_model_exchange_follows_fmi2_co_simulation_in_the_standard_scenario_within_five_millinewtons_rms(fmu3_path, fmu2_path):
     signal = scenarios.input_signal()
     cs2 = simulate(fmu2_path, "CoSimulation", signal, scenarios.T_END, 1e-3)
@@ -205,6 +208,8 @@ def test_fmi3_model_exchange_follows_fmi2_co_simulation_in_the_standard_scenario
     assert rms < RMS_LIMIT_N
 
 
+# Broad: test_tolerance_sweep.py runs FMI 3.0 Model Exchange on a chirp at two tolerances.
+@pytest.mark.broad
 def test_fmi3_model_exchange_follows_fmi2_co_simulation_in_a_chirp_within_five_millinewtons_rms(fmu3_path, fmu2_path):
     signal = chirp_signal()
     cs2 = simulate(fmu2_path, "CoSimulation", signal, 2.0, 1e-4)
@@ -227,6 +232,8 @@ def test_with_the_measured_preset_fmi3_co_simulation_follows_fmi2_within_1e_9_ne
     assert np.max(np.abs(cs3["F_act"] - plain["F_act"])) > 0.1  # the preset is on
 
 
+# Broad: test_model_exchange_hysteresis.py runs the preset in FMI 3.0 Model Exchange.
+@pytest.mark.broad
 def test_with_the_measured_preset_and_its_hysteresis_fmi3_model_exchange_follows_fmi2_co_simulation(fmu3_path, fmu2_path):
     signal = scenarios.input_signal()[:401]
     values = preset()

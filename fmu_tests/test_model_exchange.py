@@ -189,6 +189,8 @@ def test_the_transport_delay_without_pade_sections_is_refused_when_initialisatio
         fmu.freeInstance()
 
 
+# Broad: test_model_exchange_hysteresis.py runs the preset through reversals and steps.
+@pytest.mark.broad
 def test_the_thesis_measured_preset_with_its_hysteresis_runs_in_model_exchange(fmu_path):
     """The whole preset: its fitted terms (flow constants, dead volume, vent) and its Bouc-Wen
     hysteresis, whose memory Model Exchange advances where the current reverses
