@@ -3,7 +3,8 @@
 //! stages, in the order a recording goes through them ([`diagnose`] runs them):
 //!
 //! 1. [`input`]: read and check the recording, measure each channel's noise floor and
-//!    spectral lines, and cut it into training and held-out blocks.
+//!    spectral lines, and cut it into training and held-out blocks; several recordings of one
+//!    actuator are joined into one ([`diagnose_joint`]).
 //! 2. [`replay`]: run the recording's inputs through the model (crate `jetpipe-model`), check
 //!    the fits' fixed-step replay against the error-controlled one, and form the signals
 //!    along the chain that a residual may follow.
@@ -17,7 +18,7 @@
 //!    carries its signature, a discovered term otherwise; alternatives, compounds,
 //!    elimination, and withdrawal of anything that leaves a worse model.
 //! 6. [`verdict`]: the final accurate replays, the verdict and the remainder's signature,
-//!    and the report.
+//!    the report, and for a joint diagnosis each recording under the joint model.
 //! 7. [`propose`]: from a report, what to record next: a protocol on which its leading
 //!    explanations differ most (`jetpipe propose`).
 //!

@@ -8,7 +8,7 @@
 //! first value, the stopper moved to its first position at [`BRIDGE_STOPPER_SPEED`] at most) and then
 //! holds both for [`BRIDGE_HOLD_SECONDS`], so that the model enters the next recording near the
 //! equilibrium a replay of it alone would start from. Nothing was measured there: the bridge's
-//! readings are the starting model's ([`readings_of_the_model`]), neither fitted, scored nor
+//! readings are the starting model's (put there by `diagnose.rs`), neither fitted, scored nor
 //! counted in any error.
 //!
 //! The recordings may differ in rate: all are brought to the lowest, a faster one sampled at
@@ -137,7 +137,8 @@ pub fn join(recordings: &[(String, Recording)]) -> Result<Joined, String> {
 
 /// Append the bridge from the joined recording's last sample to `next`'s first; returns
 /// the bridge's last time. Its readings are a straight line from the one recording's to the
-/// other's, until [`readings_of_the_model`] puts the starting model's there.
+/// other's, until the diagnosis puts the starting model's there
+/// (`diagnose.rs`, which may replay: this stage comes before the replays).
 fn bridge(joined: &mut Recording, next: &Recording, dt: f64) -> f64 {
     let last = joined.len() - 1;
     let (t_end, x_from, x_to) = (joined.time[last], joined.x_s[last], next.x_s[0]);
@@ -191,33 +192,6 @@ fn held_mean(r: &Recording, from: f64, to: f64) -> f64 {
         k += 1;
     }
     sum / (to - from)
-}
-
-/// The bridges' readings replaced by those of `model` replayed on the joined recording: a
-/// departure there is then the additions' alone, which is small, and the noise floors, the
-/// spectra, the choice of the stopper acceleration's window and the remainder's signature,
-/// which read every sample, do not take the bridges' straight lines for the actuator.
-pub fn readings_of_the_model(
-    joined: &mut Joined,
-    model: &jetpipe_model::physics::actuator::Actuator,
-) -> Result<(), String> {
-    let replayed = crate::replay::replay(
-        model,
-        &joined.recording.with_stopper_smoothed(),
-        1e-5,
-        joined.recording.len(),
-    )?;
-    let r = &mut joined.recording;
-    for pair in joined.parts.windows(2) {
-        for k in pair[0].rows.end..pair[1].rows.start {
-            r.force[k] = replayed.force[k];
-            if let (Some(p1), Some(p2)) = (r.p1.as_mut(), r.p2.as_mut()) {
-                p1[k] = replayed.p1[k];
-                p2[k] = replayed.p2[k];
-            }
-        }
-    }
-    Ok(())
 }
 
 /// `r` sampled at `rate` from its first sample: the measured channels and the stopper

@@ -15,8 +15,9 @@
 //! * `joint`: several recordings of one actuator diagnosed together;
 //! * `flexible`: a departure no readable class holds, closed by a flexible term.
 //!
-//! The test command runs a representative subset: every module, each place of the chain
-//! and each function class at least once. The other cases are `#[ignore]`d with the reason
+//! The test command runs a representative subset: every module but `flexible` (an opt-in
+//! option whose one case takes two minutes), each place of the chain and each function class
+//! at least once. The other cases are `#[ignore]`d with the reason
 //! "a broad case", and `scripts/bench_cases.sh` runs every case, each on its own, with its
 //! time (docs/results/diagnosis_cases.md has the table).
 //!
