@@ -91,6 +91,7 @@ fn assert_reported(d: &Diagnosis) {
 }
 
 #[test]
+#[ignore = "a broad case (about 49 s of wall time two at a time; its kind has other cases here); scripts/bench_cases.sh runs every case"]
 fn glitches_in_a_recording_with_hysteresis_are_set_aside_and_the_verdict_is_the_clean_ones() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/recordings/hysteresis.csv");
     let text = std::fs::read_to_string(path).unwrap();
