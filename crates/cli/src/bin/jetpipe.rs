@@ -625,26 +625,11 @@ fn diagnose(
     jobs: Option<usize>,
 ) -> Result<(), String> {
     let report = destination.report;
-    if jobs == Some(0) {
-        return Err("--jobs 0 is invalid: must be at least 1".to_string());
-    }
+    let (options, bars) = diagnosis_options((calibrate, flexible), jobs)?;
     let started = Instant::now();
     let base = read_parameters(params)?;
     let recording = jetpipe_diagnosis::input::recording::Recording::read(recording_path, &base)?;
-    let bars = std::sync::Arc::new(TerminalBars::default());
-    let mut progress = |line: &str| {
-        let line = format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
-        bars.println(&line);
-    };
-    let mut options = jetpipe_diagnosis::Options {
-        calibrate,
-        flexible,
-        bars: Some(bars.clone()),
-        ..Default::default()
-    };
-    if let Some(jobs) = jobs {
-        options.jobs = jobs;
-    }
+    let mut progress = |line: &str| bars.println(&format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64()));
     // The diagnosis keeps the recording; the figures read it again once the report is
     // written, so a long recording is not held twice meanwhile.
     let diagnosis = jetpipe_diagnosis::diagnose_owned(recording, &base, &options, &mut progress)?;
@@ -659,7 +644,28 @@ fn diagnose(
     Ok(())
 }
 
-/// `report.json` for `report_joint.json`.
+/// The options of one diagnosis (single or joint), with the terminal's progress bars.
+fn diagnosis_options(
+    (calibrate, flexible): (bool, bool),
+    jobs: Option<usize>,
+) -> Result<(jetpipe_diagnosis::Options, std::sync::Arc<TerminalBars>), String> {
+    if jobs == Some(0) {
+        return Err("--jobs 0 is invalid: must be at least 1".to_string());
+    }
+    let bars = std::sync::Arc::new(TerminalBars::default());
+    let mut options = jetpipe_diagnosis::Options {
+        calibrate,
+        flexible,
+        bars: Some(bars.clone()),
+        ..Default::default()
+    };
+    if let Some(jobs) = jobs {
+        options.jobs = jobs;
+    }
+    Ok((options, bars))
+}
+
+/// `NAME_joint.json` beside `NAME.json`: the joint report named after the first recording.
 fn joint_report_path(report: &std::path::Path) -> PathBuf {
     let stem = report
         .file_stem()
@@ -675,9 +681,7 @@ fn diagnose_joint(
     (calibrate, flexible): (bool, bool),
     jobs: Option<usize>,
 ) -> Result<(), String> {
-    if jobs == Some(0) {
-        return Err("--jobs 0 is invalid: must be at least 1".to_string());
-    }
+    let (options, bars) = diagnosis_options((calibrate, flexible), jobs)?;
     let started = Instant::now();
     let base = read_parameters(params)?;
     let mut recordings = vec![];
@@ -685,20 +689,7 @@ fn diagnose_joint(
         let recording = jetpipe_diagnosis::input::recording::Recording::read(path, &base)?;
         recordings.push((path.display().to_string(), recording));
     }
-    let bars = std::sync::Arc::new(TerminalBars::default());
-    let mut progress = |line: &str| {
-        let line = format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64());
-        bars.println(&line);
-    };
-    let mut options = jetpipe_diagnosis::Options {
-        calibrate,
-        flexible,
-        bars: Some(bars.clone()),
-        ..Default::default()
-    };
-    if let Some(jobs) = jobs {
-        options.jobs = jobs;
-    }
+    let mut progress = |line: &str| bars.println(&format!("[{:6.1} s] {line}", started.elapsed().as_secs_f64()));
     let joint = jetpipe_diagnosis::diagnose_joint(recordings, &base, &options, &mut progress)?;
     let json = joint.to_json();
     let name = json["recording"].as_str().unwrap_or("joint").to_string();
