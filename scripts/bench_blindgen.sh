@@ -20,6 +20,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/results.sh
+source scripts/blindgen_setup.sh
 record_results blindgen "Diagnosis of recordings drawn by an independent simulator (blindgen)" "$@"
 if [ $# -ne 2 ] || [ -z "${JETPIPE_BLINDGEN:-}" ]; then
     echo "usage: JETPIPE_BLINDGEN=DIR bash scripts/bench_blindgen.sh SEED COUNT" >&2
@@ -29,28 +30,8 @@ if [ $# -ne 2 ] || [ -z "${JETPIPE_BLINDGEN:-}" ]; then
 fi
 seed="$1"
 count="$2"
-[ -d "$JETPIPE_BLINDGEN" ] || { echo "bench_blindgen.sh: $JETPIPE_BLINDGEN is not a folder (blindgen is not shipped with the repository)" >&2; exit 2; }
-blindgen="$(cd "$JETPIPE_BLINDGEN" && pwd)/blindgen.py"
-[ -f "$blindgen" ] || { echo "bench_blindgen.sh: no blindgen.py in $JETPIPE_BLINDGEN (blindgen is not shipped with the repository)" >&2; exit 2; }
-venv=target/blindgen-venv
-if ! "$venv/bin/python" -c 'import numpy, numba' >/dev/null 2>&1; then
-    python3 -m venv "$venv" >&2
-    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check numpy numba >&2
-fi
-export NUMBA_CACHE_DIR="$PWD/target/blindgen-numba-cache"
-cargo build --release --bin jetpipe >&2
-work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
-# A copy of the program: a build during the run (cargo in another shell) does not change it.
-cp target/release/jetpipe "$work/"
 # JETPIPE_BLINDGEN_REPORTS=DIR keeps the reports in DIR (for `jetpipe propose` on them).
-# JETPIPE_BLINDGEN_DRAWS=DIR keeps the draws in DIR and takes them from there when they are
-# already drawn (blindgen is deterministic in the seed): the drawing, several minutes for 30,
-# can run while the program is still being built.
-draws="${JETPIPE_BLINDGEN_DRAWS:-$work/draws}"
-if [ "$(ls "$draws"/bg_"$seed"_*.csv 2>/dev/null | wc -l)" -ne "$count" ]; then
-    "$venv/bin/python" "$blindgen" draw --seed "$seed" --count "$count" --out "$draws" >&2
-fi
+blindgen_prepare bench_blindgen.sh "$seed" "$count"
 mkdir -p "$work/reports"
 echo "| draw | rate (Hz) | length (s) | pressures | verdict | found (location, family) | held-out after / noise floor | wall (s) | wall per sample (ms) |"
 echo "|---|---|---|---|---|---|---|---|---|"

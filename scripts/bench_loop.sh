@@ -17,6 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/results.sh
+source scripts/blindgen_setup.sh
 record_results loop "The bench loop: diagnose, propose, record, diagnose jointly (blindgen)" "$@"
 if [ $# -ne 2 ] || [ -z "${JETPIPE_BLINDGEN:-}" ]; then
     echo "usage: JETPIPE_BLINDGEN=DIR bash scripts/bench_loop.sh SEED COUNT" >&2
@@ -26,22 +27,7 @@ fi
 seed="$1"
 count="$2"
 seconds="${JETPIPE_LOOP_SECONDS:-40}"
-blindgen="$(cd "$JETPIPE_BLINDGEN" && pwd)/blindgen.py"
-[ -f "$blindgen" ] || { echo "bench_loop.sh: no blindgen.py in $JETPIPE_BLINDGEN" >&2; exit 2; }
-venv=target/blindgen-venv
-if ! "$venv/bin/python" -c 'import numpy, numba' >/dev/null 2>&1; then
-    python3 -m venv "$venv" >&2
-    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check numpy numba >&2
-fi
-export NUMBA_CACHE_DIR="$PWD/target/blindgen-numba-cache"
-cargo build --release --bin jetpipe >&2
-work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
-cp target/release/jetpipe "$work/"
-draws="${JETPIPE_BLINDGEN_DRAWS:-$work/draws}"
-if [ "$(ls "$draws"/bg_"$seed"_*.csv 2>/dev/null | wc -l)" -ne "$count" ]; then
-    "$venv/bin/python" "$blindgen" draw --seed "$seed" --count "$count" --out "$draws" >&2
-fi
+blindgen_prepare bench_loop.sh "$seed" "$count"
 mkdir -p "$work/first" "$work/second" "$work/joint" "$work/next" "$work/loop/.truth"
 echo "| draw | first report | why the loop | proposal: smallest predicted difference (noise floors) | joint report | each recording, held-out / noise floor: alone → joint | wall: first, propose, joint (s) |"
 echo "|---|---|---|---|---|---|---|"
