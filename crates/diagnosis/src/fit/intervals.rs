@@ -14,6 +14,14 @@
 //! larger than the curvature's by more than the blocks' own scatter allows (its 97.5 %
 //! chi-square point) and there are four blocks or more, the interval is the held-out blocks'
 //! one, with Student's t on as many degrees of freedom as blocks.
+//!
+//! The fits score candidates on the fixed-step replay, held within a tenth of a noise floor of
+//! the error-controlled one. Against n samples that tenth is not small: a departure of 0.1
+//! floors that leans on an amount's sensitivity moves its least-squares value by up to
+//! 0.1 √n standard errors (9 at 7,500 samples), beyond any interval from the noise. So the
+//! residual here is the error-controlled replay's, and each interval carries the
+//! Gauss–Newton step from the fitted value to that replay's least squares on the training
+//! blocks ([`Interval::step`]), which the conclusion takes before the interval is reported.
 
 use crate::candidates::declared_bounds;
 use crate::candidates::parameter_value;
@@ -22,6 +30,7 @@ use crate::fit::Sensitivity;
 use crate::input::blocks::Block;
 use crate::replay::replay_fast;
 use crate::replay::signals::CHANNELS;
+use crate::replay::Replay;
 use jetpipe_model::physics::actuator::Actuator;
 use jetpipe_model::physics::parameters::Parameters;
 
@@ -65,6 +74,21 @@ pub struct Interval {
     /// The held-out blocks' standard error over the curvature's (with the effective sample
     /// size); `None` with fewer than two held-out blocks.
     pub heldout_ratio: Option<f64>,
+    /// The Gauss–Newton step of this amount, all amounts moving together, from its value to
+    /// the least squares of the residual given on the training blocks; `low` and `high` are
+    /// around the value before the step.
+    pub step: f64,
+}
+
+impl Interval {
+    /// The same interval around the value moved by `shift`.
+    pub fn shifted(self, shift: f64) -> Interval {
+        Interval {
+            low: self.low + shift,
+            high: self.high + shift,
+            ..self
+        }
+    }
 }
 
 /// Whether `name` is an amount with an interval: a curve's knot count and abscissae and a
@@ -77,16 +101,19 @@ pub(crate) fn has_interval(name: &str) -> bool {
 /// The 95 % interval of each of `names` in the model `params` on the problem's recording
 /// and blocks (`problem.base` must be `params`), in the order given; `None` for an amount
 /// without one ([`has_interval`]), one at zero with a default of zero (no scale for its
-/// step), one the replay does not see, or when the model refuses the moved value. Also the
-/// replays taken (one, and one per amount).
+/// step), one the replay does not see, or when the model refuses the moved value. The
+/// residual is `accurate`'s, the error-controlled replay of `params` at the problem's rows,
+/// when given, else the fixed-step replay's. Also the replays taken (one, and one per amount).
 pub(crate) fn intervals(
     problem: &Problem,
     params: &Parameters,
     names: &[&'static str],
+    accurate: Option<&Replay>,
     jobs: usize,
 ) -> Result<(Vec<Option<Interval>>, usize), String> {
     let recording = problem.recording;
     let at = replay_fast(&Actuator::new(params.clone())?, recording, recording.len())?;
+    let residual_of = accurate.unwrap_or(&at);
     let thesis = Parameters::default();
     let steps: Vec<Option<f64>> = names
         .iter()
@@ -119,7 +146,7 @@ pub(crate) fn intervals(
         if problem.weights[c] == 0.0 {
             return vec![];
         }
-        let modelled = [&at.force, &at.p1, &at.p2][c];
+        let modelled = [&residual_of.force, &residual_of.p1, &residual_of.p2][c];
         problem.measured[c]
             .iter()
             .zip(modelled)
@@ -172,18 +199,19 @@ pub(crate) fn linearised_intervals(
     let p = columns.len();
     let at = |a: usize, c: usize, k: usize| columns[a][c].get(k).copied().unwrap_or(0.0);
     let measured: Vec<usize> = (0..CHANNELS).filter(|&c| !residual[c].is_empty()).collect();
-    // The curvature on the training samples, and the residual's variance there.
+    // The curvature and the gradient on the training samples.
     let mut curvature = nalgebra::DMatrix::<f64>::zeros(p, p);
-    let (mut sum_squares, mut terms) = (0.0, 0usize);
+    let mut gradient = vec![0.0; p];
+    let mut terms = 0usize;
     for (k, _) in blocks.iter().enumerate().filter(|(_, b)| **b == Block::Training) {
         for &c in &measured {
-            sum_squares += residual[c][k] * residual[c][k];
             terms += 1;
             for a in 0..p {
                 let ja = at(a, c, k);
                 if ja == 0.0 {
                     continue;
                 }
+                gradient[a] += ja * residual[c][k];
                 for b in a..p {
                     curvature[(a, b)] += ja * at(b, c, k);
                 }
@@ -206,6 +234,25 @@ pub(crate) fn linearised_intervals(
     let Some(inverse) = reduced.try_inverse() else {
         return out;
     };
+    // The Gauss–Newton step, and the residual it leaves (linearised), from which the
+    // variance and the influences are taken: a residual that still holds the step's share
+    // would count it as noise, once in the variance and again in every block's spread.
+    let step: Vec<f64> = (0..seen.len())
+        .map(|i| (0..seen.len()).map(|j| inverse[(i, j)] * gradient[seen[j]]).sum())
+        .collect();
+    let residual: [Vec<f64>; CHANNELS] = std::array::from_fn(|c| {
+        residual[c]
+            .iter()
+            .enumerate()
+            .map(|(k, r)| r - seen.iter().zip(&step).map(|(&a, s)| at(a, c, k) * s).sum::<f64>())
+            .collect()
+    });
+    let sum_squares: f64 = blocks
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == Block::Training)
+        .map(|(k, _)| measured.iter().map(|&c| residual[c][k] * residual[c][k]).sum::<f64>())
+        .sum();
     let variance = sum_squares / (terms - seen.len()) as f64;
     // Each sample's influence on the step: (JᵀJ)⁻¹ times its gradient.
     let influence = |k: usize| -> Vec<f64> {
@@ -273,6 +320,7 @@ pub(crate) fn linearised_intervals(
             high: values[a] + half_width,
             method,
             heldout_ratio,
+            step: step[i],
         });
     }
     out

@@ -83,7 +83,7 @@ fn fitted_intervals(r: &Recording) -> Vec<Interval> {
         set_parameter(&mut params, name, *value).unwrap();
     }
     let problem = Problem::new(r, &params, &blocks, [NOISE_N, 0.0, 0.0]);
-    let (found, _) = intervals(&problem, &params, &NAMES, 1).unwrap();
+    let (found, _) = intervals(&problem, &params, &NAMES, None, 1).unwrap();
     found.into_iter().map(|i| i.expect("an interval")).collect()
 }
 
@@ -235,6 +235,39 @@ fn a_misfit_only_the_heldout_blocks_carry_widens_the_interval_and_the_method_say
         widened.high - widened.low > 3.0 * (white.high - white.low),
         "{widened:?} against {white:?}"
     );
+}
+
+/// A residual that still holds a share of the column (as the fixed-step replay's departure
+/// from the accurate one leaves it): the interval's step is that share, to the least squares,
+/// and the interval is as wide as without it, since what the step takes is not noise.
+#[test]
+fn a_residual_along_the_column_is_the_step_and_does_not_widen_the_interval() {
+    let n = 20_000;
+    let blocks = Block::alternating(n, 1000);
+    let column: Vec<f64> = (0..n).map(|k| (k as f64 * 0.013).sin() + 0.5).collect();
+    let noise = normals(13, n);
+    let interval = |residual: Vec<f64>| {
+        linearised_intervals(
+            &[[column.clone(), vec![], vec![]]],
+            &[residual, vec![], vec![]],
+            &blocks,
+            &[1.0],
+        )[0]
+        .unwrap()
+    };
+    let white = interval(noise.clone());
+    let standard_error = 0.5 * (white.high - white.low) / Z_975;
+    assert!(white.step.abs() < 4.0 * standard_error, "{white:?}");
+    let share = 10.0 * standard_error;
+    let leaning = interval(noise.iter().zip(&column).map(|(e, c)| e + share * c).collect());
+    assert!(
+        (leaning.step - white.step - share).abs() < 1e-9 * share,
+        "step {} for a share of {share}",
+        leaning.step - white.step
+    );
+    assert_eq!(leaning.method, IntervalMethod::Curvature, "{leaning:?}");
+    let widths = (leaning.high - leaning.low) / (white.high - white.low);
+    assert!((widths - 1.0).abs() < 1e-6, "{leaning:?} against {white:?}");
 }
 
 #[test]

@@ -1,11 +1,14 @@
 //! Step 6: the final accurate replays, the verdict and the tests of the residual.
 
+use crate::candidates::declared_bounds;
 use crate::candidates::parameter_value;
+use crate::candidates::set_parameter;
 use crate::context::Context;
 use crate::fit::calibrate::Calibrated;
 use crate::fit::scored::Localization;
 use crate::input::blocks::Block;
 use crate::policy::EXPLAINED_WITHIN_NOISE;
+use crate::policy::NEGLIGIBLE_SHARE_OF_NOISE;
 use crate::replay::errors::errors;
 use crate::replay::errors::Errors;
 use crate::replay::replay;
@@ -41,11 +44,22 @@ fn drop_terms_at_defaults(found: &mut crate::decide::findings::Findings, progres
 }
 
 /// How sure each amount added is: its 95 % interval at the final model
-/// ([`crate::fit::intervals`]), from that model's replay on the fits' rows and blocks. Taken
-/// after every decision, which none of them reads, and not counted in the report's replays,
-/// so that a report says what it said before it had intervals. A model the moved values
-/// refuse leaves the intervals out, with a line of progress, rather than the report.
-fn set_intervals(cx: &Context, found: &mut crate::decide::findings::Findings, progress: &mut dyn FnMut(&str)) {
+/// ([`crate::fit::intervals`]), from that model's error-controlled replay `after` (of every
+/// sample of `cx.full`) on the fits' rows and blocks. Taken after every decision, which none
+/// of them reads, and not counted in the report's replays. The amounts first take the
+/// intervals' Gauss–Newton step to the error-controlled replay's least squares on the
+/// training blocks (the fits' fixed-step replay leans them by up to several standard errors),
+/// kept when the weighted training misfit falls and the held-out force error does not grow
+/// by more than [`NEGLIGIBLE_SHARE_OF_NOISE`] of a noise floor; `after` and `after_errors` are
+/// then the moved model's. A model the moved values refuse leaves the intervals out, with a
+/// line of progress, rather than the report.
+fn settle_and_set_intervals(
+    cx: &Context,
+    found: &mut crate::decide::findings::Findings,
+    (after, after_errors): (&mut Replay, &mut Errors),
+    replay_accurately: &dyn Fn(&Parameters) -> Result<(Replay, Errors), String>,
+    progress: &mut dyn FnMut(&str),
+) {
     let mut names: Vec<&'static str> = vec![];
     for (name, _) in found
         .effects
@@ -65,14 +79,75 @@ fn set_intervals(cx: &Context, found: &mut crate::decide::findings::Findings, pr
         names.len(),
         if names.len() == 1 { "" } else { "s" }
     ));
-    let problem = crate::fit::Problem::new(cx.recording, &found.params, &cx.blocks, cx.channel_noise);
-    let intervals = match crate::fit::intervals::intervals(&problem, &found.params, &names, cx.options.jobs) {
-        Ok((intervals, _)) => intervals,
-        Err(why) => {
-            progress(&format!("  no intervals: {why}"));
-            return;
-        }
+    let at_rows = |replay: &Replay| match cx.recording.full_rate.as_ref() {
+        Some(f) => replay.at_rows(&f.rows),
+        None => replay.clone(),
     };
+    let problem = crate::fit::Problem::new(cx.recording, &found.params, &cx.blocks, cx.channel_noise);
+    let accurate = at_rows(after);
+    let mut intervals =
+        match crate::fit::intervals::intervals(&problem, &found.params, &names, Some(&accurate), cx.options.jobs) {
+            Ok((intervals, _)) => intervals,
+            Err(why) => {
+                progress(&format!("  no intervals: {why}"));
+                return;
+            }
+        };
+    // The step to the error-controlled replay's least squares.
+    let mut settled = found.params.clone();
+    for (name, interval) in names.iter().zip(&intervals) {
+        if let Some(i) = interval {
+            let (lower, upper) = declared_bounds(name);
+            let value = (parameter_value(&settled, name) + i.step).clamp(lower, upper);
+            if set_parameter(&mut settled, name, value).is_err() {
+                settled = found.params.clone();
+                break;
+            }
+        }
+    }
+    if settled != found.params {
+        let misfit_before = training_misfit(&problem, &accurate);
+        match replay_accurately(&settled) {
+            Ok((moved, moved_errors))
+                if training_misfit(&problem, &at_rows(&moved)) < misfit_before
+                    && moved_errors.heldout_rms <= after_errors.heldout_rms + NEGLIGIBLE_SHARE_OF_NOISE * cx.noise =>
+            {
+                let moves: Vec<String> = names
+                    .iter()
+                    .zip(intervals.iter_mut())
+                    .filter_map(|(name, interval)| {
+                        let (from, to) = (parameter_value(&found.params, name), parameter_value(&settled, name));
+                        *interval = interval.map(|i| i.shifted(to - from));
+                        (to != from).then(|| format!("{name} {from:.6e} → {to:.6e}"))
+                    })
+                    .collect();
+                progress(&format!(
+                    "  the amounts moved to the error-controlled replay's least squares ({}): held-out force error {:.5} → {:.5} N",
+                    moves.join(", "),
+                    after_errors.heldout_rms,
+                    moved_errors.heldout_rms
+                ));
+                found.params = settled;
+                for e in found.effects.iter_mut() {
+                    for (name, value) in e.parameters.iter_mut() {
+                        *value = parameter_value(&found.params, name);
+                    }
+                }
+                for d in found.discovered.iter_mut() {
+                    for (name, value) in d.parameters.iter_mut() {
+                        *value = parameter_value(&found.params, name);
+                    }
+                }
+                (*after, *after_errors) = (moved, moved_errors);
+            }
+            Ok(_) => progress(
+                "  the step to the error-controlled replay's least squares did not lower the misfit: not taken",
+            ),
+            Err(why) => progress(&format!(
+                "  the step to the error-controlled replay's least squares was refused: {why}"
+            )),
+        }
+    }
     let of = |name: &str| names.iter().position(|n| *n == name).and_then(|k| intervals[k]);
     for e in found.effects.iter_mut() {
         e.intervals = e.parameters.iter().map(|(name, _)| of(name)).collect();
@@ -80,6 +155,24 @@ fn set_intervals(cx: &Context, found: &mut crate::decide::findings::Findings, pr
     for d in found.discovered.iter_mut() {
         d.intervals = d.parameters.iter().map(|(name, _)| of(name)).collect();
     }
+}
+
+/// The misfit the fits minimise, on the training blocks: the sum of squares of each measured
+/// channel's residual in its noise floors.
+fn training_misfit(problem: &crate::fit::Problem, replay: &Replay) -> f64 {
+    let modelled = [&replay.force, &replay.p1, &replay.p2];
+    (0..crate::replay::signals::CHANNELS)
+        .filter(|&c| problem.weights[c] != 0.0)
+        .map(|c| {
+            problem.measured[c]
+                .iter()
+                .zip(modelled[c])
+                .zip(problem.blocks)
+                .filter(|(_, &b)| b == Block::Training)
+                .map(|((m, y), _)| (problem.weights[c] * (m - y)).powi(2))
+                .sum::<f64>()
+        })
+        .sum()
 }
 
 /// The final accurate replay, the verdict (step 6) and the tests of the residual; `start` is
@@ -146,7 +239,13 @@ pub(crate) fn conclude(
         w
     });
     drop_terms_at_defaults(&mut found, progress);
-    set_intervals(cx, &mut found, progress);
+    settle_and_set_intervals(
+        cx,
+        &mut found,
+        (&mut after, &mut after_errors),
+        &replay_accurately,
+        progress,
+    );
     let final_model = Actuator::new(found.params.clone())?;
     let after = after;
     // The additions were scored on the fixed-step replay, checked against the accurate one
