@@ -43,6 +43,9 @@ fn drop_terms_at_defaults(found: &mut crate::decide::findings::Findings, progres
     });
 }
 
+/// A model's error-controlled replay of every sample, and its errors.
+type AccurateReplay<'a> = dyn Fn(&Parameters) -> Result<(Replay, Errors), String> + 'a;
+
 /// How sure each amount added is: its 95 % interval at the final model
 /// ([`crate::fit::intervals`]), from that model's error-controlled replay `after` (of every
 /// sample of `cx.full`) on the fits' rows and blocks. Taken after every decision, which none
@@ -57,7 +60,7 @@ fn settle_and_set_intervals(
     cx: &Context,
     found: &mut crate::decide::findings::Findings,
     (after, after_errors): (&mut Replay, &mut Errors),
-    replay_accurately: &dyn Fn(&Parameters) -> Result<(Replay, Errors), String>,
+    replay_accurately: &AccurateReplay,
     progress: &mut dyn FnMut(&str),
 ) {
     let mut names: Vec<&'static str> = vec![];
