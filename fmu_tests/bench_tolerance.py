@@ -19,10 +19,8 @@ simulated second, its restarts (events) and the wall time. The ways (see `tolera
 Outputs every 1 ms, compared at those instants with Co-Simulation of the inputs held every
 0.1 ms: for the interpolated runs the difference includes the hold (a linear interpolation
 against a zero-order hold); the smooth runs take the law delayed by half the hold, a zero-order
-hold's delay to first order (`tolerance_sweep.delayed`). The moving stopper runs held only (FMI 2.0 Model
-Exchange has no input derivatives: a stopper moved in continuous-time mode has no compression
-term), and so do the full-scale steps and the measured preset's sine with steps (a step is not
-interpolated).
+hold's delay to first order (`tolerance_sweep.delayed`). The full-scale steps and the measured
+preset's sine with steps run held only (a step is not interpolated).
 """
 
 from __future__ import annotations
@@ -39,7 +37,7 @@ import tolerance_sweep as ts  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 ARCHIVES = {"fmi2": ROOT / "dist" / "JetPipeActuator.fmu", "fmi3": ROOT / "dist" / "JetPipeActuator-fmi3.fmu"}
-HELD_ONLY = {"moving_stopper", "moving_stopper_volumes", "full_steps", "measured_preset"}
+HELD_ONLY = {"full_steps", "measured_preset"}
 
 
 def main():

@@ -290,7 +290,7 @@ def test_an_fmi3_instance_runs_model_exchange_calls_and_its_event_indicator_vari
         x2 = list(x)
         x2[4] += 1000.0  # P1 up by 1 kPa
         fmu.setContinuousStates((ctypes.c_double * nx)(*x2), nx)
-        assert fmu.getFloat64([vrs["P1"]])[0] == x2[4]
+        assert fmu.getFloat64([vrs["P1_at_mid_stroke"]])[0] == x2[4]
         enter_event, terminate = fmu.completedIntegratorStep()
         assert not enter_event and not terminate
         fmu.terminate()

@@ -83,7 +83,7 @@ def test_the_archive_declares_both_interfaces_with_one_binary_per_platform(fmu_p
     # the hysteresis memory is advanced after each step
     assert md.modelExchange.needsCompletedIntegratorStep  # (FMPy: not completedIntegratorStepNotNeeded)
     states = [d.variable.derivative.name for d in md.derivatives]
-    assert states == ["i", "x_jp", "x_jp_velocity", "x_jp_acceleration", "P1", "P2", "p_supply_plenum",
+    assert states == ["i", "x_jp", "x_jp_velocity", "x_jp_acceleration", "P1_at_mid_stroke", "P2_at_mid_stroke", "p_supply_plenum",
                       "p_return_plenum", "p_port_line_1", "p_port_line_2", "stopper_mount_load",
                       # the command stage's and the transducers' lags and filters
                       "command_lagged", "command_filtered", "command_filtered_rate", "F_meas_lagged", "F_meas_filtered", "F_meas_filtered_rate", "P1_meas_lagged", "P1_meas_filtered", "P1_meas_filtered_rate", "P2_meas_lagged", "P2_meas_filtered", "P2_meas_filtered_rate",

@@ -109,7 +109,7 @@ def test_actuator_structure_and_bounds():
     md = fmpy.read_model_description(str(fmu_file("JetPipeActuator")))
     by_name = {v.name: v for v in md.modelVariables}
     states = {d.variable.derivative.name for d in md.derivatives}
-    assert states == {"i", "x_jp", "x_jp_velocity", "x_jp_acceleration", "P1", "P2", "p_supply_plenum",
+    assert states == {"i", "x_jp", "x_jp_velocity", "x_jp_acceleration", "P1_at_mid_stroke", "P2_at_mid_stroke", "p_supply_plenum",
                       "p_return_plenum", "p_port_line_1", "p_port_line_2", "stopper_mount_load",
                       "command_lagged", "command_filtered", "command_filtered_rate", "F_meas_lagged", "F_meas_filtered", "F_meas_filtered_rate", "P1_meas_lagged", "P1_meas_filtered", "P1_meas_filtered_rate", "P2_meas_lagged", "P2_meas_filtered", "P2_meas_filtered_rate",
                       "command_delay_pade_1", "command_delay_pade_2", "command_delay_pade_3", "command_delay_pade_4", "command_delay_pade_5", "command_delay_pade_6", "command_delay_pade_7", "command_delay_pade_8"}

@@ -184,7 +184,8 @@ class Work:
 @contextmanager
 def counting(law=None, t_end=None, value_references=None):
     """Count CVODE's work in FMPy's Model Exchange runs made inside; with `law`, set v_DA and
-    x_s to `law(t, t_end)` in every right-hand side and root function, at their own time t."""
+    x_s to `law(t, t_end)` in every right-hand side and root function, at their own time t, and
+    at the time each step reaches, where FMPy reads the outputs."""
     work = Work()
     solver = sundials.CVodeSolver
     original = (solver.f, solver.g, solver.step, solver.reset)
@@ -210,7 +211,10 @@ def counting(law=None, t_end=None, value_references=None):
 
     def step(self, t, t_next):
         try:
-            return original[2](self, t, t_next)
+            reached = original[2](self, t, t_next)
+            # the inputs at the time reached, where FMPy reads the outputs and the states
+            set_inputs(self, reached[2])
+            return reached
         finally:
             n = c_long(0)
             sundials_cvode.CVodeGetNumSteps(self.cvode_mem, byref(n))

@@ -667,7 +667,7 @@ impl CoSimModel for ActuatorFmu {
 /// `extra_inflow_1`, `extra_inflow_2`, the flexible slots' parameters and, in the snapshot
 /// (its layout 10), their lags.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 12, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 13, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped

@@ -375,6 +375,9 @@ pub mod me_vr {
     pub const COMMAND_DELAY_PADE_SECTIONS: u32 = 942;
     pub const PADE_STATES: [u32; 8] = [943, 944, 945, 946, 947, 948, 949, 950];
     pub const PADE_DERIVATIVES: [u32; 8] = [951, 952, 953, 954, 955, 956, 957, 958];
+    /// The chambers' air as pressures at mid-stroke: the states in place of P1 and P2.
+    pub const P1_AT_MID_STROKE: u32 = 959;
+    pub const P2_AT_MID_STROKE: u32 = 960;
     /// The states beyond the six, in the order of the state vector (the volumes' pressures,
     /// the mount's load, the lags and filters, the Padé chain).
     pub const STATES: [u32; 25] = {
@@ -430,7 +433,7 @@ pub mod me_vr {
     };
     /// The first and the last of them.
     pub const FIRST: u32 = X_JP_VELOCITY;
-    pub const LAST: u32 = PADE_DERIVATIVES[7];
+    pub const LAST: u32 = P2_AT_MID_STROKE;
 }
 
 /// A continuous local of Model Exchange.
@@ -450,11 +453,12 @@ const fn local(name: &'static str, value_reference: u32, unit: &'static str, des
 }
 
 /// The continuous states of Model Exchange and their derivatives, after the table's rows: the
-/// six states of (4.1), [i, x_jp, ẋ_jp, ẍ_jp, P1, P2] (i, x_jp, P1 and P2 are outputs), then
+/// six states of (4.1) with the chambers' air at mid-stroke in place of P1 and P2 (i and x_jp
+/// are outputs), then
 /// the pressures of the gas volumes behind restrictions and the lagging stopper mount's load,
 /// then the command stage's and the transducers' lags and filters (each constant, its
 /// derivative 0, while its effect is off).
-pub const MODEL_EXCHANGE_VARIABLES: [Variable; 59] = [
+pub const MODEL_EXCHANGE_VARIABLES: [Variable; 61] = [
     local(
         "x_jp_velocity",
         me_vr::X_JP_VELOCITY,
@@ -466,6 +470,18 @@ pub const MODEL_EXCHANGE_VARIABLES: [Variable; 59] = [
         me_vr::X_JP_ACCELERATION,
         "m/s2",
         "jet-pipe tip acceleration (a continuous state of Model Exchange)",
+    ),
+    local(
+        "P1_at_mid_stroke",
+        me_vr::P1_AT_MID_STROKE,
+        "Pa",
+        "chamber 1's air as the pressure it would have at its volume with the stopper at mid-stroke, brought there with no flow (P1 (V1/V1_mid)^gamma): the state of Model Exchange in place of P1, which a moving stopper leaves unchanged",
+    ),
+    local(
+        "P2_at_mid_stroke",
+        me_vr::P2_AT_MID_STROKE,
+        "Pa",
+        "chamber 2's air as the pressure it would have at its volume with the stopper at mid-stroke, brought there with no flow (P2 (V2/V2_mid)^gamma): the state of Model Exchange in place of P2, which a moving stopper leaves unchanged",
     ),
     local("der(i)", me_vr::DER_I, "A/s", "rate of the coil current, (2.3)"),
     local("der(x_jp)", me_vr::DER_X_JP, "m/s", "rate of the jet-pipe position"),
@@ -482,16 +498,16 @@ pub const MODEL_EXCHANGE_VARIABLES: [Variable; 59] = [
         "rate of the jet-pipe acceleration, (2.6)",
     ),
     local(
-        "der(P1)",
+        "der(P1_at_mid_stroke)",
         me_vr::DER_P1,
         "Pa/s",
-        "rate of the chamber 1 pressure, (2.29)",
+        "rate of P1_at_mid_stroke: (2.29) with the volume's rate taken out, which the stopper's motion does not enter",
     ),
     local(
-        "der(P2)",
+        "der(P2_at_mid_stroke)",
         me_vr::DER_P2,
         "Pa/s",
-        "rate of the chamber 2 pressure, (2.29)",
+        "rate of P2_at_mid_stroke: (2.29) with the volume's rate taken out, which the stopper's motion does not enter",
     ),
     local(
         "p_supply_plenum",
@@ -793,8 +809,8 @@ pub const CONTINUOUS_STATES: [fmi2::model::ContinuousState; 31] = [
     state(vr::X_JP, me_vr::DER_X_JP),
     state(me_vr::X_JP_VELOCITY, me_vr::DER_X_JP_VELOCITY),
     state(me_vr::X_JP_ACCELERATION, me_vr::DER_X_JP_ACCELERATION),
-    state(vr::P1, me_vr::DER_P1),
-    state(vr::P2, me_vr::DER_P2),
+    state(me_vr::P1_AT_MID_STROKE, me_vr::DER_P1),
+    state(me_vr::P2_AT_MID_STROKE, me_vr::DER_P2),
     state(me_vr::P_SUPPLY_PLENUM, me_vr::DER_P_SUPPLY_PLENUM),
     state(me_vr::P_RETURN_PLENUM, me_vr::DER_P_RETURN_PLENUM),
     state(me_vr::P_PORT_LINE_1, me_vr::DER_P_PORT_LINE_1),

@@ -64,7 +64,15 @@ fn the_states_start_at_the_co_simulations_equilibrium_and_the_derivatives_are_th
         initialise(cs, None, &[], 2.5, 0.054);
         let x = states(c);
         let (_, y) = get_reals(cs, &[vr::I, vr::X_JP, vr::P1, vr::P2]);
-        assert_eq!([x[0], x[1], x[4], x[5]], [y[0], y[1], y[2], y[3]]);
+        let (_, pressures) = get_reals(c, &[vr::P1, vr::P2]);
+        assert_eq!([x[0], x[1], pressures[0], pressures[1]], [y[0], y[1], y[2], y[3]]);
+        // the chambers' states are their air at mid-stroke (x_s = 61 mm): P (V/V_mid)^1.4,
+        // chamber 1 at 28 mm of its 35 mm there, chamber 2 at 42 mm of 35
+        let air = [y[2] * (28.0f64 / 35.0).powf(1.4), y[3] * (42.0f64 / 35.0).powf(1.4)];
+        assert!(
+            (x[4] / air[0] - 1.0).abs() < 1e-12 && (x[5] / air[1] - 1.0).abs() < 1e-12,
+            "{x:?} vs {air:?}"
+        );
         // at rest: every rate vanishes (the pressures' to the equilibrium solver's tolerance)
         let dx = derivatives(c);
         assert!(dx[..4].iter().all(|d| d.abs() < 1e-9), "{dx:?}");
@@ -72,16 +80,21 @@ fn the_states_start_at_the_co_simulations_equilibrium_and_the_derivatives_are_th
         // without volumes, a lagging mount, lags, filters or Padé chain the twenty-five states beyond the
         // six stay put
         assert_eq!(dx[6..], [0.0; 25]);
-        // away from rest: Actuator::derivatives itself
+        // away from rest: Actuator::derivatives itself, at the pressures of the air set, the
+        // air's rates those of the pressures scaled to mid-stroke (the stopper held)
         let moved = [0.12, 1.5e-4, 0.02, -30.0, 4.1e5, 1.9e5];
         let mut all = x;
         all[..6].copy_from_slice(&moved);
+        let scale = [(28.0f64 / 35.0).powf(1.4), (42.0f64 / 35.0).powf(1.4)];
+        let mut at_pressures = moved;
+        at_pressures[4] /= scale[0];
+        at_pressures[5] /= scale[1];
         assert_eq!(fmi2SetContinuousStates(c, all.as_ptr(), NX), fmi2OK);
         let v_da = 3.0;
         assert_eq!(fmi2SetReal(c, &vr::V_DA, 1, &v_da), fmi2OK);
         let model = Actuator::new(Parameters::default()).unwrap();
         let expected = model.derivatives(
-            &ModelState::from(moved),
+            &ModelState::from(at_pressures),
             &Inputs {
                 v_da,
                 x_s: 0.054,
@@ -89,10 +102,24 @@ fn the_states_start_at_the_co_simulations_equilibrium_and_the_derivatives_are_th
                 plays: None,
             },
         );
-        assert_eq!(derivatives(c)[..6].to_vec(), expected.as_slice().to_vec());
+        let dx = derivatives(c);
+        let (_, pressures) = get_reals(c, &[vr::P1, vr::P2]);
+        for k in 0..2 {
+            assert!(
+                (pressures[k] / at_pressures[4 + k] - 1.0).abs() < 1e-12,
+                "{pressures:?} vs {at_pressures:?}"
+            );
+            let rate = expected[4 + k] * scale[k];
+            assert!(
+                (dx[4 + k] - rate).abs() <= 1e-9 * rate.abs(),
+                "{dx:?}: {rate} for state {}",
+                4 + k
+            );
+        }
+        assert_eq!(dx[..4].to_vec(), expected.as_slice()[..4].to_vec());
         // the derivative variables read the same
         let (_, d) = get_reals(c, &[me_vr::DER_I, me_vr::DER_P1, me_vr::X_JP_ACCELERATION]);
-        assert_eq!(d, vec![expected[0], expected[4], moved[3]]);
+        assert_eq!(d, vec![expected[0], dx[4], moved[3]]);
         free(c);
         free(cs);
     }
@@ -151,23 +178,120 @@ fn an_explicit_integration_of_the_derivatives_follows_the_co_simulation_step() {
     }
 }
 
+/// The stopper's law of the moving-stopper cases: 54 mm ± 8 mm at 20 Hz.
+fn swinging_stopper(t: f64) -> f64 {
+    0.054 + 0.008 * (2.0 * std::f64::consts::PI * 20.0 * t).sin()
+}
+
 #[test]
-fn a_stopper_moved_in_event_mode_jumps_the_pressures_as_in_co_simulation_and_is_reported() {
+fn a_stopper_moved_continuously_in_continuous_time_mode_compresses_the_air_as_in_co_simulation() {
+    let sink = Sink::default();
+    // rigid, compliant (2e-5 m/N), and compliant on a mount lagging by 2 ms
+    let compliant = [(vr::STOPPER_COMPLIANCE, 2e-5)];
+    let lagging = [(vr::STOPPER_COMPLIANCE, 2e-5), (vr::STOPPER_MOUNT_LAG, 2e-3)];
+    for params in [&[][..], &compliant[..], &lagging[..]] {
+        unsafe { run_swinging(&sink, params) }
+    }
+}
+
+/// [`a_stopper_moved_continuously_in_continuous_time_mode_compresses_the_air_as_in_co_simulation`] with `params`.
+unsafe fn run_swinging(sink: &Sink, params: &[(u32, f64)]) {
+    // Model Exchange by classical Runge–Kutta at 1 µs through the C ABI, x_s set at each
+    // stage's time as an importer feeds a continuous input; Co-Simulation stepped every
+    // 10 µs with x_s and its slope over the step; a third instance with the stopper held.
+    let c = instantiate_model_exchange(sink, "me");
+    initialise(c, None, params, 2.5, swinging_stopper(0.0));
+    assert_eq!(fmi2EnterContinuousTimeMode(c), fmi2OK);
+    let cs = instantiate(sink, "cs");
+    initialise(cs, Some(1e-8), params, 2.5, swinging_stopper(0.0));
+    let held = instantiate(sink, "held");
+    initialise(held, Some(1e-8), params, 2.5, swinging_stopper(0.0));
+    let h = 1e-6;
+    let mut x = states(c);
+    let rate = |t: f64, x: &[f64; NX]| {
+        assert_eq!(fmi2SetTime(c, t), fmi2OK);
+        let x_s = swinging_stopper(t);
+        assert_eq!(fmi2SetReal(c, &vr::X_S, 1, &x_s), fmi2OK);
+        assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
+        derivatives(c)
+    };
+    let add = |x: &[f64; NX], k: &[f64; NX], s: f64| {
+        let mut y = *x;
+        for i in 0..NX {
+            y[i] += s * k[i];
+        }
+        y
+    };
+    let (step, steps) = (1e-5, 1500);
+    let mut largest = [0.0f64; 3];
+    let mut moved_by_the_stopper = 0.0f64;
+    for n in 0..steps {
+        let t = n as f64 * step;
+        for k in 0..10 {
+            let s = t + k as f64 * h;
+            let k1 = rate(s, &x);
+            let k2 = rate(s + h / 2.0, &add(&x, &k1, h / 2.0));
+            let k3 = rate(s + h / 2.0, &add(&x, &k2, h / 2.0));
+            let k4 = rate(s + h, &add(&x, &k3, h));
+            for i in 0..NX {
+                x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        let slope = (swinging_stopper(t + step) - swinging_stopper(t)) / step;
+        let x_s = swinging_stopper(t);
+        let order = 1;
+        assert_eq!(fmi2SetReal(cs, &vr::X_S, 1, &x_s), fmi2OK);
+        assert_eq!(fmi2SetRealInputDerivatives(cs, &vr::X_S, 1, &order, &slope), fmi2OK);
+        assert_eq!(fmi2DoStep(cs, t, step, fmi2True), fmi2OK);
+        assert_eq!(fmi2DoStep(held, t, step, fmi2True), fmi2OK);
+        rate(t + step, &x);
+        let (_, me) = get_reals(c, &[vr::F_ACT, vr::P1, vr::P2]);
+        let (_, co) = get_reals(cs, &[vr::F_ACT, vr::P1, vr::P2]);
+        let (_, still) = get_reals(held, &[vr::F_ACT]);
+        for k in 0..3 {
+            largest[k] = largest[k].max((me[k] - co[k]).abs());
+        }
+        moved_by_the_stopper = moved_by_the_stopper.max((co[0] - still[0]).abs());
+    }
+    // 15 ms: the stopper's swing moves the force by newtons; Model Exchange follows it.
+    println!("{params:?}: F_act, P1, P2 {largest:?} apart, the swing {moved_by_the_stopper} N");
+    assert!(
+        moved_by_the_stopper > 1.0,
+        "{params:?}: the swing moves F_act by {moved_by_the_stopper} N"
+    );
+    assert!(largest[0] < 1e-3, "{params:?}: F_act {} N apart", largest[0]);
+    assert!(largest[1] < 10.0 && largest[2] < 10.0, "{params:?}: P1, P2 {largest:?}");
+    free(c);
+    free(cs);
+    free(held);
+}
+
+#[test]
+fn a_stopper_moved_in_event_mode_jumps_the_pressures_as_in_co_simulation_and_leaves_the_states() {
     let sink = Sink::default();
     unsafe {
         let c = running(&sink, 2.5, 0.054);
         let cs = instantiate(&sink, "cs");
         initialise(cs, None, &[], 2.5, 0.054);
         assert_eq!(fmi2EnterEventMode(c), fmi2OK);
+        let air = states(c);
         set_inputs(c, 2.5, 0.06);
         set_inputs(cs, 2.5, 0.06);
         let mut info = fmi2EventInfo::default();
         assert_eq!(fmi2NewDiscreteStates(c, &mut info), fmi2OK);
-        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2True);
+        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2False, "the air stays");
         assert_eq!(info.newDiscreteStatesNeeded, fmi2False);
-        assert_eq!(fmi2NewDiscreteStates(c, &mut info), fmi2OK);
-        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2False, "reported once");
-        assert_eq!(outputs(c), outputs(cs));
+        let moved = states(c);
+        for k in [4, 5] {
+            assert!((moved[k] / air[k] - 1.0).abs() < 1e-14, "{moved:?} vs {air:?}");
+        }
+        let (me, co) = (outputs(c), outputs(cs));
+        for k in 0..5 {
+            assert!(
+                (me[k] - co[k]).abs() <= 1e-12 * co[k].abs().max(1.0),
+                "{me:?} vs {co:?}"
+            );
+        }
         // outside the cylinder: refused, nothing moved
         let before = states(c);
         let from = sink.len();
@@ -392,12 +516,37 @@ fn the_gas_volumes_and_the_lagging_mount_are_states_with_the_co_simulations_rate
         let model = Actuator::new(p).unwrap();
         assert!(model.has_volume_states());
         let mut pressures = [0.0; PRESSURES_WITH_VOLUMES];
-        pressures[0] = x[4];
-        pressures[1] = x[5];
+        let (_, chambers) = get_reals(c, &[vr::P1, vr::P2]);
+        pressures[0] = chambers[0];
+        pressures[1] = chambers[1];
         pressures[2..].copy_from_slice(&x[6..11]);
         let expected = model.pressure_rates_with_volumes(&model.areas(x[1]), &pressures, 0.054, 0.0);
         let dx = derivatives(c);
-        assert_eq!(dx[4..11].to_vec(), expected.to_vec());
+        assert_eq!(dx[6..11].to_vec(), expected[2..].to_vec());
+        // The chambers' air at mid-stroke (x_s = 61 mm): the piston sits c A_p q beyond the
+        // stopper and moves with the mount's state q, so Q = P (V/V_mid)^1.4 moves at
+        // (V/V_mid)^1.4 (Ṗ + 1.4 P V̇/V), V1 = A_p (x_s + c A_p q − 26 mm), V2 = A_p (96 mm − …).
+        let area = std::f64::consts::PI * 15.875e-3f64.powi(2) / 4.0;
+        let stretch = 2e-5 * area;
+        let at = 0.054 + stretch * x[10];
+        let volumes = [area * (at - 0.026), area * (0.096 - at)];
+        let volume_rates = [area * stretch * dx[10], -area * stretch * dx[10]];
+        for k in 0..2 {
+            let air_rate = (volumes[k] / (area * 0.035)).powf(1.4)
+                * (expected[k] + 1.4 * pressures[k] * volume_rates[k] / volumes[k]);
+            assert!(
+                (dx[4 + k] - air_rate).abs() <= 1e-9 * air_rate.abs(),
+                "{dx:?}: {air_rate} for state {}",
+                4 + k
+            );
+            let air = pressures[k] * (volumes[k] / (area * 0.035)).powf(1.4);
+            assert!(
+                (x[4 + k] / air - 1.0).abs() < 1e-12,
+                "state {}: {} for {air}",
+                4 + k,
+                x[4 + k]
+            );
+        }
         assert_eq!(dx[11..], [0.0; 20], "no lag, filter or Pade chain");
         assert!(dx[6] != 0.0 && dx[8] != 0.0 && dx[10] != 0.0, "{dx:?}");
         assert_eq!(dx[7], 0.0, "no return plenum");

@@ -1,5 +1,6 @@
-//! The actuator as an FMI 2.0 Model Exchange model: thirty-one states, the six of (4.1),
-//! [i, x_jp, ẋ_jp, ẍ_jp, P1, P2], then the pressures of the four gas volumes behind
+//! The actuator as an FMI 2.0 Model Exchange model: thirty-one states, the six of (4.1)
+//! with the chambers' air in place of their pressures, [i, x_jp, ẋ_jp, ẍ_jp, Q1, Q2] (see
+//! the stopper's paragraph below), then the pressures of the four gas volumes behind
 //! restrictions and the lagging stopper mount's load, then the lags and second-order filters
 //! of the command stage and of the three transducers (module `filters`: three states each),
 //! then the eight sections of the transport delay's optional Padé chain (every state beyond
@@ -45,17 +46,24 @@
 //!   communication step (a flexible slot's lags advanced from step to step);
 //! * the constants that vary in time (not yet part of Model Exchange).
 //!
-//! The stopper: a new x_s set in event mode moves it at once as in Co-Simulation (the air in
-//! each chamber conserved, P V^γ constant), and `fmi2NewDiscreteStates` reports the changed
-//! pressures. FMI 2.0 Model Exchange has no input derivatives: an x_s that an importer moves
-//! continuously in continuous-time mode changes the volumes without the compression term of
-//! ẋ_s; Co-Simulation (with `fmi2SetRealInputDerivatives`) is the form for a moving stopper.
+//! The stopper, and why the chambers' states are their air, not their pressures: FMI has no
+//! input derivatives in Model Exchange, so the right-hand side cannot know ẋ_s, and (2.29)
+//! with P as the state needs it (its term −γ P V̇/V). The state Q_i = P_i (V_i/V_ref,i)^γ, the
+//! pressure chamber i's air would have brought with no flow to its volume at mid-stroke
+//! (`P1_at_mid_stroke`, `P2_at_mid_stroke`), moves with the flows alone
+//! (`chambers::reference_pressure_rate`): a stopper that an importer moves, at events or
+//! continuously in continuous-time mode, changes the pressures read from the states
+//! (`Actuator::pressures_from_reference`, with the piston where a compliant stopper or a
+//! lagging mount puts it) and leaves the states as they are, as the air in each chamber is
+//! conserved while the volume jumps. The instance keeps the pressures, and an x_s set moves
+//! them along their adiabats at once (the same jump Co-Simulation makes at an x_s it is given
+//! without a rate).
 
 use super::ActuatorFmu;
 use crate::variables::{me_vr, vr};
 use fmi2::model::{EventUpdate, ModelExchangeModel};
 use jetpipe_model::physics::actuator::{index, Actuator, Inputs, State};
-use jetpipe_model::physics::chambers::pressure_after_volume_jump;
+use jetpipe_model::physics::chambers::{pressure_after_volume_jump, reference_pressure_rate};
 use jetpipe_model::physics::current_driver;
 use jetpipe_model::physics::effects::PLAY_OPERATORS;
 use jetpipe_model::physics::jet_pipe;
@@ -124,8 +132,34 @@ pub(super) struct MeState {
     /// Where the stopper is: the last x_s set that is inside the cylinder (see
     /// [`ActuatorFmu::exit_initialization_model_exchange`]).
     x_s: f64,
-    /// The stopper moved since the last `fmi2NewDiscreteStates`: the pressures jumped.
-    states_changed: bool,
+}
+
+/// Where the mount's state is in the state vector.
+const MOUNT_STATE: usize = 6 + node::MOUNT;
+
+/// The volumes at which the chambers' air is stated (see the module's text): each chamber's
+/// with the stopper at the middle of its range.
+fn reference_volumes(model: &Actuator) -> (f64, f64) {
+    let (low, high) = model.cylinder.stopper_range();
+    model.cylinder.volumes(0.5 * (low + high))
+}
+
+/// The chambers' states: their air as pressures at [`reference_volumes`], for the pressures
+/// in `x`, the mount's state in `nodes` and the stopper at `x_s`.
+fn air_states(model: &Actuator, x: &State, nodes: &Nodes, x_s: f64) -> [f64; 2] {
+    let (p1, p2) = (x[index::P1], x[index::P2]);
+    let (v1, v2) = model.chamber_volumes(p1, p2, nodes[node::MOUNT], x_s);
+    let (r1, r2) = reference_volumes(model);
+    let n = model.polytropic_exponent;
+    [
+        pressure_after_volume_jump(n, p1, v1, r1),
+        pressure_after_volume_jump(n, p2, v2, r2),
+    ]
+}
+
+/// The chambers' pressures for their air `air` ([`air_states`]).
+fn pressures_of_air(model: &Actuator, air: [f64; 2], nodes: &Nodes, x_s: f64) -> [f64; 2] {
+    model.pressures_from_reference(air, reference_volumes(model), nodes[node::MOUNT], x_s)
 }
 
 /// Why an effect is refused in Model Exchange, and the parameters that switch it on.
@@ -407,7 +441,8 @@ impl MeState {
     }
 }
 
-/// The rates of the [`STATES`] states: (4.1) from `Actuator::derivatives`; with gas volumes
+/// The rates of the [`STATES`] states: (4.1) from `Actuator::derivatives`, the chambers'
+/// air's from their pressures' (`chambers::reference_pressure_rate`); with gas volumes
 /// behind restrictions or a lagging mount, the pressures' from
 /// `Actuator::pressure_rates_with_volumes` (the law the Co-Simulation step integrates them
 /// with), else 0 for the volumes and the mount; the lags' and filters' from `filters::rates`
@@ -450,6 +485,16 @@ fn rates(at: &At<'_>) -> [f64; STATES] {
             chain,
         ));
     }
+    // The chambers' air from their pressures' rates, with the volumes' rates these imply
+    // (the piston moving with a compliant stopper or a lagging mount; the stopper held).
+    let (p1, p2) = (x[index::P1], x[index::P2]);
+    let (v1, v2) = model.chamber_volumes(p1, p2, nodes[node::MOUNT], x_s);
+    let offset_rate = model.piston_offset_rate(p1, p2, x_s, out[index::P1], out[index::P2], out[MOUNT_STATE]);
+    let (dv1, dv2) = model.cylinder.volume_rates(offset_rate);
+    let (r1, r2) = reference_volumes(model);
+    let n = model.polytropic_exponent;
+    out[index::P1] = reference_pressure_rate(n, p1, out[index::P1], v1, dv1, r1);
+    out[index::P2] = reference_pressure_rate(n, p2, out[index::P2], v2, dv2, r2);
     out
 }
 
@@ -471,6 +516,8 @@ pub(super) fn state_variable(at: &At<'_>, value_reference: u32) -> Option<f64> {
     match value_reference {
         me_vr::X_JP_VELOCITY => Some(at.x[index::JET_VELOCITY]),
         me_vr::X_JP_ACCELERATION => Some(at.x[index::JET_ACCELERATION]),
+        me_vr::P1_AT_MID_STROKE => Some(air_states(at.model, at.x, at.nodes, at.x_s)[0]),
+        me_vr::P2_AT_MID_STROKE => Some(air_states(at.model, at.x, at.nodes, at.x_s)[1]),
         _ => None,
     }
 }
@@ -524,7 +571,6 @@ impl ActuatorFmu {
             sections: pade_sections(self.pade_sections)?,
             memory: simulation.hysteresis_memory(),
             x_s: simulation.x_s(),
-            states_changed: false,
         })
     }
 
@@ -565,19 +611,19 @@ impl ActuatorFmu {
         })
     }
 
-    /// A new x_s in a running Model Exchange instance: checked against the cylinder, and the
-    /// stopper moved at once as in Co-Simulation (the pressures jump, conserving the air).
+    /// A new x_s in a running Model Exchange instance, in any mode: checked against the
+    /// cylinder, and the stopper moved at once as in Co-Simulation (the pressures jump along
+    /// their adiabats; the states, the chambers' air, stay).
     pub(super) fn move_stopper_model_exchange(&mut self, x_s: f64) -> Result<(), String> {
         self.params.check_stopper(x_s)?;
         if let Some(me) = self.me.as_mut() {
-            let before = me.x_s;
-            if x_s != before {
-                let gamma = me.model.polytropic_exponent;
-                let (v1_before, v2_before) = me.model.cylinder.volumes(before);
-                let (v1_after, v2_after) = me.model.cylinder.volumes(x_s);
-                me.x[index::P1] = pressure_after_volume_jump(gamma, me.x[index::P1], v1_before, v1_after);
-                me.x[index::P2] = pressure_after_volume_jump(gamma, me.x[index::P2], v2_before, v2_after);
-                me.states_changed = true;
+            if x_s != me.x_s {
+                let (p1, p2) = (me.x[index::P1], me.x[index::P2]);
+                let [p1, p2] = me
+                    .model
+                    .pressures_after_stopper_jump(p1, p2, me.nodes[node::MOUNT], me.x_s, x_s);
+                me.x[index::P1] = p1;
+                me.x[index::P2] = p2;
             }
             me.x_s = x_s;
         }
@@ -590,7 +636,7 @@ impl ActuatorFmu {
     }
 
     /// The Model Exchange part of the serialized state: the interface, then (when running)
-    /// time, states and whether the states changed.
+    /// time, states, the stopper and the hysteresis memory.
     pub(super) fn serialize_model_exchange(&self, w: &mut fmi2::state_bytes::ByteWriter) {
         w.bool(self.model_exchange);
         w.f64(self.pade_sections);
@@ -604,7 +650,6 @@ impl ActuatorFmu {
                 w.f64s(&me.filters);
                 w.f64s(&me.chain);
                 w.f64(me.x_s);
-                w.bool(me.states_changed);
                 w.bool(me.memory.is_some());
                 w.f64s(me.memory.as_ref().map_or(&[][..], |m| &m[..]));
             }
@@ -657,7 +702,6 @@ impl ActuatorFmu {
             chain.copy_from_slice(&chain_values);
             let x_s = r.f64()?;
             restored.params.check_stopper(x_s)?;
-            let states_changed = r.bool("statesChanged")?;
             let model = Actuator::new(restored.params.clone())?;
             let has_memory = r.bool("hysteresisMemory")?;
             let memory_values = r.f64s_at_most(PLAY_OPERATORS, "hysteresis memory")?;
@@ -689,7 +733,6 @@ impl ActuatorFmu {
                 sections,
                 memory,
                 x_s,
-                states_changed,
             });
         }
         Ok(())
@@ -710,6 +753,8 @@ impl ModelExchangeModel for ActuatorFmu {
     fn continuous_states(&self, x: &mut [f64]) -> Result<(), String> {
         let me = self.me_view()?;
         x[..6].copy_from_slice(me.x.as_slice());
+        let air = air_states(&me.model, &me.x, &me.nodes, me.x_s);
+        x[index::P1..index::P1 + 2].copy_from_slice(&air);
         x[6..FILTERS].copy_from_slice(&me.nodes);
         x[FILTERS..CHAIN].copy_from_slice(&me.filters);
         x[CHAIN..].copy_from_slice(&me.chain);
@@ -722,16 +767,33 @@ impl ModelExchangeModel for ActuatorFmu {
             .as_mut()
             .ok_or_else(|| "the model is not initialised".to_string())?;
         for k in [index::P1, index::P2] {
-            if x[k] <= 0.0 {
+            if x[k] <= 0.0 || !x[k].is_finite() {
                 return Err(format!(
                     "x[{k}] = {} Pa is not an absolute pressure of {} (must be > 0)",
                     x[k],
-                    if k == index::P1 { "P1" } else { "P2" }
+                    if k == index::P1 {
+                        "P1_at_mid_stroke"
+                    } else {
+                        "P2_at_mid_stroke"
+                    }
                 ));
             }
         }
+        let mut nodes = [0.0; node::STATES];
+        nodes.copy_from_slice(&x[6..FILTERS]);
+        let pressures = pressures_of_air(&me.model, [x[index::P1], x[index::P2]], &nodes, me.x_s);
+        if let Some(p) = pressures.iter().find(|p| !(p.is_finite() && **p > 0.0)) {
+            return Err(format!(
+                "the chambers' air {:?} Pa at mid-stroke gives the pressure {p} Pa with the stopper at x_s = {} m (the mount's state {} Pa): not an absolute pressure",
+                [x[index::P1], x[index::P2]],
+                me.x_s,
+                nodes[node::MOUNT]
+            ));
+        }
         me.x = State::from_column_slice(&x[..6]);
-        me.nodes.copy_from_slice(&x[6..FILTERS]);
+        me.x[index::P1] = pressures[0];
+        me.x[index::P2] = pressures[1];
+        me.nodes = nodes;
         me.filters.copy_from_slice(&x[FILTERS..CHAIN]);
         me.chain.copy_from_slice(&x[CHAIN..]);
         Ok(())
@@ -773,16 +835,13 @@ impl ModelExchangeModel for ActuatorFmu {
         nominals[CHAIN..].iter_mut().for_each(|n| *n = 1.0);
     }
 
-    /// Every event (a reversal of the current, z7, among them) advances the hysteresis memory.
+    /// Every event (a reversal of the current, z7, among them) advances the hysteresis
+    /// memory; no continuous state changes at one (a stopper moved leaves the air as it is).
     fn new_discrete_states(&mut self) -> Result<EventUpdate, String> {
-        let changed = self.me.as_mut().map_or(false, |me| {
+        if let Some(me) = self.me.as_mut() {
             advance_memory(&me.model, &mut me.memory, me.x[index::CURRENT]);
-            std::mem::replace(&mut me.states_changed, false)
-        });
-        Ok(EventUpdate {
-            values_of_continuous_states_changed: changed,
-            ..EventUpdate::default()
-        })
+        }
+        Ok(EventUpdate::default())
     }
 
     /// The hysteresis memory advanced to the accepted step's end.

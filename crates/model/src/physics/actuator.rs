@@ -5,7 +5,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::chambers::{pressure_rate, CylinderGeometry};
+use super::chambers::{self, pressure_rate, CylinderGeometry};
 use super::effects::{self, Hysteresis, PLAY_OPERATORS};
 use super::jet_pipe::StaticCurve;
 use super::orifice_flow::{self, leakage_flow, mass_flow, FlowConstants};
@@ -768,6 +768,115 @@ impl Actuator {
     /// the state a lagging mount follows ([`node::MOUNT`]).
     pub fn mount_load(&self, p1: f64, p2: f64, x_s: f64) -> f64 {
         (p1 - p2).max(self.mount_floor(x_s))
+    }
+
+    /// How far beyond the stopper the piston sits (m): 0 on a rigid stopper ((2.32) puts it
+    /// at the stopper), c A_p times the mount's load on a compliant one: its state `mount` when
+    /// it lags, else [`Self::mount_load`] (the laws of [`Self::pressure_rates_with_volumes`]).
+    pub fn piston_offset(&self, p1: f64, p2: f64, mount: f64, x_s: f64) -> f64 {
+        let stretch = self.params.stopper_compliance * self.piston_area;
+        if stretch == 0.0 {
+            0.0
+        } else if self.mount_lag.is_some() {
+            stretch * mount
+        } else {
+            stretch * self.mount_load(p1, p2, x_s)
+        }
+    }
+
+    /// The rate of [`Self::piston_offset`] with the stopper held, for the rates `dp1`, `dp2`
+    /// and `dmount` of its pressures and of the mount's state.
+    pub fn piston_offset_rate(&self, p1: f64, p2: f64, x_s: f64, dp1: f64, dp2: f64, dmount: f64) -> f64 {
+        let stretch = self.params.stopper_compliance * self.piston_area;
+        if stretch == 0.0 {
+            0.0
+        } else if self.mount_lag.is_some() {
+            stretch * dmount
+        } else if p1 - p2 < self.mount_floor(x_s) {
+            0.0
+        } else {
+            stretch * (dp1 - dp2)
+        }
+    }
+
+    /// The chambers' volumes with the piston at [`Self::piston_offset`] beyond the stopper.
+    pub fn chamber_volumes(&self, p1: f64, p2: f64, mount: f64, x_s: f64) -> (f64, f64) {
+        self.cylinder.volumes(x_s + self.piston_offset(p1, p2, mount, x_s))
+    }
+
+    /// The chambers' pressures whose air, brought with no flow to the volumes `reference`, has
+    /// the pressures `at_reference` ([`chambers::reference_pressure_rate`]), with the piston
+    /// where those pressures put it. On a compliant stopper without a lag the offset e solves
+    /// e = c A_p max(P1(e) − P2(e), floor), whose right side falls as e grows (the piston
+    /// enlarges chamber 1 and shrinks chamber 2): one root, bracketed and found by the
+    /// Illinois method.
+    pub fn pressures_from_reference(
+        &self,
+        at_reference: [f64; 2],
+        reference: (f64, f64),
+        mount: f64,
+        x_s: f64,
+    ) -> [f64; 2] {
+        let n = self.polytropic_exponent;
+        let at = |offset: f64| {
+            let (v1, v2) = self.cylinder.volumes(x_s + offset);
+            [
+                chambers::pressure_after_volume_jump(n, at_reference[0], reference.0, v1),
+                chambers::pressure_after_volume_jump(n, at_reference[1], reference.1, v2),
+            ]
+        };
+        let stretch = self.params.stopper_compliance * self.piston_area;
+        if stretch == 0.0 || self.mount_lag.is_some() {
+            return at(self.piston_offset(0.0, 0.0, mount, x_s));
+        }
+        let floor = self.mount_floor(x_s);
+        // Beyond the cylinder a pressure is not finite: the offset is too far, the side < 0.
+        let side = |offset: f64| {
+            let p = at(offset);
+            let s = stretch * (p[0] - p[1]).max(floor) - offset;
+            if s.is_finite() {
+                s
+            } else {
+                f64::NEG_INFINITY
+            }
+        };
+        let low = stretch * floor;
+        let at_low = side(low);
+        if at_low <= 0.0 {
+            return at(low);
+        }
+        // The side falls at least as fast as the offset grows: its root is within at_low.
+        let (mut a, mut fa, mut b, mut fb) = (low, at_low, low + at_low, side(low + at_low));
+        for _ in 0..200 {
+            if fb == 0.0 || (b - a).abs() <= 4.0 * f64::EPSILON * (x_s.abs() + b.abs()) {
+                break;
+            }
+            let c = if fb.is_finite() && fa.is_finite() {
+                b - fb * (b - a) / (fb - fa)
+            } else {
+                0.5 * (a + b)
+            };
+            let c = if c > a.min(b) && c < a.max(b) { c } else { 0.5 * (a + b) };
+            let fc = side(c);
+            if (fc > 0.0) == (fb > 0.0) {
+                // a kept again: its side halved (Illinois), so that the next guess moves it.
+                fa *= 0.5;
+            } else {
+                a = b;
+                fa = fb;
+            }
+            b = c;
+            fb = fc;
+        }
+        at(b)
+    }
+
+    /// The chambers' pressures after the stopper jumps from `from` to `to` with no time for a
+    /// flow: the air in each conserved, P V^γ constant, the volumes before and after with the
+    /// piston where the pressures put it ([`Self::chamber_volumes`]).
+    pub fn pressures_after_stopper_jump(&self, p1: f64, p2: f64, mount: f64, from: f64, to: f64) -> [f64; 2] {
+        let before = self.chamber_volumes(p1, p2, mount, from);
+        self.pressures_from_reference([p1, p2], before, mount, to)
     }
 
     /// Static jet pipe position x̄ for a current, (2.4)–(2.5).

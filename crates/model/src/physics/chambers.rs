@@ -71,6 +71,22 @@ pub fn pressure_after_volume_jump(gamma: f64, pressure: f64, volume_before: f64,
     pressure * (volume_before / volume_after).powf(gamma)
 }
 
+/// The rate of the chamber's air as a pressure at a fixed reference volume V_ref, Q =
+/// P (V/V_ref)^γ (the pressure [`pressure_after_volume_jump`] would bring it to there), for
+/// the rate Ṗ of (2.29) at the volume's rate V̇: Q̇ = (V/V_ref)^γ (Ṗ + γ P V̇/V), which by
+/// (2.29) is γ R T ṁ V^(γ−1)/V_ref^γ. V̇ cancels: Q's rate does not need the stopper's
+/// velocity, which is why Model Exchange integrates Q.
+pub fn reference_pressure_rate(
+    gamma: f64,
+    pressure: f64,
+    pressure_rate: f64,
+    volume: f64,
+    volume_rate: f64,
+    reference_volume: f64,
+) -> f64 {
+    (volume / reference_volume).powf(gamma) * (pressure_rate + gamma * pressure * volume_rate / volume)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -117,5 +133,20 @@ mod tests {
         }
         let jump = pressure_after_volume_jump(gamma, p0, v0, v1);
         assert!((p - jump).abs() < 1e-6 * jump, "{p} vs {jump}");
+    }
+
+    #[test]
+    fn the_pressure_at_a_reference_volume_moves_with_the_flow_alone() {
+        let (gamma, r, t, p, v, v_ref, flow): (f64, f64, f64, f64, f64, f64, f64) =
+            (1.4, 287.0, 293.15, 3e5, 4e-6, 5e-6, 2e-5);
+        let alone = gamma * r * t * flow * v.powf(gamma - 1.0) / v_ref.powf(gamma);
+        for volume_rate in [0.0, 1e-4, -3e-3] {
+            let rate = pressure_rate(gamma, r, t, v, volume_rate, flow, p);
+            let q_rate = reference_pressure_rate(gamma, p, rate, v, volume_rate, v_ref);
+            assert!(
+                (q_rate - alone).abs() < 1e-12 * alone.abs(),
+                "{q_rate} vs {alone} at dV/dt {volume_rate}"
+            );
+        }
     }
 }

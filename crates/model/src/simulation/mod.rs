@@ -40,7 +40,6 @@ use self::stepping::volumes_need_the_split_method;
 use crate::electromechanics::ElectromechanicalPropagator;
 use crate::integrator::{Sdirk4, Statistics, Tolerances};
 use crate::physics::actuator::{index, Actuator, Outputs, State, N_STATES};
-use crate::physics::chambers::pressure_after_volume_jump;
 use crate::physics::command_stage::{self, CommandStage};
 use crate::physics::effects::PLAY_OPERATORS;
 use crate::physics::extra_force::{self, StopperMotion};
@@ -551,15 +550,16 @@ impl Simulation {
         Ok(())
     }
 
-    /// Move the stopper instantly, conserving the air in each chamber.
+    /// Move the stopper instantly, conserving the air in each chamber (with the piston where a
+    /// compliant stopper or a lagging mount puts it).
     pub fn set_stopper(&mut self, x_s: f64) -> Result<(), String> {
         self.model.params.check_stopper(x_s)?;
         if x_s != self.x_s {
-            let gamma = self.model.polytropic_exponent;
-            let (v1_before, v2_before) = self.model.cylinder.volumes(self.x_s);
-            let (v1_after, v2_after) = self.model.cylinder.volumes(x_s);
-            self.state[index::P1] = pressure_after_volume_jump(gamma, self.state[index::P1], v1_before, v1_after);
-            self.state[index::P2] = pressure_after_volume_jump(gamma, self.state[index::P2], v2_before, v2_after);
+            let (p1, p2) = (self.state[index::P1], self.state[index::P2]);
+            let mount = self.stopper_mount_state().unwrap_or(0.0);
+            let [p1, p2] = self.model.pressures_after_stopper_jump(p1, p2, mount, self.x_s, x_s);
+            self.state[index::P1] = p1;
+            self.state[index::P2] = p2;
             self.x_s = x_s;
             self.input_changed = true;
         }

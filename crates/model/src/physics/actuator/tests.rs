@@ -317,3 +317,73 @@ fn the_extra_flow_slots_are_off_by_default_and_leave_the_thesis_model_unchanged(
         );
     }
 }
+
+#[test]
+fn the_pressures_are_found_again_from_their_values_at_the_reference_volumes() {
+    let rigid = Parameters::default();
+    let compliant = Parameters {
+        stopper_compliance: 2e-4,
+        ..Parameters::default()
+    };
+    let lagging = Parameters {
+        stopper_compliance: 2e-4,
+        stopper_mount_lag: 5e-3,
+        ..Parameters::default()
+    };
+    let x_s = 0.054;
+    // P1 − P2 of 3 bar lies above the spring floor (0.13 bar at 54 mm), −1 bar on it.
+    for (name, params) in [("rigid", rigid), ("compliant", compliant), ("lagging", lagging)] {
+        let model = Actuator::new(params).unwrap();
+        let reference = model.cylinder.volumes(0.061);
+        for (p1, p2, mount) in [
+            (4.5e5_f64, 1.5e5_f64, 2.9e5_f64),
+            (1.5e5, 2.5e5, 0.2e5),
+            (6.0e5, 1.0e5, 5.0e5),
+        ] {
+            let (v1, v2) = model.chamber_volumes(p1, p2, mount, x_s);
+            let n = model.polytropic_exponent;
+            let at_reference = [
+                chambers::pressure_after_volume_jump(n, p1, v1, reference.0),
+                chambers::pressure_after_volume_jump(n, p2, v2, reference.1),
+            ];
+            let found = model.pressures_from_reference(at_reference, reference, mount, x_s);
+            for (f, p) in found.iter().zip([p1, p2]) {
+                assert!((f - p).abs() <= 1e-9 * p, "{name}: {found:?} for {:?}", [p1, p2]);
+            }
+        }
+        if name != "rigid" {
+            let moved = model.chamber_volumes(4.5e5, 1.5e5, 2.9e5, x_s);
+            assert!(
+                (moved.0 - model.cylinder.volumes(x_s).0).abs() > 1e-8,
+                "{name}: the piston moved"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_stopper_jump_conserves_each_chambers_air_with_the_piston_where_the_pressures_put_it() {
+    for lag in [0.0, 5e-3] {
+        let model = Actuator::new(Parameters {
+            stopper_compliance: 2e-4,
+            stopper_mount_lag: lag,
+            ..Parameters::default()
+        })
+        .unwrap();
+        let (p1, p2, mount) = (4.5e5, 1.5e5, 2.9e5);
+        let [q1, q2] = model.pressures_after_stopper_jump(p1, p2, mount, 0.054, 0.070);
+        let n = model.polytropic_exponent;
+        let before = model.chamber_volumes(p1, p2, mount, 0.054);
+        let after = model.chamber_volumes(q1, q2, mount, 0.070);
+        let air = |p: f64, v: f64| p * v.powf(n);
+        assert!(
+            (air(q1, after.0) / air(p1, before.0) - 1.0).abs() < 1e-12,
+            "lag {lag}: chamber 1"
+        );
+        assert!(
+            (air(q2, after.1) / air(p2, before.1) - 1.0).abs() < 1e-12,
+            "lag {lag}: chamber 2"
+        );
+        assert!(q1 < p1 && q2 > p2, "lag {lag}: chamber 1 grows, chamber 2 shrinks");
+    }
+}
