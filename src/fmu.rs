@@ -311,6 +311,7 @@ impl ActuatorFmu {
                 sections: 0,
                 v_da: simulation.v_da(),
                 x_s: simulation.x_s(),
+                scale: model_exchange::AirScale::at(simulation.model(), simulation.x_s()),
                 time: simulation.time(),
                 memory: memory.as_ref(),
             };

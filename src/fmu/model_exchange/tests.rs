@@ -245,3 +245,51 @@ fn fmu_states_carry_the_hysteresis_memory_and_a_restored_instance_continues_bit_
     }
     assert_eq!(d.0, d.1);
 }
+
+#[test]
+fn a_rigid_stoppers_cached_factors_give_the_general_conversions_and_rates() {
+    let model = Actuator::new(Parameters::default()).unwrap();
+    let x = State::from([0.1, 1e-4, 0.02, -30.0, 4.2e5, 1.7e5]);
+    let nodes = [0.0; node::STATES];
+    let filters = [0.0; filters::STATES];
+    let chain = [0.0; PADE_SECTIONS];
+    for x_s in [0.03, 0.054, 0.061, 0.09] {
+        let scale = AirScale::at(&model, x_s);
+        assert!(matches!(scale, AirScale::Rigid(_)), "{scale:?}");
+        let general = air_states(&model, &x, &nodes, x_s, AirScale::PistonMoves);
+        assert_eq!(air_states(&model, &x, &nodes, x_s, scale), general, "x_s {x_s}");
+        let back = pressures_of_air(&model, general, &nodes, x_s, scale);
+        let back_general = pressures_of_air(&model, general, &nodes, x_s, AirScale::PistonMoves);
+        for k in 0..2 {
+            let p = x[index::P1 + k];
+            assert!(
+                (back[k] - back_general[k]).abs() <= 4.0 * f64::EPSILON * p,
+                "x_s {x_s}: {back:?} {back_general:?}"
+            );
+            assert!(
+                (back[k] - p).abs() <= 8.0 * f64::EPSILON * p,
+                "x_s {x_s}: {back:?} for {p}"
+            );
+        }
+        let at = |scale| At {
+            model: &model,
+            x: &x,
+            nodes: &nodes,
+            filters: &filters,
+            chain: &chain,
+            sections: 0,
+            v_da: 3.0,
+            x_s,
+            scale,
+            time: 0.0,
+            memory: None,
+        };
+        assert_eq!(rates(&at(scale)), rates(&at(AirScale::PistonMoves)), "x_s {x_s}");
+    }
+    let compliant = Actuator::new(Parameters {
+        stopper_compliance: 1e-5,
+        ..Parameters::default()
+    })
+    .unwrap();
+    assert_eq!(AirScale::at(&compliant, 0.054), AirScale::PistonMoves);
+}

@@ -770,6 +770,11 @@ impl Actuator {
         (p1 - p2).max(self.mount_floor(x_s))
     }
 
+    /// Whether the piston sits at the stopper whatever the pressures ([`Self::piston_offset`] 0).
+    pub fn stopper_is_rigid(&self) -> bool {
+        self.params.stopper_compliance == 0.0
+    }
+
     /// How far beyond the stopper the piston sits (m): 0 on a rigid stopper ((2.32) puts it
     /// at the stopper), c A_p times the mount's load on a compliant one: its state `mount` when
     /// it lags, else [`Self::mount_load`] (the laws of [`Self::pressure_rates_with_volumes`]).
