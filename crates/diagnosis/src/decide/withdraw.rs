@@ -40,6 +40,14 @@ fn names(
         .collect()
 }
 
+/// Whether a model with errors `e` is worse than the starting model's `before`, held out or
+/// over the whole recording, by more than [`NEGLIGIBLE_SHARE_OF_NOISE`] of the force's `noise`
+/// floor: the rule no reported model breaks.
+pub(crate) fn worse_than_start(e: &Errors, before: &Errors, noise: f64) -> bool {
+    let negligible = NEGLIGIBLE_SHARE_OF_NOISE * noise;
+    e.heldout_rms > before.heldout_rms + negligible || e.rms > before.rms + negligible
+}
+
 /// The search scores its additions on the fast replay; the accurate one decides. When it
 /// finds the model with them worse than the model the diagnosis started from (`start`), held
 /// out or over the whole recording, by more than [`NEGLIGIBLE_SHARE_OF_NOISE`] of the force's
@@ -55,8 +63,7 @@ pub(crate) fn withdraw_if_worse<R>(
     noise: f64,
     replay_accurately: &mut dyn FnMut(&Parameters) -> Result<Replayed<R>, String>,
 ) -> Result<Option<Withdrawal<R>>, String> {
-    let negligible = NEGLIGIBLE_SHARE_OF_NOISE * noise;
-    let worse = |e: &Errors| e.heldout_rms > before.heldout_rms + negligible || e.rms > before.rms + negligible;
+    let worse = |e: &Errors| worse_than_start(e, before, noise);
     if !worse(after) {
         return Ok(None);
     }

@@ -50,16 +50,14 @@ type AccurateReplay<'a> = dyn Fn(&Parameters) -> Result<(Replay, Errors), String
 /// ([`crate::fit::intervals`]), from that model's error-controlled replay `after` (of every
 /// sample of `cx.full`) on the fits' rows and blocks. Taken after every decision, which none
 /// of them reads, and not counted in the report's replays. The amounts first take the
-/// intervals' Gauss–Newton step to the error-controlled replay's least squares on the
-/// training blocks (the fits' fixed-step replay leans them by up to several standard errors),
-/// kept when the weighted training misfit falls and the held-out force error does not grow
-/// by more than [`NEGLIGIBLE_SHARE_OF_NOISE`] of a noise floor; `after` and `after_errors` are
-/// then the moved model's. A model the moved values refuse leaves the intervals out, with a
-/// line of progress, rather than the report.
+/// intervals' Gauss–Newton step to the error-controlled replay's least squares
+/// ([`move_to_least_squares`]). A model the moved values refuse leaves the intervals out, with
+/// a line of progress, rather than the report.
 fn settle_and_set_intervals(
     cx: &Context,
     found: &mut crate::decide::findings::Findings,
     (after, after_errors): (&mut Replay, &mut Errors),
+    before_errors: &Errors,
     replay_accurately: &AccurateReplay,
     progress: &mut dyn FnMut(&str),
 ) {
@@ -82,75 +80,33 @@ fn settle_and_set_intervals(
         names.len(),
         if names.len() == 1 { "" } else { "s" }
     ));
-    let at_rows = |replay: &Replay| match cx.recording.full_rate.as_ref() {
-        Some(f) => replay.at_rows(&f.rows),
-        None => replay.clone(),
+    // (the model the intervals are taken at; `found` may move from it below)
+    let at = found.params.clone();
+    let problem = crate::fit::Problem::new(cx.recording, &at, &cx.blocks, cx.channel_noise);
+    let accurate = at_fitted_rows(cx, after);
+    let mut intervals = match crate::fit::intervals::intervals(&problem, &at, &names, Some(&accurate), cx.options.jobs)
+    {
+        Ok((intervals, _)) => intervals,
+        Err(why) => {
+            progress(&format!("  no intervals: {why}"));
+            return;
+        }
     };
-    let problem = crate::fit::Problem::new(cx.recording, &found.params, &cx.blocks, cx.channel_noise);
-    let accurate = at_rows(after);
-    let mut intervals =
-        match crate::fit::intervals::intervals(&problem, &found.params, &names, Some(&accurate), cx.options.jobs) {
-            Ok((intervals, _)) => intervals,
-            Err(why) => {
-                progress(&format!("  no intervals: {why}"));
-                return;
-            }
-        };
-    // The step to the error-controlled replay's least squares.
-    let mut settled = found.params.clone();
-    for (name, interval) in names.iter().zip(&intervals) {
-        if let Some(i) = interval {
-            let (lower, upper) = declared_bounds(name);
-            let value = (parameter_value(&settled, name) + i.step).clamp(lower, upper);
-            if set_parameter(&mut settled, name, value).is_err() {
-                settled = found.params.clone();
-                break;
-            }
-        }
-    }
-    if settled != found.params {
-        let misfit_before = training_misfit(&problem, &accurate);
-        match replay_accurately(&settled) {
-            Ok((moved, moved_errors))
-                if training_misfit(&problem, &at_rows(&moved)) < misfit_before
-                    && moved_errors.heldout_rms <= after_errors.heldout_rms + NEGLIGIBLE_SHARE_OF_NOISE * cx.noise =>
-            {
-                let moves: Vec<String> = names
-                    .iter()
-                    .zip(intervals.iter_mut())
-                    .filter_map(|(name, interval)| {
-                        let (from, to) = (parameter_value(&found.params, name), parameter_value(&settled, name));
-                        *interval = interval.map(|i| i.shifted(to - from));
-                        (to != from).then(|| format!("{name} {from:.6e} → {to:.6e}"))
-                    })
-                    .collect();
-                progress(&format!(
-                    "  the amounts moved to the error-controlled replay's least squares ({}): held-out force error {:.5} → {:.5} N",
-                    moves.join(", "),
-                    after_errors.heldout_rms,
-                    moved_errors.heldout_rms
-                ));
-                found.params = settled;
-                for e in found.effects.iter_mut() {
-                    for (name, value) in e.parameters.iter_mut() {
-                        *value = parameter_value(&found.params, name);
-                    }
-                }
-                for d in found.discovered.iter_mut() {
-                    for (name, value) in d.parameters.iter_mut() {
-                        *value = parameter_value(&found.params, name);
-                    }
-                }
-                (*after, *after_errors) = (moved, moved_errors);
-            }
-            Ok(_) => progress(
-                "  the step to the error-controlled replay's least squares did not lower the misfit: not taken",
-            ),
-            Err(why) => progress(&format!(
-                "  the step to the error-controlled replay's least squares was refused: {why}"
-            )),
-        }
-    }
+    let mut steps = Steps {
+        names: &names,
+        intervals: &mut intervals,
+        problem: &problem,
+        accurate: &accurate,
+    };
+    move_to_least_squares(
+        cx,
+        found,
+        &mut steps,
+        (after, after_errors),
+        before_errors,
+        replay_accurately,
+        progress,
+    );
     let of = |name: &str| names.iter().position(|n| *n == name).and_then(|k| intervals[k]);
     for e in found.effects.iter_mut() {
         e.intervals = e.parameters.iter().map(|(name, _)| of(name)).collect();
@@ -158,6 +114,100 @@ fn settle_and_set_intervals(
     for d in found.discovered.iter_mut() {
         d.intervals = d.parameters.iter().map(|(name, _)| of(name)).collect();
     }
+}
+
+/// An error-controlled replay at the rows the fits saw.
+fn at_fitted_rows(cx: &Context, replay: &Replay) -> Replay {
+    match cx.recording.full_rate.as_ref() {
+        Some(f) => replay.at_rows(&f.rows),
+        None => replay.clone(),
+    }
+}
+
+/// The amounts, their intervals (each with its Gauss–Newton step), the fits' problem and the
+/// error-controlled replay of the model at the fitted rows.
+struct Steps<'a> {
+    names: &'a [&'static str],
+    intervals: &'a mut [Option<crate::fit::intervals::Interval>],
+    problem: &'a crate::fit::Problem<'a>,
+    accurate: &'a Replay,
+}
+
+/// The amounts moved by their intervals' Gauss–Newton steps to the error-controlled replay's
+/// least squares on the training blocks (the fits' fixed-step replay leans them by up to
+/// several standard errors). Kept when the weighted training misfit falls, the held-out force
+/// error does not grow by more than [`NEGLIGIBLE_SHARE_OF_NOISE`] of a noise floor, and the
+/// moved model is not worse than the starting model (`before_errors`) by the rule of
+/// [`crate::decide::withdraw::worse_than_start`], which the withdrawal before it applied;
+/// then `found`'s values, the intervals' centres, `after` and `after_errors` are the moved
+/// model's.
+fn move_to_least_squares(
+    cx: &Context,
+    found: &mut crate::decide::findings::Findings,
+    steps: &mut Steps<'_>,
+    (after, after_errors): (&mut Replay, &mut Errors),
+    before_errors: &Errors,
+    replay_accurately: &AccurateReplay,
+    progress: &mut dyn FnMut(&str),
+) {
+    let mut settled = found.params.clone();
+    for (name, interval) in steps.names.iter().zip(steps.intervals.iter()) {
+        if let Some(i) = interval {
+            let (lower, upper) = declared_bounds(name);
+            let value = (parameter_value(&settled, name) + i.step).clamp(lower, upper);
+            if set_parameter(&mut settled, name, value).is_err() {
+                return;
+            }
+        }
+    }
+    if settled == found.params {
+        return;
+    }
+    let misfit_before = training_misfit(steps.problem, steps.accurate);
+    let (moved, moved_errors) = match replay_accurately(&settled) {
+        Ok(replayed) => replayed,
+        Err(why) => {
+            progress(&format!(
+                "  the step to the error-controlled replay's least squares was refused: {why}"
+            ));
+            return;
+        }
+    };
+    let taken = training_misfit(steps.problem, &at_fitted_rows(cx, &moved)) < misfit_before
+        && moved_errors.heldout_rms <= after_errors.heldout_rms + NEGLIGIBLE_SHARE_OF_NOISE * cx.noise
+        && !crate::decide::withdraw::worse_than_start(&moved_errors, before_errors, cx.noise);
+    if !taken {
+        progress("  the step to the error-controlled replay's least squares did not lower the misfit within the errors allowed: not taken");
+        return;
+    }
+    let moves: Vec<String> = steps
+        .names
+        .iter()
+        .zip(steps.intervals.iter_mut())
+        .filter_map(|(name, interval)| {
+            let (from, to) = (parameter_value(&found.params, name), parameter_value(&settled, name));
+            *interval = interval.map(|i| i.shifted(to - from));
+            (to != from).then(|| format!("{name} {from:.6e} → {to:.6e}"))
+        })
+        .collect();
+    progress(&format!(
+        "  the amounts moved to the error-controlled replay's least squares ({}): held-out force error {:.5} → {:.5} N",
+        moves.join(", "),
+        after_errors.heldout_rms,
+        moved_errors.heldout_rms
+    ));
+    found.params = settled;
+    for e in found.effects.iter_mut() {
+        for (name, value) in e.parameters.iter_mut() {
+            *value = parameter_value(&found.params, name);
+        }
+    }
+    for d in found.discovered.iter_mut() {
+        for (name, value) in d.parameters.iter_mut() {
+            *value = parameter_value(&found.params, name);
+        }
+    }
+    (*after, *after_errors) = (moved, moved_errors);
 }
 
 /// The misfit the fits minimise, on the training blocks: the sum of squares of each measured
@@ -246,6 +296,7 @@ pub(crate) fn conclude(
         cx,
         &mut found,
         (&mut after, &mut after_errors),
+        &before_errors,
         &replay_accurately,
         progress,
     );
