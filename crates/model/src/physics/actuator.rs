@@ -780,7 +780,7 @@ impl Actuator {
     /// it lags, else [`Self::mount_load`] (the laws of [`Self::pressure_rates_with_volumes`]).
     pub fn piston_offset(&self, p1: f64, p2: f64, mount: f64, x_s: f64) -> f64 {
         let stretch = self.params.stopper_compliance * self.piston_area;
-        if stretch == 0.0 {
+        if self.stopper_is_rigid() {
             0.0
         } else if self.mount_lag.is_some() {
             stretch * mount
@@ -793,7 +793,7 @@ impl Actuator {
     /// and `dmount` of its pressures and of the mount's state.
     pub fn piston_offset_rate(&self, p1: f64, p2: f64, x_s: f64, dp1: f64, dp2: f64, dmount: f64) -> f64 {
         let stretch = self.params.stopper_compliance * self.piston_area;
-        if stretch == 0.0 {
+        if self.stopper_is_rigid() {
             0.0
         } else if self.mount_lag.is_some() {
             stretch * dmount
@@ -830,10 +830,10 @@ impl Actuator {
                 chambers::pressure_after_volume_jump(n, at_reference[1], reference.1, v2),
             ]
         };
-        let stretch = self.params.stopper_compliance * self.piston_area;
-        if stretch == 0.0 || self.mount_lag.is_some() {
+        if self.stopper_is_rigid() || self.mount_lag.is_some() {
             return at(self.piston_offset(0.0, 0.0, mount, x_s));
         }
+        let stretch = self.params.stopper_compliance * self.piston_area;
         let floor = self.mount_floor(x_s);
         // Beyond the cylinder a pressure is not finite: the offset is too far, the side < 0.
         let side = |offset: f64| {
