@@ -344,8 +344,9 @@ const fn fmi_variable(row: &Row) -> Variable {
     }
 }
 
-/// Value references of the variables of Model Exchange beyond the table's: the jet pipe's
-/// velocity and acceleration (states that are not outputs) and the six derivatives.
+/// Value references of the variables of Model Exchange beyond the table's: the states that
+/// are not outputs (the jet pipe's velocity and acceleration, the chambers' air, the gas
+/// volumes', the mount's, the lags', the filters' and the Padé chain's) and the derivatives.
 pub mod me_vr {
     pub const X_JP_VELOCITY: u32 = 900;
     pub const X_JP_ACCELERATION: u32 = 901;

@@ -32,6 +32,24 @@ unsafe fn derivatives(c: fmi2Component) -> [f64; NX] {
     dx
 }
 
+/// One classical Runge–Kutta step of `h` from `t` of the states `x` at the rates `rate`.
+fn runge_kutta_step(x: &mut [f64; NX], t: f64, h: f64, rate: impl Fn(f64, &[f64; NX]) -> [f64; NX]) {
+    let along = |k: &[f64; NX], s: f64| {
+        let mut y = *x;
+        for i in 0..NX {
+            y[i] += s * k[i];
+        }
+        y
+    };
+    let k1 = rate(t, x);
+    let k2 = rate(t + h / 2.0, &along(&k1, h / 2.0));
+    let k3 = rate(t + h / 2.0, &along(&k2, h / 2.0));
+    let k4 = rate(t + h, &along(&k3, h));
+    for i in 0..NX {
+        x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    }
+}
+
 /// A Model Exchange instance initialised at the equilibrium of `v_da`, `x_s`, in
 /// continuous-time mode.
 unsafe fn running(sink: &Sink, v_da: f64, x_s: f64) -> fmi2Component {
@@ -147,22 +165,8 @@ fn an_explicit_integration_of_the_derivatives_follows_the_co_simulation_step() {
             assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
             derivatives(c)
         };
-        let add = |x: &[f64; NX], k: &[f64; NX], s: f64| {
-            let mut y = *x;
-            for i in 0..NX {
-                y[i] += s * k[i];
-            }
-            y
-        };
         for n in 0..8000 {
-            let t = n as f64 * h;
-            let k1 = rate(t, &x);
-            let k2 = rate(t + h / 2.0, &add(&x, &k1, h / 2.0));
-            let k3 = rate(t + h / 2.0, &add(&x, &k2, h / 2.0));
-            let k4 = rate(t + h, &add(&x, &k3, h));
-            for i in 0..NX {
-                x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
+            runge_kutta_step(&mut x, n as f64 * h, h, rate);
         }
         assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
         assert_eq!(fmi2DoStep(cs, 0.0, 4e-3, fmi2True), fmi2OK);
@@ -215,27 +219,13 @@ unsafe fn run_swinging(sink: &Sink, params: &[(u32, f64)]) {
         assert_eq!(fmi2SetContinuousStates(c, x.as_ptr(), NX), fmi2OK);
         derivatives(c)
     };
-    let add = |x: &[f64; NX], k: &[f64; NX], s: f64| {
-        let mut y = *x;
-        for i in 0..NX {
-            y[i] += s * k[i];
-        }
-        y
-    };
     let (step, steps) = (1e-5, 1500);
     let mut largest = [0.0f64; 3];
     let mut moved_by_the_stopper = 0.0f64;
     for n in 0..steps {
         let t = n as f64 * step;
         for k in 0..10 {
-            let s = t + k as f64 * h;
-            let k1 = rate(s, &x);
-            let k2 = rate(s + h / 2.0, &add(&x, &k1, h / 2.0));
-            let k3 = rate(s + h / 2.0, &add(&x, &k2, h / 2.0));
-            let k4 = rate(s + h, &add(&x, &k3, h));
-            for i in 0..NX {
-                x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
+            runge_kutta_step(&mut x, t + k as f64 * h, h, rate);
         }
         let slope = (swinging_stopper(t + step) - swinging_stopper(t)) / step;
         let x_s = swinging_stopper(t);
