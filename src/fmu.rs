@@ -666,9 +666,11 @@ impl CoSimModel for ActuatorFmu {
 /// hysteresis memory; version 11: Model Exchange's states of the lags, filters and Padé chain
 /// and `command_delay_pade_sections`; version 12: the plain constants `extra_force_offset`,
 /// `extra_inflow_1`, `extra_inflow_2`, the flexible slots' parameters and, in the snapshot
-/// (its layout 10), their lags.
+/// (its layout 10), their lags; version 13: Model Exchange's chamber states are their air at
+/// mid-stroke; version 14: in the snapshot (its layout 11), the stopper's offset the last step
+/// held.
 const STATE_FORMAT: StateFormat =
-    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 13, model: "JetPipeActuator");
+    fmi2::state_format!(magic: b"JetPipeActuatorState", version: 14, model: "JetPipeActuator");
 
 /// Far more numbers than a simulation's snapshot holds (about 60 and the past commands: three
 /// for each communication step within the transport delay, 3e5 for a 0.1 s delay stepped

@@ -80,6 +80,13 @@ pub fn family_of(constant: &str, place: Place, follows: Follows) -> Family {
         Follows::Signal(ModulationSignal::Time) => Family::Drift,
         Follows::Signal(ModulationSignal::StopperVelocitySign) => Family::Asymmetry,
         Follows::Signal(_) if constant.contains("area_scale") => Family::Asymmetry,
+        // The stopper's offset places the piston: following the load, the stopper gives.
+        Follows::Signal(
+            ModulationSignal::Force
+            | ModulationSignal::P1
+            | ModulationSignal::P2
+            | ModulationSignal::PressureDifference,
+        ) if constant == "L_sup" => Family::Compliance,
         Follows::Signal(_) => match place {
             Place::Mechanics => Family::ExtraForce,
             Place::Chambers => Family::ExtraFlow,

@@ -20,7 +20,10 @@
 //!
 //! The chambers' dead volumes are modulatable as the pressure equations' capacity
 //! (`DEAD_VOLUMES`), and the cylinder's bore as the piston's area (`BORE`), which the force and
-//! both chambers' volumes read.
+//! both chambers' volumes read. The stopper's offset L_sup (`PISTON_PLACE`) places the piston:
+//! modulated, it moves the piston as the stopper would, and the air in each chamber is carried
+//! across each change from one step to the next, P V^γ constant (the simulation keeps the
+//! offset the last step held), as it is across a jump of the stopper.
 
 use super::actuator::Actuator;
 use super::flexible::{self, FLEXIBLE_SLOTS};
@@ -59,6 +62,7 @@ pub const MODULATABLE: &[u32] = &[
     vr::DEAD_VOLUME_1,
     vr::DEAD_VOLUME_2,
     vr::D_CYL,
+    vr::L_SUP,
     vr::K_SPRING,
     vr::FRICTION_COULOMB,
     vr::VISCOUS_FRICTION,
@@ -87,6 +91,11 @@ const BORE: &[u32] = &[vr::D_CYL];
 /// change itself neither compresses nor lets out air (a volume that really moved would need
 /// its own dV/dt term, which the model does not have).
 const DEAD_VOLUMES: &[u32] = &[vr::DEAD_VOLUME_1, vr::DEAD_VOLUME_2];
+
+/// The stopper's offset L_sup between the stopper and the piston (2.32): modulated, the
+/// piston's place, which both chambers' volumes read; a change moves the piston and carries
+/// the chambers' air with it ([`moves_the_piston`]).
+const PISTON_PLACE: &[u32] = &[vr::L_SUP];
 
 /// The constants the current driver's and jet pipe's propagator is built from.
 const ELECTROMECHANICAL: &[u32] = &[
@@ -438,6 +447,12 @@ fn modulates_any_of(p: &Parameters, constants: &[u32]) -> bool {
     self::constants(p).iter().any(|&c| c != 0 && constants.contains(&c))
 }
 
+/// Whether a slot varies the stopper's offset L_sup, so that a change moves the piston and the
+/// air in the chambers is carried across it.
+pub fn moves_the_piston(p: &Parameters) -> bool {
+    modulates_any_of(p, PISTON_PLACE)
+}
+
 /// Whether a slot modulates the current driver or the jet pipe (their propagator is then
 /// rebuilt for each step).
 pub fn modulates_electromechanics(p: &Parameters) -> bool {
@@ -664,6 +679,7 @@ pub(crate) struct Held {
     inv_sqrt_temperature: f64,
     dead_volumes: [f64; 2],
     bore_and_area: (f64, f64),
+    piston_place: f64,
 }
 
 /// Each slot's constant, of both kinds (the modulation slots', then the flexible slots'),
@@ -680,6 +696,7 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         inv_sqrt_temperature: model.flow.inv_sqrt_temperature,
         dead_volumes: [model.cylinder.dead_volume_1, model.cylinder.dead_volume_2],
         bore_and_area: (model.cylinder.d_cyl, model.piston_area),
+        piston_place: model.cylinder.l_sup,
     };
     let constants = constants(&model.params);
     let increments = increments(&model.params, signals);
@@ -758,6 +775,18 @@ pub(crate) fn apply(model: &mut Actuator, signals: &Signals) -> Result<Held, Str
         model.cylinder.d_cyl = p.d_cyl;
         model.piston_area = model.cylinder.piston_area();
     }
+    if modulates_any_of(p, PISTON_PLACE) {
+        model.cylinder.l_sup = p.l_sup;
+        if let Err(e) = p.check_stopper(signals.x_s) {
+            let e = format!(
+                "the slots take L_sup to {} m at t = {} s: {e}",
+                number(p.l_sup),
+                signals.time
+            );
+            restore(model, held);
+            return Err(e);
+        }
+    }
     Ok(held)
 }
 
@@ -774,6 +803,7 @@ pub(crate) fn restore(model: &mut Actuator, held: Held) {
     model.flow.inv_sqrt_temperature = held.inv_sqrt_temperature;
     [model.cylinder.dead_volume_1, model.cylinder.dead_volume_2] = held.dead_volumes;
     (model.cylinder.d_cyl, model.piston_area) = held.bore_and_area;
+    model.cylinder.l_sup = held.piston_place;
 }
 
 /// A copy of `model` with the slots' constants at `signals` (for the outputs and the

@@ -173,6 +173,10 @@ pub struct Simulation {
     /// The flexible slots' low-passed signals at the last sample, per slot and axis
     /// ([`crate::physics::flexible`]; followed only where a slot lags).
     flexible_lags: [[f64; 2]; FLEXIBLE_SLOTS],
+    /// The stopper's offset L_sup the last step held, or where the slots put it at the starting
+    /// state: where the next step holds another, the piston moves and the chambers' air is
+    /// carried across the change ([`modulation::moves_the_piston`]).
+    held_piston_place: f64,
 }
 
 /// The optional stages of a step, decided once when a simulation is built from its model (its
@@ -198,6 +202,8 @@ struct StepPlan {
     /// A transducer filters its reading (and so has a memory, which records the reading after
     /// each step).
     filtering_transducers: bool,
+    /// A slot moves the piston (L_sup): the chambers' air is carried across each change.
+    moving_piston: bool,
     /// The hysteresis operator has a memory to follow.
     hysteresis: bool,
     /// A force follows the stopper's velocity or acceleration at the sample, formed from the
@@ -217,6 +223,7 @@ impl StepPlan {
             lagged: flexible::lags_on(p),
             command_path: command_stage::is_active(p) || p.command_delay != 0.0,
             filtering_transducers: transducers.iter().any(Option::is_some),
+            moving_piston: modulation::moves_the_piston(p),
             hysteresis: model.hysteresis.is_active(),
             stopper_acceleration: model.reads_stopper_motion,
             after_step: transducers.iter().any(Option::is_some) || model.reads_stopper_motion,
@@ -325,6 +332,12 @@ impl Simulation {
         // through the stage, as every later entry of the line is.
         let seen_before = command_stage.current(&model.params);
         let plan = StepPlan::of(&model, &transducers);
+        let held_piston_place = if plan.moving_piston {
+            let signals = modulated::signals_at(&model, &state, v_da, x_s, 0.0, 0.0, time);
+            modulation::model_at(&model, &signals).map_or(model.cylinder.l_sup, |at| at.cylinder.l_sup)
+        } else {
+            model.cylinder.l_sup
+        };
         let mut nodes = [0.0; node::STATES];
         if model.restrictions.any() {
             let places = model
@@ -384,6 +397,7 @@ impl Simulation {
             modulated_propagator: None,
             slots_held: false,
             flexible_lags,
+            held_piston_place,
         }
     }
 

@@ -149,9 +149,34 @@ impl Simulation {
         } else {
             None
         };
+        if self.plan.moving_piston {
+            self.carry_air_to_held_piston_place();
+        }
         self.chamber_rates_at_end = None;
         self.slots_held = true;
         Ok(HeldModulation { constants, propagator })
+    }
+
+    /// The chambers' pressures after the piston moves from the stopper's offset L_sup the last
+    /// step held to the one the model holds now: the same jump as the stopper's by the
+    /// difference, the air in each chamber conserved
+    /// ([`Actuator::pressures_after_stopper_jump`]; L_sup larger is the stopper nearer, the
+    /// piston's position x_s − L_p − L_s − L_sup).
+    fn carry_air_to_held_piston_place(&mut self) {
+        let now = self.model.cylinder.l_sup;
+        let before = std::mem::replace(&mut self.held_piston_place, now);
+        if before == now {
+            return;
+        }
+        let (p1, p2) = (self.state[index::P1], self.state[index::P2]);
+        let mount = self.stopper_mount_state().unwrap_or(0.0);
+        // With the offset now, the stopper at x_s + (now − before) puts the piston where the
+        // offset before put it at x_s.
+        let [p1, p2] = self
+            .model
+            .pressures_after_stopper_jump(p1, p2, mount, self.x_s + (now - before), self.x_s);
+        self.state[index::P1] = p1;
+        self.state[index::P2] = p2;
     }
 
     /// Undo [`Self::hold_modulated`].

@@ -54,18 +54,19 @@ pub struct SimulationSnapshot {
     command_stage: CommandStage,
     transducers: [Option<SensorMemory>; 3],
     flexible_lags: [[f64; 2]; FLEXIBLE_SLOTS],
+    held_piston_place: f64,
 }
 
 /// The first of [`SimulationSnapshot::to_values`]: a reader of another layout refuses the
 /// numbers instead of misreading them. Raise it whenever the layout changes.
-/// Layout 10: the flexible slots' lags.
-pub const SNAPSHOT_LAYOUT: f64 = 10.0;
+/// Layout 10: the flexible slots' lags; 11: the stopper's offset the last step held.
+pub const SNAPSHOT_LAYOUT: f64 = 11.0;
 
 /// Numbers before the two counted lists: the layout, 26 scalars, the state, the volumes'
 /// pressures, the plays, the command stage ([`command_stage::VALUES`]), the flexible slots'
-/// lags and the six work counters as two halves each.
+/// lags, the stopper's offset the last step held and the six work counters as two halves each.
 const FIXED_VALUES: usize =
-    1 + 26 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + LAGS + 2 * STATISTICS;
+    1 + 26 + N_STATES + node::STATES + PLAY_OPERATORS + command_stage::VALUES + LAGS + 1 + 2 * STATISTICS;
 const STATISTICS: usize = 6;
 /// The flexible slots' lag states: two axes per slot.
 const LAGS: usize = 2 * FLEXIBLE_SLOTS;
@@ -104,6 +105,7 @@ impl Simulation {
             command_stage: self.command_stage,
             transducers: self.transducers.clone(),
             flexible_lags: self.flexible_lags,
+            held_piston_place: self.held_piston_place,
         }
     }
 
@@ -141,6 +143,7 @@ impl Simulation {
         sim.command_stage = s.command_stage;
         sim.transducers = s.transducers.clone();
         sim.flexible_lags = s.flexible_lags;
+        sim.held_piston_place = s.held_piston_place;
         sim.plan = StepPlan::of(&sim.model, &sim.transducers);
         Ok(sim)
     }
@@ -162,7 +165,8 @@ impl SimulationSnapshot {
     /// acceleration they gave, the acceleration input a_s and its rate; the state;
     /// the pressures of the gas volumes behind restrictions (supply, return, line 1, line 2); the
     /// plays; the command stage (time, held, lagged, filtered and its rate); the flexible slots'
-    /// lag states (slot 1's two axes, then slot 2's); the work counters (steps, rejected,
+    /// lag states (slot 1's two axes, then slot 2's); the stopper's offset L_sup the last step
+    /// held; the work counters (steps, rejected,
     /// right-hand sides, Jacobians, Newton failures, stiff hand-overs), each as its low then
     /// its high 32 bits, since an `f64` holds integers exactly only up to 2^53; then the
     /// number of past commands and their (time, v_DA, rate); then for each transducer (force,
@@ -211,6 +215,7 @@ impl SimulationSnapshot {
         for lags in &self.flexible_lags {
             v.extend_from_slice(lags);
         }
+        v.push(self.held_piston_place);
         for count in statistics_counts(&self.statistics) {
             v.push((count & 0xffff_ffff) as f64);
             v.push((count >> 32) as f64);
@@ -269,6 +274,7 @@ impl SimulationSnapshot {
         for (k, lags) in flexible_lags.iter_mut().enumerate() {
             lags.copy_from_slice(&lag_values[2 * k..2 * k + 2]);
         }
+        let held_piston_place = next(1)[0];
         let halves = next(2 * STATISTICS);
         let mut counts = [0u64; STATISTICS];
         for (k, count) in counts.iter_mut().enumerate() {
@@ -341,6 +347,7 @@ impl SimulationSnapshot {
             .chain(&nodes)
             .chain(&stage)
             .chain(lag_values)
+            .chain(std::iter::once(&held_piston_place))
             .chain(sensor)
             .all(|v| v.is_finite())
             && command_history.iter().all(|c| c.v_da.is_finite() && c.rate.is_finite())
@@ -410,6 +417,7 @@ impl SimulationSnapshot {
             command_stage: CommandStage::from_values(stage),
             transducers,
             flexible_lags,
+            held_piston_place,
         })
     }
 }

@@ -545,3 +545,135 @@ fn an_effective_area_error_modulated_by_the_pressure_difference_adds_its_force_a
     assert!(checked > 150, "{checked} of 300 samples above the spring's floor");
     assert!(largest > 0.1, "the slot moved the force by {largest} N");
 }
+
+/// Chamber 1's and 2's pressures at each sample of 0.3 s of the command of [`command`], the
+/// stopper moving from `from` to `to` at a constant rate, stepped every `step` seconds by the
+/// error-controlled simulation or the fixed-step replay.
+fn chamber_pressures(p: Parameters, from: f64, to: f64, step: f64, replayed: bool) -> Vec<[f64; 2]> {
+    let model = Actuator::new(p).unwrap();
+    let steps = (0.3 / step).round() as usize;
+    let position = |k: usize| from + (to - from) * k as f64 / steps as f64;
+    let command_at = |k: usize| command((k as f64 * step * 1e3) as usize);
+    let mut out = Vec::new();
+    if replayed {
+        let mut fixed = FixedStep::at_equilibrium(model, command(0), from, 0.0)
+            .unwrap()
+            .unwrap();
+        for k in 0..steps {
+            fixed.set_command(command_at(k)).unwrap();
+            fixed.step_to((k + 1) as f64 * step, position(k + 1)).unwrap();
+            let y = fixed.outputs();
+            out.push([y.p1, y.p2]);
+        }
+    } else {
+        let mut sim = Simulation::at_equilibrium(model, command(0), from, 0.0, 1e-8).unwrap();
+        for k in 0..steps {
+            sim.set_command(command_at(k)).unwrap();
+            sim.set_stopper_rate((position(k + 1) - sim.x_s()) / step).unwrap();
+            sim.step(step).unwrap();
+            sim.land_stopper_at(position(k + 1));
+            let y = sim.outputs();
+            out.push([y.p1, y.p2]);
+        }
+    }
+    out
+}
+
+/// The largest difference of two runs' pressures (Pa), over the samples of the coarser (every
+/// `every`-th of `fine`).
+fn largest_pressure_gap(coarse: &[[f64; 2]], fine: &[[f64; 2]], every: usize) -> f64 {
+    coarse
+        .iter()
+        .enumerate()
+        .flat_map(|(k, c)| {
+            let f = fine[(k + 1) * every - 1];
+            [(c[0] - f[0]).abs(), (c[1] - f[1]).abs()]
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_stopper_offset_that_a_slot_moves_with_the_stopper_keeps_the_piston_and_both_chambers_as_at_rest() {
+    // The stopper moves 8 mm and the slot takes its offset L_sup 8 mm further: the piston,
+    // at x_s − L_p − L_s − L_sup, stays where it was, and so must the chambers' pressures. The
+    // slot's changes have to move the piston back and carry the air in the chambers exactly
+    // as the stopper's motion moves it forth.
+    let (from, to) = (0.050, 0.058);
+    let slotted = with_slot(Slot::through(
+        vr::L_SUP,
+        ModulationSignal::StopperPosition,
+        &[from, to],
+        &[0.0, to - from],
+    ));
+    for replayed in [false, true] {
+        let at_rest = chamber_pressures(Parameters::default(), from, from, 1e-4, replayed);
+        let moved = chamber_pressures(Parameters::default(), from, to, 1e-4, replayed);
+        let coarse = chamber_pressures(slotted.clone(), from, to, 1e-3, replayed);
+        let fine = chamber_pressures(slotted.clone(), from, to, 1e-4, replayed);
+        let motion = largest_pressure_gap(&moved, &at_rest, 1);
+        let (gap_coarse, gap_fine) = (
+            largest_pressure_gap(&coarse, &at_rest, 10),
+            largest_pressure_gap(&fine, &at_rest, 1),
+        );
+        // The stopper's motion alone moves the pressures by tens of kilopascals…
+        assert!(
+            motion > 2e4,
+            "replayed {replayed}: the motion moves them by only {motion} Pa"
+        );
+        // …the slot undoes it to within what a step's lag leaves (the slot moves the piston
+        // at the steps' starts, the stopper within them), which falls as the step does.
+        assert!(
+            gap_fine < 0.01 * motion,
+            "replayed {replayed}: {gap_fine} Pa of {motion}"
+        );
+        assert!(
+            gap_fine < 0.3 * gap_coarse,
+            "replayed {replayed}: {gap_fine} Pa at 0.1 ms steps, {gap_coarse} Pa at 1 ms"
+        );
+    }
+}
+
+#[test]
+fn a_stopper_offset_falling_with_p1_minus_p2_by_the_compliance_times_the_area_is_the_compliant_stopper() {
+    // A compliant stopper lets the piston c A_p max(P1 − P2, floor) beyond it, continuously
+    // within a step (its own terms in the pressures' rates); a slot on L_sup that falls by
+    // c A_p per pascal of P1 − P2 above the floor moves it there from step to step.
+    let x_s = 0.054;
+    let compliance = 2e-5;
+    let compliant = Parameters {
+        stopper_compliance: compliance,
+        ..Parameters::default()
+    };
+    let model = Actuator::new(compliant.clone()).unwrap();
+    let area = model.piston_area;
+    let floor = model.spring_force(x_s) / area;
+    let slotted = with_slot(Slot::through(
+        vr::L_SUP,
+        ModulationSignal::PressureDifference,
+        &[floor, floor + 1e6],
+        &[-compliance * area * floor, -compliance * area * (floor + 1e6)],
+    ));
+    for replayed in [false, true] {
+        let reference = chamber_pressures(compliant.clone(), x_s, x_s, 1e-4, replayed);
+        let rigid = chamber_pressures(Parameters::default(), x_s, x_s, 1e-4, replayed);
+        let coarse = chamber_pressures(slotted.clone(), x_s, x_s, 1e-3, replayed);
+        let fine = chamber_pressures(slotted.clone(), x_s, x_s, 1e-4, replayed);
+        let compliance_moves = largest_pressure_gap(&rigid, &reference, 1);
+        let (gap_coarse, gap_fine) = (
+            largest_pressure_gap(&coarse, &reference, 10),
+            largest_pressure_gap(&fine, &reference, 1),
+        );
+        assert!(
+            compliance_moves > 1e4,
+            "replayed {replayed}: the compliance moves the pressures by only {compliance_moves} Pa"
+        );
+        assert!(
+            gap_fine < 0.02 * compliance_moves,
+            "replayed {replayed}: {gap_fine} Pa of {compliance_moves}"
+        );
+        assert!(
+            gap_fine < 0.3 * gap_coarse,
+            "replayed {replayed}: {gap_fine} Pa at 0.1 ms steps, {gap_coarse} Pa at 1 ms"
+        );
+    }
+}
