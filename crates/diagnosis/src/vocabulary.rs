@@ -66,6 +66,24 @@ vocabulary! {
     }
 }
 
+impl From<jetpipe_model::variables::ChainPlace> for Place {
+    fn from(place: jetpipe_model::variables::ChainPlace) -> Place {
+        use jetpipe_model::variables::ChainPlace as C;
+        match place {
+            C::Command => Place::Command,
+            C::CurrentDriver => Place::CurrentDriver,
+            C::JetPipe => Place::JetPipe,
+            C::Valve => Place::Valve,
+            C::Supply => Place::Supply,
+            C::Return => Place::Return,
+            C::Chambers => Place::Chambers,
+            C::Mechanics => Place::Mechanics,
+            C::ForceSensor => Place::ForceSensor,
+            C::PressureSensors => Place::PressureSensors,
+        }
+    }
+}
+
 vocabulary! {
     /// What kind of departure a term is.
     Family {

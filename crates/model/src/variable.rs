@@ -52,3 +52,19 @@ pub struct Variable {
     pub max: Option<f64>,
     pub description: &'static str,
 }
+
+/// The place of the chain a constant of the table belongs to, from the command to the
+/// transducers: where a departure of it would be, for the diagnosis that locates one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ChainPlace {
+    Command,
+    CurrentDriver,
+    JetPipe,
+    Valve,
+    Supply,
+    Return,
+    Chambers,
+    Mechanics,
+    ForceSensor,
+    PressureSensors,
+}

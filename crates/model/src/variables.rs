@@ -2,7 +2,7 @@
 //! and the setters all come from here (the FMU crate turns the rows into FMI variables), so
 //! they cannot drift apart.
 
-pub use crate::variable::{Causality, VarType, Variability, Variable};
+pub use crate::variable::{Causality, ChainPlace, VarType, Variability, Variable};
 
 mod extra_flow;
 mod extra_force;
@@ -32,6 +32,11 @@ pub struct Row {
     pub reference: &'static str,
     /// The physical reason for the limits.
     pub reason: &'static str,
+    /// The place of the chain the constant belongs to (for a constant the diagnosis may vary).
+    pub place: Option<ChainPlace>,
+    /// A difference step for the outputs' sensitivity to the constant where its start value is
+    /// 0 and no hundredth of it gives one: a typical size of the quantity.
+    pub sensitivity_step: Option<f64>,
 }
 
 // Builders for the rows (const: the table is a constant; no float arithmetic in them, which
@@ -43,7 +48,19 @@ impl Row {
             min_excluded: false,
             reference: "",
             reason: "",
+            place: None,
+            sensitivity_step: None,
         }
+    }
+    /// The place of the chain the constant belongs to.
+    const fn at(mut self, place: ChainPlace) -> Row {
+        self.place = Some(place);
+        self
+    }
+    /// A typical size of the quantity, for a sensitivity where the value is 0.
+    const fn step(mut self, step: f64) -> Row {
+        self.sensitivity_step = Some(step);
+        self
     }
     /// Values must be > `min`.
     const fn above(mut self, min: f64) -> Row {
@@ -264,15 +281,18 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .above(0.0).at_most(1e7)
         .cite("Table 2.1, (2.18)")
-        .because(PRESSURE),
+        .because(PRESSURE)
+        .at(ChainPlace::Supply),
     parameter("P_r", vr::P_R, "Pa", 101_325.0, "return pressure, absolute")
         .above(0.0).at_most(1e7)
         .cite("(2.18)")
-        .because(PRESSURE),
+        .because(PRESSURE)
+        .at(ChainPlace::Return),
     parameter("T", vr::T_GAS, "K", 293.15, "gas temperature, constant (2.6)")
         .above(0.0).at_most(1000.0)
         .cite("§2.6, (2.18)")
-        .because("1000 K: no pneumatic actuator runs hotter; air is still an ideal gas there"),
+        .because("1000 K: no pneumatic actuator runs hotter; air is still an ideal gas there")
+        .at(ChainPlace::Chambers),
     parameter("gamma", vr::GAMMA, "1", 1.4, "isentropic exponent of air")
         .above(1.0).at_most(5.0 / 3.0)
         .cite("(2.19)-(2.22), (2.29)")
@@ -284,11 +304,14 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("k_cd", vr::K_CD, "A/V", 0.04, "current driver gain (2.3)")
         .at_least(-1.0).at_most(1.0)
         .cite("(2.3)")
-        .because("1 A/V gives 10 A at the D/A's 10 V, 25 times the coil's rated 0.4 A"),
+        .because("1 A/V gives 10 A at the D/A's 10 V, 25 times the coil's rated 0.4 A")
+        .at(ChainPlace::CurrentDriver),
     parameter("i_offset", vr::I_OFFSET, "A", 0.0, "current driver offset (2.3)")
         .at_least(-1.0).at_most(1.0)
         .cite("(2.3)")
-        .because("2.5 times the coil's rated 0.4 A"),
+        .because("2.5 times the coil's rated 0.4 A")
+        .at(ChainPlace::CurrentDriver)
+        .step(1e-3),
     parameter(
         "omega_cd",
         vr::OMEGA_CD,
@@ -298,11 +321,13 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .above(0.0).at_most(1e6)
         .cite("Table 3.1, (2.1)")
-        .because(RATE),
+        .because(RATE)
+        .at(ChainPlace::CurrentDriver),
     parameter("k_m", vr::K_M, "N/A", 1.946, "jet pipe motor constant (2.4)")
         .at_least(-100.0).at_most(100.0)
         .cite("Table 3.1, (2.4)")
-        .because("50 times Table 3.1's 1.946 N/A: 40 N on the jet pipe at the rated 0.4 A"),
+        .because("50 times Table 3.1's 1.946 N/A: 40 N on the jet pipe at the rated 0.4 A")
+        .at(ChainPlace::JetPipe),
     parameter(
         "omega_1",
         vr::OMEGA_1,
@@ -312,7 +337,8 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .above(0.0).at_most(1e6)
         .cite("Table 3.1, (2.6)")
-        .because(RATE),
+        .because(RATE)
+        .at(ChainPlace::JetPipe),
     parameter(
         "omega_2",
         vr::OMEGA_2,
@@ -322,11 +348,13 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .above(0.0).at_most(1e6)
         .cite("Table 3.1, (2.6)")
-        .because(RATE),
+        .because(RATE)
+        .at(ChainPlace::JetPipe),
     parameter("zeta_2", vr::ZETA_2, "1", 0.019, "jet pipe damping ratio (2.6)")
         .at_least(0.0).at_most(100.0)
         .cite("Table 3.1, (2.6)")
-        .because("a damping ratio of 100 is already a first-order lag"),
+        .because("a damping ratio of 100 is already a first-order lag")
+        .at(ChainPlace::JetPipe),
     parameter(
         "x_jp_sat",
         vr::X_JP_SAT,
@@ -336,7 +364,8 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .above(0.0).at_most(0.01)
         .cite("(2.5), §3.2.1")
-        .because(TRAVEL),
+        .because(TRAVEL)
+        .at(ChainPlace::JetPipe),
     parameter(
         "F_jp_sat",
         vr::F_JP_SAT,
@@ -346,7 +375,8 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .above(0.0).at_most(100.0)
         .cite("(2.5), §4.2.1")
-        .because("100 N: 100 times the force the motor gives at the rated current (k_m 0.4 A = 0.8 N)"),
+        .because("100 N: 100 times the force the motor gives at the rated current (k_m 0.4 A = 0.8 N)")
+        .at(ChainPlace::JetPipe),
     parameter(
         "x_jp_offset",
         vr::X_JP_OFFSET,
@@ -356,7 +386,9 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .at_least(-0.01).at_most(0.01)
         .cite("Table 3.1, (2.7)")
-        .because(TRAVEL),
+        .because(TRAVEL)
+        .at(ChainPlace::JetPipe)
+        .step(2e-6),
     parameter(
         "D_jp",
         vr::D_JP,
@@ -366,11 +398,13 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .above(0.0).at_most(0.01)
         .cite("Table 3.1, (2.8)-(2.17)")
-        .because("10 mm: ten times Table 3.1's jet pipe, most of the 15.9 mm bore"),
+        .because("10 mm: ten times Table 3.1's jet pipe, most of the 15.9 mm bore")
+        .at(ChainPlace::Valve),
     parameter("C_d", vr::C_D, "1", 0.696, "orifice discharge coefficient (2.18)")
         .above(0.0).at_most(1.0)
         .cite("Table 3.1, (2.18)")
-        .because("a discharge coefficient is the actual flow over the ideal flow"),
+        .because("a discharge coefficient is the actual flow over the ideal flow")
+        .at(ChainPlace::Valve),
     parameter(
         "C_dm_A_lpp",
         vr::C_DM_A_LPP,
@@ -380,7 +414,8 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .at_least(-1e-4).at_most(1e-4)
         .cite("Table 3.1, (2.23)")
-        .because(LEAK_AREA),
+        .because(LEAK_AREA)
+        .at(ChainPlace::Chambers),
     parameter(
         "C_db_A_lpp",
         vr::C_DB_A_LPP,
@@ -390,7 +425,8 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     )
         .at_least(0.0).at_most(1e-4)
         .cite("Table 3.1, (2.23)")
-        .because(LEAK_AREA),
+        .because(LEAK_AREA)
+        .at(ChainPlace::Chambers),
     parameter("L_cyl", vr::L_CYL, "m", 78.0e-3, "cylinder length")
         .above(0.0).at_most(1.0)
         .cite("Table 3.1, (2.31)")
@@ -406,7 +442,8 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("L_sup", vr::L_SUP, "m", 11.0e-3, "support length")
         .at_least(0.0).at_most(1.0)
         .cite("Table 3.1, (2.32)")
-        .because(LENGTH),
+        .because(LENGTH)
+        .at(ChainPlace::Chambers),
     parameter(
         "L_spring0",
         vr::L_SPRING0,
@@ -420,11 +457,13 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("D_cyl", vr::D_CYL, "m", 15.875e-3, "cylinder bore")
         .above(0.0).at_most(0.5)
         .cite("Table 3.1, (2.30)-(2.31)")
-        .because("a bore of 0.5 m, thirty times Table 3.1's, is no hand actuator"),
+        .because("a bore of 0.5 m, thirty times Table 3.1's, is no hand actuator")
+        .at(ChainPlace::Mechanics),
     parameter("k_spring", vr::K_SPRING, "N/m", 88.14, "spring rate (2.37)")
         .at_least(0.0).at_most(1e5)
         .cite("Table 3.1, (2.37)")
-        .because("1e5 N/m, a thousand times Table 3.1's: over the 70 mm stroke its force would exceed the piston's largest pneumatic force, A_p (P_s - P_r) = 109 N, sixty times"),
+        .because("1e5 N/m, a thousand times Table 3.1's: over the 70 mm stroke its force would exceed the piston's largest pneumatic force, A_p (P_s - P_r) = 109 N, sixty times")
+        .at(ChainPlace::Mechanics),
     Row::of(Variable {
         name: "start_at_equilibrium",
         value_reference: vr::START_AT_EQUILIBRIUM,
@@ -483,7 +522,9 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("friction_coulomb", vr::FRICTION_COULOMB, "N", 0.0, "piston_friction: Coulomb friction opposing stopper motion, (2.35) (0 = off)")
         .at_least(0.0).at_most(1000.0)
         .cite("(2.35)")
-        .because("1000 N: nine times the piston's largest pneumatic force, A_p (P_s - P_r) = 109 N"),
+        .because("1000 N: nine times the piston's largest pneumatic force, A_p (P_s - P_r) = 109 N")
+        .at(ChainPlace::Mechanics)
+        .step(0.1),
     parameter("friction_velocity", vr::FRICTION_VELOCITY, "m/s", 0.0, "piston_friction: the friction reaches the Coulomb level as tanh(v / this) of the stopper velocity v (0 = at once, as (2.35))")
         .at_least(0.0).at_most(1.0)
         .cite("(2.35)")
@@ -499,11 +540,15 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("dead_volume_1", vr::DEAD_VOLUME_1, "m3", 0.0, "dead_volume: port and line volume added to chamber 1 (0 = off)")
         .at_least(0.0).at_most(1e-3)
         .cite("(2.30)")
-        .because(DEAD_VOLUME),
+        .because(DEAD_VOLUME)
+        .at(ChainPlace::Chambers)
+        .step(1e-7),
     parameter("dead_volume_2", vr::DEAD_VOLUME_2, "m3", 0.0, "dead_volume: port and line volume added to chamber 2 (0 = off)")
         .at_least(0.0).at_most(1e-3)
         .cite("(2.31)")
-        .because(DEAD_VOLUME),
+        .because(DEAD_VOLUME)
+        .at(ChainPlace::Chambers)
+        .step(1e-7),
     parameter("supply_resistance", vr::SUPPLY_RESISTANCE, "Pa.s/kg", 0.0, "supply_pressure_drop: the supply pressure at the jet pipe falls by this times the supply mass flow (0 = off)")
         .at_least(0.0).at_most(1e12)
         .cite("§2.6")
@@ -519,27 +564,34 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("force_sensor_offset", vr::FORCE_SENSOR_OFFSET, "N", 0.0, "sensor_offset_gain: offset of F_meas (0 = off)")
         .at_least(-1000.0).at_most(1000.0)
         .cite("")
-        .because("1000 N: nine times the largest force the actuator gives (109 N)"),
+        .because("1000 N: nine times the largest force the actuator gives (109 N)")
+        .at(ChainPlace::ForceSensor)
+        .step(0.1),
     parameter("force_sensor_gain", vr::FORCE_SENSOR_GAIN, "1", 1.0, "sensor_offset_gain: gain of F_meas (1 = off)")
         .above(0.0).at_most(10.0)
         .cite("")
-        .because("a gain of 10 is no calibration error of a force sensor"),
+        .because("a gain of 10 is no calibration error of a force sensor")
+        .at(ChainPlace::ForceSensor),
     parameter("supply_area_scale_1", vr::SUPPLY_AREA_SCALE_1, "1", 1.0, "valve asymmetry: factor on the supply orifice area of port 1 (1 = the geometry of (2.8)-(2.17))")
         .at_least(0.0).at_most(10.0)
         .cite("(2.8)")
-        .because(AREA_SCALE),
+        .because(AREA_SCALE)
+        .at(ChainPlace::Valve),
     parameter("supply_area_scale_2", vr::SUPPLY_AREA_SCALE_2, "1", 1.0, "valve asymmetry: factor on the supply orifice area of port 2 (1 = the geometry)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.10)")
-        .because(AREA_SCALE),
+        .because(AREA_SCALE)
+        .at(ChainPlace::Valve),
     parameter("return_area_scale_1", vr::RETURN_AREA_SCALE_1, "1", 1.0, "valve asymmetry: factor on the return orifice area of port 1 (1 = the geometry)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.9)")
-        .because(AREA_SCALE),
+        .because(AREA_SCALE)
+        .at(ChainPlace::Valve),
     parameter("return_area_scale_2", vr::RETURN_AREA_SCALE_2, "1", 1.0, "valve asymmetry: factor on the return orifice area of port 2 (1 = the geometry)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.11)")
-        .because(AREA_SCALE),
+        .because(AREA_SCALE)
+        .at(ChainPlace::Valve),
     parameter("return_resistance", vr::RETURN_RESISTANCE, "Pa.s/kg", 0.0, "return restriction: the pressure the return orifices vent into rises above P_r by this times the return mass flow (0 = off)")
         .at_least(0.0).at_most(1e12)
         .cite("(2.18)")
@@ -695,7 +747,9 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("viscous_friction", vr::VISCOUS_FRICTION, "N.s/m", 0.0, "viscous friction: a force of this times the stopper velocity opposes the motion where the pressures set the force (0 = off)")
         .at_least(0.0).at_most(1e5)
         .cite("(2.33)-(2.35)")
-        .because("1e5 N.s/m: 1000 N at 1 cm/s"),
+        .because("1e5 N.s/m: 1000 N at 1 cm/s")
+        .at(ChainPlace::Mechanics)
+        .step(1.0),
     parameter("position_force_rate", vr::POSITION_FORCE_RATE, "N/m", 0.0, "a force of this times (x_s - position_force_reference) opposes the stopper position where the pressures set the force (0 = off)")
         .at_least(-1e5).at_most(1e5)
         .cite("(2.37)")
@@ -719,7 +773,9 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("extra_force_pressure_difference", vr::EXTRA_FORCE_PRESSURE_DIFFERENCE, "m2", 0.0, "extra force on the piston: the force the sensor reads gains this times (P1 - P2) where the pressures set the force: an error of the effective piston area (0 = off)")
         .at_least(-1e-3).at_most(1e-3)
         .cite("(2.36)")
-        .because("1e-3 m2: about four times the piston area"),
+        .because("1e-3 m2: about four times the piston area")
+        .at(ChainPlace::Mechanics)
+        .step(1e-6),
     parameter("extra_force_sign_velocity", vr::EXTRA_FORCE_SIGN_VELOCITY, "m/s", 1e-3, "the speed over which the smooth sign tanh(v / this) of extra_force_sign_pressure turns")
         .at_least(1e-6).at_most(1.0)
         .cite("")
@@ -759,11 +815,14 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("p1_sensor_offset", vr::P1_SENSOR_OFFSET, "Pa", 0.0, "pressure transducer 1: offset of P1_meas (0 = off)")
         .at_least(-1e6).at_most(1e6)
         .cite("")
-        .because("1 MPa: more than the supply's gauge pressure (551.6 kPa)"),
+        .because("1 MPa: more than the supply's gauge pressure (551.6 kPa)")
+        .at(ChainPlace::PressureSensors)
+        .step(100.0),
     parameter("p1_sensor_gain", vr::P1_SENSOR_GAIN, "1", 1.0, "pressure transducer 1: gain of P1_meas (1 = off)")
         .above(0.0).at_most(10.0)
         .cite("")
-        .because("a transducer reads a rise as a rise (gain > 0); ten times is no longer a calibration error"),
+        .because("a transducer reads a rise as a rise (gain > 0); ten times is no longer a calibration error")
+        .at(ChainPlace::PressureSensors),
     parameter("p1_sensor_drift", vr::P1_SENSOR_DRIFT, "Pa/s", 0.0, "pressure transducer 1: P1_meas gains this times the time (0 = off)")
         .at_least(-1e5).at_most(1e5)
         .cite("")
@@ -787,11 +846,14 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
     parameter("p2_sensor_offset", vr::P2_SENSOR_OFFSET, "Pa", 0.0, "pressure transducer 2: offset of P2_meas (0 = off)")
         .at_least(-1e6).at_most(1e6)
         .cite("")
-        .because("1 MPa: more than the supply's gauge pressure (551.6 kPa)"),
+        .because("1 MPa: more than the supply's gauge pressure (551.6 kPa)")
+        .at(ChainPlace::PressureSensors)
+        .step(100.0),
     parameter("p2_sensor_gain", vr::P2_SENSOR_GAIN, "1", 1.0, "pressure transducer 2: gain of P2_meas (1 = off)")
         .above(0.0).at_most(10.0)
         .cite("")
-        .because("a transducer reads a rise as a rise (gain > 0); ten times is no longer a calibration error"),
+        .because("a transducer reads a rise as a rise (gain > 0); ten times is no longer a calibration error")
+        .at(ChainPlace::PressureSensors),
     parameter("p2_sensor_drift", vr::P2_SENSOR_DRIFT, "Pa/s", 0.0, "pressure transducer 2: P2_meas gains this times the time (0 = off)")
         .at_least(-1e5).at_most(1e5)
         .cite("")
@@ -996,6 +1058,16 @@ mod tests {
         assert!(check(vr::C_D, 1.0).is_ok());
         let e = check(vr::P_S, f64::NAN).unwrap_err();
         assert!(e.contains("P_s = NaN") && e.contains("finite"), "{e}");
+    }
+
+    #[test]
+    fn every_constant_a_slot_may_vary_names_its_place_in_the_chain_and_no_other_row_does() {
+        use crate::physics::flexible::FLEXIBLE_TARGETS;
+        for row in TABLE {
+            let target = FLEXIBLE_TARGETS.contains(&row.variable.value_reference);
+            assert_eq!(row.place.is_some(), target, "{}", row.variable.name);
+            assert!(row.sensitivity_step.is_none() || target, "{}", row.variable.name);
+        }
     }
 
     #[test]

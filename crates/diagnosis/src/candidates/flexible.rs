@@ -34,19 +34,21 @@ pub const KNOTS_PAIRED: usize = 4;
 /// protocol still shows several times).
 pub const LAGS: [f64; 6] = [0.0, 0.01, 0.03, 0.1, 0.3, 1.0];
 
-/// The constant a flexible term adds to at each place, with the place.
-pub const TARGETS: [(Place, &str); 11] = [
-    (Place::Mechanics, "extra_force_offset"),
-    (Place::Chambers, "extra_inflow_1"),
-    (Place::Chambers, "extra_inflow_2"),
-    (Place::ForceSensor, "force_sensor_offset"),
-    (Place::PressureSensors, "p1_sensor_offset"),
-    (Place::PressureSensors, "p2_sensor_offset"),
-    (Place::CurrentDriver, "i_offset"),
-    (Place::JetPipe, "x_jp_offset"),
-    (Place::Valve, "C_d"),
-    (Place::Supply, "P_s"),
-    (Place::Return, "P_r"),
+/// The constant a flexible term adds to at each place (the place its row in the variable
+/// table gives): a force on the piston, a mass flow into each chamber, each transducer's offset,
+/// the current's and the jet's offsets, the discharge coefficient, the supply and return.
+pub const TARGETS: [&str; 11] = [
+    "extra_force_offset",
+    "extra_inflow_1",
+    "extra_inflow_2",
+    "force_sensor_offset",
+    "p1_sensor_offset",
+    "p2_sensor_offset",
+    "i_offset",
+    "x_jp_offset",
+    "C_d",
+    "P_s",
+    "P_r",
 ];
 
 /// The signals a flexible term may follow: every signal of the chain the slots read but the

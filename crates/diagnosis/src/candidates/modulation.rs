@@ -50,27 +50,13 @@ impl std::fmt::Display for Follows {
     }
 }
 
-/// The place of the chain a constant belongs to: the place of a catalogue candidate that
-/// fits it as a constant, else the place its name says.
-pub fn place_of(constant: &'static str, catalogue: &[Candidate]) -> Place {
-    if let Some(c) = catalogue
+/// The place of the chain a constant belongs to: its row's place in the variable table.
+pub fn place_of(constant: &'static str) -> Place {
+    jetpipe_model::variables::TABLE
         .iter()
-        .find(|c| c.terms.iter().any(|t| t.mechanism == Mechanism::Parameter(constant)))
-    {
-        return c.location;
-    }
-    match constant {
-        n if n.starts_with("force_sensor") => Place::ForceSensor,
-        n if n.starts_with("p1_sensor") || n.starts_with("p2_sensor") => Place::PressureSensors,
-        "k_cd" | "i_offset" | "omega_cd" => Place::CurrentDriver,
-        "k_m" | "omega_1" | "omega_2" | "zeta_2" | "x_jp_offset" | "x_jp_sat" | "F_jp_sat" => Place::JetPipe,
-        "P_s" => Place::Supply,
-        "P_r" => Place::Return,
-        "T" | "dead_volume_1" | "dead_volume_2" | "C_dm_A_lpp" | "C_db_A_lpp" => Place::Chambers,
-        "D_cyl" | "k_spring" | "friction_coulomb" | "viscous_friction" => Place::Mechanics,
-        n if n.starts_with("extra_force") => Place::Mechanics,
-        _ => Place::Valve,
-    }
+        .find(|r| r.variable.name == constant)
+        .and_then(|r| r.place)
+        .map_or(Place::Unknown, Place::from)
 }
 
 /// The family of a departure where `constant` at `place` follows `follows`.
@@ -96,7 +82,8 @@ pub fn family_of(constant: &str, place: Place, follows: Follows) -> Family {
 }
 
 /// A difference step for a constant's sensitivity: the catalogue's where it fits the
-/// constant, else a hundredth of its value, else a typical size of the quantity.
+/// constant, else a hundredth of its value, else the typical size its row in the variable
+/// table gives, else 1e-3.
 pub fn sensitivity_step(constant: &'static str, base: &Parameters, catalogue: &[Candidate]) -> f64 {
     if let Some(t) = catalogue
         .iter()
@@ -109,21 +96,11 @@ pub fn sensitivity_step(constant: &'static str, base: &Parameters, catalogue: &[
     if value != 0.0 {
         return 0.01 * value.abs();
     }
-    match constant {
-        "friction_coulomb" | "force_sensor_offset" => 0.1,
-        "viscous_friction" => 1.0,
-        "dead_volume_1" | "dead_volume_2" => 1e-7,
-        "p1_sensor_offset" | "p2_sensor_offset" => 100.0,
-        "i_offset" => 1e-3,
-        "x_jp_offset" => 2e-6,
-        // About 0.5 % of the thesis piston's area (1.98e-4 m²).
-        "extra_force_pressure_difference" => 1e-6,
-        // A hundredth of a newton, and a tenth of a milligram a second (the valve passes
-        // about a gram a second at full opening).
-        "extra_force_offset" => 0.01,
-        "extra_inflow_1" | "extra_inflow_2" => 1e-7,
-        _ => 1e-3,
-    }
+    jetpipe_model::variables::TABLE
+        .iter()
+        .find(|r| r.variable.name == constant)
+        .and_then(|r| r.sensitivity_step)
+        .unwrap_or(1e-3)
 }
 
 /// The names of the constants the model can modulate.
@@ -385,5 +362,39 @@ mod tests {
             text.starts_with("friction_coulomb changes by +2.5000 N between 60.00 mm and 66.00 mm of x_s"),
             "{text}"
         );
+    }
+}
+
+#[cfg(test)]
+mod place_tests {
+    use super::*;
+    use jetpipe_model::physics::flexible::FLEXIBLE_TARGETS;
+
+    #[test]
+    fn every_written_candidate_on_a_constant_the_slots_may_vary_sits_at_that_constants_place_in_the_variable_table() {
+        let base = Parameters::default();
+        let knots = crate::candidates::curves::CurveKnots::default();
+        let mut checked = 0;
+        for has_pressures in [true, false] {
+            for periodic_hz in [None, Some(3.0)] {
+                let catalogue = crate::candidates::catalogue::catalogue(&base, has_pressures, periodic_hz, &knots);
+                for vr in FLEXIBLE_TARGETS.iter() {
+                    let name = VARIABLES.iter().find(|v| v.value_reference == *vr).unwrap().name;
+                    assert_ne!(
+                        place_of(name),
+                        Place::Unknown,
+                        "{name} has no place in the variable table"
+                    );
+                    for c in catalogue
+                        .iter()
+                        .filter(|c| c.terms.iter().any(|t| t.mechanism == Mechanism::Parameter(name)))
+                    {
+                        assert_eq!(c.location, place_of(name), "{name} in {}", c.label);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 20, "{checked}");
     }
 }

@@ -231,9 +231,9 @@ fn best_surface(
     let with_pressures = cx.recording.p1.is_some() && cx.recording.p2.is_some();
     let targets: Vec<(Place, &'static str)> = TARGETS
         .iter()
-        .copied()
+        .filter_map(|name| jetpipe_model::variables::VARIABLES.iter().find(|v| v.name == *name))
+        .map(|v| (crate::candidates::modulation::place_of(v.name), v.name))
         .filter(|(place, _)| with_pressures || *place != Place::PressureSensors)
-        .filter(|(_, name)| jetpipe_model::variables::VARIABLES.iter().any(|v| v.name == *name))
         .collect();
     let jobs = cx.options.jobs;
     let sensitivities: Vec<Option<(Place, &'static str, Sensitivity)>> =

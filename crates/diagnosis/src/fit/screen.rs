@@ -347,7 +347,7 @@ pub fn candidate(s: &Screened, params: &Parameters, catalogue: &[Candidate]) -> 
         return None;
     }
     let free = free_slots(params);
-    let location = place_of(s.constant, catalogue);
+    let location = place_of(s.constant);
     let family = family_of(s.constant, location, s.follows);
     let nominal = parameter_value(params, s.constant);
     let (lower, upper) = crate::candidates::declared_bounds(s.constant);

@@ -3,7 +3,7 @@
 //! slots ([`crate::physics::flexible`]). Kept apart from the rest of the table only for the
 //! length of `variables.rs`; [`super::TABLE`] holds them after the extra flow slots.
 
-use super::{parameter, Row};
+use super::{parameter, ChainPlace, Row};
 
 /// Value references of the constants and the flexible slots: slot k's variables from
 /// `FLEXIBLE_k_PARAMETER`, in the order parameter, signal_1, signal_2, frequency, lag_1,
@@ -46,17 +46,23 @@ pub(super) const CONSTANTS: [Row; 3] = [
         .at_least(-1e3)
         .at_most(1e3)
         .cite("(2.36)")
-        .because(FORCE),
+        .because(FORCE)
+        .at(ChainPlace::Mechanics)
+        .step(0.01),
     parameter("extra_inflow_1", vr::EXTRA_INFLOW_1, "kg/s", 0.0, INFLOW_1)
         .at_least(-1e-2)
         .at_most(1e-2)
         .cite("(2.24)")
-        .because(FLOW),
+        .because(FLOW)
+        .at(ChainPlace::Chambers)
+        .step(1e-7),
     parameter("extra_inflow_2", vr::EXTRA_INFLOW_2, "kg/s", 0.0, INFLOW_2)
         .at_least(-1e-2)
         .at_most(1e-2)
         .cite("(2.25)")
-        .because(FLOW),
+        .because(FLOW)
+        .at(ChainPlace::Chambers)
+        .step(1e-7),
 ];
 
 const PARAMETER: &str = "flexible slot: the value reference of the constant it varies (0 = off): one of the constants a modulation slot may modulate (see modulation_1_parameter) or extra_force_offset 780, extra_inflow_1 781, extra_inflow_2 782; the constant is its start value plus the slot's increment at the signals, held over each step at the step's start";
