@@ -46,7 +46,7 @@ fn main() {
                     quantisation_step(x)
                 );
             }
-            if let Some(v) = varying(x, x) {
+            if let Some(v) = varying(x, x, &recording.v_da) {
                 varied += 1;
                 println!(
                     "  noise of {name} varies: {:.4e} to {:.4e}, RMS {:.4e} (floor {:.4e}), {}",

@@ -115,7 +115,11 @@ impl<'a> Context<'a> {
             let quantile = departure
                 .as_ref()
                 .map_or(noise_floor(&recorded), |d| noise_floor(&recorded).min(noise_floor(d)));
-            let varies = match (varying(&recorded, x), departure.as_ref().map(|d| varying(d, x))) {
+            let command = &full.v_da;
+            let varies = match (
+                varying(&recorded, x, command),
+                departure.as_ref().map(|d| varying(d, x, command)),
+            ) {
                 (Some(r), None) => Some(r),
                 (Some(r), Some(Some(d))) => Some(if d.rms < r.rms { d } else { r }),
                 _ => None,
@@ -241,7 +245,10 @@ impl<'a> Context<'a> {
         let floor = |x: &[f64], m: &[f64], channel: usize| {
             let departure = crate::input::lines::without_lines(&difference(x, m), sample_rate, 3);
             let quantile = noise_floor(&departure);
-            match varies[channel].then(|| varying(&departure, x)).flatten() {
+            match varies[channel]
+                .then(|| varying(&departure, x, &self.recording.v_da))
+                .flatten()
+            {
                 Some(v) if v.rms > quantile => v.rms,
                 _ => quantile,
             }

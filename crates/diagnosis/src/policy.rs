@@ -31,6 +31,12 @@ pub const GAP_STEPS: f64 = 1.5;
 /// `explained` still means within [`EXPLAINED_WITHIN_NOISE`] of the noise measured.
 pub const NOISE_VARIES: f64 = 1.6;
 
+/// A channel's local noise level follows a series (the channel's own size, the command's
+/// activity) when their correlation over the windows exceeds this: for noise growing in
+/// proportion to a force swinging 15–75 N it is about 0.98; a level that falls as the force
+/// grows does not follow it.
+pub const NOISE_FOLLOWS_CORRELATION: f64 = 0.5;
+
 /// The most places a report names as not told apart (`tied_locations`).
 pub const MOST_TIED_LOCATIONS: usize = 3;
 /// A named effect must lower the held-out force error by this fraction…

@@ -116,8 +116,12 @@ pub struct VaryingNoise {
 /// How the noise of `x` (a channel, or its departure from a model) varies, when its local
 /// level's ninetieth percentile is more than [`crate::policy::NOISE_VARIES`] times its tenth;
 /// `None` for noise of a steady level. `level` is the channel itself, whose size the noise
-/// may follow.
-pub fn varying(x: &[f64], level: &[f64]) -> Option<VaryingNoise> {
+/// may follow; `command` the recorded command, whose activity (its mean step from sample to
+/// sample over each window) a level that rises and falls with is the actuator answering the
+/// command faster than the model does, not noise (a loop closed on the logged force at the
+/// sampling rate feeds the force's noise back, and the actuator's answer to it lifts the
+/// force's fourth differences wherever the loop is closed).
+pub fn varying(x: &[f64], level: &[f64], command: &[f64]) -> Option<VaryingNoise> {
     let levels = local_levels(x);
     if levels.len() < 10 {
         return None;
@@ -135,7 +139,16 @@ pub fn varying(x: &[f64], level: &[f64]) -> Option<VaryingNoise> {
         .take(levels.len())
         .map(|c| c.iter().map(|v| v.abs()).sum::<f64>() / WINDOW as f64)
         .collect();
-    let follows_level = correlation(&levels[..magnitude.len()], &magnitude).abs() > 0.5;
+    let activity: Vec<f64> = command
+        .chunks_exact(WINDOW)
+        .take(levels.len())
+        .map(|c| c.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<f64>() / (WINDOW - 1) as f64)
+        .collect();
+    let follows = crate::policy::NOISE_FOLLOWS_CORRELATION;
+    if correlation(&levels[..activity.len()], &activity) > follows {
+        return None;
+    }
+    let follows_level = correlation(&levels[..magnitude.len()], &magnitude) > follows;
     // Noise that wanders does so slowly: most of its level's variance stays in a mean over
     // a few seconds. A level that changes from window to window is a signal's activity.
     if !follows_level && slow_share(&levels) < SLOW_SHARE {
@@ -362,7 +375,7 @@ pub(crate) mod tests {
         for seed in 1..=10 {
             for lsb in [0.0, 0.0153] {
                 let x = bench_like(seed, 0.05, lsb);
-                assert_eq!(varying(&x, &x), None, "seed {seed}, lsb {lsb}");
+                assert_eq!(varying(&x, &x, &x), None, "seed {seed}, lsb {lsb}");
             }
         }
     }
@@ -374,7 +387,8 @@ pub(crate) mod tests {
             .map(|k| 45.0 + 30.0 * (0.3 * k as f64 * 1e-3).sin())
             .collect();
         let growing: Vec<f64> = level.iter().zip(&e).map(|(l, e)| l + 0.004 * l * e).collect();
-        let v = varying(&growing, &growing).expect("varies");
+        let still = vec![5.0; growing.len()];
+        let v = varying(&growing, &growing, &still).expect("varies");
         assert!(v.follows_level);
         let truth = (level.iter().map(|l| (0.004 * l).powi(2)).sum::<f64>() / level.len() as f64).sqrt();
         assert!((v.rms / truth - 1.0).abs() < 0.1, "{} against {truth}", v.rms);
@@ -386,10 +400,29 @@ pub(crate) mod tests {
             .enumerate()
             .map(|(k, (l, e))| l + 0.05 * (1.0 + 0.8 * (2.0 * std::f64::consts::PI * k as f64 * 1e-3 / 7.0).sin()) * e)
             .collect();
-        let v = varying(&wandering, &wandering).expect("varies");
+        let v = varying(&wandering, &wandering, &still).expect("varies");
         assert!(!v.follows_level, "{v:?}");
         let truth = 0.05 * (1.0f64 + 0.32).sqrt();
         assert!((v.rms / truth - 1.0).abs() < 0.1, "{} against {truth}", v.rms);
+    }
+
+    #[test]
+    fn a_level_that_rises_where_the_command_is_busy_is_the_actuator_answering_it_and_not_noise() {
+        // Four seconds of a command stepping every sample (a loop closed on the logged force)
+        // and four of a held command, in turn: where the command is busy the force carries
+        // three times the sensor's fourth differences.
+        let e = normals(4, 80_000);
+        let busy = |k: usize| (k / 4000) % 2 == 0;
+        let command: Vec<f64> = (0..80_000)
+            .map(|k| if busy(k) { 5.0 + 0.1 * e[(k * 7) % 80_000] } else { 5.0 })
+            .collect();
+        let force: Vec<f64> = (0..80_000)
+            .map(|k| 40.0 + if busy(k) { 0.15 } else { 0.05 } * e[k])
+            .collect();
+        assert_eq!(varying(&force, &force, &command), None);
+        // The same force beside a command that is busy throughout varies (in time).
+        let steady_busy: Vec<f64> = (0..80_000).map(|k| 5.0 + 0.1 * e[(k * 7) % 80_000]).collect();
+        assert!(varying(&force, &force, &steady_busy).is_some());
     }
 
     #[test]
