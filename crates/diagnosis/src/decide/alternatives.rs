@@ -132,8 +132,7 @@ pub(crate) struct Added<'a> {
 /// more too, which must leave a penalised misfit lower by a further penalty and a smaller
 /// force error; one as rich as it or a discovered term must leave a penalised misfit lower
 /// by a penalty, and after a named effect also close a share of the way to the noise), best first by their penalised held-out misfit, at most
-/// [`DISCOVERY_TRIALS`]; among those adequate, the fewest parameters win, then the smaller
-/// penalised misfit.
+/// [`DISCOVERY_TRIALS`]; among those adequate, the [`simplest`].
 pub(crate) fn alternative_at_place(
     check: &Check,
     found: &Localization,
@@ -209,7 +208,7 @@ pub(crate) fn alternative_at_place(
         }
         adequate.push((terms, score, check.discovered(candidate, set, params, force), trial));
     }
-    Ok(simplest(adequate, name, progress))
+    Ok(simplest(adequate, penalty, name, progress))
 }
 
 /// Their linearisations: a jet pipe's travel 30 % short comes to within the noise in three.
@@ -304,24 +303,56 @@ pub(crate) fn simpler_elsewhere(
         }
         adequate.push((terms, score, check.discovered(candidate, set, params, force), trial));
     }
-    Ok(simplest(adequate, &format!("the {name}"), progress))
+    Ok(simplest(adequate, penalty, &format!("the {name}"), progress))
 }
 
-/// Of the adequate terms (their parameters, penalised misfit, term and model), the one with
-/// the fewest parameters, then the smallest penalised misfit.
+/// Of the adequate terms (their parameters, penalised misfit, term and model), the
+/// [`simplest_index`].
 fn simplest(
-    adequate: Vec<(f64, f64, DiscoveredTerm, Parameters)>,
+    mut adequate: Vec<(f64, f64, DiscoveredTerm, Parameters)>,
+    penalty: f64,
     instead_of: &str,
     progress: &mut dyn FnMut(&str),
 ) -> Option<(DiscoveredTerm, Parameters)> {
-    let best = adequate
-        .into_iter()
-        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    best.map(|(_, _, term, trial)| {
-        progress(&format!(
-            "adding a {} at the {} instead of {instead_of}",
-            term.candidate, term.location
-        ));
-        (term, trial)
-    })
+    let sizes: Vec<(f64, f64)> = adequate.iter().map(|a| (a.0, a.1)).collect();
+    let (_, _, term, trial) = adequate.swap_remove(simplest_index(&sizes, penalty)?);
+    progress(&format!(
+        "adding a {} at the {} instead of {instead_of}",
+        term.candidate, term.location
+    ));
+    Some((term, trial))
+}
+
+/// Of terms given as (parameters, penalised misfit), the one with the fewest parameters among
+/// those whose penalised misfit is within one `penalty` of the smallest, then the smallest
+/// penalised misfit. A simpler term is preferred only where the held-out blocks do not tell
+/// it from the best: a command lag left four times the misfit of the command's second-order
+/// filter that had written the recording, and was taken for having one parameter fewer.
+fn simplest_index(terms: &[(f64, f64)], penalty: f64) -> Option<usize> {
+    let lowest = terms.iter().map(|t| t.1).fold(f64::INFINITY, f64::min);
+    (0..terms.len())
+        .filter(|&i| terms[i].1 <= lowest + penalty)
+        .min_by(|&i, &j| {
+            terms[i]
+                .0
+                .total_cmp(&terms[j].0)
+                .then(terms[i].1.total_cmp(&terms[j].1))
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::simplest_index;
+
+    #[test]
+    fn a_simpler_term_wins_only_where_the_held_out_blocks_do_not_tell_it_from_the_best() {
+        // Penalised misfits in noise floors squared, a penalty of 9 per parameter.
+        assert_eq!(simplest_index(&[(1.0, 22615.0), (2.0, 5606.0)], 9.0), Some(1));
+        assert_eq!(simplest_index(&[(2.0, 5606.0), (1.0, 5610.0)], 9.0), Some(1));
+        assert_eq!(
+            simplest_index(&[(2.0, 5606.0), (1.0, 5620.0), (3.0, 5600.0)], 9.0),
+            Some(0)
+        );
+        assert_eq!(simplest_index(&[], 9.0), None);
+    }
 }
