@@ -70,9 +70,9 @@ pub(crate) struct Context<'a> {
     pub(crate) mechanical_noise: f64,
     /// The piston's area, m², once known ([`Self::with_piston_area`]; 0 before).
     pub(crate) piston_area: f64,
-    /// Where the replays drive the stopper with smoothed positions, the residual limit of
-    /// the smoothing ([`crate::input::recording::smoothed_stopper_positions`]), m².
-    pub(crate) stopper_smoothing: Option<f64>,
+    /// The stopper positions the replays drive the model with
+    /// ([`crate::input::recording::Recording::stopper_positions`]).
+    pub(crate) stopper_positions: crate::input::recording::StopperPositions,
     /// Which channels' noise is not steady ([`crate::input::noise::varying`]): their floors are
     /// the RMS of the local level, and stay so when taken again after an addition.
     pub(crate) noise_varies: [bool; CHANNELS],
@@ -206,7 +206,7 @@ impl<'a> Context<'a> {
             channel_noise,
             mechanical_noise: noise,
             piston_area: 0.0,
-            stopper_smoothing: None,
+            stopper_positions: crate::input::recording::StopperPositions::AsRecorded,
             noise_varies: varies.map(|v| v.is_some()),
         })
     }

@@ -232,7 +232,14 @@ pub(crate) fn diagnose_prepared(
         progress(&sentence);
         input_checks.push(sentence);
     }
-    let stopper_smoothing = recording.stopper_smoothing();
+    let stopper_positions = recording.stopper_positions();
+    if let crate::input::recording::StopperPositions::AnsweringTheirRounding { correlation } = stopper_positions {
+        let sentence = format!(
+            "The force answers the rounding of the stopper positions (correlation {correlation:.2} between the change of slope a smoothing would take out of each interval and the force's content at the sampling rate): the stopper moved as it was logged, in steps, and the model is driven with the positions as recorded."
+        );
+        progress(&sentence);
+        input_checks.push(sentence);
+    }
     let mut smoothed = recording.into_stopper_smoothed();
     let before_model = Actuator::new(base.clone())?;
     // The fits' fixed-step replay, checked against the error-controlled one of the starting
@@ -280,7 +287,7 @@ pub(crate) fn diagnose_prepared(
     // (a model without such a force reads none: the share goes back to 0 at the end).
     params.stopper_acceleration_input_share = 1.0;
     let mut cx = cx.with_piston_area(before_model.piston_area);
-    cx.stopper_smoothing = stopper_smoothing;
+    cx.stopper_positions = stopper_positions;
     // 3–5. Replay, localize, add what earns its place; then refit the additions together.
     let mut replays = 1;
     let mut found = crate::decide::decision::run_rounds(&mut cx, params, &mut replays, progress)?;

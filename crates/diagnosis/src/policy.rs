@@ -37,6 +37,12 @@ pub const NOISE_VARIES: f64 = 1.6;
 /// grows does not follow it.
 pub const NOISE_FOLLOWS_CORRELATION: f64 = 0.5;
 
+/// The force answers the stopper positions' rounding, and the model is driven with them as
+/// recorded, when their correlation exceeds this many times its standard error with none,
+/// 1/√n ([`crate::input::recording::force_answers_stopper_rounding`]): by chance once in
+/// about two million recordings.
+pub const STOPPER_ROUNDING_STANDARD_ERRORS: f64 = 5.0;
+
 /// The most places a report names as not told apart (`tied_locations`).
 pub const MOST_TIED_LOCATIONS: usize = 3;
 /// A named effect must lower the held-out force error by this fraction…

@@ -185,7 +185,7 @@ fn slow_share(levels: &[f64]) -> f64 {
     smooth.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / n as f64 / variance
 }
 
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn correlation(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len()) as f64;
     let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
     let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);

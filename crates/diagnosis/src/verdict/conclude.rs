@@ -385,7 +385,7 @@ pub(crate) fn conclude(
         fast_replay,
         fast_replay_final,
         start_pressures: crate::replay::start_pressures(&final_model, full),
-        stopper_smoothing: cx.stopper_smoothing,
+        stopper_positions: cx.stopper_positions,
         acceleration_window: if final_model.params.stopper_acceleration_input_share > 0.0 {
             full.acceleration_window
         } else {

@@ -69,10 +69,9 @@ pub struct Diagnosis {
     /// The chamber pressures the final model's replay started from, where the recording has
     /// pressure channels ([`crate::replay::start_pressures`]); at the equilibrium otherwise.
     pub start_pressures: Option<[f64; 2]>,
-    /// Where the replays drove the stopper with the smoothed positions
-    /// ([`crate::input::recording::Recording::with_stopper_smoothed`]), the smoothing's residual limit, m²;
-    /// `None` where they drove it with the recorded ones.
-    pub stopper_smoothing: Option<f64>,
+    /// The stopper positions the replays drove the model with
+    /// ([`crate::input::recording::Recording::stopper_positions`]).
+    pub stopper_positions: crate::input::recording::StopperPositions,
     /// The half-width (s) of the stopper acceleration the final model reads as its input a_s
     /// ([`crate::input::acceleration`]); 0 where it reads none (no force on the stopper's motion).
     pub acceleration_window: f64,

@@ -1,6 +1,7 @@
 //! The report: the printed summary and the JSON of `jetpipe diagnose --report`.
 
 use crate::fit::intervals::Interval;
+use crate::input::recording::StopperPositions;
 use crate::policy::MOST_TIED_LOCATIONS;
 use crate::replay::errors::Errors;
 use crate::verdict::diagnosis::Diagnosis;
@@ -272,13 +273,17 @@ impl Diagnosis {
             })).collect::<Vec<_>>(),
             "residual_tests": self.residual_tests,
             "fmu_start_values": start_values,
-            "stopper_positions": if self.stopper_smoothing.is_some() {
-                "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21, at each sample whose seven positions leave a sum of squares no larger than stopper_positions_smoothing_residual_limit_m2 about their least-squares quadratic (the recorded positions elsewhere, so at a motion's sharp turns, and at the first and last three samples), as the FMU must be to reproduce these errors, with der(x_s) on to the next sample set before the outputs at a sample are read"
-            } else {
-                "the model was driven with x_s_m as recorded (sampled every 1.5 ms or slower, where the smoothing applied at faster rates would round the motion's turns), as the FMU must be to reproduce these errors, with der(x_s) on to the next sample set before the outputs at a sample are read"
+            "stopper_positions": match self.stopper_positions {
+                StopperPositions::Smoothed { .. } => "the model was driven with x_s_m smoothed by a quadratic Savitzky-Golay filter over samples k-3..k+3, weights (-2, 3, 6, 7, 6, 3, -2)/21, at each sample whose seven positions leave a sum of squares no larger than stopper_positions_smoothing_residual_limit_m2 about their least-squares quadratic (the recorded positions elsewhere, so at a motion's sharp turns, and at the first and last three samples), as the FMU must be to reproduce these errors, with der(x_s) on to the next sample set before the outputs at a sample are read",
+                StopperPositions::AsRecorded => "the model was driven with x_s_m as recorded (sampled every 1.5 ms or slower, where the smoothing applied at faster rates would round the motion's turns), as the FMU must be to reproduce these errors, with der(x_s) on to the next sample set before the outputs at a sample are read",
+                StopperPositions::AnsweringTheirRounding { .. } => "the model was driven with x_s_m as recorded (the force answers the positions' rounding, stopper_positions_rounding_correlation: the stopper moved in the steps it was logged in), as the FMU must be to reproduce these errors, with der(x_s) on to the next sample set before the outputs at a sample are read",
             },
-            "stopper_positions_smoothed": self.stopper_smoothing.is_some(),
-            "stopper_positions_smoothing_residual_limit_m2": self.stopper_smoothing,
+            "stopper_positions_smoothed": self.stopper_positions.residual_limit().is_some(),
+            "stopper_positions_smoothing_residual_limit_m2": self.stopper_positions.residual_limit(),
+            "stopper_positions_rounding_correlation": match self.stopper_positions {
+                StopperPositions::AnsweringTheirRounding { correlation } => Some(correlation),
+                _ => None,
+            },
             "stopper_acceleration_input": (self.acceleration_window > 0.0).then(|| json!({
                 "half_width_s": self.acceleration_window,
                 "recipe": "the model read the stopper acceleration from its input a_s (stopper_acceleration_input_share = 1): at each sample time t, (x(t + T) - 2 x(t) + x(t - T)) / T^2 with T = half_width_s, x the positions the model was driven with, linear between samples; T shrinks to the time left near either end, and a_s = 0 at the first and last samples. Feed the FMU the same a_s to reproduce these errors",
