@@ -240,7 +240,7 @@ pub(crate) fn diagnose_prepared(
         progress(&sentence);
         input_checks.push(sentence);
     }
-    let mut smoothed = recording.into_stopper_smoothed();
+    let mut smoothed = recording.into_driven_by(stopper_positions);
     let before_model = Actuator::new(base.clone())?;
     // The fits' fixed-step replay, checked against the error-controlled one of the starting
     // model, which the verdict compares the final model with.

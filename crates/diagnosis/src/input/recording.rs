@@ -274,8 +274,15 @@ impl Recording {
     }
 
     /// [`Self::with_stopper_smoothed`], in place.
-    pub fn into_stopper_smoothed(mut self) -> Recording {
-        if let Some(limit) = self.stopper_smoothing() {
+    pub fn into_stopper_smoothed(self) -> Recording {
+        let positions = self.stopper_positions();
+        self.into_driven_by(positions)
+    }
+
+    /// The recording with the stopper positions `positions` says ([`Self::stopper_positions`],
+    /// already worked out).
+    pub fn into_driven_by(mut self, positions: StopperPositions) -> Recording {
+        if let Some(limit) = positions.residual_limit() {
             self.x_s = smoothed_stopper_positions(&self.x_s, limit);
         }
         self
