@@ -242,7 +242,8 @@ impl Recording {
     /// The recording with the stopper positions the model is driven with: at each sample k
     /// with three samples either side, the recorded positions at k − 3 ..= k + 3 weighted by
     /// [`STOPPER_SMOOTHING_WEIGHTS`] (a quadratic Savitzky–Golay filter); the recorded
-    /// position itself at the first and last three samples.
+    /// position itself at the first and last three samples. Where the force answers the
+    /// positions' rounding, they are kept as recorded ([`Self::stopper_positions`]).
     ///
     /// The model moves the stopper linearly between samples and forms the velocity a
     /// velocity-dependent force (friction) reads from the slopes of the intervals. Positions
