@@ -23,6 +23,7 @@
 //!    explanations differ most (`jetpipe propose`).
 //!
 //! Beside the stages: [`policy`] states every threshold and precedence rule once,
+//! [`statistics`] the small statistics every stage uses,
 //! `context.rs` (its `Context`) is what every stage reads, and the result types live in the stage that
 //! produces them and are re-exported here.
 
@@ -38,6 +39,7 @@ mod context;
 mod diagnose;
 mod parallel;
 pub mod policy;
+pub mod statistics;
 pub mod vocabulary;
 
 pub use context::{Options, ProgressBars};

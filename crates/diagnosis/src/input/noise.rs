@@ -9,6 +9,8 @@
 //! does not jump between the few values a quantised channel's second differences take
 //! (the median of the single differences did: 0.046 or 0.055 N on 0.050 N of noise).
 
+use crate::statistics::correlation;
+
 /// Second differences per window.
 pub const WINDOW: usize = 64;
 
@@ -183,22 +185,6 @@ fn slow_share(levels: &[f64]) -> f64 {
         })
         .collect();
     smooth.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / n as f64 / variance
-}
-
-pub(crate) fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len()) as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        ab += (x - ma) * (y - mb);
-        aa += (x - ma) * (x - ma);
-        bb += (y - mb) * (y - mb);
-    }
-    if aa > 0.0 && bb > 0.0 {
-        ab / (aa * bb).sqrt()
-    } else {
-        0.0
-    }
 }
 
 /// The step to which `x` is quantised, if it looks quantised: the largest of the smallest

@@ -186,7 +186,7 @@ pub fn force_answers_stopper_rounding(x: &[f64], force: &[f64], residual_limit: 
         return None;
     }
     let departure: Vec<f64> = samples.map(quadratic_departure).collect();
-    let r = crate::input::noise::correlation(&rounding, &departure);
+    let r = crate::statistics::correlation(&rounding, &departure);
     (r.abs() > crate::policy::STOPPER_ROUNDING_STANDARD_ERRORS / (changed as f64).sqrt()).then_some(r)
 }
 

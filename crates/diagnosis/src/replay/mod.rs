@@ -14,18 +14,21 @@ pub mod signals;
 pub mod signature;
 
 use crate::input::recording::Recording;
+use crate::statistics::line_value_at_start;
 use jetpipe_model::physics::actuator::{Actuator, Outputs};
 use jetpipe_model::physics::sensors::{Channel, SensorLaw};
 use jetpipe_model::simulation::{FixedStep, Simulation, StepFailure};
 
-/// The readings averaged for the chamber pressures at the start ([`start_pressures`]): their
-/// noise falls by half, and at 250 Hz they span 12 ms, within which a held command moves
-/// the chambers little.
+/// The readings through which a line gives the chamber pressures at the start
+/// ([`start_pressures`]): its value at the first sample carries 0.84 of one reading's noise,
+/// and at 250 Hz they span 12 ms, over which the chambers' motion is nearly straight.
 pub const START_READINGS: usize = 4;
 
 /// The chamber pressures (Pa) at the recording's first sample as `model`'s transducers read
-/// them: the mean of the first [`START_READINGS`] readings of each, taken back through the
-/// transducer's static law. A lag or a delay of the reading is left out: the replay starts
+/// them: the value at the first sample of the line through the first [`START_READINGS`]
+/// readings of each (their mean would be the pressure at the readings' middle, 5.6 kPa
+/// above the first where a stopper moving at 44 mm/s at the start raised it at 0.9 MPa/s,
+/// read at 250 Hz), taken back through the transducer's static law. A lag or a delay of the reading is left out: the replay starts
 /// from rest, where a transducer's memory holds what it reads, and the law's inverse would
 /// differentiate the readings, which over four samples is their noise times the lag over
 /// the sampling interval (an 11 ms lag read at 2 kHz started the chambers kPa away and made
@@ -39,7 +42,7 @@ pub fn start_pressures(model: &Actuator, recording: &Recording) -> Option<[f64; 
         return None;
     }
     let time = &recording.time[..k];
-    // The mean quantity behind the first readings, and whether the law's static curve is
+    // The quantity behind the readings at the first sample, and whether the law's static curve is
     // flat there (the reading then bounds the quantity from below only).
     let back = |channel: Channel, readings: &[f64]| -> Option<(f64, bool)> {
         let law = SensorLaw {
@@ -47,7 +50,7 @@ pub fn start_pressures(model: &Actuator, recording: &Recording) -> Option<[f64; 
             delay: 0.0,
             ..SensorLaw::of(&model.params, channel)
         };
-        // The static curve is undone on the mean, after the rest of the law.
+        // The static curve is undone on the line's value, after the rest of the law.
         let curve = law.curve;
         let law = SensorLaw {
             curve: Default::default(),
@@ -58,7 +61,7 @@ pub fn start_pressures(model: &Actuator, recording: &Recording) -> Option<[f64; 
         } else {
             law.unread(time, &readings[..k])?
         };
-        let value = curve.inverse(values.iter().sum::<f64>() / k as f64)?;
+        let value = curve.inverse(line_value_at_start(time, &values))?;
         let probe = FLAT_PROBE * value.abs().max(1.0);
         let flat = curve.is_on() && (curve.at(value + probe) - curve.at(value)) < FLAT_SLOPE * probe;
         value.is_finite().then_some((value, flat))
@@ -416,11 +419,14 @@ mod tests {
     #[test]
     fn with_pressure_channels_the_replay_starts_the_chambers_at_the_first_readings_through_the_transducers() {
         let mut recording = protocol_of(200);
-        // The first four readings average 4.1e5 and 2.05e5 Pa; later ones do not count.
+        // The first four readings move steadily from 4.1e5 and 2.05e5 Pa (their means are
+        // 3 kPa and 1.5 kPa away); later ones do not count.
         let p1: Vec<f64> = (0..200)
-            .map(|k| [4.0e5, 4.2e5, 4.1e5, 4.1e5][k.min(3)] + if k >= 4 { 5e4 } else { 0.0 })
+            .map(|k| [4.1e5, 4.12e5, 4.14e5, 4.16e5][k.min(3)] + if k >= 4 { 5e4 } else { 0.0 })
             .collect();
-        let p2: Vec<f64> = (0..200).map(|k| if k < 4 { 2.05e5 } else { 3e5 }).collect();
+        let p2: Vec<f64> = (0..200)
+            .map(|k| [2.05e5, 2.04e5, 2.03e5, 2.02e5][k.min(3)] + if k >= 4 { 1e5 } else { 0.0 })
+            .collect();
         recording.p1 = Some(p1);
         recording.p2 = Some(p2);
         let model = Actuator::new(Parameters {
@@ -469,9 +475,11 @@ mod tests {
             ..Parameters::default()
         })
         .unwrap();
+        // The line through the four readings takes 0.6 of the alternating noise to its start
+        // (240 Pa); the lag's inverse would have added 4400 Pa.
         let start = start_pressures(&model, &recording).expect("pressure channels");
-        assert!((start[0] - (4.0e5 - 5e3)).abs() < 1e-6, "{start:?}");
-        assert!((start[1] - 2.0e5).abs() < 1e-6, "{start:?}");
+        assert!((start[0] - (4.0e5 - 5e3 + 240.0)).abs() < 1e-6, "{start:?}");
+        assert!((start[1] - (2.0e5 + 240.0)).abs() < 1e-6, "{start:?}");
     }
 
     #[test]

@@ -4,7 +4,8 @@
 
 use serde_json::{json, Value};
 
-use crate::replay::signals::{correlation, rms, ChainSignals};
+use crate::replay::signals::{rms, ChainSignals};
+use crate::statistics::correlation;
 
 /// Quantile bins of a signal for its conditional means.
 pub const BINS: usize = 10;
