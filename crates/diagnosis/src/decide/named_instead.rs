@@ -11,8 +11,9 @@
 //! every addition is refitted beside it, and where the held-out misfit with the named
 //! parameters' penalty is within one penalty of the term's and the effect's signature shows,
 //! the named effect replaces the term: a name is the simpler reading of the same departure.
-//! It does so only where the named effect brings the force to the noise: beside a remainder,
-//! the term may be standing in for part of it, and a name would claim what it cannot show.
+//! It does so only where the named effect brings the force to the noise, and the pressures
+//! the recording has: beside a remainder in any channel, the term may be standing in for part
+//! of it, and a name would claim what it cannot show.
 
 use crate::candidates::catalogue;
 use crate::candidates::parameter_value;
@@ -154,6 +155,18 @@ fn named_in_place_of(
         ));
         return Ok(None);
     }
+    // So does a remainder in the pressures: a force-side term in the pressures' remainder
+    // took its place beside laminar leaks standing in for a turbulent flow between the
+    // chambers (pressures 1.7 noise floors off held out), and the sensor's offset and gain
+    // fitted there, 1.4 mN and 1e-5, were named.
+    if let Some(ratio) = pressures_off_held_out(cx, &fit.params, replays)? {
+        progress(&format!(
+            "  {}: not named in the {}'s place while a pressure stays {ratio:.2} noise floors off held out",
+            fit.scored.fit.candidate.named.unwrap_or(fit.scored.fit.candidate.label),
+            term.candidate
+        ));
+        return Ok(None);
+    }
     let name = fit.scored.fit.candidate.named.expect("a named candidate");
     let (test, parameters) = fit.signature(cx, replays)?;
     if !test.present {
@@ -191,6 +204,25 @@ fn named_in_place_of(
         },
         fit.params,
     )))
+}
+
+/// The held-out RMS error of the pressure further from the model `params`', in its noise
+/// floors, where it is above [`EXPLAINED_WITHIN_NOISE`]; `None` where both are within it or
+/// the recording has no pressures.
+fn pressures_off_held_out(cx: &Context, params: &Parameters, replays: &mut usize) -> Result<Option<f64>, String> {
+    if cx.pressure_noise.is_none() {
+        return Ok(None);
+    }
+    let problem = Problem::new(cx.recording, params, &cx.blocks, cx.channel_noise);
+    let with = replay_fast(&Actuator::new(params.clone())?, cx.recording, cx.n)?;
+    *replays += 1;
+    let (_, heldout) = problem.errors(&[with.force, with.p1, with.p2]);
+    let count = heldout_count(&cx.blocks) as f64;
+    let worst = (1..heldout.len())
+        .filter(|&c| problem.weights[c] > 0.0)
+        .map(|c| (heldout[c] / count).sqrt())
+        .fold(0.0, f64::max);
+    Ok((worst > EXPLAINED_WITHIN_NOISE).then_some(worst))
 }
 
 /// The refittable parameters of every addition but those `keep_term` / `keep_effect` leave
