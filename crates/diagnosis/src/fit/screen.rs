@@ -578,7 +578,64 @@ mod tests {
         assert_eq!(shapes[0], vec![0, 8]);
         // The step's corners come next: at 3 (the line through the ends passes 1.125 there) or 4.
         assert!(shapes[2].contains(&3) && shapes[2].contains(&4), "{shapes:?}");
-        assert_eq!(shapes.len(), MAX_KNOTS - 1);
+        // From two knots to every fine one.
+        assert_eq!(shapes.len(), MAX_KNOTS.min(x.len()) - 1);
+    }
+
+    #[test]
+    fn a_constant_wandering_in_time_through_seven_turns_is_screened_with_all_seven() {
+        // The banded recording's sensitivity times a wander of ±1 with seven turns over
+        // its 20 s: a polyline needs a knot at each turn and the ends, nine in all.
+        let (mut recording, blocks, sensitivity, x_s) = banded();
+        let band = |x: f64| (2.0 * (x - 0.060) / 0.003).clamp(0.0, 2.0);
+        let wander: Vec<f64> = recording
+            .time
+            .iter()
+            .map(|t| (2.0 * std::f64::consts::PI * 3.5 * t / 20.0).sin())
+            .collect();
+        // The band taken out again and the wander put in, the noise kept.
+        for (k, f) in recording.force.iter_mut().enumerate() {
+            *f += f64::from(sensitivity[FORCE][k]) * (wander[k] - band(x_s[k]));
+        }
+        let base = Parameters::default();
+        let problem = Problem::new(&recording, &base, &blocks, [0.05, 0.0, 0.0]);
+        let zero = vec![0.0; recording.len()];
+        let residual = residuals(
+            &problem,
+            &Replay {
+                force: zero.clone(),
+                p1: zero.clone(),
+                p2: zero.clone(),
+                current: zero.clone(),
+                x_jp: zero,
+                steps: 0,
+            },
+        );
+        let knots = knots_of(&recording.time, &blocks, ModulationSignal::Time).unwrap();
+        let (xs, ys, _) = screen_pair(&problem, &residual, &sensitivity, &recording.time, &knots, 10.0)
+            .expect("a wander beats a constant");
+        let mut phi = vec![0.0; xs.len()];
+        let misfit: f64 = recording
+            .time
+            .iter()
+            .zip(&wander)
+            .map(|(&t, w)| {
+                hats(&xs, t, &mut phi);
+                let got: f64 = phi.iter().zip(&ys).map(|(p, y)| p * y).sum();
+                (got - w).powi(2)
+            })
+            .sum::<f64>()
+            / wander.len() as f64;
+        // Straight between the fine knots nearest its turns, the shape departs from the sine
+        // by about a sixth of its swing; with six knots, four turns at most, by half of it.
+        let turns = ys.windows(3).filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < 0.0).count();
+        assert_eq!(turns, 7, "{xs:?} {ys:?}");
+        assert!(
+            misfit.sqrt() < 0.2,
+            "the shape departs from the wander by {} RMS over {} knots ({xs:?})",
+            misfit.sqrt(),
+            xs.len()
+        );
     }
 
     /// A recording whose force residual is a sensitivity times a band of the stopper's

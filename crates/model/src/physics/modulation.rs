@@ -34,7 +34,7 @@ use crate::variables::{self, number, vr};
 pub const SLOTS: usize = 2;
 
 /// The most knots a slot has.
-pub const MAX_KNOTS: usize = 6;
+pub const MAX_KNOTS: usize = 12;
 
 /// The constants a slot may modulate, as value references.
 pub const MODULATABLE: &[u32] = &[
@@ -532,8 +532,8 @@ pub fn field_mut(slots: &mut [Slot; SLOTS], value_reference: u32) -> Option<&mut
         1 => Some(&mut slot.signal),
         2 => Some(&mut slot.frequency),
         3 => Some(&mut slot.knots),
-        4..=9 => Some(&mut slot.x[j - 4]),
-        10..=15 => Some(&mut slot.y[j - 10]),
+        4..=15 => Some(&mut slot.x[j - 4]),
+        16..=27 => Some(&mut slot.y[j - 16]),
         _ => None,
     }
 }

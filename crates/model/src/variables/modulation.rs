@@ -1,32 +1,32 @@
 //! The rows of the modulation slots ([`crate::physics::modulation`]): two slots, each a
-//! constant of the table, a signal of the chain, a frequency and up to six knots. Kept apart
+//! constant of the table, a signal of the chain, a frequency and up to twelve knots. Kept apart
 //! from the rest of the table only for the length of `variables.rs`; [`super::TABLE`] holds
 //! them after the others.
 
 use super::{parameter, Row};
 
 /// Value references of the slots: slot k's variables from `MODULATION_k_PARAMETER`, in the
-/// order parameter, signal, frequency, knots, x_1..x_6, y_1..y_6 (a stride of
+/// order parameter, signal, frequency, knots, x_1..x_12, y_1..y_12 (a stride of
 /// [`MODULATION_STRIDE`] between slots).
 pub mod vr {
-    pub const MODULATION_1_PARAMETER: u32 = 700;
-    pub const MODULATION_1_SIGNAL: u32 = 701;
-    pub const MODULATION_1_FREQUENCY: u32 = 702;
-    pub const MODULATION_1_KNOTS: u32 = 703;
-    /// Knot j's signal value at this plus j − 1 (j = 1..6); its increment at MODULATION_1_Y plus j − 1.
-    pub const MODULATION_1_X: u32 = 704;
-    pub const MODULATION_1_X_LAST: u32 = MODULATION_1_X + 5;
-    pub const MODULATION_1_Y: u32 = 710;
-    pub const MODULATION_1_Y_LAST: u32 = MODULATION_1_Y + 5;
-    pub const MODULATION_2_PARAMETER: u32 = 720;
-    pub const MODULATION_2_SIGNAL: u32 = 721;
-    pub const MODULATION_2_FREQUENCY: u32 = 722;
-    pub const MODULATION_2_KNOTS: u32 = 723;
-    /// Knot j's signal value at this plus j − 1 (j = 1..6); its increment at MODULATION_2_Y plus j − 1.
-    pub const MODULATION_2_X: u32 = 724;
-    pub const MODULATION_2_X_LAST: u32 = MODULATION_2_X + 5;
-    pub const MODULATION_2_Y: u32 = 730;
-    pub const MODULATION_2_Y_LAST: u32 = MODULATION_2_Y + 5;
+    pub const MODULATION_1_PARAMETER: u32 = 1000;
+    pub const MODULATION_1_SIGNAL: u32 = 1001;
+    pub const MODULATION_1_FREQUENCY: u32 = 1002;
+    pub const MODULATION_1_KNOTS: u32 = 1003;
+    /// Knot j's signal value at this plus j − 1 (j = 1..12); its increment at MODULATION_1_Y plus j − 1.
+    pub const MODULATION_1_X: u32 = 1004;
+    pub const MODULATION_1_X_LAST: u32 = MODULATION_1_X + 11;
+    pub const MODULATION_1_Y: u32 = 1016;
+    pub const MODULATION_1_Y_LAST: u32 = MODULATION_1_Y + 11;
+    pub const MODULATION_2_PARAMETER: u32 = 1030;
+    pub const MODULATION_2_SIGNAL: u32 = 1031;
+    pub const MODULATION_2_FREQUENCY: u32 = 1032;
+    pub const MODULATION_2_KNOTS: u32 = 1033;
+    /// Knot j's signal value at this plus j − 1 (j = 1..12); its increment at MODULATION_2_Y plus j − 1.
+    pub const MODULATION_2_X: u32 = 1034;
+    pub const MODULATION_2_X_LAST: u32 = MODULATION_2_X + 11;
+    pub const MODULATION_2_Y: u32 = 1046;
+    pub const MODULATION_2_Y_LAST: u32 = MODULATION_2_Y + 11;
     /// From one slot's variable to the same variable of the next slot.
     pub const MODULATION_STRIDE: u32 = MODULATION_2_PARAMETER - MODULATION_1_PARAMETER;
     /// The last value reference of the slots.
@@ -42,7 +42,7 @@ const Y: &str = "the increment of the slot's constant at the knot, in the consta
 const CODE: &str = "a value reference of this table: 0 (off) or a constant listed in the description";
 const CODES: &str = "the signal codes run from 0 to 13";
 const HERTZ: &str = "100 kHz: a hundred times the bench's sampling rate";
-const AT_MOST_SIX: &str = "at most 6 knots";
+const AT_MOST_TWELVE: &str = "at most 12 knots";
 const SIGNAL_VALUE: &str =
     "1e9 exceeds every signal of the chain in its SI unit (the largest, a pressure, is below 1e7 Pa)";
 const INCREMENT: &str = "1e9 exceeds every constant's own limits; those are checked at each knot";
@@ -70,8 +70,8 @@ macro_rules! slot_rows {
             .because(HERTZ),
             parameter(concat!("modulation_", $k, "_knots"), $base + 3, "1", 0.0, KNOTS)
                 .at_least(0.0)
-                .at_most(6.0)
-                .because(AT_MOST_SIX),
+                .at_most(12.0)
+                .because(AT_MOST_TWELVE),
             parameter(concat!("modulation_", $k, "_x_1"), $base + 4, "1", 0.0, X)
                 .at_least(-1e9)
                 .at_most(1e9)
@@ -96,27 +96,75 @@ macro_rules! slot_rows {
                 .at_least(-1e9)
                 .at_most(1e9)
                 .because(SIGNAL_VALUE),
-            parameter(concat!("modulation_", $k, "_y_1"), $base + 10, "1", 0.0, Y)
+            parameter(concat!("modulation_", $k, "_x_7"), $base + 10, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_8"), $base + 11, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_9"), $base + 12, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_10"), $base + 13, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_11"), $base + 14, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_x_12"), $base + 15, "1", 0.0, X)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(SIGNAL_VALUE),
+            parameter(concat!("modulation_", $k, "_y_1"), $base + 16, "1", 0.0, Y)
                 .at_least(-1e9)
                 .at_most(1e9)
                 .because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_2"), $base + 11, "1", 0.0, Y)
+            parameter(concat!("modulation_", $k, "_y_2"), $base + 17, "1", 0.0, Y)
                 .at_least(-1e9)
                 .at_most(1e9)
                 .because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_3"), $base + 12, "1", 0.0, Y)
+            parameter(concat!("modulation_", $k, "_y_3"), $base + 18, "1", 0.0, Y)
                 .at_least(-1e9)
                 .at_most(1e9)
                 .because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_4"), $base + 13, "1", 0.0, Y)
+            parameter(concat!("modulation_", $k, "_y_4"), $base + 19, "1", 0.0, Y)
                 .at_least(-1e9)
                 .at_most(1e9)
                 .because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_5"), $base + 14, "1", 0.0, Y)
+            parameter(concat!("modulation_", $k, "_y_5"), $base + 20, "1", 0.0, Y)
                 .at_least(-1e9)
                 .at_most(1e9)
                 .because(INCREMENT),
-            parameter(concat!("modulation_", $k, "_y_6"), $base + 15, "1", 0.0, Y)
+            parameter(concat!("modulation_", $k, "_y_6"), $base + 21, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_7"), $base + 22, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_8"), $base + 23, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_9"), $base + 24, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_10"), $base + 25, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_11"), $base + 26, "1", 0.0, Y)
+                .at_least(-1e9)
+                .at_most(1e9)
+                .because(INCREMENT),
+            parameter(concat!("modulation_", $k, "_y_12"), $base + 27, "1", 0.0, Y)
                 .at_least(-1e9)
                 .at_most(1e9)
                 .because(INCREMENT),
@@ -125,8 +173,8 @@ macro_rules! slot_rows {
 }
 
 /// The rows of slot 1, then those of slot 2.
-pub(super) const SLOT_1: [Row; 16] = slot_rows!(1, vr::MODULATION_1_PARAMETER);
-pub(super) const SLOT_2: [Row; 16] = slot_rows!(2, vr::MODULATION_2_PARAMETER);
+pub(super) const SLOT_1: [Row; 28] = slot_rows!(1, vr::MODULATION_1_PARAMETER);
+pub(super) const SLOT_2: [Row; 28] = slot_rows!(2, vr::MODULATION_2_PARAMETER);
 
 /// The slots' rows after the table's others: the modulation slots', the extra force's product
 /// slots' (`variables/extra_force.rs`), the extra flow slots' (`variables/extra_flow.rs`), the

@@ -152,23 +152,24 @@ fn the_slots_description_names_every_modulatable_constant_with_its_value_referen
 #[test]
 fn every_variable_of_both_slots_is_a_parameter_of_the_table_that_sets_its_own_field() {
     let names: Vec<&str> = value_references().map(variable_name).collect();
-    assert_eq!(names.len(), 32);
+    assert_eq!(names.len(), 56);
     assert_eq!(names[0], "modulation_1_parameter");
-    assert_eq!(names[15], "modulation_1_y_6");
-    assert_eq!(names[16], "modulation_2_parameter");
-    assert_eq!(names[17], "modulation_2_signal");
-    assert_eq!(names[18], "modulation_2_frequency");
-    assert_eq!(names[19], "modulation_2_knots");
-    assert_eq!(names[20], "modulation_2_x_1");
-    assert_eq!(names[26], "modulation_2_y_1");
+    assert_eq!(names[15], "modulation_1_x_12");
+    assert_eq!(names[27], "modulation_1_y_12");
+    assert_eq!(names[28], "modulation_2_parameter");
+    assert_eq!(names[29], "modulation_2_signal");
+    assert_eq!(names[30], "modulation_2_frequency");
+    assert_eq!(names[31], "modulation_2_knots");
+    assert_eq!(names[32], "modulation_2_x_1");
+    assert_eq!(names[44], "modulation_2_y_1");
     for (j, r) in value_references().enumerate() {
         assert!(Parameters::VALUE_REFERENCES.contains(&r), "{}", names[j]);
         let mut p = Parameters::default();
         // A value every field accepts, told apart from every other field's.
-        let value = if j % 16 == 0 {
+        let value = if j % 28 == 0 {
             vr::K_CD as f64
         } else {
-            (j % 16).min(6) as f64
+            (j % 28).min(12) as f64
         };
         p.set(r, value).unwrap_or_else(|e| panic!("{}: {e}", names[j]));
         assert_eq!(p.get(r), Some(value));
@@ -209,7 +210,7 @@ fn a_constant_that_is_not_modulatable_is_refused_naming_the_slot_the_value_and_w
     assert!(e.starts_with("modulation_2_knots = 1.5 is invalid"), "{e}");
     let mut p = Parameters::default();
     assert!(p.set(vr::MODULATION_1_SIGNAL, 14.0).is_err(), "beyond the row's limits");
-    assert!(p.set(vr::MODULATION_1_KNOTS, 7.0).is_err());
+    assert!(p.set(vr::MODULATION_1_KNOTS, 13.0).is_err());
     assert!(p.set(vr::MODULATION_1_PARAMETER, 1001.0).is_err());
     assert_eq!(p, Parameters::default(), "a refused setting changes nothing");
     for &constant in MODULATABLE {
