@@ -3,8 +3,9 @@
 # the actuator with randomly drawn mechanisms, protocols, rates and noise, whose truth stays
 # sealed until its scorer reads the reports. Writes docs/results/blindgen.md: one row per draw
 # (rate, length, pressure channels, verdict, what was found, the held-out error after in noise
-# floors, wall time per sample), then the scorer's lines and totals (honest, located, explained;
-# by class, by rate and with or without pressures).
+# floors, wall time per sample), the FMU's replay of each report (its force error against the
+# reported one), then the scorer's lines and totals (honest, located, explained; by class, by
+# rate and with or without pressures).
 #
 #   JETPIPE_BLINDGEN=DIR bash scripts/bench_blindgen.sh SEED COUNT
 #
@@ -33,6 +34,12 @@ count="$2"
 # JETPIPE_BLINDGEN_REPORTS=DIR keeps the reports in DIR (for `jetpipe propose` on them).
 blindgen_prepare bench_blindgen.sh "$seed" "$count"
 mkdir -p "$work/reports"
+# The FMU of the same commit, packaged now (a build during the run does not change it), and
+# the Python environment that replays the reports through it.
+cargo build --release -p jetpipe-fmu --lib >&2
+"$work/jetpipe" package --out "$work/JetPipeActuator.fmu" --out-fmi3 "$work/JetPipeActuator-fmi3.fmu" \
+    --library target/release/libjetpipe.so >&2
+bash scripts/venv.sh >&2
 echo "| draw | rate (Hz) | length (s) | pressures | verdict | found (location, family) | held-out after / noise floor | wall (s) | wall per sample (ms) |"
 echo "|---|---|---|---|---|---|---|---|---|"
 for rec in "$draws"/bg_"$seed"_*.csv; do
@@ -86,6 +93,12 @@ print(f"Additions withdrawn on {len(withdrawn)} of {len(reports)} draws ({kept} 
 PY
 python3 scripts/never_worse.py "$work"/reports/*.json
 echo
+echo "The FMU set to each report's start values and driven by its recording as the diagnosis drove"
+echo "its model (scripts/fmu_replay_reports.py):"
+echo
+.venv/bin/python scripts/fmu_replay_reports.py "$work/JetPipeActuator.fmu" "$draws" "$work/reports" --jobs 2 \
+    | tee "$work/fmu.txt"
+echo
 echo "The scorer's account (truth revealed only here):"
 echo
 echo '```'
@@ -93,7 +106,7 @@ echo '```'
 echo '```'
 # The totals, for the history table of docs/results/blindgen.md: the scorer's line for all
 # draws, and the median of the table's wall time per recorded sample.
-python3 - "$work/rows.md" "$work/score.txt" <<'PY'
+python3 - "$work/rows.md" "$work/score.txt" "$work/fmu.txt" <<'PY'
 import re, statistics, sys
 rows = [line.strip().strip("|").split("|") for line in open(sys.argv[1]) if line.startswith("| bg_")]
 per_sample = [float(r[8]) for r in rows if r[8].strip() not in ("", "—")]
@@ -104,6 +117,9 @@ parts = [f"honest {score[1]} / located {score[3]} / explained {score[4]} of {sco
          else "the scorer gave no totals"]
 if per_sample:
     parts.append(f"median {statistics.median(per_sample):.2f} ms a sample")
+fmu = re.search(r"^FMU: (\d+) of (\d+) within", open(sys.argv[3]).read(), re.M)
+if fmu:
+    parts.append(f"FMU within 10 % on {fmu[1]} of {fmu[2]}")
 parts.append(f"{len(rows)} draws in {sum(wall) / 60:.0f} min")
 print("TOTALS: " + "; ".join(parts))
 PY
