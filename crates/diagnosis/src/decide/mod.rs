@@ -9,6 +9,7 @@ pub(crate) mod discover;
 pub(crate) mod eliminate;
 pub(crate) mod findings;
 pub(crate) mod flexible;
+pub(crate) mod frequency;
 pub(crate) mod joint_refit;
 pub(crate) mod named;
 pub(crate) mod named_effect;

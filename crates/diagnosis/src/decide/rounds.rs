@@ -238,6 +238,9 @@ pub(crate) fn one_round(
     {
         *margin = if paired { None } else { found.margin(place) };
     }
+    // A sinusoid's frequency, held by the fits at the spectral line's, moved through the
+    // model where another leaves less (`frequency.rs`).
+    crate::decide::frequency::polish_frequency(cx, f, replays, progress)?;
     // Each addition was fitted with those before it held. Refitting them together now,
     // not only at the end, lets the next round start from where they explain most: a
     // discovered restriction fitted while friction was still missing leaves the pressures

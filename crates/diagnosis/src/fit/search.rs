@@ -6,7 +6,7 @@
 const GOLDEN_SHARE: f64 = 0.618_033_988_749_894_9;
 
 /// Golden-section search of `steps` steps on [a, b]: the best point and its cost.
-pub(super) fn golden(a: f64, b: f64, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
+pub(crate) fn golden(a: f64, b: f64, steps: usize, f: &mut dyn FnMut(f64) -> f64) -> (f64, f64) {
     let phi = GOLDEN_SHARE;
     let (mut a, mut b) = (a, b);
     let mut c = b - phi * (b - a);
