@@ -53,6 +53,18 @@ pub struct Variable {
     pub description: &'static str,
 }
 
+/// What a constant is, where that says more about a departure of it than its place does:
+/// the kind of departure it makes when it follows a state of the chain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ConstantKind {
+    /// A factor on one port's orifice area: following any state, port 1 departs from port 2,
+    /// an asymmetry.
+    PortAreaFactor,
+    /// A length the load bears on: following the force or a chamber pressure, it gives under
+    /// the load, a compliance.
+    LoadBearingLength,
+}
+
 /// The place of the chain a constant of the table belongs to, from the command to the
 /// transducers: where a departure of it would be, for the diagnosis that locates one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

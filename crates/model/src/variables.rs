@@ -2,7 +2,7 @@
 //! and the setters all come from here (the FMU crate turns the rows into FMI variables), so
 //! they cannot drift apart.
 
-pub use crate::variable::{Causality, ChainPlace, VarType, Variability, Variable};
+pub use crate::variable::{Causality, ChainPlace, ConstantKind, VarType, Variability, Variable};
 
 mod extra_flow;
 mod extra_force;
@@ -37,6 +37,8 @@ pub struct Row {
     /// A difference step for the outputs' sensitivity to the constant where its start value is
     /// 0 and no hundredth of it gives one: a typical size of the quantity.
     pub sensitivity_step: Option<f64>,
+    /// What the constant is where its place does not say which kind of departure it makes.
+    pub kind: Option<ConstantKind>,
 }
 
 // Builders for the rows (const: the table is a constant; no float arithmetic in them, which
@@ -50,7 +52,13 @@ impl Row {
             reason: "",
             place: None,
             sensitivity_step: None,
+            kind: None,
         }
+    }
+    /// What the constant is, for the kind of departure it makes.
+    const fn is(mut self, kind: ConstantKind) -> Row {
+        self.kind = Some(kind);
+        self
     }
     /// The place of the chain the constant belongs to.
     const fn at(mut self, place: ChainPlace) -> Row {
@@ -443,7 +451,8 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(1.0)
         .cite("Table 3.1, (2.32)")
         .because(LENGTH)
-        .at(ChainPlace::Chambers),
+        .at(ChainPlace::Chambers)
+        .is(ConstantKind::LoadBearingLength),
     parameter(
         "L_spring0",
         vr::L_SPRING0,
@@ -576,22 +585,26 @@ const ROWS_BEFORE_THE_SLOTS: &[Row] = &[
         .at_least(0.0).at_most(10.0)
         .cite("(2.8)")
         .because(AREA_SCALE)
-        .at(ChainPlace::Valve),
+        .at(ChainPlace::Valve)
+        .is(ConstantKind::PortAreaFactor),
     parameter("supply_area_scale_2", vr::SUPPLY_AREA_SCALE_2, "1", 1.0, "valve asymmetry: factor on the supply orifice area of port 2 (1 = the geometry)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.10)")
         .because(AREA_SCALE)
-        .at(ChainPlace::Valve),
+        .at(ChainPlace::Valve)
+        .is(ConstantKind::PortAreaFactor),
     parameter("return_area_scale_1", vr::RETURN_AREA_SCALE_1, "1", 1.0, "valve asymmetry: factor on the return orifice area of port 1 (1 = the geometry)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.9)")
         .because(AREA_SCALE)
-        .at(ChainPlace::Valve),
+        .at(ChainPlace::Valve)
+        .is(ConstantKind::PortAreaFactor),
     parameter("return_area_scale_2", vr::RETURN_AREA_SCALE_2, "1", 1.0, "valve asymmetry: factor on the return orifice area of port 2 (1 = the geometry)")
         .at_least(0.0).at_most(10.0)
         .cite("(2.11)")
         .because(AREA_SCALE)
-        .at(ChainPlace::Valve),
+        .at(ChainPlace::Valve)
+        .is(ConstantKind::PortAreaFactor),
     parameter("return_resistance", vr::RETURN_RESISTANCE, "Pa.s/kg", 0.0, "return restriction: the pressure the return orifices vent into rises above P_r by this times the return mass flow (0 = off)")
         .at_least(0.0).at_most(1e12)
         .cite("(2.18)")
@@ -1067,7 +1080,26 @@ mod tests {
             let target = FLEXIBLE_TARGETS.contains(&row.variable.value_reference);
             assert_eq!(row.place.is_some(), target, "{}", row.variable.name);
             assert!(row.sensitivity_step.is_none() || target, "{}", row.variable.name);
+            assert!(row.kind.is_none() || target, "{}", row.variable.name);
         }
+    }
+
+    #[test]
+    fn the_four_port_area_factors_and_the_support_length_alone_say_what_kind_of_constant_they_are() {
+        let kinds: Vec<(&str, ConstantKind)> = TABLE
+            .iter()
+            .filter_map(|r| r.kind.map(|k| (r.variable.name, k)))
+            .collect();
+        assert_eq!(
+            kinds,
+            [
+                ("L_sup", ConstantKind::LoadBearingLength),
+                ("supply_area_scale_1", ConstantKind::PortAreaFactor),
+                ("supply_area_scale_2", ConstantKind::PortAreaFactor),
+                ("return_area_scale_1", ConstantKind::PortAreaFactor),
+                ("return_area_scale_2", ConstantKind::PortAreaFactor),
+            ]
+        );
     }
 
     #[test]

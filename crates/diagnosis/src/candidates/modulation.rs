@@ -21,7 +21,7 @@ use crate::candidates::{interned, parameter_value, Candidate, Mechanism};
 use crate::vocabulary::{Family, Place};
 use jetpipe_model::physics::modulation::{ModulationSignal, MODULATABLE};
 use jetpipe_model::physics::parameters::Parameters;
-use jetpipe_model::variables::VARIABLES;
+use jetpipe_model::variables::{ConstantKind, VARIABLES};
 
 /// A signal a constant may follow in a recording.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -59,21 +59,20 @@ pub fn place_of(constant: &'static str) -> Place {
         .map_or(Place::Unknown, Place::from)
 }
 
-/// The family of a departure where `constant` at `place` follows `follows`.
+/// The family of a departure where `constant` at `place` follows `follows`: by what the
+/// signal is, then by what the constant is (its row's kind), then by its place.
 pub fn family_of(constant: &str, place: Place, follows: Follows) -> Family {
-    match follows {
-        Follows::Periodic(_) => Family::Periodic,
-        Follows::Signal(ModulationSignal::Time) => Family::Drift,
-        Follows::Signal(ModulationSignal::StopperVelocitySign) => Family::Asymmetry,
-        Follows::Signal(_) if constant.contains("area_scale") => Family::Asymmetry,
-        // The stopper's offset places the piston: following the load, the stopper gives.
-        Follows::Signal(
-            ModulationSignal::Force
-            | ModulationSignal::P1
-            | ModulationSignal::P2
-            | ModulationSignal::PressureDifference,
-        ) if constant == "L_sup" => Family::Compliance,
-        Follows::Signal(_) => match place {
+    let kind = jetpipe_model::variables::TABLE
+        .iter()
+        .find(|r| r.variable.name == constant)
+        .and_then(|r| r.kind);
+    match (follows, kind) {
+        (Follows::Periodic(_), _) => Family::Periodic,
+        (Follows::Signal(ModulationSignal::Time), _) => Family::Drift,
+        (Follows::Signal(ModulationSignal::StopperVelocitySign), _) => Family::Asymmetry,
+        (Follows::Signal(_), Some(ConstantKind::PortAreaFactor)) => Family::Asymmetry,
+        (Follows::Signal(signal), Some(ConstantKind::LoadBearingLength)) if signal.is_load() => Family::Compliance,
+        (Follows::Signal(_), _) => match place {
             Place::Mechanics => Family::ExtraForce,
             Place::Chambers => Family::ExtraFlow,
             _ => Family::Nonlinearity,
@@ -362,6 +361,42 @@ mod tests {
             text.starts_with("friction_coulomb changes by +2.5000 N between 60.00 mm and 66.00 mm of x_s"),
             "{text}"
         );
+    }
+}
+
+#[cfg(test)]
+mod family_tests {
+    use super::*;
+
+    #[test]
+    fn a_modulations_family_comes_from_the_signal_then_the_constants_kind_then_its_place() {
+        let family = |constant: &'static str, follows| family_of(constant, place_of(constant), follows);
+        let signal = Follows::Signal;
+        assert_eq!(family("L_sup", signal(ModulationSignal::Force)), Family::Compliance);
+        assert_eq!(
+            family("L_sup", signal(ModulationSignal::PressureDifference)),
+            Family::Compliance
+        );
+        // Not under the load: the place's kind (L_sup sits with the chambers' volumes).
+        assert_eq!(
+            family("L_sup", signal(ModulationSignal::JetPosition)),
+            Family::ExtraFlow
+        );
+        assert_eq!(family("L_sup", signal(ModulationSignal::Time)), Family::Drift);
+        assert_eq!(
+            family("return_area_scale_2", signal(ModulationSignal::P2)),
+            Family::Asymmetry
+        );
+        assert_eq!(family("C_d", signal(ModulationSignal::P2)), Family::Nonlinearity);
+        assert_eq!(
+            family("friction_coulomb", signal(ModulationSignal::StopperPosition)),
+            Family::ExtraForce
+        );
+        assert_eq!(
+            family("dead_volume_1", signal(ModulationSignal::Force)),
+            Family::ExtraFlow
+        );
+        assert_eq!(family("P_s", Follows::Periodic(3.0)), Family::Periodic);
     }
 }
 

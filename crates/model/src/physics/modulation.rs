@@ -193,6 +193,17 @@ impl ModulationSignal {
         ModulationSignal::Cosine,
     ];
 
+    /// The force or a chamber pressure: what the load on the piston is made of.
+    pub fn is_load(self) -> bool {
+        matches!(
+            self,
+            ModulationSignal::Force
+                | ModulationSignal::P1
+                | ModulationSignal::P2
+                | ModulationSignal::PressureDifference
+        )
+    }
+
     /// The code `modulation_k_signal` takes for it.
     pub fn code(self) -> u32 {
         ModulationSignal::ALL.iter().position(|&s| s == self).unwrap_or(0) as u32
