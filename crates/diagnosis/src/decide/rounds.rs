@@ -61,7 +61,7 @@ pub(crate) enum RoundEnd {
 
 /// One round (steps 3–5): replay the findings' model, localize what departs, and add what
 /// earns its place there when `may_add`; then refit every addition together and remove
-/// what the new one made redundant.
+/// what the new one made redundant. Read as propose → check → commit → refit.
 pub(crate) fn one_round(
     cx: &Context,
     f: &mut Findings,
@@ -89,23 +89,46 @@ pub(crate) fn one_round(
     if round == 0 {
         f.first_candidates = found.candidates.clone();
     }
-    let added = if may_add {
+    let proposed = if may_add {
         find_addition(cx, &r, &problem, &found, f, replays, progress)?
     } else {
         None
     };
-    // What was added is a hypothesis, not a lock: a simpler term at its place that does
-    // as well on the held-out blocks replaces it (a supply set low is its plain pressure,
-    // not a line resistance), and so does a richer one that does better than a named
-    // effect by its penalty.
+    let Some(proposed) = proposed else {
+        f.localization = Some(found);
+        return Ok(RoundEnd::NothingAdded);
+    };
+    let checked = simpler_in_its_place(cx, &r, &problem, &found, f, proposed, replays, progress)?;
+    let checked = tied_where_it_stands(cx, &found, checked);
+    commit(cx, f, &r, &found, checked, progress)?;
+    refit_after_addition(cx, f, replays, progress)?;
+    f.stages.push(Stage::of(f));
+    Ok(RoundEnd::Added)
+}
+
+/// What was added is a hypothesis, not a lock: a simpler term at its place that does as
+/// well on the held-out blocks replaces it (a supply set low is its plain pressure, not a
+/// line resistance), and so does a richer one that does better than a named effect by its
+/// penalty.
+#[allow(clippy::too_many_arguments)]
+fn simpler_in_its_place(
+    cx: &Context,
+    r: &Round,
+    problem: &Problem,
+    found: &Localization,
+    f: &Findings,
+    added: Addition,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Addition, String> {
     let check = crate::decide::alternatives::Check {
         cx,
-        problem: &problem,
+        problem,
         count: r.count,
         force_before: r.force_before,
     };
-    let added = match added {
-        Some(Addition::Named(s, sentence)) => {
+    Ok(match added {
+        Addition::Named(s, sentence) => {
             let mut with = f.params.clone();
             let simpler = if apply_named(&mut with, &s).is_ok() {
                 let a = crate::decide::alternatives::Added {
@@ -116,37 +139,41 @@ pub(crate) fn one_round(
                         && cx.recording.p1.is_some()
                         && cx.recording.p2.is_some(),
                 };
-                crate::decide::alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)?
+                crate::decide::alternatives::alternative_at_place(&check, found, &f.params, &a, replays, progress)?
             } else {
                 None
             };
             match simpler {
-                Some((term, trial)) => Some(Addition::Discovered(term, Box::new(trial), None)),
-                None => Some(Addition::Named(s, sentence)),
+                Some((term, trial)) => Addition::Discovered(term, Box::new(trial), None),
+                None => Addition::Named(s, sentence),
             }
         }
-        Some(Addition::Discovered(term, trial, Some(s))) => {
+        Addition::Discovered(term, trial, Some(s)) => {
             let a = crate::decide::alternatives::Added {
                 scored: &s,
                 with: &trial,
                 named: false,
                 measured_shape: false,
             };
-            match crate::decide::alternatives::alternative_at_place(&check, &found, &f.params, &a, replays, progress)? {
-                Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
+            match crate::decide::alternatives::alternative_at_place(&check, found, &f.params, &a, replays, progress)? {
+                Some((simpler, with)) => Addition::Discovered(simpler, Box::new(with), None),
                 None => match crate::decide::alternatives::simpler_elsewhere(
-                    &check, &found, &f.params, &a, &r.current, replays, progress,
+                    &check, found, &f.params, &a, &r.current, replays, progress,
                 )? {
-                    Some((simpler, with)) => Some(Addition::Discovered(simpler, Box::new(with), None)),
-                    None => Some(Addition::Discovered(term, trial, Some(s))),
+                    Some((simpler, with)) => Addition::Discovered(simpler, Box::new(with), None),
+                    None => Addition::Discovered(term, trial, Some(s)),
                 },
             }
         }
         other => other,
-    };
-    // A term put in another's place is tied to the places that one was.
-    let added = match added {
-        Some(Addition::Discovered(mut term, trial, s))
+    })
+}
+
+/// A term put in another's place is tied to the places that one was; one along the command
+/// path is tied to every place a static function of the command acts alike at.
+fn tied_where_it_stands(cx: &Context, found: &Localization, added: Addition) -> Addition {
+    match added {
+        Addition::Discovered(mut term, trial, s)
             if term.tied_locations.is_empty() || is_along_the_command_path(&term) =>
         {
             // Ties already given (by the fit that added it) are in its reading already.
@@ -162,16 +189,27 @@ pub(crate) fn one_round(
                 );
             }
             term.reading = with_undecided(std::mem::take(&mut term.reading), undecided);
-            Some(Addition::Discovered(term, trial, s))
+            Addition::Discovered(term, trial, s)
         }
         other => other,
-    };
+    }
+}
+
+/// The addition into the findings, with the margin by which each new addition's place won.
+fn commit(
+    cx: &Context,
+    f: &mut Findings,
+    r: &Round,
+    found: &Localization,
+    added: Addition,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(), String> {
     let earlier = (f.effects.len(), f.discovered.len());
     // Two terms added as a pair were judged together, against no single place: their
     // places get no margin.
-    let paired = matches!(added, Some(Addition::Pair(..)));
+    let paired = matches!(added, Addition::Pair(..));
     match added {
-        Some(Addition::Discovered(term, trial, _)) => {
+        Addition::Discovered(term, trial, _) => {
             match f.discovered.iter().position(|d| same_term(d, &term)) {
                 // The same candidate with the same parameters again: a refit of the earlier
                 // term (its first fit, through a linear regressor, left a viscous friction
@@ -199,7 +237,7 @@ pub(crate) fn one_round(
             }
             f.params = *trial;
         }
-        Some(Addition::Pair(terms, trial)) => {
+        Addition::Pair(terms, trial) => {
             // No terms: the earlier additions refitted beside a candidate that stayed off.
             if !terms.is_empty() {
                 f.discovered.extend(terms);
@@ -209,21 +247,17 @@ pub(crate) fn one_round(
             // A term added beside the earlier ones moved their constants.
             sync_earlier(f);
         }
-        Some(Addition::Named(s, sentence)) => {
-            let effect = add_effect(cx, &mut f.params, &r, &found, s, sentence, progress)?;
+        Addition::Named(s, sentence) => {
+            let effect = add_effect(cx, &mut f.params, r, found, s, sentence, progress)?;
             f.effects.push(effect);
             f.newest = Some((true, f.effects.len() - 1));
         }
-        Some(Addition::NamedWithTerm(s, sentence, term, trial)) => {
-            let effect = add_effect(cx, &mut f.params, &r, &found, *s, sentence, progress)?;
+        Addition::NamedWithTerm(s, sentence, term, trial) => {
+            let effect = add_effect(cx, &mut f.params, r, found, *s, sentence, progress)?;
             f.effects.push(effect);
             f.discovered.push(term);
             f.newest = Some((false, f.discovered.len() - 1));
             f.params = *trial;
-        }
-        None => {
-            f.localization = Some(found);
-            return Ok(RoundEnd::NothingAdded);
         }
     }
     // How clearly the place of each addition this round made won in its localization.
@@ -238,6 +272,17 @@ pub(crate) fn one_round(
     {
         *margin = if paired { None } else { found.margin(place) };
     }
+    Ok(())
+}
+
+/// After an addition: a sinusoid's frequency moved through the model, every addition
+/// refitted together, and what the new one made redundant removed.
+fn refit_after_addition(
+    cx: &Context,
+    f: &mut Findings,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(), String> {
     // A sinusoid's frequency, held by the fits at the spectral line's, moved through the
     // model where another leaves less (`frequency.rs`).
     crate::decide::frequency::polish_frequency(cx, f, replays, progress)?;
@@ -255,8 +300,7 @@ pub(crate) fn one_round(
             f.joint_refit = Some(refit);
         }
     }
-    f.stages.push(Stage::of(f));
-    Ok(RoundEnd::Added)
+    Ok(())
 }
 
 /// Replay the current model; `None` when every channel is within its noise held out.
