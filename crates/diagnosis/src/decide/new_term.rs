@@ -48,7 +48,74 @@ pub(crate) fn discover_term(
     replays: &mut usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Option<(DiscoveredTerm, Parameters, Scored)>, String> {
-    let (recording, count, force_before, noise) = (cx.recording, r.count, r.force_before, cx.noise);
+    let (count, noise) = (r.count, cx.noise);
+    let at_place = trial_order(found, earlier, count, noise);
+    let before_total: f64 = r.heldout.iter().sum();
+    let training_before = rms_where(
+        &difference(&cx.recording.force, &r.current.force),
+        &cx.blocks,
+        Block::Training,
+    );
+    let mut modulation: Option<(DiscoveredTerm, Parameters, Scored)> = None;
+    let mut written_best: Option<(DiscoveredTerm, Parameters, Scored)> = None;
+    for s in at_place {
+        let label = s.fit.candidate.label;
+        if let Some((w, _, _)) = &written_best {
+            if s.force_heldout_rms > PROMISE_BEYOND_WRITTEN * w.heldout_after {
+                continue;
+            }
+        }
+        let judged = Judged {
+            before_total,
+            training_before,
+        };
+        let Some((term, trial)) = in_the_model(cx, r, problem, found, params, earlier, s, judged, replays, progress)?
+        else {
+            continue;
+        };
+        let after = term.heldout_after;
+        let candidate = &s.fit.candidate;
+        let is_modulation = crate::candidates::modulation::is_modulation(candidate);
+        match &modulation {
+            None if is_modulation => {
+                progress(&format!(
+                    "  {label}: kept unless a written candidate does nearly as well in the model"
+                ));
+                modulation = Some((term, trial, s.clone()));
+            }
+            None if after <= EXPLAINED_WITHIN_NOISE * noise => return Ok(Some((term, trial, s.clone()))),
+            None => {
+                if written_best.as_ref().map_or(true, |(w, _, _)| after < w.heldout_after) {
+                    progress(&format!(
+                        "  {label}: kept unless a later trial, promising half of what it leaves, does better in the model"
+                    ));
+                    written_best = Some((term, trial, s.clone()));
+                }
+            }
+            Some((kept, _, _)) if !is_modulation => {
+                if after <= written_instead_bar(kept.heldout_after, noise) {
+                    progress(&format!(
+                        "  {label} instead of the {}: nearly as good and written",
+                        kept.candidate
+                    ));
+                    return Ok(Some((term, trial, s.clone())));
+                }
+            }
+            Some(_) => {}
+        }
+    }
+    // A written term wins over a modulation that does not do clearly better in the model.
+    Ok(match (written_best, modulation) {
+        (Some(w), Some(m)) if w.0.heldout_after > written_instead_bar(m.0.heldout_after, noise) => Some(m),
+        (Some(w), _) => Some(w),
+        (None, m) => m,
+    })
+}
+
+/// The order in which the located place's candidates are tried in the model: its own first,
+/// then those of the places that explain nearly as much, then its written candidates that
+/// the trials leave out, then the earlier terms' own candidates.
+fn trial_order<'a>(found: &'a Localization, earlier: &[DiscoveredTerm], count: f64, noise: f64) -> Vec<&'a Scored> {
     // The located place's candidates first, then those of the places that explain nearly as
     // much: where the recording cannot tell places apart (a short lag anywhere before the jet
     // pipe reads as a delay under a slow sine) and the located place has no term to keep, the
@@ -112,139 +179,117 @@ pub(crate) fn discover_term(
         .filter(|s| !at_place.iter().any(|a| a.fit.candidate == s.fit.candidate))
         .collect();
     at_place.extend(refits);
-    let before_total: f64 = r.heldout.iter().sum();
-    let training_before = rms_where(
-        &difference(&recording.force, &r.current.force),
-        &cx.blocks,
-        Block::Training,
-    );
-    let mut modulation: Option<(DiscoveredTerm, Parameters, Scored)> = None;
-    let mut written_best: Option<(DiscoveredTerm, Parameters, Scored)> = None;
-    for s in at_place {
-        let label = s.fit.candidate.label;
-        if let Some((w, _, _)) = &written_best {
-            if s.force_heldout_rms > PROMISE_BEYOND_WRITTEN * w.heldout_after {
-                continue;
-            }
-        }
-        let penalty = used_terms(s) * discovery_penalty_per_term(count);
-        let worse_pressures =
-            (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
-        if worse_pressures || before_total - s.fit.heldout_total() < penalty {
-            progress(&format!(
-                "  {label}: not better than its parameters' penalty, or worse in a pressure"
-            ));
-            continue;
-        }
-        if crate::candidates::modulation::is_modulation(&s.fit.candidate)
-            && crate::candidates::modulation::is_flat(&s.fit.values)
-        {
-            progress(&format!(
-                "  {label}: the same change at every knot, a constant's own candidate carries it"
-            ));
-            continue;
-        }
-        let Some(mut set) = crate::decide::discover::model_terms(&s.fit.candidate, &s.fit.values, params, problem)
-        else {
-            progress(&format!("  {label}: the FMU has no parameters for it"));
-            continue;
-        };
-        if crate::candidates::curves::is_command_curve(&s.fit.candidate) {
-            set = command_curve_knots_freed(cx, problem, params, set, replays, progress);
-        }
-        curve_corners_across_unvisited(cx, r, problem, params, &s.fit.candidate, &mut set);
-        let mut trial = params.clone();
-        if set
-            .iter()
-            .any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
-            || trial.validate().is_err()
-        {
-            progress(&format!("  {label}: its parameters are outside the model's limits"));
-            continue;
-        }
-        let with = replay_fast(&Actuator::new(trial.clone())?, recording, cx.n)?;
-        *replays += 1;
-        let residual = difference(&recording.force, &with.force);
-        let after = rms_where(&residual, &cx.blocks, Block::HeldOut);
+    at_place
+}
+
+/// The misfits a trial is judged against: the round's held-out total and its force's
+/// training error.
+#[derive(Clone, Copy)]
+struct Judged {
+    before_total: f64,
+    training_before: f64,
+}
+
+/// One candidate put in the model: the term it adds and the parameters that carry it, when
+/// it earns its penalty, keeps the pressures, fits the model's limits and, replayed, is worth
+/// adding on the force or on the pressures.
+#[allow(clippy::too_many_arguments)]
+fn in_the_model(
+    cx: &Context,
+    r: &Round,
+    problem: &Problem,
+    found: &Localization,
+    params: &Parameters,
+    earlier: &[DiscoveredTerm],
+    s: &Scored,
+    judged: Judged,
+    replays: &mut usize,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<(DiscoveredTerm, Parameters)>, String> {
+    let (recording, count, force_before, noise) = (cx.recording, r.count, r.force_before, cx.noise);
+    let Judged {
+        before_total,
+        training_before,
+    } = judged;
+    let label = s.fit.candidate.label;
+    let penalty = used_terms(s) * discovery_penalty_per_term(count);
+    let worse_pressures =
+        (1..CHANNELS).any(|c| problem.weights[c] > 0.0 && s.fit.heldout[c] > 1.05 * r.heldout[c] + count * 0.01);
+    if worse_pressures || before_total - s.fit.heldout_total() < penalty {
         progress(&format!(
-            "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
+            "  {label}: not better than its parameters' penalty, or worse in a pressure"
         ));
-        let refines = earlier.iter().any(|d| carried_alike(d, label, &set));
-        let training_after = rms_where(&residual, &cx.blocks, Block::Training);
-        let force_ok = worth_adding(force_before, after, noise, refines)
-            || shown_mostly_where_fitted(force_before, after, training_before - training_after, noise);
-        // A term on the pressure transducers is judged on the pressures; so is one upstream
-        // of the piston whose departure shows in the pressures more than in the force (a
-        // stopper position 1 mm off leaves 2 noise floors in the force, 9 in the pressures).
-        let pressures =
-            if s.fit.candidate.location == Place::PressureSensors || (!force_ok && cx.pressure_noise.is_some()) {
-                pressures_judgement(cx, r, problem, &with, after, progress, label)
-            } else {
-                None
-            };
-        if pressures.is_some() || force_ok {
-            let candidate = &s.fit.candidate;
-            progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
-            let term = DiscoveredTerm {
-                location: candidate.location,
-                family: crate::candidates::curve_reading::family(candidate.family, &set),
-                candidate: candidate.label,
-                reading: with_undecided(
-                    crate::decide::discover::reading(
-                        candidate.label,
-                        candidate.location,
-                        candidate.family,
-                        &set,
-                        params,
-                    ),
-                    found.undecided_beside(candidate.location, cx.pressure_noise.is_some()),
-                ),
-                parameters: set,
-                heldout_before: force_before,
-                heldout_after: after,
-                share: 1.0 - (after / force_before).powi(2),
-                pressures_heldout: pressures,
-                tied_locations: found.tied_with(candidate.location),
-                intervals: vec![],
-                margin: None,
-                flexible: None,
-            };
-            let is_modulation = crate::candidates::modulation::is_modulation(candidate);
-            match &modulation {
-                None if is_modulation => {
-                    progress(&format!(
-                        "  {label}: kept unless a written candidate does nearly as well in the model"
-                    ));
-                    modulation = Some((term, trial, s.clone()));
-                }
-                None if after <= EXPLAINED_WITHIN_NOISE * noise => return Ok(Some((term, trial, s.clone()))),
-                None => {
-                    if written_best.as_ref().map_or(true, |(w, _, _)| after < w.heldout_after) {
-                        progress(&format!(
-                            "  {label}: kept unless a later trial, promising half of what it leaves, does better in the model"
-                        ));
-                        written_best = Some((term, trial, s.clone()));
-                    }
-                }
-                Some((kept, _, _)) if !is_modulation => {
-                    if after <= written_instead_bar(kept.heldout_after, noise) {
-                        progress(&format!(
-                            "  {label} instead of the {}: nearly as good and written",
-                            kept.candidate
-                        ));
-                        return Ok(Some((term, trial, s.clone())));
-                    }
-                }
-                Some(_) => {}
-            }
-        }
+        return Ok(None);
     }
-    // A written term wins over a modulation that does not do clearly better in the model.
-    Ok(match (written_best, modulation) {
-        (Some(w), Some(m)) if w.0.heldout_after > written_instead_bar(m.0.heldout_after, noise) => Some(m),
-        (Some(w), _) => Some(w),
-        (None, m) => m,
-    })
+    if crate::candidates::modulation::is_modulation(&s.fit.candidate)
+        && crate::candidates::modulation::is_flat(&s.fit.values)
+    {
+        progress(&format!(
+            "  {label}: the same change at every knot, a constant's own candidate carries it"
+        ));
+        return Ok(None);
+    }
+    let Some(mut set) = crate::decide::discover::model_terms(&s.fit.candidate, &s.fit.values, params, problem) else {
+        progress(&format!("  {label}: the FMU has no parameters for it"));
+        return Ok(None);
+    };
+    if crate::candidates::curves::is_command_curve(&s.fit.candidate) {
+        set = command_curve_knots_freed(cx, problem, params, set, replays, progress);
+    }
+    curve_corners_across_unvisited(cx, r, problem, params, &s.fit.candidate, &mut set);
+    let mut trial = params.clone();
+    if set
+        .iter()
+        .any(|(name, value)| set_parameter(&mut trial, name, *value).is_err())
+        || trial.validate().is_err()
+    {
+        progress(&format!("  {label}: its parameters are outside the model's limits"));
+        return Ok(None);
+    }
+    let with = replay_fast(&Actuator::new(trial.clone())?, recording, cx.n)?;
+    *replays += 1;
+    let residual = difference(&recording.force, &with.force);
+    let after = rms_where(&residual, &cx.blocks, Block::HeldOut);
+    progress(&format!(
+        "  {label}: in the model, force held-out {force_before:.4} -> {after:.4} N"
+    ));
+    let refines = earlier.iter().any(|d| carried_alike(d, label, &set));
+    let training_after = rms_where(&residual, &cx.blocks, Block::Training);
+    let force_ok = worth_adding(force_before, after, noise, refines)
+        || shown_mostly_where_fitted(force_before, after, training_before - training_after, noise);
+    // A term on the pressure transducers is judged on the pressures; so is one upstream
+    // of the piston whose departure shows in the pressures more than in the force (a
+    // stopper position 1 mm off leaves 2 noise floors in the force, 9 in the pressures).
+    let pressures = if s.fit.candidate.location == Place::PressureSensors || (!force_ok && cx.pressure_noise.is_some())
+    {
+        pressures_judgement(cx, r, problem, &with, after, progress, label)
+    } else {
+        None
+    };
+    if pressures.is_some() || force_ok {
+        let candidate = &s.fit.candidate;
+        progress(&format!("adding a {} at the {}", candidate.label, candidate.location));
+        let term = DiscoveredTerm {
+            location: candidate.location,
+            family: crate::candidates::curve_reading::family(candidate.family, &set),
+            candidate: candidate.label,
+            reading: with_undecided(
+                crate::decide::discover::reading(candidate.label, candidate.location, candidate.family, &set, params),
+                found.undecided_beside(candidate.location, cx.pressure_noise.is_some()),
+            ),
+            parameters: set,
+            heldout_before: force_before,
+            heldout_after: after,
+            share: 1.0 - (after / force_before).powi(2),
+            pressures_heldout: pressures,
+            tied_locations: found.tied_with(candidate.location),
+            intervals: vec![],
+            margin: None,
+            flexible: None,
+        };
+        return Ok(Some((term, trial)));
+    }
+    Ok(None)
 }
 
 /// The held-out force error (N) at or below which a written term is taken instead of a
