@@ -91,7 +91,9 @@ pub const NAMED_SHARE_OF_PLACE: f64 = 0.75;
 /// for something else (measured: 0.88–1.00 for the named effects of the synthetic bench,
 /// Bouc–Wen hysteresis lowest; 0.63–0.76 for a supply drift and a port restriction).
 pub const NAMED_MIN_SHARE: f64 = 0.8;
-pub const MAX_EFFECTS: usize = 3;
+/// How many additions the rounds may make: up to three departures at different places,
+/// besides a named effect.
+pub const MAX_EFFECTS: usize = 4;
 
 /// How many additions, the earliest first, are revisited once the rounds leave a channel
 /// above its bar (`decide/revisit.rs`): each revisit costs a round.
