@@ -478,18 +478,7 @@ mod tests {
         let (recording, blocks, sensitivity, x_s) = banded();
         let base = Parameters::default();
         let problem = Problem::new(&recording, &base, &blocks, [0.05, 0.0, 0.0]);
-        let zero = vec![0.0; recording.len()];
-        let residual = residuals(
-            &problem,
-            &Replay {
-                force: zero.clone(),
-                p1: zero.clone(),
-                p2: zero.clone(),
-                current: zero.clone(),
-                x_jp: zero,
-                steps: 0,
-            },
-        );
+        let residual = residuals(&problem, &silent_replay(recording.len()));
         let knots = knots_of(&x_s, &blocks, ModulationSignal::StopperPosition).unwrap();
         let (xs, ys, _) =
             screen_pair(&problem, &residual, &sensitivity, &x_s, &knots, 10.0).expect("a band beats a constant");
@@ -599,18 +588,7 @@ mod tests {
         }
         let base = Parameters::default();
         let problem = Problem::new(&recording, &base, &blocks, [0.05, 0.0, 0.0]);
-        let zero = vec![0.0; recording.len()];
-        let residual = residuals(
-            &problem,
-            &Replay {
-                force: zero.clone(),
-                p1: zero.clone(),
-                p2: zero.clone(),
-                current: zero.clone(),
-                x_jp: zero,
-                steps: 0,
-            },
-        );
+        let residual = residuals(&problem, &silent_replay(recording.len()));
         let knots = knots_of(&recording.time, &blocks, ModulationSignal::Time).unwrap();
         let (xs, ys, _) = screen_pair(&problem, &residual, &sensitivity, &recording.time, &knots, 10.0)
             .expect("a wander beats a constant");
@@ -640,6 +618,19 @@ mod tests {
 
     /// A recording whose force residual is a sensitivity times a band of the stopper's
     /// position (0 below 60 mm, 2 above 63 mm, linear between), with noise.
+    /// A replay whose every signal is zero: the residual is the recording itself.
+    fn silent_replay(n: usize) -> Replay {
+        let zero = vec![0.0; n];
+        Replay {
+            force: zero.clone(),
+            p1: zero.clone(),
+            p2: zero.clone(),
+            current: zero.clone(),
+            x_jp: zero,
+            steps: 0,
+        }
+    }
+
     fn banded() -> (crate::input::recording::Recording, Vec<Block>, Sensitivity, Vec<f64>) {
         let n = 20_000;
         let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
